@@ -1,0 +1,44 @@
+# radtree — two commands do everything on a fresh machine:
+#   make demo   create .venv, install radtree, build + simulate + report the Mendoza example
+#   make test   same install, then lint, type check and the whole test suite
+PYTHON ?= python3
+VENV   := .venv
+BIN    := $(VENV)/bin
+STAMP  := $(VENV)/.installed
+EXAMPLE := examples/mendoza-street
+
+.PHONY: install demo test lint typecheck pytest bench clean
+
+$(STAMP): pyproject.toml
+	$(PYTHON) -m venv $(VENV)
+	$(BIN)/pip install --quiet --upgrade pip
+	$(BIN)/pip install --quiet -e ".[dev,sweep]"
+	touch $(STAMP)
+
+install: $(STAMP)
+
+demo: $(STAMP)
+	$(BIN)/radtree doctor
+	$(BIN)/radtree build $(EXAMPLE)
+	$(BIN)/radtree simulate $(EXAMPLE)
+	$(BIN)/radtree report $(EXAMPLE)
+	@echo ""
+	@echo "Results: $(EXAMPLE)/results/illuminance.csv"
+	@echo "Report:  $(EXAMPLE)/report/index.html"
+
+lint: $(STAMP)
+	$(BIN)/ruff check radtree tests benchmarks
+
+typecheck: $(STAMP)
+	$(BIN)/mypy radtree
+
+pytest: $(STAMP)
+	$(BIN)/python -m pytest -q -x --durations=15
+
+test: lint typecheck pytest
+
+bench: $(STAMP)
+	for b in benchmarks/*.py; do $(BIN)/python $$b || exit 1; done
+
+clean:
+	rm -rf $(EXAMPLE)/build $(EXAMPLE)/results $(EXAMPLE)/report
