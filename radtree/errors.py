@@ -1,0 +1,36 @@
+"""One error type for people: every failure radtree expects ends up as a RadtreeError."""
+
+from __future__ import annotations
+
+
+class RadtreeError(Exception):
+    """A failure with a message meant for the user (no traceback needed)."""
+
+
+class ConfigError(RadtreeError):
+    """A project file or option is invalid; the message names file, field, value and expectation."""
+
+    def __init__(self, message: str, *, source: str | None = None, field: str | None = None):
+        self.source = source
+        self.field = field
+        where = []
+        if source:
+            where.append(str(source))
+        if field:
+            where.append(f"field '{field}'")
+        prefix = ": ".join([", ".join(where)]) + ": " if where else ""
+        super().__init__(prefix + message)
+
+
+class EngineError(RadtreeError):
+    """An external program (Radiance) failed; carries the command and its stderr."""
+
+    def __init__(self, message: str, *, command: list[str] | None = None, stderr: str = ""):
+        self.command = command or []
+        self.stderr = stderr
+        text = message
+        if command:
+            text += f"\n  command: {' '.join(command)}"
+        if stderr.strip():
+            text += f"\n  stderr: {stderr.strip()[-2000:]}"
+        super().__init__(text)
