@@ -1,0 +1,126 @@
+"""Finding Radiance: the binaries of the ``pyradiance`` wheel, else a Radiance on PATH.
+
+Radiance needs RAYPATH to point at its ``.cal`` library (``rayinit.cal``), or even
+``rtrace -version`` fails. :func:`radiance_env` returns an environment with PATH and RAYPATH
+set; the generated Makefiles set the same two variables themselves.
+"""
+
+from __future__ import annotations
+
+import functools
+import os
+import shutil
+import subprocess
+from dataclasses import dataclass
+from pathlib import Path
+
+from radtree.errors import EngineError
+
+REQUIRED = ("oconv", "rtrace", "gendaylit", "rcalc")
+
+
+@dataclass(frozen=True)
+class RadianceInstall:
+    """Where Radiance lives: ``bin_dir`` holds the programs, ``lib_dir`` the .cal library."""
+
+    bin_dir: Path
+    lib_dir: Path | None
+    origin: str  # "pyradiance" or "PATH"
+
+    def program(self, name: str) -> str:
+        return str(self.bin_dir / name)
+
+    def env(self) -> dict[str, str]:
+        env = dict(os.environ)
+        env["PATH"] = f"{self.bin_dir}{os.pathsep}{env.get('PATH', '')}"
+        raypath = ["."]
+        if self.lib_dir is not None:
+            raypath.append(str(self.lib_dir))
+        if env.get("RAYPATH"):
+            raypath.append(env["RAYPATH"])
+        env["RAYPATH"] = os.pathsep.join(raypath)
+        return env
+
+    @property
+    def raypath(self) -> str:
+        return self.env()["RAYPATH"]
+
+
+def _from_pyradiance() -> RadianceInstall | None:
+    try:
+        import importlib.util
+
+        spec = importlib.util.find_spec("pyradiance")
+    except (ImportError, ValueError):
+        return None
+    if spec is None or spec.origin is None:
+        return None
+    root = Path(spec.origin).parent
+    bin_dir, lib_dir = root / "bin", root / "lib"
+    if all((bin_dir / p).exists() for p in REQUIRED):
+        return RadianceInstall(bin_dir, lib_dir if lib_dir.exists() else None, "pyradiance")
+    return None
+
+
+def _from_path() -> RadianceInstall | None:
+    rtrace = shutil.which("rtrace")
+    if rtrace is None:
+        return None
+    bin_dir = Path(rtrace).resolve().parent
+    if not all((bin_dir / p).exists() for p in REQUIRED):
+        return None
+    for cand in (bin_dir.parent / "lib", bin_dir.parent / "lib" / "ray", Path("/usr/local/lib/ray")):
+        if (cand / "rayinit.cal").exists():
+            return RadianceInstall(bin_dir, cand, "PATH")
+    return RadianceInstall(bin_dir, None, "PATH")
+
+
+@functools.lru_cache(maxsize=1)
+def find_radiance() -> RadianceInstall | None:
+    """The Radiance to use (pyradiance wheel first), or None. ``RADTREE_NO_RADIANCE=1`` hides it."""
+    if os.environ.get("RADTREE_NO_RADIANCE") == "1":
+        return None
+    return _from_pyradiance() or _from_path()
+
+
+def require_radiance() -> RadianceInstall:
+    install = find_radiance()
+    if install is None:
+        raise EngineError(
+            "Radiance was not found: install the 'pyradiance' package (pip install pyradiance) "
+            "or put a Radiance installation on PATH, or use --engine numpy"
+        )
+    return install
+
+
+def run(cmd: list[str], *, stdin: bytes | None = None, cwd: str | Path | None = None,
+        stdout_path: Path | None = None) -> bytes:
+    """Run a Radiance program (argument list, no shell); failures raise :class:`EngineError`."""
+    install = require_radiance()
+    argv = [install.program(cmd[0]) if (install.bin_dir / cmd[0]).exists() else cmd[0], *cmd[1:]]
+    try:
+        if stdout_path is not None:
+            with open(stdout_path, "wb") as out:
+                proc = subprocess.run(argv, input=stdin, stdout=out, stderr=subprocess.PIPE,
+                                      cwd=cwd, env=install.env(), check=False)
+            output = b""
+        else:
+            proc = subprocess.run(argv, input=stdin, capture_output=True, cwd=cwd,
+                                  env=install.env(), check=False)
+            output = proc.stdout
+    except OSError as exc:
+        raise EngineError(f"could not start {cmd[0]}: {exc}", command=cmd) from exc
+    if proc.returncode != 0:
+        raise EngineError(f"{cmd[0]} failed (exit {proc.returncode})", command=cmd,
+                          stderr=proc.stderr.decode(errors="replace"))
+    return output
+
+
+def version() -> str | None:
+    """``rtrace -version`` of the Radiance found, or None."""
+    if find_radiance() is None:
+        return None
+    try:
+        return run(["rtrace", "-version"]).decode().strip()
+    except EngineError:
+        return None

@@ -1,0 +1,179 @@
+"""Radiance materials as small classes that render their exact Radiance text.
+
+All optical values are photopic (visible) fractions in [0, 1]; colours are grey (R = G = B), so
+the photopic value Radiance computes (0.265 R + 0.670 G + 0.065 B) equals the stated value.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+# Transmittance → transmissivity converter for Radiance ``glass`` (normal incidence).
+_A, _B, _C, _D = 0.8402528435, 0.0072522239, 0.9166530661, 0.0036261119
+MAX_GLASS_TRANSMITTANCE = 0.9183
+
+
+def fmt(x: float) -> str:
+    """Format an optical coefficient the way radtree writes it: up to 4 decimals, no trailing 0."""
+    s = f"{x:.4f}".rstrip("0").rstrip(".")
+    return "0" if s in ("-0", "") else s
+
+
+def _check_fraction(name: str, value: float, what: str) -> None:
+    if not isinstance(value, int | float) or math.isnan(value):
+        raise ValueError(f"material '{name}': {what} must be a number, got {value!r}")
+    if not 0.0 <= value <= 1.0:
+        raise ValueError(f"material '{name}': {what} must be between 0 and 1, got {value}")
+
+
+def transmissivity_from_transmittance(tn: float) -> float:
+    """Radiance ``glass`` transmissivity from a measured normal transmittance Tn.
+
+    tn = (sqrt(0.8402528435 + 0.0072522239·Tn²) − 0.9166530661) / 0.0036261119 / Tn,
+    valid for 0 < Tn ≤ 0.9183 (above that the transmissivity would exceed 1).
+    """
+    if not isinstance(tn, int | float) or math.isnan(tn):
+        raise ValueError(f"transmittance must be a number, got {tn!r}")
+    if tn <= 0.0:
+        raise ValueError(f"transmittance must be > 0 for the glass converter, got {tn}")
+    if tn > MAX_GLASS_TRANSMITTANCE:
+        raise ValueError(
+            f"transmittance {tn} is above {MAX_GLASS_TRANSMITTANCE}, where the glass "
+            "transmissivity would exceed 1"
+        )
+    return (math.sqrt(_A + _B * tn * tn) - _C) / _D / tn
+
+
+@dataclass(frozen=True)
+class Plastic:
+    """Lambertian (optionally glossy) opaque material: ``void plastic NAME 0 0 5 ρ ρ ρ spec rough``."""
+
+    name: str
+    reflectance: float
+    specularity: float = 0.0
+    roughness: float = 0.0
+
+    def __post_init__(self) -> None:
+        _check_fraction(self.name, self.reflectance, "reflectance")
+        _check_fraction(self.name, self.specularity, "specularity")
+        _check_fraction(self.name, self.roughness, "roughness")
+
+    @property
+    def transmittance(self) -> float:
+        return 0.0
+
+    def to_radiance(self) -> str:
+        r = fmt(self.reflectance)
+        return (
+            f"void plastic {self.name}\n0\n0\n5 {r} {r} {r} "
+            f"{fmt(self.specularity)} {fmt(self.roughness)}\n"
+        )
+
+
+@dataclass(frozen=True)
+class Trans:
+    """Translucent material (Radiance ``trans``), e.g. a leaf or a translucent crown shell.
+
+    Built from the hemispherical reflectance R (diffuse), the diffuse transmittance T_d and the
+    specular (direct, undeviated) transmittance T_s. With spec = 0:
+    C = R + T_d + T_s, trans = (T_d + T_s)/C, tspec = T_s/(T_d + T_s).
+    """
+
+    name: str
+    reflectance: float
+    diffuse_transmittance: float
+    specular_transmittance: float = 0.0
+
+    def __post_init__(self) -> None:
+        _check_fraction(self.name, self.reflectance, "reflectance")
+        _check_fraction(self.name, self.diffuse_transmittance, "diffuse transmittance")
+        _check_fraction(self.name, self.specular_transmittance, "specular transmittance")
+        total = self.reflectance + self.diffuse_transmittance + self.specular_transmittance
+        if total > 1.0 + 1e-9:
+            raise ValueError(
+                f"material '{self.name}': reflectance + transmittance = {total:.4f} exceeds 1"
+            )
+        if total <= 0.0:
+            raise ValueError(f"material '{self.name}': reflectance + transmittance must be > 0")
+
+    @property
+    def transmittance(self) -> float:
+        return self.diffuse_transmittance + self.specular_transmittance
+
+    @property
+    def coefficients(self) -> tuple[float, float, float]:
+        """(C, trans, tspec) as Radiance expects them."""
+        t = self.transmittance
+        c = self.reflectance + t
+        trans = t / c
+        tspec = self.specular_transmittance / t if t > 0 else 0.0
+        return c, trans, tspec
+
+    def to_radiance(self) -> str:
+        c, trans, tspec = self.coefficients
+        cc = fmt(c)
+        return f"void trans {self.name}\n0\n0\n7 {cc} {cc} {cc} 0 0 {fmt(trans)} {fmt(tspec)}\n"
+
+
+@dataclass(frozen=True)
+class Glass:
+    """Radiance ``glass``: specular transmission, Fresnel reflection (~8 %), no diffuse reflectance.
+
+    Use :meth:`from_transmittance` to build it from a measured normal transmittance.
+    """
+
+    name: str
+    transmissivity: float
+
+    def __post_init__(self) -> None:
+        _check_fraction(self.name, self.transmissivity, "transmissivity")
+
+    @classmethod
+    def from_transmittance(cls, name: str, transmittance: float) -> Glass:
+        return cls(name, transmissivity_from_transmittance(transmittance))
+
+    @property
+    def reflectance(self) -> float:
+        return 0.0
+
+    @property
+    def transmittance(self) -> float:
+        """Normal-incidence transmittance of this transmissivity (inverse of the converter)."""
+        tn = self.transmissivity
+        # Radiance glass: T = tn (1-r)^2 / (1 - r^2 tn^2), r = 0.04 at n = 1.52 (normal incidence)
+        r = ((1.52 - 1.0) / (1.52 + 1.0)) ** 2
+        return tn * (1 - r) ** 2 / (1 - (r * tn) ** 2)
+
+    def to_radiance(self) -> str:
+        t = fmt(self.transmissivity)
+        return f"void glass {self.name}\n0\n0\n3 {t} {t} {t}\n"
+
+
+@dataclass(frozen=True)
+class Hole:
+    """Fully open: rays pass undisturbed (an opening in a perforated shell).
+
+    Radiance geometry with this material is simply not written; the NumPy engine ignores it.
+    """
+
+    name: str
+
+    @property
+    def reflectance(self) -> float:
+        return 0.0
+
+    @property
+    def transmittance(self) -> float:
+        return 1.0
+
+    def to_radiance(self) -> str:
+        return ""
+
+
+Material = Plastic | Trans | Glass | Hole
+
+
+def with_reflectance(material: Plastic, reflectance: float) -> Plastic:
+    """The same Lambertian material with another reflectance (per-hour ground reflectance)."""
+    return Plastic(material.name, reflectance, material.specularity, material.roughness)

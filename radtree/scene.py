@@ -1,0 +1,130 @@
+"""The in-memory scene: triangle meshes tagged with material names, materials, sensor grids.
+
+A scene is plain data, shared by both engines. Coordinates in metres, x east, y north, z up.
+Illuminance sensors are points with a unit normal (the sensor's facing) and a row label.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from radtree.optics import Hole, Material
+
+
+@dataclass
+class Mesh:
+    """A triangle mesh made of one material.
+
+    ``vertices`` (N, 3) float metres; ``faces`` (M, 3) int indices into ``vertices``. Triangles are
+    two-sided for both engines (Radiance polygons are two-sided for plastic/trans/glass).
+    """
+
+    name: str
+    material: str
+    vertices: np.ndarray
+    faces: np.ndarray
+
+    def __post_init__(self) -> None:
+        self.vertices = np.asarray(self.vertices, dtype=float).reshape(-1, 3)
+        self.faces = np.asarray(self.faces, dtype=np.int64).reshape(-1, 3)
+        if len(self.faces) and (self.faces.min() < 0 or self.faces.max() >= len(self.vertices)):
+            raise ValueError(f"mesh '{self.name}': face index outside its {len(self.vertices)} vertices")
+        if not np.all(np.isfinite(self.vertices)):
+            raise ValueError(f"mesh '{self.name}': vertices must be finite")
+
+    @property
+    def n_triangles(self) -> int:
+        return int(len(self.faces))
+
+    @property
+    def triangles(self) -> np.ndarray:
+        """(M, 3, 3) triangle corner coordinates."""
+        return self.vertices[self.faces]
+
+    def area(self) -> float:
+        t = self.triangles
+        return float(0.5 * np.linalg.norm(np.cross(t[:, 1] - t[:, 0], t[:, 2] - t[:, 0]), axis=1).sum())
+
+    @staticmethod
+    def merge(name: str, material: str, meshes: list[Mesh]) -> Mesh:
+        verts, faces, offset = [], [], 0
+        for m in meshes:
+            verts.append(m.vertices)
+            faces.append(m.faces + offset)
+            offset += len(m.vertices)
+        if not verts:
+            return Mesh(name, material, np.zeros((0, 3)), np.zeros((0, 3), int))
+        return Mesh(name, material, np.vstack(verts), np.vstack(faces))
+
+
+def quad(name: str, material: str, corners: np.ndarray) -> Mesh:
+    """A planar quadrilateral (4 corners in order) as two triangles."""
+    return Mesh(name, material, np.asarray(corners, float), np.array([[0, 1, 2], [0, 2, 3]]))
+
+
+@dataclass
+class SensorGrid:
+    """Named illuminance sensors: ``points`` (N, 3) m, unit ``normals`` (N, 3), ``rows`` labels."""
+
+    name: str
+    points: np.ndarray
+    normals: np.ndarray
+    rows: list[str] = field(default_factory=list)
+
+    def __post_init__(self) -> None:
+        self.points = np.asarray(self.points, dtype=float).reshape(-1, 3)
+        self.normals = np.asarray(self.normals, dtype=float).reshape(-1, 3)
+        if len(self.points) == 0:
+            raise ValueError(f"sensor grid '{self.name}' has no points")
+        if self.normals.shape != self.points.shape:
+            raise ValueError(f"sensor grid '{self.name}': one normal per point is needed")
+        norms = np.linalg.norm(self.normals, axis=1)
+        if np.any(norms < 1e-9):
+            raise ValueError(f"sensor grid '{self.name}': zero-length normal")
+        self.normals = self.normals / norms[:, None]
+        if not self.rows:
+            self.rows = [""] * len(self.points)
+        if len(self.rows) != len(self.points):
+            raise ValueError(f"sensor grid '{self.name}': one row label per point is needed")
+
+    def __len__(self) -> int:
+        return len(self.points)
+
+    def to_pts(self) -> str:
+        """Radiance ``rtrace`` input: one ``x y z dx dy dz`` line per sensor."""
+        lines = [
+            " ".join(f"{v:.6f}" for v in (*p, *n)) for p, n in zip(self.points, self.normals)
+        ]
+        return "\n".join(lines) + "\n"
+
+
+@dataclass
+class Scene:
+    """Geometry + materials + sensor grids. ``notes`` say what the scene contains, for reports."""
+
+    meshes: list[Mesh]
+    materials: dict[str, Material]
+    grids: dict[str, SensorGrid]
+    notes: list[str] = field(default_factory=list)
+    ground_material: str = "ground"
+
+    def __post_init__(self) -> None:
+        for m in self.meshes:
+            if m.material not in self.materials:
+                raise ValueError(f"mesh '{m.name}' uses undefined material '{m.material}'")
+
+    @property
+    def n_triangles(self) -> int:
+        return sum(m.n_triangles for m in self.meshes)
+
+    def solid_meshes(self) -> list[Mesh]:
+        """Meshes that interact with light (holes left out)."""
+        return [m for m in self.meshes if not isinstance(self.materials[m.material], Hole)]
+
+    def mesh(self, name: str) -> Mesh:
+        for m in self.meshes:
+            if m.name == name:
+                return m
+        raise KeyError(name)

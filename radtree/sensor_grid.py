@@ -1,0 +1,53 @@
+"""Sensor grids on the façade: the study's 8-point circle and a dense grid around it.
+
+Points sit ``offset_m`` off the wall, normals point out of the wall (towards the street).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from radtree.config import Sensors
+from radtree.scene import SensorGrid
+from radtree.site.frame import FacadeFrame
+
+
+def row_label(dz: float, radius: float) -> str:
+    """Row of a sensor by its height above the circle's centre: upper, middle, lower third."""
+    if dz > radius / 3.0 + 1e-9:
+        return "higher"
+    if dz < -radius / 3.0 - 1e-9:
+        return "lower"
+    return "intermediate"
+
+
+def facade_circle(sensors: Sensors, frame: FacadeFrame, name: str = "facade") -> SensorGrid:
+    """``count`` sensors at equal angle steps on a circle in the façade plane.
+
+    With 8 sensors at 45° steps starting at 0° (to the right), three are higher, two
+    intermediate (left and right) and three lower, as in the study.
+    """
+    angles = np.arange(sensors.count) * 2.0 * math.pi / sensors.count
+    u = sensors.x_m + sensors.radius_m * np.cos(angles)
+    z = sensors.height_m + sensors.radius_m * np.sin(angles)
+    local = np.column_stack([u, np.full_like(u, sensors.offset_m), z])
+    rows = [row_label(dz, sensors.radius_m) for dz in z - sensors.height_m]
+    normals = np.tile(frame.normal, (len(u), 1))
+    return SensorGrid(name, frame.to_world(local), normals, rows)
+
+
+def facade_dense_grid(sensors: Sensors, frame: FacadeFrame, name: str = "facade_map") -> SensorGrid:
+    """A square grid of side ``dense_size_m`` and spacing ``dense_spacing_m`` centred on the
+    sensors, for false-colour façade maps. Row labels are the sensor-row names by height."""
+    half = sensors.dense_size_m / 2.0
+    n = max(2, int(round(sensors.dense_size_m / sensors.dense_spacing_m)) + 1)
+    us = sensors.x_m + np.linspace(-half, half, n)
+    zs = sensors.height_m + np.linspace(-half, half, n)
+    zs = zs[zs > 0.05]
+    U, Z = np.meshgrid(us, zs)
+    local = np.column_stack([U.ravel(), np.full(U.size, sensors.offset_m), Z.ravel()])
+    rows = [f"z={zz:.2f}" for zz in Z.ravel()]
+    normals = np.tile(frame.normal, (U.size, 1))
+    return SensorGrid(name, frame.to_world(local), normals, rows)

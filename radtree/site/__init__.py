@@ -1,0 +1,1 @@
+"""Sites: the street canyon (and, later, blocks of offices) around the studied façade."""

@@ -1,0 +1,89 @@
+"""Sun position, computed once in radtree and handed to everything else.
+
+Uses pvlib's implementation of the NREL Solar Position Algorithm (SPA). Angles in degrees:
+altitude above the horizon (apparent, i.e. with atmospheric refraction), azimuth clockwise
+from north (compass). Vectors in the scene frame: x east, y north, z up.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from datetime import datetime, timedelta, timezone
+
+import numpy as np
+
+SUN_HALF_ANGLE_DEG = 0.2665  # the sun's disc subtends 0.533°
+SUN_SOLID_ANGLE_SR = 2.0 * math.pi * (1.0 - math.cos(math.radians(SUN_HALF_ANGLE_DEG)))
+
+
+@dataclass(frozen=True)
+class SunPosition:
+    """Where the sun is at one instant.
+
+    ``altitude_deg`` is the apparent altitude (refraction included), ``azimuth_deg`` the compass
+    azimuth (clockwise from north).
+    """
+
+    altitude_deg: float
+    azimuth_deg: float
+
+    @property
+    def vector(self) -> np.ndarray:
+        """Unit vector towards the sun, x east, y north, z up."""
+        return direction_vector(self.altitude_deg, self.azimuth_deg)
+
+    @property
+    def radiance_azimuth_deg(self) -> float:
+        """Azimuth in Radiance's ``gendaylit -ang`` convention: degrees west of south."""
+        return compass_to_radiance_azimuth(self.azimuth_deg)
+
+    @property
+    def above_horizon(self) -> bool:
+        return self.altitude_deg > 0.0
+
+
+def direction_vector(altitude_deg: float, azimuth_deg: float) -> np.ndarray:
+    """Unit vector for an altitude and a compass azimuth (x east, y north, z up)."""
+    alt = math.radians(altitude_deg)
+    az = math.radians(azimuth_deg)
+    return np.array([math.sin(az) * math.cos(alt), math.cos(az) * math.cos(alt), math.sin(alt)])
+
+
+def compass_to_radiance_azimuth(azimuth_deg: float) -> float:
+    """Compass azimuth (clockwise from north) → Radiance azimuth (degrees west of south)."""
+    a = azimuth_deg - 180.0
+    return (a + 180.0) % 360.0 - 180.0
+
+
+def local_datetime(date: str, time: str, utc_offset_hours: float) -> datetime:
+    """A timezone-aware local clock datetime from ``YYYY-MM-DD`` and ``HH:MM``."""
+    tz = timezone(timedelta(hours=utc_offset_hours))
+    return datetime.fromisoformat(f"{date}T{time}").replace(tzinfo=tz)
+
+
+def sun_position(
+    when: datetime, latitude: float, longitude: float, elevation_m: float = 0.0
+) -> SunPosition:
+    """Sun position (NREL SPA via pvlib) for a timezone-aware datetime.
+
+    ``longitude`` in degrees east (west negative), ``latitude`` north positive.
+    """
+    import pandas as pd
+    import pvlib
+
+    if when.tzinfo is None:
+        raise ValueError("sun_position needs a timezone-aware datetime")
+    times = pd.DatetimeIndex([pd.Timestamp(when)])
+    sp = pvlib.solarposition.spa_python(times, latitude, longitude, altitude=elevation_m)
+    return SunPosition(
+        altitude_deg=float(sp["apparent_elevation"].iloc[0]),
+        azimuth_deg=float(sp["azimuth"].iloc[0]),
+    )
+
+
+def angular_separation_deg(a: np.ndarray, b: np.ndarray) -> float:
+    """Angle between two direction vectors, degrees."""
+    a = np.asarray(a, float) / np.linalg.norm(a)
+    b = np.asarray(b, float) / np.linalg.norm(b)
+    return math.degrees(math.acos(float(np.clip(np.dot(a, b), -1.0, 1.0))))
