@@ -261,6 +261,9 @@ def load_measured(path: str | os.PathLike, units: str | None = None
         lines_by_time.setdefault(t, []).append(line)
         records.append(rec)
 
+    if label_col == "sensor" and any(isinstance(r["sensor"], str) for r in records):
+        for r in records:  # mixed numeric and named ids: keep them all as text
+            r["sensor"] = str(r["sensor"])
     frame = pd.DataFrame.from_records(records)
     labels: tuple[str | int, ...] = ()
     if label_col is not None:
@@ -340,16 +343,23 @@ def grid_mean(measured: pd.DataFrame,
     if "time" not in cols or "measured_lux" not in cols:
         raise RadtreeError(
             f"measured table needs columns 'time' and 'measured_lux' (has {', '.join(map(str, measured.columns))})")
+    measured = measured.assign(time=[normalise_time(str(t)) for t in measured["time"]])
+    values = pd.to_numeric(measured["measured_lux"], errors="coerce")
+    if not values.map(math.isfinite).all():
+        bad = sorted(set(measured.loc[~values.map(math.isfinite), "time"]))
+        raise RadtreeError(f"measured table has missing or non-numeric values at {', '.join(bad)}")
+    measured = measured.assign(measured_lux=values.astype(float))
     if "sensor" in cols:
         out = measured.groupby("time", sort=True)["measured_lux"].mean().reset_index()
     elif "row" in cols:
         if sensors_per_row is None:
             raise RadtreeError("a per-row measured table needs sensors_per_row to form the grid mean")
         weights = {str(k).lower(): int(v) for k, v in sensors_per_row.items()}
-        unknown = sorted(set(measured["row"].astype(str)) - set(weights))
+        rows = measured["row"].astype(str).str.lower()
+        unknown = sorted(set(rows) - set(weights))
         if unknown:
             raise RadtreeError(f"no sensor count for measured row(s) {', '.join(unknown)}")
-        w = measured["row"].astype(str).map(weights).astype(float)
+        w = rows.map(weights).astype(float)
         weighted = (measured["measured_lux"] * w).groupby(measured["time"]).sum()
         out = (weighted / w.groupby(measured["time"]).sum()).rename("measured_lux").reset_index()
     else:
@@ -358,5 +368,4 @@ def grid_mean(measured: pd.DataFrame,
             dupes = sorted(set(out.loc[out["time"].duplicated(), "time"]))
             raise RadtreeError(f"measured grid means repeat hour(s) {', '.join(dupes)}")
         out = out.sort_values("time", kind="stable")
-    out["time"] = [normalise_time(t) for t in out["time"]]
     return out.reset_index(drop=True)

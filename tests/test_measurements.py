@@ -123,8 +123,8 @@ def test_normalise_time():
         ("# Units: lux\ntime,measured_lux\n10:30,1157,x\n", 3, "3 field"),
         ("# Units: lux\ntime,measured_lux\n10:30,250000\n", 3, "exceeds the plausible maximum"),
         ("# Units: klux\ntime,measured_lux\n10:30,1157\n", 3, "lux rather than klux"),
-        ("# Units: lux\ntime,measured_lux\n10:30,1157\n11:30,1.504\n", 4,
-         r"grid mean 1.504 lx at 11:30 .*klux"),
+        ("# Units: lux\ntime,measured_lux\n10:30,1157\n11:30,0.504\n", 4,
+         r"grid mean 0.504 lx at 11:30 .*klux"),
         ("# Units: lux\ntime,time,measured_lux\n10:30,10:30,1\n", 2, "repeated column"),
     ],
 )
@@ -186,7 +186,7 @@ def test_hour_missing_a_row_is_an_error(tmp_path):
         ("# Units: lux\nrow,sensors,measured_mean_lux\nhigher,2.5,1407\n", 3, "whole number"),
         ("# Units: lux\nrow,sensors,measured_mean_lux\nhigher,0,1407\n", 3, "whole number"),
         ("# Units: lux\nrow,sensors,measured_mean_lux\nhigher,3,-1\n", 3, "negative"),
-        ("# Units: lux\nrow,sensors,measured_mean_lux\nhigher,3,1.4\n", 3, "klux"),
+        ("# Units: lux\nrow,sensors,measured_mean_lux\nhigher,3,0.4\n", 3, "klux"),
         ("# Units: lux\nrow,sensors,measured_mean_lux\nhigher,3,\n", 3, "empty value"),
         ("# Units: lux\nrow,measured_mean_lux\nhigher,1407\n", 2, "missing column.*sensors"),
     ],
@@ -225,3 +225,19 @@ def test_grid_mean_of_sensors_and_of_means():
     assert list(grid_mean(means)["time"]) == ["10:30", "11:30"]
     with pytest.raises(RadtreeError, match="repeat hour"):
         grid_mean(pd.DataFrame({"time": ["10:30", "10:30"], "measured_lux": [1.0, 2.0]}))
+
+
+def test_mixed_sensor_ids_are_kept_as_text(tmp_path):
+    path = write(tmp_path, "# Units: lux\ntime,sensor,lux\n10:30,2,1200\n10:30,s1,1000\n")
+    frame, shape = load_measured(path)
+    assert list(frame["sensor"]) == ["2", "s1"]
+    assert shape.labels == ("2", "s1")
+
+
+def test_grid_mean_rejects_missing_values_and_normalises_labels():
+    with pytest.raises(RadtreeError, match="non-numeric values at 11:30"):
+        grid_mean(pd.DataFrame({"time": ["10:30", "11:30"], "measured_lux": [1.0, None]}))
+    rows = pd.DataFrame({"time": ["9:30", "09:30"], "row": ["Higher", "lower"],
+                         "measured_lux": [200.0, 100.0]})
+    out = grid_mean(rows, {"HIGHER": 1, "lower": 1})
+    assert out.to_dict("records") == [{"time": "09:30", "measured_lux": 150.0}]

@@ -1,0 +1,102 @@
+"""Running a Radiance build folder: oconv → rtrace -I per hour, in Python or via its Makefile.
+
+The Python runner executes exactly the commands the generated Makefile holds (argument lists,
+no shell), writing every output to a temporary name first.
+"""
+
+from __future__ import annotations
+
+import os
+import tempfile
+from pathlib import Path
+
+import numpy as np
+
+from radtree.config import EngineParams
+from radtree.engines.base import GridResult
+from radtree.engines.radiance.binaries import require_radiance, run
+from radtree.engines.radiance.writer import BuildPlan, rgb_to_lux, write_build
+from radtree.errors import EngineError
+from radtree.scene import Scene
+from radtree.sky import SkyState
+
+ENGINE_NAME = "radiance"
+DEFAULT_AB = 2
+
+
+def run_hour(plan: BuildPlan, hour: str, dry_run: bool = False,
+             echo=None) -> dict[str, GridResult]:
+    """Build the hour's octree and trace every grid; return lux per grid.
+
+    With ``dry_run`` the commands are only passed to ``echo`` (e.g. print) and nothing runs.
+    """
+    folder = plan.folder
+    oct_rel = f"octrees/{hour}.oct"
+    commands = [(plan.oconv_command(hour), None, oct_rel)]
+    for g in plan.grids:
+        commands.append((plan.rtrace_command(hour), f"grids/{g}.pts", f"results/{hour}_{g}.rgb"))
+    if dry_run:
+        for argv, stdin, stdout in commands:
+            line = " ".join(argv) + (f" < {stdin}" if stdin else "") + f" > {stdout}"
+            if echo:
+                echo(f"(cd {folder} && {line})")
+        return {}
+    (folder / "octrees").mkdir(exist_ok=True)
+    (folder / "results").mkdir(exist_ok=True)
+    results: dict[str, GridResult] = {}
+    for argv, stdin, stdout in commands:
+        out = folder / stdout
+        tmp = out.with_name(out.name + ".tmp")
+        data = (folder / stdin).read_bytes() if stdin else None
+        try:
+            run(argv, stdin=data, cwd=folder, stdout_path=tmp)
+            os.replace(tmp, out)
+        finally:
+            if tmp.exists():
+                tmp.unlink()
+    for g in plan.grids:
+        rgb_path = folder / f"results/{hour}_{g}.rgb"
+        lux = read_rgb_as_lux(rgb_path, expected=None)
+        lux_path = folder / f"results/{hour}_{g}.lux"
+        tmp = lux_path.with_name(lux_path.name + ".tmp")
+        np.savetxt(tmp, lux, fmt="%.6g")
+        os.replace(tmp, lux_path)
+        results[g] = GridResult(lux, None)
+    return results
+
+
+def read_rgb_as_lux(path: Path, expected: int | None) -> np.ndarray:
+    """Read ``rtrace -I -h`` output (R G B per line) and convert to lux."""
+    try:
+        rows = np.loadtxt(path, ndmin=2)
+    except (OSError, ValueError) as exc:
+        raise EngineError(f"cannot read rtrace output {path}: {exc}") from exc
+    if rows.size == 0 or rows.shape[1] < 3:
+        raise EngineError(f"rtrace output {path} is empty or malformed")
+    if expected is not None and len(rows) != expected:
+        raise EngineError(f"rtrace output {path} has {len(rows)} values, expected {expected}")
+    return rgb_to_lux(rows[:, :3])
+
+
+def trace_hour(scene: Scene, state: SkyState, params: EngineParams,
+               grids: list[str] | None = None, seed: int | None = None,
+               workdir: Path | None = None, ab: int | None = None) -> dict[str, GridResult]:
+    """Trace one hour with Radiance in a (temporary) build folder; lux per grid.
+
+    ``ab`` overrides ``params.ab``; when both are None, ``-ab 2``. ``seed`` is unused: Radiance's
+    sampling is deterministic for a given octree and options.
+    """
+    install = require_radiance()
+    use_ab = ab if ab is not None else (params.ab if params.ab is not None else DEFAULT_AB)
+    if grids is not None:
+        missing = [g for g in grids if g not in scene.grids]
+        if missing:
+            raise EngineError(f"unknown sensor grid(s): {', '.join(missing)}")
+        scene = Scene(scene.meshes, scene.materials, {g: scene.grids[g] for g in grids},
+                      scene.notes, scene.ground_material)
+    if workdir is None:
+        with tempfile.TemporaryDirectory(prefix="radtree-") as tmp:
+            plan = write_build(scene, [state], params, use_ab, Path(tmp), install)
+            return run_hour(plan, state.label)
+    plan = write_build(scene, [state], params, use_ab, Path(workdir), install)
+    return run_hour(plan, state.label)

@@ -1,0 +1,168 @@
+"""Writing a scene as a Radiance build folder a Radiance user recognises.
+
+```
+build/<scenario>/
+  materials.rad            all materials (the ground's default reflectance)
+  geometry/<mesh>.rad      one file per mesh, triangles as polygons
+  grids/<grid>.pts         rtrace input: x y z dx dy dz per sensor
+  skies/<HHMM>.sky         sun (and sky, ground glow) of each hour
+  skies/<HHMM>_ground.rad  the hour's ground material (reflectance from the sun altitude)
+  Makefile                 one target per hour: oconv → rtrace -I → rcalc (lux)
+  octrees/, results/       made by `make`
+```
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+from jinja2 import Environment, PackageLoader, StrictUndefined
+
+import radtree
+from radtree.config import EngineParams
+from radtree.engines.radiance.binaries import RadianceInstall
+from radtree.fileio import write_text
+from radtree.optics import Hole, Plastic, with_reflectance
+from radtree.scene import Mesh, Scene
+from radtree.sky import (
+    ANALYTIC_SKY_CAL,
+    SkyState,
+    analytic_sky_text,
+    gendaylit_command,
+    ground_glow_text,
+    perez_sky_suffix,
+    sun_radiance_text,
+)
+
+
+def mesh_to_radiance(mesh: Mesh) -> str:
+    """Triangles as Radiance polygons: ``MAT polygon NAME.i 0 0 9 x1 y1 z1 x2 y2 z2 x3 y3 z3``."""
+    tri = mesh.triangles
+    out = [f"# {mesh.name}: {len(tri)} triangles, material {mesh.material}\n"]
+    for i, t in enumerate(tri):
+        coords = " ".join(f"{v:.5f}" for v in t.ravel())
+        out.append(f"{mesh.material} polygon {mesh.name}.{i}\n0\n0\n9 {coords}\n")
+    return "\n".join(out)
+
+
+def rtrace_options(params: EngineParams, ab: int) -> list[str]:
+    """rtrace options for illuminance: -I (irradiance at points) -h (no header) and ambient."""
+    return [
+        "-h", "-I", "-ab", str(ab), "-ad", str(params.ad), "-as", str(params.as_),
+        "-ar", str(params.ar), "-aa", f"{params.aa:g}", "-lw", f"{params.lw:g}",
+    ]
+
+
+def sky_text(state: SkyState, install: RadianceInstall | None) -> str:
+    """The hour's light in Radiance: sun (if on), sky (if any) and distant ground glow."""
+    header = (f"# {state.time} local ({state.datetime.isoformat()}): sun altitude "
+              f"{state.sun.altitude_deg:.3f}°, azimuth {state.sun.azimuth_deg:.3f}° "
+              f"(compass; Radiance {state.sun.radiance_azimuth_deg:.3f}° west of south)\n"
+              f"# direct normal {state.direct_normal_lux:g} lx, sky model {state.sky_model}\n\n")
+    if state.sky_model == "perez":
+        from radtree.engines.radiance.binaries import run
+
+        if install is None:
+            raise RuntimeError("a Perez sky needs gendaylit (Radiance)")
+        cmd = gendaylit_command(state)
+        text = run(cmd).decode()
+        return header + f"# {' '.join(cmd)}\n" + text + "\n" + perez_sky_suffix(state.ground_glow)
+    parts = [header]
+    if state.sun_on:
+        parts.append(sun_radiance_text(state) + "\n")
+    if state.sky_model in ("uniform", "cosine", "cie_overcast"):
+        cal = "skybright.cal" if state.sky_model != "uniform" else None
+        parts.append(analytic_sky_text(state, f"skies/{state.sky_model}.cal" if cal else None))
+        parts.append("\n")
+    parts.append(ground_glow_text(state))
+    return "".join(parts)
+
+
+@dataclass
+class BuildPlan:
+    """What a build folder holds, for the Python runner and the Makefile alike."""
+
+    folder: Path
+    hours: list[str]                       # labels HHMM
+    grids: list[str]
+    scene_files: list[str]                 # relative to folder, in oconv order
+    hour_files: dict[str, list[str]]
+    rtrace_opts: list[str]
+    states: dict[str, SkyState] = field(default_factory=dict)
+
+    def oconv_command(self, hour: str) -> list[str]:
+        return ["oconv", *self.scene_files, *self.hour_files[hour]]
+
+    def rtrace_command(self, hour: str) -> list[str]:
+        return ["rtrace", *self.rtrace_opts, f"octrees/{hour}.oct"]
+
+
+def write_build(scene: Scene, states: list[SkyState], params: EngineParams, ab: int,
+                folder: Path, install: RadianceInstall | None, scenario: str = "scene") -> BuildPlan:
+    """Write the scene, the hours' skies, the grids and the Makefile into ``folder``."""
+    folder.mkdir(parents=True, exist_ok=True)
+    (folder / "geometry").mkdir(exist_ok=True)
+    (folder / "grids").mkdir(exist_ok=True)
+    (folder / "skies").mkdir(exist_ok=True)
+
+    mats = []
+    for name, m in scene.materials.items():
+        if isinstance(m, Hole) or name == scene.ground_material:
+            continue
+        mats.append(m.to_radiance())
+    write_text(folder / "materials.rad", "# materials (ground: per hour in skies/)\n\n"
+               + "\n".join(mats))
+    scene_files = ["materials.rad"]
+    geometry_files = []
+    for mesh in scene.solid_meshes():
+        rel = f"geometry/{mesh.name}.rad"
+        write_text(folder / rel, mesh_to_radiance(mesh))
+        geometry_files.append(rel)
+    for grid in scene.grids.values():
+        write_text(folder / "grids" / f"{grid.name}.pts", grid.to_pts())
+    for name, cal in ANALYTIC_SKY_CAL.items():
+        write_text(folder / "skies" / f"{name}.cal", f"{{ {name} sky: relative luminance }}\n{cal}")
+
+    hour_files: dict[str, list[str]] = {}
+    ground = scene.materials.get(scene.ground_material)
+    for st in states:
+        files = []
+        if isinstance(ground, Plastic):
+            gm = with_reflectance(ground, st.ground_reflectance)
+            rel = f"skies/{st.label}_ground.rad"
+            write_text(folder / rel, f"# ground reflectance at {st.time} "
+                       f"(sun altitude {st.sun.altitude_deg:.2f}°)\n" + gm.to_radiance())
+            files.append(rel)
+        files += geometry_files
+        rel_sky = f"skies/{st.label}.sky"
+        write_text(folder / rel_sky, sky_text(st, install))
+        files.append(rel_sky)
+        hour_files[st.label] = files
+    # oconv order: materials, hour's ground material, geometry, sky
+    plan = BuildPlan(folder=folder, hours=[s.label for s in states], grids=list(scene.grids),
+                     scene_files=scene_files, hour_files=hour_files,
+                     rtrace_opts=rtrace_options(params, ab),
+                     states={s.label: s for s in states})
+    write_makefile(plan, install, scenario)
+    return plan
+
+
+def write_makefile(plan: BuildPlan, install: RadianceInstall | None, scenario: str) -> None:
+    env = Environment(loader=PackageLoader("radtree", "templates"), undefined=StrictUndefined,
+                      keep_trailing_newline=True)
+    text = env.get_template("Makefile.j2").render(
+        version=radtree.__version__, scenario=scenario, hours=plan.hours, grids=plan.grids,
+        scene_files=plan.scene_files, hour_files=plan.hour_files,
+        rtrace_opts=" ".join(plan.rtrace_opts),
+        bin_dir=str(install.bin_dir) if install else "/usr/local/bin",
+        raypath=install.raypath if install else ".:/usr/local/lib/ray",
+    )
+    write_text(plan.folder / "Makefile", text)
+
+
+def rgb_to_lux(rgb: np.ndarray) -> np.ndarray:
+    """Radiance RGB irradiance → lux: 179 · (0.265 R + 0.670 G + 0.065 B)."""
+    rgb = np.atleast_2d(np.asarray(rgb, float))
+    return 179.0 * (0.265 * rgb[:, 0] + 0.670 * rgb[:, 1] + 0.065 * rgb[:, 2])
