@@ -1,0 +1,54 @@
+"""Provenance: what produced a build or a result (versions, parameters, seeds, input hashes)."""
+
+from __future__ import annotations
+
+import hashlib
+import platform
+from datetime import datetime, timezone
+from pathlib import Path
+from typing import Any
+
+import radtree
+
+
+def file_sha256(path: Path) -> str:
+    h = hashlib.sha256()
+    with open(path, "rb") as f:
+        for chunk in iter(lambda: f.read(1 << 20), b""):
+            h.update(chunk)
+    return h.hexdigest()
+
+
+def input_files(project) -> dict[str, str]:
+    """Every input file the project names, with its SHA-256."""
+    paths = {"project": project.source}
+    for key, p in (("measured", project.measured), ("measured_rows", project.measured_rows),
+                   ("direct_normal", project.light.direct_normal_table),
+                   ("epw", project.light.epw),
+                   ("ground_reflectance", project.street.ground_reflectance_table),
+                   ("photo", project.tree.perforated.photo)):
+        if p is not None:
+            paths[key] = p
+    return {k: f"{Path(v).name} sha256:{file_sha256(Path(v))}" for k, v in paths.items()
+            if Path(v).exists()}
+
+
+def manifest(project, extra: dict[str, Any] | None = None) -> dict[str, Any]:
+    from radtree.engines.radiance.binaries import find_radiance, version
+
+    install = find_radiance()
+    d = {
+        "radtree_version": radtree.__version__,
+        "radiance_version": version(),
+        "radiance_origin": install.origin if install else None,
+        "python": platform.python_version(),
+        "created": datetime.now(timezone.utc).isoformat(timespec="seconds"),
+        "project": project.name,
+        "parameters": project.to_dict(),
+        "seeds": {"engine": project.engine.seed, "louvers": project.tree.louvers.seed},
+        "inputs": input_files(project),
+        "params_hash": {s.name: project.params_hash(s) for s in project.scenarios},
+    }
+    if extra:
+        d.update(extra)
+    return d

@@ -1,0 +1,76 @@
+"""The *calculated* ground-reflected term (scenarios A and D of the study).
+
+The façade sensors are traced with a black ground and no ground glow; then, per vertical
+sensor, E_refl = ρ(α) · E_ground · F is added, where
+
+* ρ(α): the concrete reflectance at the hour's sun altitude (per-hour table);
+* E_ground: the illuminance on the street — ``open``: the unobstructed global horizontal
+  illuminance (direct + sky); ``shaded`` (default): the street under the crown's shade, i.e.
+  ``permeability`` × the open value (the measured canopy permeability, 5–6 % in Mendoza: the
+  street under a continuous row of mulberries is shaded for most of the day);
+* F: the view factor from a vertical sensor at height h to the street — ``street`` (default):
+  a street of width W, infinitely long, F = (1 − h/√(h² + W²))/2 (≈ 0.38 at h = 5 m,
+  W = 20 m); ``unbounded``: F = 0.5.
+
+Only sensors whose normal is horizontal (|n_z| < 0.1) receive the term.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from radtree.config import Project, Scenario
+from radtree.light import ground_reflectance_at
+from radtree.scene import SensorGrid
+from radtree.site.street import sky_view_factor_to_street
+from radtree.sky import SkyState
+
+GROUND_CHOICES = ("shaded", "open")
+VIEW_FACTOR_CHOICES = ("street", "unbounded")
+
+
+@dataclass(frozen=True)
+class ReflectionChoice:
+    ground: str = "shaded"
+    view_factor: str = "street"
+    permeability: float = 0.055
+
+    def describe(self) -> str:
+        g = ("street under the crown: permeability "
+             f"{self.permeability:g} × open global horizontal" if self.ground == "shaded"
+             else "open street: unobstructed global horizontal")
+        f = ("(1 − h/√(h²+W²))/2 for the street width" if self.view_factor == "street"
+             else "0.5 (unbounded ground)")
+        return f"E_refl = ρ(α)·E_ground·F with E_ground = {g}, F = {f}"
+
+
+def reflection_choice(project: Project, scenario: Scenario) -> ReflectionChoice:
+    sw = scenario.switches
+    ground = str(sw.get("reflection.ground", "shaded"))
+    vf = str(sw.get("reflection.view_factor", "street"))
+    if ground not in GROUND_CHOICES:
+        raise ValueError(f"scenario {scenario.name}: reflection.ground must be one of "
+                         f"{GROUND_CHOICES}, got {ground!r}")
+    if vf not in VIEW_FACTOR_CHOICES:
+        raise ValueError(f"scenario {scenario.name}: reflection.view_factor must be one of "
+                         f"{VIEW_FACTOR_CHOICES}, got {vf!r}")
+    perm = float(sw.get("reflection.permeability", project.tree.homogeneous.permeability))
+    return ReflectionChoice(ground, vf, perm)
+
+
+def calculated_reflection(project: Project, scenario: Scenario, state: SkyState,
+                          grid: SensorGrid) -> np.ndarray:
+    """Lux added to each sensor of ``grid`` for this hour (0 for non-vertical sensors)."""
+    choice = reflection_choice(project, scenario)
+    rho = ground_reflectance_at(project, state.sun.altitude_deg)
+    e_open = state.direct_horizontal_lux + state.sky_horizontal_lux
+    e_ground = e_open * (choice.permeability if choice.ground == "shaded" else 1.0)
+    heights = grid.points[:, 2]
+    if choice.view_factor == "street":
+        F = np.array([sky_view_factor_to_street(h, project.street.width_m) for h in heights])
+    else:
+        F = np.full(len(heights), 0.5)
+    vertical = np.abs(grid.normals[:, 2]) < 0.1
+    return np.where(vertical, rho * e_ground * F, 0.0)
