@@ -11,11 +11,12 @@ import hashlib
 import json
 import math
 import re
-import tomllib
 from dataclasses import asdict, dataclass, field, fields, is_dataclass, replace
 from datetime import date as _date
 from pathlib import Path
 from typing import Any
+
+import tomllib
 
 from radtree.errors import ConfigError
 

@@ -1,0 +1,247 @@
+"""Sky-gap outlines: classified sky -> polygons in angular coordinates -> GeoJSON.
+
+The sky pixels (4-connected regions) are traced with ``skimage.measure.find_contours`` at the
+0.5 level between sky (1) and canopy/outside (0), simplified in pixel space with
+``skimage.measure.approximate_polygon`` (tolerance in pixels), and every vertex is converted
+to (zenith, azimuth) in degrees with the photo's lens, mask, north and mirror settings.
+Each gap is one polygon: its outer ring plus the rings of canopy islands inside it (holes).
+Gaps and holes smaller than ``min_area_px`` pixels are dropped (holes are then filled).
+
+Python API (for the perforated crown model): :func:`trace_gaps` returns :class:`GapOutline`
+objects; ``GapOutline.exterior``/``holes`` are closed (n, 2) arrays of (zenith_deg,
+azimuth_deg) with azimuth in [0, 360); ``GapOutline.vectors()`` gives unit world vectors.
+For horizontal-axis photos the pair is (angle from the lens axis, angle around the axis).
+
+GeoJSON (:func:`outlines_geojson`): a FeatureCollection of Polygon features with coordinates
+``[azimuth_deg, zenith_deg]``. Azimuths are unwrapped along each ring (consecutive vertices
+never jump by 360°, so values can leave [0, 360)); a ring that winds around the zenith (the
+image centre) is closed along the zenith line (zenith = 0) so that it is a proper polygon in
+the (azimuth, zenith) plane. Exterior rings are counter-clockwise and holes clockwise in that
+plane (RFC 7946). Properties: image, gap (id), solid_angle_sr, pixels, holes, contains_zenith.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import os
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+from skimage.measure import approximate_polygon, find_contours, label, points_in_poly
+
+from radtree.fileio import write_text
+
+from .directions import photo_to_world
+from .geometry import FisheyeGeometry, PixelField
+
+
+@dataclass(frozen=True)
+class GapOutline:
+    """One sky gap: outer ring and holes as closed (n, 2) arrays of (zenith, azimuth) degrees."""
+
+    exterior: NDArray[np.float64]
+    holes: tuple[NDArray[np.float64], ...] = ()
+    solid_angle_sr: float = 0.0
+    pixels: int = 0
+    contains_zenith: bool = False
+    axis: str = "up"
+    exterior_px: NDArray[np.float64] = field(default_factory=lambda: np.zeros((0, 2)), repr=False)
+    holes_px: tuple[NDArray[np.float64], ...] = field(default=(), repr=False)
+
+    def rings(self) -> list[NDArray[np.float64]]:
+        """Exterior followed by the holes."""
+        return [self.exterior, *self.holes]
+
+    def vectors(self, facade_azimuth: float | None = None) -> list[NDArray[np.float64]]:
+        """World unit vectors (n, 3) of each ring (x east, y north, z up).
+
+        Horizontal-axis photos need ``facade_azimuth`` (compass direction of the lens axis).
+        """
+        return [
+            photo_to_world(r[:, 0], r[:, 1], axis=self.axis, facade_azimuth=facade_azimuth)
+            for r in self.rings()
+        ]
+
+
+def _signed_area(xy: NDArray[np.float64]) -> float:
+    x, y = xy[:, 0], xy[:, 1]
+    return 0.5 * float(np.dot(x, np.roll(y, -1)) - np.dot(y, np.roll(x, -1)))
+
+
+def _contour_label(c: NDArray[np.float64], padded: NDArray[np.bool_], labels: NDArray) -> int:
+    """Label of the sky region a contour borders (contour vertices sit between two pixels)."""
+    r, k = c[0]
+    if abs(r - round(r)) < 1e-6:
+        cand = [(int(round(r)), int(math.floor(k))), (int(round(r)), int(math.ceil(k)))]
+    else:
+        cand = [(int(math.floor(r)), int(round(k))), (int(math.ceil(r)), int(round(k)))]
+    for i, j in cand:
+        if padded[i, j]:
+            return int(labels[i, j])
+    return 0
+
+
+def trace_gaps(
+    sky: NDArray[np.bool_],
+    field_: PixelField,
+    geometry: FisheyeGeometry,
+    *,
+    tolerance_px: float = 1.0,
+    min_area_px: float = 4.0,
+) -> list[GapOutline]:
+    """Vectorise the sky gaps of a classified photo, largest first.
+
+    ``sky`` covers ``field_`` (the bounding box of the valid pixels). ``tolerance_px`` is the
+    simplification tolerance (0 keeps every contour vertex).
+    """
+    padded = np.pad(sky & field_.valid, 1)
+    labels = label(padded, connectivity=1)
+    n_labels = int(labels.max())
+    if n_labels == 0:
+        return []
+    sizes = np.bincount(labels.ravel(), minlength=n_labels + 1)
+    weights = np.pad(field_.weight, 1)
+    solid = np.bincount(labels.ravel(), weights=weights.ravel(), minlength=n_labels + 1)
+    groups: dict[int, list[tuple[float, NDArray[np.float64]]]] = {}
+    for c in find_contours(padded.astype(np.float32), 0.5):
+        if len(c) < 4:
+            continue
+        lab = _contour_label(c, padded, labels)
+        if lab == 0 or sizes[lab] < min_area_px:
+            continue
+        groups.setdefault(lab, []).append((abs(_signed_area(c)), c))
+
+    # pixel coordinates (x, y) of contour vertices: index space has pixel centres at integers
+    x0 = field_.cols.start - 1 + 0.5
+    y0 = field_.rows.start - 1 + 0.5
+    cx, cy, radius = geometry.mask.cx, geometry.mask.cy, geometry.mask.radius
+
+    def to_xy(c: NDArray[np.float64]) -> NDArray[np.float64]:
+        if tolerance_px > 0:
+            c = approximate_polygon(c, tolerance_px)
+        xy = np.c_[c[:, 1] + x0, c[:, 0] + y0]
+        d = xy - (cx, cy)
+        r = np.hypot(d[:, 0], d[:, 1])
+        scale = np.where(r > radius, radius / np.maximum(r, 1e-12), 1.0)  # rim vertices onto 90°
+        return (cx, cy) + d * scale[:, None]
+
+    def to_angles(xy: NDArray[np.float64]) -> NDArray[np.float64]:
+        z, a = geometry.to_direction(xy[:, 0], xy[:, 1])
+        return np.c_[z, a]
+
+    centre = np.array([[cx, cy]])
+    out: list[GapOutline] = []
+    for lab, rings in groups.items():
+        rings.sort(key=lambda t: -t[0])
+        ext_xy = to_xy(rings[0][1])
+        if len(ext_xy) < 4:
+            continue
+        holes_xy = [to_xy(c) for area, c in rings[1:] if area >= min_area_px]
+        holes_xy = [h for h in holes_xy if len(h) >= 4]
+        inside = bool(points_in_poly(centre, ext_xy)[0]) and not any(
+            bool(points_in_poly(centre, h)[0]) for h in holes_xy
+        )
+        out.append(
+            GapOutline(
+                exterior=to_angles(ext_xy),
+                holes=tuple(to_angles(h) for h in holes_xy),
+                solid_angle_sr=float(solid[lab]),
+                pixels=int(sizes[lab]),
+                contains_zenith=inside,
+                axis=geometry.axis,
+                exterior_px=ext_xy,
+                holes_px=tuple(holes_xy),
+            )
+        )
+    out.sort(key=lambda g: -g.solid_angle_sr)
+    return out
+
+
+def gap_polygons(outlines: list[GapOutline], *, include_holes: bool = False) -> list[NDArray]:
+    """The gap outlines as a list of closed (n, 2) arrays of (zenith_deg, azimuth_deg).
+
+    Exteriors only by default; with ``include_holes`` the hole rings follow (read the list
+    with the even–odd rule).
+    """
+    rings: list[NDArray] = []
+    for g in outlines:
+        rings.append(g.exterior)
+        if include_holes:
+            rings.extend(g.holes)
+    return rings
+
+
+# -- GeoJSON ---------------------------------------------------------------------------------
+def _ring_coordinates(
+    angles: NDArray[np.float64], px: NDArray[np.float64], centre: NDArray[np.float64], exterior: bool
+) -> list[list[float]]:
+    az = np.unwrap(angles[:, 1], period=360.0)
+    az = az - 360.0 * math.floor(az[0] / 360.0)
+    zen = angles[:, 0]
+    winds = bool(points_in_poly(centre, px)[0])
+    if winds:  # close along the zenith line: a proper polygon in the (azimuth, zenith) plane
+        az = np.r_[az, az[-1], az[0]]
+        zen = np.r_[zen, 0.0, 0.0]
+    xy = np.c_[az, zen]
+    if not np.allclose(xy[0], xy[-1]):
+        xy = np.r_[xy, xy[:1]]
+    ccw = _signed_area(xy[:-1]) > 0
+    if ccw != exterior:
+        xy = xy[::-1]
+    return [[round(float(a), 4), round(float(z), 4)] for a, z in xy]
+
+
+def outlines_geojson(
+    outlines: list[GapOutline],
+    geometry: FisheyeGeometry,
+    *,
+    image: str,
+    properties: dict[str, Any] | None = None,
+) -> dict[str, Any]:
+    """A GeoJSON FeatureCollection of the gaps (coordinates [azimuth_deg, zenith_deg])."""
+    centre = np.array([[geometry.mask.cx, geometry.mask.cy]])
+    features = []
+    for i, g in enumerate(outlines):
+        rings = [_ring_coordinates(g.exterior, g.exterior_px, centre, True)]
+        rings += [_ring_coordinates(h, hp, centre, False) for h, hp in zip(g.holes, g.holes_px)]
+        features.append(
+            {
+                "type": "Feature",
+                "geometry": {"type": "Polygon", "coordinates": rings},
+                "properties": {
+                    "image": image,
+                    "gap": i,
+                    "solid_angle_sr": round(g.solid_angle_sr, 8),
+                    "pixels": g.pixels,
+                    "holes": len(g.holes),
+                    "contains_zenith": g.contains_zenith,
+                },
+            }
+        )
+    meta = {
+        "coordinates": (
+            "[azimuth_deg, zenith_deg]; azimuth clockwise from north"
+            if geometry.axis == "up"
+            else "[angle around the lens axis (clockwise from up, looking out), angle from the axis]"
+        ),
+        **{k: v for k, v in geometry.describe().items()},
+        **(properties or {}),
+    }
+    return {"type": "FeatureCollection", "radtree": meta, "features": features}
+
+
+def merge_collections(collections: list[dict[str, Any]]) -> dict[str, Any]:
+    """One FeatureCollection holding the features of several (each feature names its image)."""
+    feats = [f for c in collections for f in c["features"]]
+    meta = collections[0]["radtree"] if collections else {}
+    return {"type": "FeatureCollection", "radtree": {"coordinates": meta.get("coordinates", "")},
+            "features": feats}
+
+
+def write_geojson(path: str | os.PathLike, collection: dict[str, Any]) -> Path:
+    """Write a FeatureCollection atomically (compact JSON)."""
+    return write_text(path, json.dumps(collection, separators=(",", ":")) + "\n")

@@ -1,0 +1,49 @@
+"""Shared fixtures: a reduced copy of the Mendoza example in a temporary folder."""
+
+from __future__ import annotations
+
+import re
+import shutil
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parents[1]
+MENDOZA = ROOT / "examples" / "mendoza-street"
+SHARED = ROOT.parent / "shared"
+
+
+def copy_project(dst: Path, replace: dict[str, str] | None = None,
+                 hours: list[str] | None = None) -> Path:
+    """Copy the Mendoza example to ``dst``; regex replacements on its radtree.toml."""
+    shutil.copytree(MENDOZA, dst, ignore=shutil.ignore_patterns("build", "results", "report",
+                                                                "diagnose", "sweep"))
+    toml = dst / "radtree.toml"
+    text = toml.read_text()
+    for pat, rep in (replace or {}).items():
+        text, n = re.subn(pat, rep, text, flags=re.M)
+        assert n, f"pattern {pat!r} not found in radtree.toml"
+    if hours is not None:
+        text = re.sub(r"^hours = \[.*\]$", "hours = [" + ", ".join(f'"{h}"' for h in hours) + "]",
+                      text, flags=re.M)
+    toml.write_text(text)
+    return dst
+
+
+def radiance_available() -> bool:
+    from radtree.engines.radiance.binaries import find_radiance
+
+    return find_radiance() is not None
+
+
+needs_radiance = pytest.mark.skipif(not radiance_available(), reason="Radiance not found")
+
+
+@pytest.fixture
+def open_street(tmp_path: Path) -> Path:
+    """Mendoza without crowns (open street), two hours, two scenarios (A calculated, B traced)."""
+    p = copy_project(tmp_path / "proj", hours=["10:30", "13:30"])
+    text = (p / "radtree.toml").read_text()
+    text = re.sub(r'model = "\w+"', 'model = "none"', text)
+    (p / "radtree.toml").write_text(text)
+    return p

@@ -1,0 +1,141 @@
+"""Real Radiance runs (no mocks): analytic skies, build folder, Makefile, CLI."""
+
+import math
+import subprocess
+
+import numpy as np
+import pandas as pd
+import pytest
+from click.testing import CliRunner
+
+from radtree.cli import main
+from radtree.config import EngineParams
+from radtree.engines.radiance.engine import trace_hour
+from radtree.engines.radiance.writer import mesh_to_radiance
+from radtree.errors import EngineError
+from radtree.scene import Scene, SensorGrid, quad
+from radtree.sky import SkyState
+from radtree.solar import SunPosition, local_datetime
+
+from .conftest import needs_radiance
+
+pytestmark = needs_radiance
+
+NOON = local_datetime("2024-12-22", "12:00", -3)
+
+
+def sky_state(sky="uniform", L=1000.0):
+    return SkyState("12:00", NOON, SunPosition(60.0, 0.0), 0.0, sky_model=sky,
+                    zenith_luminance=L, ground_glow=False)
+
+
+def sensors():
+    return SensorGrid("s", [[0, 0, 0], [3, 2, 1], [0, 0, 0]], [[0, 0, 1], [0, 0, 1], [1, 0, 0]])
+
+
+# -ab 1: the glow sky is reached by one ambient bounce; -aa 0 (no interpolation), -ad 8192
+PARAMS = EngineParams(ab=1, aa=0.0, ad=8192, as_=0)
+
+
+def test_uniform_sky_gives_pi_L():
+    lux = trace_hour(Scene([], {}, {"s": sensors()}), sky_state(), PARAMS)["s"].lux
+    assert lux[:2] == pytest.approx([math.pi * 1000] * 2, rel=0.02)
+    assert lux[2] == pytest.approx(math.pi * 1000 / 2, rel=0.02)  # vertical: half the sky
+
+
+def test_cosine_sky_gives_two_thirds_pi_L0():
+    st = sky_state("cosine")
+    lux = trace_hour(Scene([], {}, {"s": sensors()}), st, PARAMS)["s"].lux
+    assert lux[:2] == pytest.approx([2 * math.pi * 1000 / 3] * 2, rel=0.02)
+    # vertical sensor under L0 cos θ: ∫ L0 cosθ · sinθ cosφ dω over the facing half = L0·π/3...
+    # = L0 ∫0^{π/2} cos θ sin²θ dθ ∫_{-π/2}^{π/2} cos φ dφ = L0 · (1/3) · 2
+    assert lux[2] == pytest.approx(2 * 1000 / 3, rel=0.03)
+
+
+def test_collimated_sun_on_unobstructed_sensor():
+    st = SkyState("12:00", NOON, SunPosition(60.0, 0.0), 100000.0, ground_glow=False)
+    lux = trace_hour(Scene([], {}, {"s": sensors()}), st, EngineParams(ab=0))["s"].lux
+    assert lux[0] == pytest.approx(100000 * math.sin(math.radians(60)), rel=0.005)
+
+
+def test_slab_of_trans_under_uniform_sky(tmp_path):
+    from radtree.optics import Trans
+
+    big = 2000.0
+    slab = quad("slab", "sheet", [[-big, -big, 1], [big, -big, 1], [big, big, 1], [-big, big, 1]])
+    scene = Scene([slab], {"sheet": Trans("sheet", 0.0, 0.3, 0.0)}, {"s": sensors()})
+    lux = trace_hour(scene, sky_state(), EngineParams(ab=2, aa=0, ad=4096, as_=0))["s"].lux
+    assert lux[0] == pytest.approx(0.3 * math.pi * 1000, rel=0.03)
+
+
+def test_polygon_text():
+    m = quad("w", "paint", [[0, 0, 0], [1, 0, 0], [1, 0, 1], [0, 0, 1]])
+    text = mesh_to_radiance(m)
+    assert "paint polygon w.0\n0\n0\n9 0.00000 0.00000 0.00000 1.00000 0.00000 0.00000 " \
+           "1.00000 0.00000 1.00000\n" in text
+    assert text.count("polygon") == 2
+
+
+def test_radiance_failure_carries_command_and_stderr(tmp_path):
+    from radtree.engines.radiance.binaries import run
+
+    with pytest.raises(EngineError) as err:
+        run(["oconv", str(tmp_path / "missing.rad")])
+    assert "oconv" in str(err.value) and "missing.rad" in str(err.value)
+
+
+def test_build_simulate_and_makefile(open_street):
+    r = CliRunner().invoke(main, ["build", str(open_street), "--no-pictures"])
+    assert r.exit_code == 0, r.output
+    b = open_street / "build" / "A"
+    for rel in ["materials.rad", "geometry/facade.rad", "geometry/ground.rad",
+                "grids/facade.pts", "grids/facade_map.pts", "skies/1030.sky", "skies/1330.sky",
+                "skies/1030_ground.rad", "Makefile", "manifest.json"]:
+        assert (b / rel).exists(), rel
+    assert (open_street / "build" / "Makefile").exists()
+    # scenario A (calculated) has a black ground; B the per-hour concrete reflectance 0.151
+    assert "5 0 0 0 0 0" in (b / "skies/1030_ground.rad").read_text()
+    assert "5 0.151 0.151 0.151" in (open_street / "build/B/skies/1030_ground.rad").read_text()
+    # the generated Makefile runs without Python
+    subprocess.run(["make", "-s", "-j2", "-C", str(open_street / "build" / "B"), "1330"],
+                   check=True, capture_output=True)
+    make_lux = np.loadtxt(open_street / "build/B/results/1330_facade.lux")
+    assert len(make_lux) == 8
+
+    r = CliRunner().invoke(main, ["simulate", str(open_street), "--fresh"])
+    assert r.exit_code == 0, r.output
+    df = pd.read_csv(open_street / "results" / "illuminance.csv")
+    for col in ["scenario", "model", "datetime", "time", "grid", "sensor", "row", "x", "y", "z",
+                "lux", "lux_stderr", "engine", "params_hash"]:
+        assert col in df.columns
+    assert set(df["scenario"]) == {"A", "B", "C", "D", "E"}
+    assert set(df["engine"]) == {"radiance"}
+    fac = df[(df.grid == "facade") & (df.scenario == "B") & (df.time == "13:30")]
+    assert len(fac) == 8
+    # same commands; Radiance ambient sampling differs slightly between processes
+    np.testing.assert_allclose(fac["lux"].to_numpy(), make_lux, rtol=0.01)
+    # open street at 13:30: direct on the façade ≈ 116450·cos(80.5°)·cos(5.85°) ≈ 19 100 lx,
+    # plus ground and sky: the sensors must exceed the direct part
+    assert fac["lux"].mean() > 19000
+    # A: calculated reflection = black ground traced + analytic term
+    a = df[(df.grid == "facade") & (df.scenario == "A") & (df.time == "13:30")]
+    assert (a["lux_reflected_calc"] > 0).all()
+    assert a["lux"].mean() < fac["lux"].mean()
+
+    # a rerun reuses every finished hour
+    r = CliRunner().invoke(main, ["simulate", str(open_street)])
+    assert "0 hours traced, 10 reused" in r.output
+
+
+def test_dry_run_prints_commands(open_street):
+    r = CliRunner().invoke(main, ["simulate", str(open_street), "-s", "B", "--dry-run"])
+    assert r.exit_code == 0, r.output
+    assert "oconv materials.rad skies/1030_ground.rad" in r.output
+    assert "rtrace -h -I -ab" in r.output and "< grids/facade.pts" in r.output
+    assert not (open_street / "results" / "illuminance.csv").exists()
+
+
+def test_unknown_hour_is_an_error(open_street):
+    r = CliRunner().invoke(main, ["simulate", str(open_street), "--hour", "12:00"])
+    assert r.exit_code == 2
+    assert "unknown hour(s) 12:00" in r.output
