@@ -32,7 +32,7 @@ def run_hour(plan: BuildPlan, hour: str, dry_run: bool = False,
     """
     folder = plan.folder
     oct_rel = f"octrees/{hour}.oct"
-    commands = [(plan.oconv_command(hour), None, oct_rel)]
+    commands: list[tuple[list[str], str | None, str]] = [(plan.oconv_command(hour), None, oct_rel)]
     for g in plan.grids:
         commands.append((plan.rtrace_command(hour), f"grids/{g}.pts", f"results/{hour}_{g}.rgb"))
     if dry_run:
