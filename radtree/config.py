@@ -290,6 +290,39 @@ class Sensors:
 
 
 @dataclass(frozen=True)
+class Office:
+    """A block of offices in the studied façade (the building application, SPEC.md §5).
+
+    ``bays`` × ``storeys`` identical offices, each ``width_m`` wide, ``height_m`` high (floor to
+    ceiling) and ``depth_m`` deep, with a glazed façade towards the street. Storey ``k`` (0 =
+    ground) has its floor at ``ground_floor_m + k·storey_height_m``. The glazing's measured
+    normal transmittance ``glazing_transmittance`` becomes a Radiance ``glass`` transmissivity;
+    ``frame_fraction`` of each façade opening is opaque frame. Results are read in the central
+    office. Work plane at ``workplane_height_m``, grids at ``grid_spacing_m`` spacing,
+    ``wall_offset_m`` from the walls.
+    """
+
+    bays: int = 3
+    storeys: int = 3
+    width_m: float = 3.0
+    height_m: float = 2.5
+    depth_m: float = 6.0
+    storey_height_m: float = 2.5
+    ground_floor_m: float = 2.5
+    glazing_transmittance: float = 0.8
+    frame_fraction: float = 0.1
+    window_sill_m: float = 0.0
+    window_head_m: float = 2.5
+    floor_reflectance: float = 0.2
+    wall_reflectance: float = 0.5
+    ceiling_reflectance: float = 0.7
+    workplane_height_m: float = 0.8
+    grid_spacing_m: float = 0.5
+    wall_offset_m: float = 0.5
+    facade_grid_spacing_m: float = 0.5
+
+
+@dataclass(frozen=True)
 class EngineParams:
     """Tracing parameters. Radiance: ``ab`` (None = from the crown model), ``ad``, ``as_``,
     ``ar``, ``aa``, ``lw``. NumPy engine: ``rays`` per sensor, ``max_bounces``, ``seed``."""
@@ -334,6 +367,8 @@ class Project:
     scenarios: tuple[Scenario, ...]
     measured: Path | None = None
     measured_rows: Path | None = None
+    office: Office | None = None
+    extra_geometry: tuple[tuple[Path, str], ...] = ()
 
     @property
     def build_dir(self) -> Path:
@@ -360,7 +395,8 @@ class Project:
     def params_hash(self, scenario: Scenario) -> str:
         """Short hash of everything that changes a scenario's numbers."""
         d = self.to_dict()
-        payload = {k: d[k] for k in ("site", "street", "light", "tree", "sensors", "engine")}
+        payload = {k: d[k] for k in ("site", "street", "light", "tree", "sensors", "engine",
+                                     "office", "extra_geometry")}
         payload["engine"].pop("workers", None)
         payload["scenario"] = _plain(scenario)
         text = json.dumps(payload, sort_keys=True, default=str)
@@ -605,6 +641,39 @@ def parse_project(data: dict, path: Path) -> Project:
     engine = _dataclass_from(en, EngineParams, base)
     en.check_unknown()
 
+    # office block (optional)
+    office = None
+    if top.has("office"):
+        orr = top.sub("office")
+        for k in ("width_m", "height_m", "depth_m", "storey_height_m", "grid_spacing_m",
+                  "facade_grid_spacing_m"):
+            _positive(orr, k)
+        for k in ("floor_reflectance", "wall_reflectance", "ceiling_reflectance",
+                  "frame_fraction"):
+            _fraction(orr, k)
+        if orr.has("glazing_transmittance"):
+            orr.number("glazing_transmittance", lo=0.0, lo_open=True, hi=0.9183)
+        for k in ("bays", "storeys"):
+            if orr.has(k):
+                orr.integer(k, lo=1, hi=21)
+        office = _dataclass_from(orr, Office, base)
+        if office.bays % 2 == 0 or office.storeys % 2 == 0:
+            raise orr.error("bays", "bays and storeys must be odd so that a central office exists")
+        if office.height_m > office.storey_height_m:
+            raise orr.error("height_m", f"office height {office.height_m} m exceeds the storey "
+                            f"height {office.storey_height_m} m")
+        orr.check_unknown()
+
+    # extra user geometry: [[geometry]] file = "x.obj", material = "name"
+    extra = []
+    for i, item in enumerate(top.raw("geometry", []) or []):
+        r = _Reader(item, f"geometry[{i}]", src)
+        gpath = r.optional_path("file", base)
+        if gpath is None:
+            raise r.error("file", "missing (an OBJ/STL/PLY or .rad file)")
+        extra.append((gpath, r.string("material")))
+        r.check_unknown()
+
     # scenarios
     raw_sc = top.raw("scenario", None)
     if raw_sc is None:
@@ -643,7 +712,8 @@ def parse_project(data: dict, path: Path) -> Project:
 
     return Project(name=name, root=path.parent, source=path, site=site, street=street,
                    light=light, tree=tree, sensors=sensors, engine=engine,
-                   scenarios=tuple(scenarios), measured=measured, measured_rows=measured_rows)
+                   scenarios=tuple(scenarios), measured=measured, measured_rows=measured_rows,
+                   office=office, extra_geometry=tuple(extra))
 
 
 def project_dict(project: Project) -> dict[str, Any]:

@@ -64,6 +64,18 @@ def make_scene(project: Project, scenario: Scenario, dense_grid: bool | None = N
     notes = [f"street canyon {project.street.width_m:g} m wide, façade looks "
              f"{project.street.facade_azimuth_deg:g}° (compass), façade ρ "
              f"{project.street.facade_reflectance:g}"]
+    if project.office is not None:
+        from radtree.site.office import office_parts
+
+        o_meshes, o_materials, o_grids, o_notes = office_parts(project, frame)
+        meshes = [m for m in meshes if m.name != "facade"] + o_meshes
+        materials.update(o_materials)
+        grids = o_grids
+        notes += o_notes
+    if project.extra_geometry:
+        from radtree.site.user_geometry import load_user_meshes
+
+        meshes = meshes + load_user_meshes(project.extra_geometry)
     t0 = time.perf_counter()
     ab = 2
     info: dict[str, float] = {}
