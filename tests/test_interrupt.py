@@ -1,0 +1,44 @@
+"""An interrupted `radtree simulate` keeps finished hours; a rerun computes only the rest."""
+
+import os
+import signal
+import subprocess
+import sys
+import time
+
+import pandas as pd
+
+from .conftest import needs_radiance
+
+
+@needs_radiance
+def test_sigint_keeps_finished_hours_and_resumes(open_street):
+    env = dict(os.environ)
+    cmd = [sys.executable, "-m", "radtree.cli", "simulate", str(open_street), "--workers", "1"]
+    proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, env=env)
+    parts = open_street / "results" / "parts"
+    deadline = time.time() + 120
+    while time.time() < deadline:
+        if parts.exists() and len(list(parts.glob("*.csv"))) >= 2:
+            break
+        if proc.poll() is not None:
+            break
+        time.sleep(0.05)
+    assert proc.poll() is None, "the run finished before it could be interrupted"
+    proc.send_signal(signal.SIGINT)
+    out, err = proc.communicate(timeout=120)
+    assert proc.returncode == 130, err.decode()
+    assert b"interrupted" in err
+    finished = sorted(p.name for p in parts.glob("*.csv"))
+    assert 2 <= len(finished) < 10
+    assert not list(parts.glob(".*tmp"))                   # no half-written part
+    assert not (open_street / "results" / "illuminance.csv").exists()
+    mtimes = {p.name: p.stat().st_mtime_ns for p in parts.glob("*.csv")}
+
+    done = subprocess.run(cmd, capture_output=True, env=env, timeout=300)
+    assert done.returncode == 0, done.stderr.decode()
+    assert f"{10 - len(finished)} hours traced, {len(finished)} reused" in done.stdout.decode()
+    for name, mt in mtimes.items():                       # finished parts were not recomputed
+        assert (parts / name).stat().st_mtime_ns == mt
+    table = pd.read_csv(open_street / "results" / "illuminance.csv")
+    assert len(table[table.grid == "facade"]) == 5 * 2 * 8
