@@ -144,8 +144,15 @@ def simulate(project: str, scenarios: tuple[str, ...], engine: str, hours: tuple
     if convergence:
         from radtree.convergence import convergence_table
 
-        table = convergence_table(p, list(scenarios) or None, echo=click.echo)
+        from radtree.fileio import atomic_path
+
+        table = convergence_table(p, list(scenarios) or None, list(hours) or None,
+                                  echo=click.echo)
         click.echo(table.to_string(index=False))
+        out = p.results_dir / "convergence.csv"
+        with atomic_path(out) as tmp:
+            table.to_csv(tmp, index=False)
+        click.echo(f"convergence table → {out}")
         return
     eng = choose_engine(engine if engine != "auto" else p.engine.name)
     click.echo(f"engine: {eng}" + (" (auto)" if engine == "auto" else ""))
@@ -163,6 +170,18 @@ def simulate(project: str, scenarios: tuple[str, ...], engine: str, hours: tuple
 
 
 
+
+def _register_commands() -> None:
+    """Commands that live beside their subject (hemi, report, …)."""
+    from radtree.hemi.cli import hemi_command
+    from radtree.report.cli import report_command
+    from radtree.trees.cli import calibrate_command
+
+    for cmd in (hemi_command, report_command, calibrate_command):
+        main.add_command(cmd)
+
+
+_register_commands()
 
 if __name__ == "__main__":  # pragma: no cover
     main()

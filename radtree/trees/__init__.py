@@ -1,4 +1,12 @@
 """Crown models (homogeneous, perforated, louvers) in two forms (sensor dome, free-standing).
 
-Entry point: :func:`radtree.trees.build.build_tree`.
+Entry point: :func:`radtree.trees.build.build_tree` (``build_tree(project, scenario, frame)``
+→ :class:`TreeModel`). Also: :func:`radtree.trees.build.build_crown` (a model/form without a
+scenario), :func:`radtree.trees.calibrate.calibrate` (the ``radtree calibrate`` command lives in
+:mod:`radtree.trees.cli`), :func:`radtree.trees.picture.render_model_png`, and
+:class:`radtree.trees.raycast.DirectTracer` (straight-ray direct transmission).
 """
+
+from radtree.trees.build import TreeModel, apply_switches, build_crown, build_tree
+
+__all__ = ["TreeModel", "apply_switches", "build_crown", "build_tree"]

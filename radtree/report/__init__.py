@@ -1,0 +1,31 @@
+"""The project report: statistics, tables, figures → ``PROJECT/report/index.html``.
+
+    from radtree.config import load_project
+    from radtree.report import build_report
+    build_report(load_project("examples/mendoza-street"))   # → Path to report/index.html
+
+Reads only the results layout (``results/illuminance.csv``, ``timing.csv``, ``manifest.json``,
+``convergence.csv``, ``build/<scenario>/manifest.json`` and ``model.png``) and the project's
+measurement files. The heavy modules (pandas, matplotlib) load on the first call.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from pathlib import Path
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from radtree.config import Project
+
+__all__ = ["build_report"]
+
+
+def build_report(project: Project, echo: Callable[[str], None] = print) -> Path:
+    """Write ``PROJECT/report/`` atomically and return the path of ``index.html``.
+
+    See :func:`radtree.report.build.build_report`.
+    """
+    from radtree.report.build import build_report as _build
+
+    return _build(project, echo=echo)

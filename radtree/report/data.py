@@ -1,0 +1,458 @@
+"""Everything the report shows, read from the results layout and reduced with radtree.stats.
+
+Reads only ``PROJECT/results/`` (illuminance.csv, timing.csv, manifest.json, convergence.csv),
+``PROJECT/build/<scenario>/manifest.json`` and ``model.png``, and the project's measurement
+files. Nothing here knows which engine produced the numbers.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pandas as pd
+
+from radtree.config import Project
+from radtree.errors import RadtreeError
+from radtree.measurements import (
+    MeasuredShape,
+    grid_mean,
+    load_measured,
+    load_measured_rows,
+    normalise_time,
+)
+from radtree.stats import (
+    FACADE_GRID,
+    Comparison,
+    compare,
+    hourly_means,
+    row_hourly_between_models,
+    row_hourly_means,
+    row_means,
+)
+
+MAP_GRID = "facade_map"
+FORM_ORDER = ("dome", "free")
+FORM_LABELS = {"dome": "sensor dome (study form)", "free": "free-standing crown",
+               "unknown": "crown form not recorded"}
+MODEL_LABELS = {"none": "none (open street)"}
+PNG_SIGNATURE = b"\x89PNG\r\n\x1a\n"
+TIMING_PARTS = ("preparation_s", "geometry_s", "tracing_s")
+
+
+@dataclass
+class ScenarioInfo:
+    """What the report knows about one scenario of the results table."""
+
+    name: str
+    model: str
+    form: str
+    form_source: str
+    reflection: str
+    reflection_note: str
+    sky: str
+    description: str
+    engine: str
+    params_hash: str
+    current_hash: str | None
+    in_project: bool
+    build: dict[str, Any] = field(default_factory=dict)
+    build_manifest_found: bool = False
+    picture: Path | None = None
+    picture_problem: str = ""
+
+    @property
+    def form_label(self) -> str:
+        return FORM_LABELS.get(self.form, self.form)
+
+    @property
+    def model_label(self) -> str:
+        return MODEL_LABELS.get(self.model, self.model)
+
+    @property
+    def label(self) -> str:
+        return f"{self.name}: {self.model_label}, {self.reflection or 'reflection ?'}"
+
+
+@dataclass
+class ReportData:
+    project: Project
+    results: pd.DataFrame
+    scenarios: list[ScenarioInfo]
+    hourly_sim: pd.DataFrame                 # hourly_means on the façade grid
+    hourly: pd.DataFrame                     # time, measured_lux, one column per scenario
+    measured: pd.DataFrame | None            # time, measured_lux (grid mean)
+    measured_shape: MeasuredShape | None
+    comparison: Comparison | None
+    stats: pd.DataFrame | None               # comparison.stats in scenario order
+    rows: pd.DataFrame | None                # per-row daily means (vs measured when known)
+    rows_measured: bool
+    rows_between: pd.DataFrame | None
+    timing: pd.DataFrame | None
+    convergence: pd.DataFrame | None
+    results_manifest: dict[str, Any] | None
+    map_time: str | None
+    map_time_reason: str
+    notes: list[str] = field(default_factory=list)
+
+    @property
+    def names(self) -> list[str]:
+        return [s.name for s in self.scenarios]
+
+    def scenario(self, name: str) -> ScenarioInfo:
+        for s in self.scenarios:
+            if s.name == name:
+                return s
+        raise KeyError(name)
+
+
+# --------------------------------------------------------------------------- reading
+
+
+def results_path(project: Project) -> Path:
+    return project.results_dir / "illuminance.csv"
+
+
+def read_results(project: Project) -> pd.DataFrame:
+    """The tidy results table; RadtreeError if ``simulate`` has not been run."""
+    path = results_path(project)
+    if not path.is_file():
+        raise RadtreeError(f"no results: run `radtree simulate {project.root}` first "
+                           f"({path} not found)")
+    try:
+        df = pd.read_csv(path, dtype={"scenario": str, "time": str, "row": str, "grid": str,
+                                      "params_hash": str, "engine": str, "model": str,
+                                      "reflection": str})
+    except (OSError, ValueError) as exc:
+        raise RadtreeError(f"{path}: cannot read the results table ({exc})") from exc
+    for col in ("scenario", "model", "time", "grid", "sensor", "lux"):
+        if col not in df.columns:
+            raise RadtreeError(f"{path}: results table lacks column '{col}'")
+    if df.empty:
+        raise RadtreeError(f"{path}: results table is empty; run `radtree simulate "
+                           f"{project.root}` first")
+    try:
+        df["time"] = [normalise_time(str(t)) for t in df["time"]]
+    except RadtreeError as exc:
+        raise RadtreeError(f"{path}: {exc}") from None
+    if "lux_stderr" not in df.columns:
+        df["lux_stderr"] = np.nan
+    return df
+
+
+def _read_json(path: Path, notes: list[str]) -> dict[str, Any] | None:
+    if not path.is_file():
+        return None
+    try:
+        data = json.loads(path.read_text(encoding="utf-8"))
+    except (OSError, ValueError) as exc:
+        notes.append(f"{path} could not be read ({exc}); its facts are left out")
+        return None
+    if not isinstance(data, dict):
+        notes.append(f"{path} is not a JSON object; its facts are left out")
+        return None
+    return data
+
+
+def _read_csv(path: Path, required: tuple[str, ...], notes: list[str]) -> pd.DataFrame | None:
+    if not path.is_file():
+        return None
+    try:
+        df = pd.read_csv(path, dtype={"scenario": str})
+    except (OSError, ValueError) as exc:
+        notes.append(f"{path} could not be read ({exc}); it is left out")
+        return None
+    missing = [c for c in required if c not in df.columns]
+    if missing:
+        notes.append(f"{path} lacks column(s) {', '.join(missing)}; it is left out")
+        return None
+    return df
+
+
+def _is_png(path: Path) -> bool:
+    try:
+        with open(path, "rb") as f:
+            return f.read(8) == PNG_SIGNATURE
+    except OSError:
+        return False
+
+
+def _unique(series: pd.Series) -> list[str]:
+    return [str(v) for v in pd.unique(series.dropna()) if str(v) != ""]
+
+
+# --------------------------------------------------------------------------- scenarios
+
+
+def _reflection_notes(project: Project, notes: list[str]) -> dict[str, str]:
+    from radtree.scenarios import reflection_notes
+
+    try:
+        return reflection_notes(project)
+    except (RadtreeError, ValueError) as exc:
+        notes.append(f"ground-reflection description failed: {exc}")
+        out = {}
+        for sc in project.scenarios:
+            out[sc.name] = ("calculated (details unavailable)" if sc.reflection == "calculated"
+                            else "traced: sun → street → façade through the crown model")
+        return out
+
+
+def _sky_label(project: Project, sky: str) -> str:
+    if sky == "none":
+        return "sun only"
+    if sky == "perez":
+        return (f"sun + clear-sky Perez sky ({project.light.diffuse_horizontal_lux:g} lx "
+                "diffuse horizontal)")
+    return sky
+
+
+def scenario_infos(project: Project, results: pd.DataFrame,
+                   notes: list[str]) -> list[ScenarioInfo]:
+    """One entry per scenario in the results, grouped by crown form, project order inside."""
+    in_project = {s.name: s for s in project.scenarios}
+    order = {s.name: i for i, s in enumerate(project.scenarios)}
+    refl_notes = _reflection_notes(project, notes)
+    infos = []
+    for name in _unique(results["scenario"]):
+        rows = results[results["scenario"] == name]
+        sc = in_project.get(name)
+        models = _unique(rows["model"])
+        model = models[0] if models else (sc.model if sc else "?")
+        refl_col = _unique(rows["reflection"]) if "reflection" in rows.columns else []
+        reflection = refl_col[0] if refl_col else (sc.reflection if sc else "")
+        hashes = _unique(rows["params_hash"]) if "params_hash" in rows.columns else []
+        engines = _unique(rows["engine"]) if "engine" in rows.columns else []
+        folder = project.build_dir / name
+        mf = _read_json(folder / "manifest.json", notes)
+        build = mf.get("build", {}) if mf else {}
+        build = build if isinstance(build, dict) else {}
+        if build.get("form"):
+            form, source = str(build["form"]), "build manifest"
+        elif sc is not None:
+            form, source = sc.form or project.tree.form, "project file"
+        else:
+            form, source = "unknown", ""
+        if sc is not None:
+            note = refl_notes.get(name, "")
+        else:
+            note = (f"{reflection} (scenario not in the project file; mode from the results)"
+                    if reflection else "not recorded")
+            notes.append(f"scenario {name} is in the results but not in the project file "
+                         f"{project.source.name}; it is reported from the results alone")
+        picture, problem = None, ""
+        png = folder / "model.png"
+        if png.is_file():
+            if png.stat().st_size > 0 and _is_png(png):
+                picture = png
+            else:
+                problem = f"{png} is not a valid PNG picture"
+        current = project.params_hash(sc) if sc is not None else None
+        if len(hashes) > 1:
+            notes.append(f"scenario {name}: the results mix parameter hashes "
+                         f"{', '.join(hashes)}")
+        elif hashes and current is not None and hashes[0] != current:
+            notes.append(f"scenario {name}: the results were computed with parameters "
+                         f"{hashes[0]}, but the project file (read by this radtree) now gives "
+                         f"{current} — the report shows the stored results; run `radtree "
+                         "simulate` to update them")
+        infos.append(ScenarioInfo(
+            name=name, model=model, form=form, form_source=source, reflection=reflection,
+            reflection_note=note,
+            sky=_sky_label(project, sc.sky or project.light.sky) if sc is not None else "?",
+            description=sc.description if sc is not None else "",
+            engine=", ".join(engines), params_hash=", ".join(hashes), current_hash=current,
+            in_project=sc is not None, build=build, build_manifest_found=mf is not None,
+            picture=picture, picture_problem=problem,
+        ))
+
+    def key(info: ScenarioInfo) -> tuple[int, str, int, str]:
+        f = FORM_ORDER.index(info.form) if info.form in FORM_ORDER else len(FORM_ORDER)
+        return (f, info.form, order.get(info.name, len(order)), info.name)
+
+    return sorted(infos, key=key)
+
+
+# --------------------------------------------------------------------------- measurements
+
+
+def _measured_rows_frame(project: Project, measured: pd.DataFrame | None,
+                         notes: list[str]) -> pd.DataFrame | None:
+    if project.measured_rows is not None:
+        return load_measured_rows(project.measured_rows)
+    if measured is not None and "row" in measured.columns:
+        rows = measured.assign(row=measured["row"].astype(str).str.lower())
+        notes.append("per-row measured daily means derived from the hourly measured file "
+                     "(mean over its hours)")
+        return (rows.groupby("row", sort=False)["measured_lux"].mean()
+                .rename("measured_mean_lux").reset_index())
+    return None
+
+
+def _row_tables(project: Project, results: pd.DataFrame, measured: pd.DataFrame | None,
+                measured_times: list[str] | None, order: list[str],
+                notes: list[str]) -> tuple[pd.DataFrame | None, bool, pd.DataFrame | None]:
+    facade = results[results["grid"].astype(str) == FACADE_GRID]
+    if facade.empty or facade["row"].dropna().empty:
+        notes.append("the façade grid has no row labels: no per-row comparison")
+        return None, False, None
+    measured_rows = _measured_rows_frame(project, measured, notes)
+    rows = None
+    if measured_rows is not None:
+        try:
+            rows = row_means(results, measured_rows, times=measured_times)
+        except RadtreeError as exc:
+            notes.append(f"per-row comparison with the measured daily means not possible: {exc}")
+    with_measured = rows is not None
+    if rows is None:
+        per = row_hourly_means(results)
+        rows = (per.groupby(["scenario", "row"], sort=True)
+                .agg(model=("model", "first"), simulated_mean_lux=("lux", "mean"))
+                .reset_index())
+        se = per.groupby(["scenario", "row"], sort=True)["lux_stderr"].apply(
+            lambda v: float(np.sqrt(np.sum(np.asarray(v, float) ** 2)) / len(v)))
+        rows["simulated_stderr"] = se.to_numpy()
+        rows["measured_mean_lux"] = math.nan
+        rows["ratio"] = math.nan
+        rows["difference_lux"] = math.nan
+    rank = {n: i for i, n in enumerate(order)}
+    row_rank = {"higher": 0, "intermediate": 1, "lower": 2}
+    rows = rows.assign(_s=rows["scenario"].map(rank), _r=rows["row"].map(row_rank).fillna(9))
+    rows = rows.sort_values(["_s", "_r", "row"]).drop(columns=["_s", "_r"])
+    between = None
+    if len(order) > 1:
+        try:
+            between = row_hourly_between_models(results, reference=order[0])
+            between = between.assign(_s=between["scenario"].map(rank),
+                                     _r=between["row"].map(row_rank).fillna(9))
+            between = between.sort_values(["_s", "_r"]).drop(columns=["_s", "_r"])
+        except RadtreeError as exc:
+            notes.append(f"per-row hourly comparison between models not possible: {exc}")
+    return rows.reset_index(drop=True), with_measured, between
+
+
+# --------------------------------------------------------------------------- assembly
+
+
+def _map_time(results: pd.DataFrame, measured: pd.DataFrame | None,
+              hourly_sim: pd.DataFrame) -> tuple[str | None, str]:
+    maps = results[results["grid"].astype(str) == MAP_GRID]
+    if maps.empty:
+        return None, ("the results hold no dense façade grid ('facade_map'; set "
+                      "sensors.dense_grid = true and simulate again)")
+    times = set(maps["time"])
+    if measured is not None:
+        m = measured[measured["time"].isin(times)]
+        if not m.empty:
+            best = m.loc[m["measured_lux"].idxmax()]
+            return str(best["time"]), (f"{best['time']}, the hour of highest measured façade "
+                                       f"illuminance ({best['measured_lux']:.0f} lx)")
+    sim = hourly_sim[hourly_sim["time"].isin(times)]
+    if sim.empty:
+        t = sorted(times)[0]
+        return t, f"{t}, the first hour of the dense grid"
+    mean = sim.groupby("time")["lux"].mean()
+    t = str(mean.idxmax())
+    return t, (f"{t}, the hour of highest simulated façade illuminance (mean over the "
+               "scenarios; no measurements)")
+
+
+def collect(project: Project, echo: Callable[[str], None] = print) -> ReportData:
+    """Read the results layout and compute every table the report shows."""
+    notes: list[str] = []
+    results = read_results(project)
+    if results[results["grid"].astype(str) == FACADE_GRID].empty:
+        raise RadtreeError(f"{results_path(project)}: no rows for the façade sensor grid "
+                           f"'{FACADE_GRID}'")
+    scenarios = scenario_infos(project, results, notes)
+    order = [s.name for s in scenarios]
+    rank = {n: i for i, n in enumerate(order)}
+    hourly_sim = hourly_means(results)
+    hourly_sim = (hourly_sim.assign(_s=hourly_sim["scenario"].map(rank))
+                  .sort_values(["_s", "time"]).drop(columns="_s").reset_index(drop=True))
+
+    measured = measured_shape = comparison = stats = None
+    measured_times: list[str] | None = None
+    measured_tidy = None
+    if project.measured is not None:
+        measured_tidy, measured_shape = load_measured(project.measured)
+        facade = results[results["grid"].astype(str) == FACADE_GRID].dropna(subset=["row"])
+        per_row = facade.groupby(facade["row"].astype(str).str.lower())["sensor"].nunique()
+        measured = grid_mean(measured_tidy,
+                             per_row.to_dict() if "row" in measured_tidy.columns else None)
+        reflection = {s.name: s.reflection for s in scenarios}
+        echo(f"  comparing {len(order)} scenario(s) with {len(measured)} measured hour(s)")
+        comparison = compare(results, measured_tidy, reflection=reflection)
+        notes.extend(comparison.notes)
+        stats = comparison.stats.assign(_s=comparison.stats["scenario"].map(rank))
+        stats = stats.sort_values("_s").drop(columns="_s").reset_index(drop=True)
+        measured_times = list(measured["time"])
+    else:
+        notes.append("the project names no measurements ([project] measured): simulated values "
+                     "only, no statistics")
+
+    # hourly table: every simulated or measured hour, measured blank where not measured
+    wide = hourly_sim.pivot(index="time", columns="scenario", values="lux")
+    wide = wide.reindex(columns=order)
+    if measured is not None:
+        hourly = measured[["time", "measured_lux"]].merge(
+            wide.reset_index(), on="time", how="outer")
+    else:
+        hourly = wide.reset_index()
+        hourly.insert(1, "measured_lux", math.nan)
+    hourly = hourly.sort_values("time").reset_index(drop=True)
+    hourly.columns = [str(c) for c in hourly.columns]
+
+    rows, rows_measured, between = _row_tables(project, results, measured_tidy, measured_times,
+                                               order, notes)
+
+    timing = _read_csv(project.results_dir / "timing.csv", ("scenario", *TIMING_PARTS), notes)
+    if timing is None:
+        notes.append("no results/timing.csv: wall-clock times unavailable")
+    else:
+        timing = timing.assign(scenario=timing["scenario"].astype(str))
+        absent = [n for n in order if n not in set(timing["scenario"])]
+        if absent:
+            notes.append(f"timing.csv has no entry for scenario(s) {', '.join(absent)}")
+    convergence = _read_csv(project.results_dir / "convergence.csv",
+                            ("scenario", "ab", "facade_mean_lux"), notes)
+    if convergence is not None:
+        convergence = convergence.assign(scenario=convergence["scenario"].astype(str))
+    manifest = _read_json(project.results_dir / "manifest.json", notes)
+    map_time, reason = _map_time(results, measured, hourly_sim)
+    return ReportData(
+        project=project, results=results, scenarios=scenarios, hourly_sim=hourly_sim,
+        hourly=hourly, measured=measured, measured_shape=measured_shape, comparison=comparison,
+        stats=stats, rows=rows, rows_measured=rows_measured, rows_between=between,
+        timing=timing, convergence=convergence, results_manifest=manifest, map_time=map_time,
+        map_time_reason=reason, notes=notes)
+
+
+# --------------------------------------------------------------------------- geometry
+
+
+def facade_coordinates(x: np.ndarray, y: np.ndarray,
+                       azimuth_deg: float) -> tuple[np.ndarray, np.ndarray]:
+    """Horizontal coordinate along the façade for world points (x, y), and the axis used.
+
+    The axis is the principal direction of the points' x/y spread (PCA), oriented like the
+    façade frame's "along" axis of ``azimuth_deg`` (to the right seen from the street); for a
+    degenerate spread (one column of points) the frame's axis itself.
+    """
+    a = math.radians(azimuth_deg)
+    frame_along = np.array([math.cos(a), -math.sin(a)])
+    xy = np.column_stack([np.asarray(x, float), np.asarray(y, float)])
+    axis = frame_along
+    if len(xy) >= 2:
+        centred = xy - xy.mean(axis=0)
+        _, s, vt = np.linalg.svd(centred, full_matrices=False)
+        if s[0] > 1e-6 and (len(s) < 2 or s[0] > 5 * s[1]):
+            axis = vt[0]
+            if float(axis @ frame_along) < 0:
+                axis = -axis
+    return xy @ axis, axis

@@ -1,0 +1,44 @@
+"""What every crown builder returns (re-exported by :mod:`radtree.trees.build`)."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+from radtree.optics import Material
+from radtree.scene import Mesh
+from radtree.site.frame import FacadeFrame
+
+# Material names used by the crown models; they must not clash with the street's
+# (``facade_paint``, ``ground``, ``opposite_facade``).
+LEAF = "leaf"
+SHELL = "crown_shell"
+TRUNK = "trunk"
+BARK_REFLECTANCE = 0.2
+
+
+@dataclass
+class TreeModel:
+    """A built crown: world-space meshes tagged with material names, the materials, notes.
+
+    ``recommended_ab`` is the Radiance ambient-bounce count this model needs (diffusely
+    transmitting layers pass light only through ambient bounces). ``info`` holds numbers for
+    reports and tests (analytic transmissions, openness, slat counts, radii ...).
+    """
+
+    meshes: list[Mesh]
+    materials: dict[str, Material]
+    notes: list[str]
+    recommended_ab: int
+    triangles: int = 0
+    build_seconds: float = 0.0
+    info: dict[str, float] = field(default_factory=dict)
+    form: str = "dome"
+    model: str = "none"
+    frame: FacadeFrame | None = None  # the façade frame the crown was built in
+
+    def __post_init__(self) -> None:
+        for m in self.meshes:
+            if m.material not in self.materials:
+                raise ValueError(f"mesh '{m.name}' uses undefined material '{m.material}'")
+        if not self.triangles:
+            self.triangles = sum(m.n_triangles for m in self.meshes)
