@@ -103,12 +103,13 @@ def _auto_threshold(values: NDArray[np.float32], method: str) -> float:
 def classify(
     values: NDArray[np.float32],
     valid: NDArray[np.bool_],
-    spec: ThresholdSpec = ThresholdSpec(),
+    spec: ThresholdSpec | str | float = ThresholdSpec(),
     *,
-    zenith: NDArray[np.float64] | None = None,
+    zenith: NDArray[np.floating] | None = None,
     ring_edges: NDArray[np.float64] | None = None,
 ) -> Classification:
     """Threshold ``values`` (0–255) over ``valid`` pixels; zonal needs ``zenith`` and ``ring_edges``."""
+    spec = ThresholdSpec.parse(spec)
     inside = values[valid]
     if inside.size == 0:
         raise RadtreeError("no valid pixels inside the mask")
@@ -125,11 +126,11 @@ def classify(
     z = np.where(valid, zenith, 0.0)
     ring = np.clip(np.searchsorted(ring_edges, z, side="right") - 1, 0, n - 1)
     thresholds = np.full(n, global_t)
-    counts = np.zeros(n)
-    for i in range(n):
-        sel = valid & (ring == i)
-        v = values[sel]
-        counts[i] = v.size
+    ring_v = ring[valid]
+    order = np.argsort(ring_v, kind="stable")
+    counts = np.bincount(ring_v, minlength=n)
+    groups = np.split(inside[order], np.cumsum(counts)[:-1])
+    for i, v in enumerate(groups):
         if v.size >= 16 and float(v.min()) < float(v.max()):
             thresholds[i] = _auto_threshold(v, "otsu")
     sky = valid & (values > thresholds[ring])

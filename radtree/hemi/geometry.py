@@ -22,6 +22,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from functools import lru_cache
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -45,8 +46,8 @@ class PixelField:
     rows: slice
     cols: slice
     valid: NDArray[np.bool_]
-    zenith: NDArray[np.float64]
-    azimuth: NDArray[np.float64]
+    zenith: NDArray[np.float32]
+    azimuth: NDArray[np.float32]
     weight: NDArray[np.float64]
 
     @property
@@ -132,30 +133,50 @@ class FisheyeGeometry:
         return slice(r0, r1), slice(c0, c1)
 
     def pixel_field(self, max_zenith: float = 90.0) -> PixelField:
-        """Directions and solid angles of all pixel centres within ``max_zenith`` degrees."""
+        """Directions and solid angles of all pixel centres within ``max_zenith`` degrees.
+
+        Cached for the last few geometries (a batch of photos from one camera shares it); the
+        arrays are read-only.
+        """
+        return _pixel_field(self, float(max_zenith))
+
+    def _compute_pixel_field(self, max_zenith: float) -> PixelField:
         rows, cols = self.bounds()
         y = np.arange(rows.start, rows.stop, dtype=np.float64) + 0.5
         x = np.arange(cols.start, cols.stop, dtype=np.float64) + 0.5
         dx = x[None, :] - self.mask.cx
         dy = y[:, None] - self.mask.cy
         rho = np.hypot(dx, dy) / self.mask.radius
-        zenith = self.lens.zenith(rho)
-        valid = np.isfinite(zenith) & (zenith <= max_zenith)
-        zenith = np.where(valid, zenith, np.nan)
-        alpha = np.degrees(np.arctan2(np.broadcast_to(dx, rho.shape), -np.broadcast_to(dy, rho.shape)))
-        beta = alpha - self.north_deg
-        azimuth = np.where(valid, np.mod(-beta if self.mirror else beta, 360.0), np.nan)
-        weight = self.pixel_solid_angle(zenith, rho)
-        return PixelField(rows, cols, valid, zenith, azimuth, np.where(valid, weight, 0.0))
+        rho_max = float(self.lens.radius(np.array([min(max_zenith, self.lens.max_zenith_deg)]))[0])
+        valid = rho <= rho_max
+        # the trigonometry only for pixels inside the circle
+        r_in = rho[valid]
+        z_in = self.lens.zenith(r_in)
+        ok = np.isfinite(z_in)
+        if not ok.all():
+            valid[valid] = ok
+            r_in, z_in = r_in[ok], z_in[ok]
+        dxb = np.broadcast_to(dx, rho.shape)[valid]
+        dyb = np.broadcast_to(dy, rho.shape)[valid]
+        beta = np.degrees(np.arctan2(dxb, -dyb)) - self.north_deg
+        zenith = np.full(rho.shape, np.nan, dtype=np.float32)
+        azimuth = np.full(rho.shape, np.nan, dtype=np.float32)
+        weight = np.zeros(rho.shape)
+        zenith[valid] = z_in
+        azimuth[valid] = np.mod(-beta if self.mirror else beta, 360.0)
+        weight[valid] = self.pixel_solid_angle(z_in, r_in)
+        for a in (valid, zenith, azimuth, weight):
+            a.setflags(write=False)
+        return PixelField(rows, cols, valid, zenith, azimuth, weight)
 
     def pixel_solid_angle(
         self, zenith: NDArray[np.float64], rho: NDArray[np.float64]
     ) -> NDArray[np.float64]:
         """Solid angle (sr) of a 1 × 1 px pixel at (zenith, rho): sinθ / (R² · rho · drho/dθ)."""
-        t = np.radians(np.nan_to_num(zenith))
-        d = self.lens.derivative(np.nan_to_num(zenith))
+        z = np.asarray(zenith, dtype=np.float64)
+        d = self.lens.derivative(z)
         with np.errstate(divide="ignore", invalid="ignore"):
-            w = np.sin(t) / (np.maximum(rho, 1e-12) * d)
+            w = np.sin(np.radians(z)) / (np.maximum(rho, 1e-12) * d)
         d0 = float(self.lens.derivative(np.zeros(1))[0])
         w = np.where(rho < 1e-9, 1.0 / d0**2, w)  # limit at the image centre
         return w / self.mask.radius**2
@@ -171,3 +192,13 @@ class FisheyeGeometry:
             "mirror": self.mirror,
             "full_frame": self.full_frame,
         }
+
+
+@lru_cache(maxsize=2)
+def _pixel_field(geometry: FisheyeGeometry, max_zenith: float) -> PixelField:
+    return geometry._compute_pixel_field(max_zenith)
+
+
+def clear_pixel_field_cache() -> None:
+    """Forget cached pixel fields (frees memory; benchmarks use it to time a cold start)."""
+    _pixel_field.cache_clear()

@@ -183,14 +183,15 @@ def channel_values(
                 "use --channel luma"
             )
         return _linearise(px, gamma)
+    if channel == "blue":
+        return _linearise(np.ascontiguousarray(px[:, :, 2]), gamma)
+    if channel == "2bg":
+        b, g = _linearise(px[:, :, 2], gamma), _linearise(px[:, :, 1], gamma)
+        return np.clip(2.0 * b - g, 0.0, 255.0).astype(np.float32)
     lin = _linearise(px, gamma)
     r, g, b = lin[:, :, 0], lin[:, :, 1], lin[:, :, 2]
-    if channel == "blue":
-        return np.ascontiguousarray(b)
     if channel == "luma":
         return (0.299 * r + 0.587 * g + 0.114 * b).astype(np.float32)
-    if channel == "2bg":
-        return np.clip(2.0 * b - g, 0.0, 255.0).astype(np.float32)
     den = 2.0 * g + r + b
     with np.errstate(invalid="ignore", divide="ignore"):
         gla = np.where(den > 0, (2.0 * g - r - b) / den, 0.0)

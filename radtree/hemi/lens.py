@@ -42,6 +42,7 @@ FC_E9_RADIAN_COEFFICIENTS = (0.6427, 0.0346, -0.024491)
 
 _HALF_PI = math.pi / 2.0
 _TABLE_SIZE = 4097
+NEWTON_STEPS = 1  # after a 4097-point table lookup one step reaches ~1e-12 degrees
 
 
 def radian_to_x_coefficients(coefficients: tuple[float, ...]) -> tuple[float, ...]:
@@ -166,7 +167,7 @@ class Projection:
         table_rho, table_z = self._table
         inside = (rho >= 0) & (rho <= 1.0 + 1e-12)
         z = np.interp(np.clip(rho, 0.0, 1.0), table_rho, table_z)
-        for _ in range(2):  # Newton refinement on the smooth polynomial
+        for _ in range(NEWTON_STEPS):  # refine the table lookup on the smooth polynomial
             f = _poly(self.coefficients, z / 90.0) / self._p1 - rho
             d = _dpoly(self.coefficients, z / 90.0) / self._p1 / 90.0
             z = np.clip(z - f / d, 0.0, 90.0)

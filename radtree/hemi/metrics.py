@@ -14,22 +14,27 @@ have pixels; cells without pixels are left out and the weights renormalised):
 * ``openness`` = Σ Ω_ij T_ij / Σ Ω_ij with Ω_ij = Δφ (cos θa − cos θb): the sky fraction of the
   analysed solid angle. Over 0–90° it is the canopy openness of the hemisphere; for a shorter
   range it is normalised over the analysed solid angle (no extrapolation beyond θe).
-* ``svf`` (sky view factor) = Σ C_ij T_ij / Σ C_ij with C_ij = Δφ (sin²θb − sin²θa) / 2, i.e.
-  ∫gap·cosθ·sinθ / ∫cosθ·sinθ: over 0–90° the share of a horizontal surface's irradiance from a
-  uniform sky that is not blocked. For a shorter range it is normalised by the cosine-weighted
-  integral of the analysed range (a fully open sky gives 1 for any range).
+* ``svf`` (sky view factor) = Σ C_ij Tc_ij / Σ C_ij with C_ij = Δφ (sin²θb − sin²θa) / 2 and
+  Tc_ij the cosine-weighted sky share of the cell (pixels weighted by solid angle × cosθ), i.e.
+  ∫gap·cosθ·sinθ / ∫cosθ·sinθ evaluated pixel by pixel, so it does not depend on the number of
+  rings. Over 0–90° it is the share of a horizontal surface's irradiance from a uniform sky
+  that is not blocked (for a horizontal-axis photo: of the vertical façade's). For a shorter
+  range it is normalised by the cosine-weighted integral of the analysed range (a fully open
+  sky gives 1 for any range).
 * ``difn`` (diffuse non-interceptance, %, LAI-2000/2200 convention) = 100 · Σ W'_i T_i / Σ W'_i,
-  W'_i = ∫ sinθ cosθ dθ over ring i (the LAI-2200 weights, which sum to 1/2 over the
-  hemisphere, are these cosine weights for its five rings; DIFN = 2 Σ W'_i T_i). With one photo
-  the ring transmittances are azimuthal means, so DIFN equals 100 · svf whenever every cell has
-  pixels; they differ only where cells are empty (full-frame corners).
+  T_i the ring gap fraction and W'_i = ∫ sinθ cosθ dθ over ring i (the LAI-2200 weights, which
+  sum to 1/2 over the hemisphere, are these cosine weights for its five rings; DIFN =
+  2 Σ W'_i T_i). It is the ring-quadrature version of 100 · svf: equal for a sky that is uniform
+  within each ring, different by the within-ring cosine weighting otherwise (< 1 % relative for
+  10° rings).
 * ``lai_eff`` (Miller 1967) = 2 Σ W_i K_i with contact numbers K_i = −ln(max(T_i, floor)) cosθ_i
   (θ_i the ring centre) and W_i = (cos θa − cos θb) / Σ (cos θa − cos θb): Miller's integral
   2∫−ln T cosθ sinθ dθ, normalised over the analysed rings (LAI-2000 practice: missing rings
   are assumed to have the mean contact number).
 * ``lai`` (Lang & Xiang 1986 log-averaging) = the same with K_i = −mean_j ln(max(T_ij, floor)) ·
   cosθ_i: averaging logarithms per segment accounts for clumping at the segment scale.
-* ``clumping_lx`` = lai_eff / lai (≤ 1; NaN when lai = 0).
+* ``clumping_lx`` = lai_eff / lai (≤ 1 by Jensen's inequality unless the floor binds in a
+  segment; NaN when lai = 0).
 * ``floor``: gap fractions are floored at ``gap_floor`` (default 0.001) before taking logarithms,
   so a ring or segment without sky contributes −ln(0.001) ≈ 6.9 instead of infinity.
 * ``ellipsoid_x``: Campbell's (1986, 1990) ellipsoidal leaf-angle parameter fitted by least
@@ -129,10 +134,14 @@ class RingGrid:
 
 @dataclass(frozen=True)
 class GapTable:
-    """Gap fraction per ring × segment (NaN where a cell has no pixels) and sampling counts."""
+    """Gap fraction per ring × segment (NaN where a cell has no pixels) and sampling counts.
+
+    ``gap`` weights pixels by solid angle, ``gap_cos`` by solid angle × cosθ (for the SVF).
+    """
 
     grid: RingGrid
     gap: NDArray[np.float64]
+    gap_cos: NDArray[np.float64]
     pixels: NDArray[np.int64]
     sky_pixels: NDArray[np.int64]
     sampled_solid_angle: NDArray[np.float64]
@@ -156,31 +165,37 @@ class GapTable:
 def gap_table(
     sky: NDArray[np.bool_],
     valid: NDArray[np.bool_],
-    zenith: NDArray[np.float64],
-    azimuth: NDArray[np.float64],
+    zenith: NDArray[np.floating],
+    azimuth: NDArray[np.floating],
     weight: NDArray[np.float64],
     grid: RingGrid,
 ) -> GapTable:
     """Tabulate the solid-angle-weighted gap fraction of each cell of ``grid``."""
-    ring, seg, inside = grid.locate(zenith, azimuth)
-    sel = valid & inside
-    idx = (ring * grid.segments + seg)[sel]
-    w = weight[sel]
-    s = sky[sel]
+    z = np.asarray(zenith[valid], dtype=np.float64)
+    ring, seg, inside = grid.locate(z, np.asarray(azimuth[valid], dtype=np.float64))
+    idx = (ring * grid.segments + seg)[inside]
+    z = z[inside]
+    w = weight[valid][inside]
+    wc = w * np.cos(np.radians(z))
+    s = sky[valid][inside]
     n = grid.rings * grid.segments
     w_all = np.bincount(idx, weights=w, minlength=n)
     w_sky = np.bincount(idx[s], weights=w[s], minlength=n)
+    wc_all = np.bincount(idx, weights=wc, minlength=n)
+    wc_sky = np.bincount(idx[s], weights=wc[s], minlength=n)
     count = np.bincount(idx, minlength=n)
     count_sky = np.bincount(idx[s], minlength=n)
     with np.errstate(invalid="ignore", divide="ignore"):
         gap = np.where(count > 0, w_sky / np.where(w_all > 0, w_all, 1.0), np.nan)
+        gap_cos = np.where(wc_all > 0, wc_sky / np.where(wc_all > 0, wc_all, 1.0), gap)
     shape = (grid.rings, grid.segments)
     return GapTable(
         grid,
         gap.reshape(shape),
+        gap_cos.reshape(shape),
         count.reshape(shape).astype(np.int64),
         count_sky.reshape(shape).astype(np.int64),
-        w_all.reshape(shape),
+        np.asarray(w_all, dtype=np.float64).reshape(shape),
     )
 
 
@@ -198,7 +213,7 @@ def openness(table: GapTable) -> float:
 
 def sky_view_factor(table: GapTable) -> float:
     """Cosine-weighted sky fraction ∫gap cosθ dΩ / ∫cosθ dΩ over the analysed range (0–1)."""
-    return _weighted_mean(table.gap, table.grid.cell_cosine_weight())
+    return _weighted_mean(table.gap_cos, table.grid.cell_cosine_weight())
 
 
 def difn(table: GapTable) -> float:

@@ -2,7 +2,8 @@
 
 The sky pixels (4-connected regions) are traced with ``skimage.measure.find_contours`` at the
 0.5 level between sky (1) and canopy/outside (0), simplified in pixel space with
-``skimage.measure.approximate_polygon`` (tolerance in pixels), and every vertex is converted
+``skimage.measure.approximate_polygon`` (tolerance in pixels; rings of up to 48 traced vertices,
+gaps about 10 px across, are kept as traced), and every vertex is converted
 to (zenith, azimuth) in degrees with the photo's lens, mask, north and mirror settings.
 Each gap is one polygon: its outer ring plus the rings of canopy islands inside it (holes).
 Gaps and holes smaller than ``min_area_px`` pixels are dropped (holes are then filled).
@@ -38,6 +39,8 @@ from radtree.fileio import write_text
 from .directions import photo_to_world
 from .geometry import FisheyeGeometry, PixelField
 
+SIMPLIFY_MIN_VERTICES = 48  # shorter rings (gaps up to ~10 px across) are kept as traced
+
 
 @dataclass(frozen=True)
 class GapOutline:
@@ -67,9 +70,25 @@ class GapOutline:
         ]
 
 
+def _winds_around(xy: NDArray[np.float64], cx: float, cy: float) -> bool:
+    """Whether the closed ring ``xy`` (pixels) encloses the point (cx, cy)."""
+    lo, hi = xy.min(axis=0), xy.max(axis=0)
+    if not (lo[0] <= cx <= hi[0] and lo[1] <= cy <= hi[1]):
+        return False
+    return bool(points_in_poly(np.array([[cx, cy]]), xy)[0])
+
+
+def _contains_centre(
+    ext: NDArray[np.float64], holes: list[NDArray[np.float64]], cx: float, cy: float
+) -> bool:
+    return _winds_around(ext, cx, cy) and not any(_winds_around(h, cx, cy) for h in holes)
+
+
 def _signed_area(xy: NDArray[np.float64]) -> float:
+    """Shoelace area of a ring (closed or not); positive when counter-clockwise in x-y."""
     x, y = xy[:, 0], xy[:, 1]
-    return 0.5 * float(np.dot(x, np.roll(y, -1)) - np.dot(y, np.roll(x, -1)))
+    inner = float(np.dot(x[:-1], y[1:]) - np.dot(x[1:], y[:-1]))
+    return 0.5 * (inner + float(x[-1] * y[0] - x[0] * y[-1]))
 
 
 def _contour_label(c: NDArray[np.float64], padded: NDArray[np.bool_], labels: NDArray) -> int:
@@ -121,40 +140,51 @@ def trace_gaps(
     cx, cy, radius = geometry.mask.cx, geometry.mask.cy, geometry.mask.radius
 
     def to_xy(c: NDArray[np.float64]) -> NDArray[np.float64]:
-        if tolerance_px > 0:
+        if tolerance_px > 0 and len(c) > SIMPLIFY_MIN_VERTICES:
             c = approximate_polygon(c, tolerance_px)
-        xy = np.c_[c[:, 1] + x0, c[:, 0] + y0]
-        d = xy - (cx, cy)
-        r = np.hypot(d[:, 0], d[:, 1])
-        scale = np.where(r > radius, radius / np.maximum(r, 1e-12), 1.0)  # rim vertices onto 90°
-        return (cx, cy) + d * scale[:, None]
+        return c[:, ::-1] + (x0, y0)  # (row, col) -> (x, y)
 
-    def to_angles(xy: NDArray[np.float64]) -> NDArray[np.float64]:
-        z, a = geometry.to_direction(xy[:, 0], xy[:, 1])
-        return np.c_[z, a]
-
-    centre = np.array([[cx, cy]])
-    out: list[GapOutline] = []
+    # simplify every ring first, then convert all vertices to angles in one vectorised call
+    gaps: list[tuple[int, NDArray[np.float64], list[NDArray[np.float64]]]] = []
     for lab, rings in groups.items():
         rings.sort(key=lambda t: -t[0])
         ext_xy = to_xy(rings[0][1])
         if len(ext_xy) < 4:
             continue
         holes_xy = [to_xy(c) for area, c in rings[1:] if area >= min_area_px]
-        holes_xy = [h for h in holes_xy if len(h) >= 4]
-        inside = bool(points_in_poly(centre, ext_xy)[0]) and not any(
-            bool(points_in_poly(centre, h)[0]) for h in holes_xy
-        )
+        gaps.append((lab, ext_xy, [h for h in holes_xy if len(h) >= 4]))
+    if not gaps:
+        return []
+    all_xy = np.concatenate([r for _, e, hs in gaps for r in (e, *hs)])
+    d = all_xy - (cx, cy)
+    dist = np.hypot(d[:, 0], d[:, 1])
+    scale = np.where(dist > radius, radius / np.maximum(dist, 1e-12), 1.0)  # rim onto 90°
+    all_xy = (cx, cy) + d * scale[:, None]
+    zen, azi = geometry.to_direction(all_xy[:, 0], all_xy[:, 1])
+    angles = np.c_[zen, azi]
+
+    out: list[GapOutline] = []
+    k = 0
+    for lab, ext_xy, holes_xy in gaps:
+        n = len(ext_xy)
+        ext_xy, ext_ang = all_xy[k : k + n], angles[k : k + n]
+        k += n
+        hole_xy, hole_ang = [], []
+        for h in holes_xy:
+            n = len(h)
+            hole_xy.append(all_xy[k : k + n])
+            hole_ang.append(angles[k : k + n])
+            k += n
         out.append(
             GapOutline(
-                exterior=to_angles(ext_xy),
-                holes=tuple(to_angles(h) for h in holes_xy),
+                exterior=ext_ang,
+                holes=tuple(hole_ang),
                 solid_angle_sr=float(solid[lab]),
                 pixels=int(sizes[lab]),
-                contains_zenith=inside,
+                contains_zenith=_contains_centre(ext_xy, hole_xy, cx, cy),
                 axis=geometry.axis,
                 exterior_px=ext_xy,
-                holes_px=tuple(holes_xy),
+                holes_px=tuple(hole_xy),
             )
         )
     out.sort(key=lambda g: -g.solid_angle_sr)
@@ -182,7 +212,7 @@ def _ring_coordinates(
     az = np.unwrap(angles[:, 1], period=360.0)
     az = az - 360.0 * math.floor(az[0] / 360.0)
     zen = angles[:, 0]
-    winds = bool(points_in_poly(centre, px)[0])
+    winds = _winds_around(px, float(centre[0, 0]), float(centre[0, 1]))
     if winds:  # close along the zenith line: a proper polygon in the (azimuth, zenith) plane
         az = np.r_[az, az[-1], az[0]]
         zen = np.r_[zen, 0.0, 0.0]
