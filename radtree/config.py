@@ -708,6 +708,7 @@ def parse_project(data: dict, path: Path) -> Project:
     names = [sc.name for sc in scenarios]
     if len(set(names)) != len(names):
         raise ConfigError(f"scenario names repeat: {names}", source=src, field="scenario")
+    top.raw("sweep")  # read by radtree.sweep
     top.check_unknown()
 
     return Project(name=name, root=path.parent, source=path, site=site, street=street,

@@ -83,8 +83,8 @@ def trace_hour(scene: Scene, state: SkyState, params: EngineParams,
                workdir: Path | None = None, ab: int | None = None) -> dict[str, GridResult]:
     """Trace one hour with Radiance in a (temporary) build folder; lux per grid.
 
-    ``ab`` overrides ``params.ab``; when both are None, ``-ab 2``. ``seed`` is unused: Radiance's
-    sampling is deterministic for a given octree and options.
+    ``ab`` overrides ``params.ab``; when both are None, ``-ab 2``. ``seed`` is unused: with ``-u-``
+    Radiance's sampling is repeatable for a given octree and options.
     """
     install = require_radiance()
     use_ab = ab if ab is not None else (params.ab if params.ab is not None else DEFAULT_AB)

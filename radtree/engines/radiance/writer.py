@@ -48,9 +48,10 @@ def mesh_to_radiance(mesh: Mesh) -> str:
 
 
 def rtrace_options(params: EngineParams, ab: int) -> list[str]:
-    """rtrace options for illuminance: -I (irradiance at points) -h (no header) and ambient."""
+    """rtrace options for illuminance: -I (irradiance at points), -h (no header), -u- (correlated
+    sampling: the same octree and options give the same numbers) and the ambient parameters."""
     return [
-        "-h", "-I", "-ab", str(ab), "-ad", str(params.ad), "-as", str(params.as_),
+        "-h", "-I", "-u-", "-ab", str(ab), "-ad", str(params.ad), "-as", str(params.as_),
         "-ar", str(params.ar), "-aa", f"{params.aa:g}", "-lw", f"{params.lw:g}",
     ]
 

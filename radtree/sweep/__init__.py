@@ -1,0 +1,43 @@
+"""Parameter sweeps over the unknowns of a project (SPEC §1), run on dask.distributed.
+
+    from radtree.sweep import run_sweep
+    out = run_sweep("examples/mendoza-street", ["tree.crown.trunk_distance_m=2:6:5",
+                                               "tree.louvers.layers=3,4,5"], scenarios=["A"])
+    out.table        # every case's tidy rows + case_id, case_hash and parameter columns
+    out.sensitivity  # per scenario × parameter × metric: main-effect range, Spearman ρ
+
+Modules: :mod:`~radtree.sweep.design` (parameters, full factorial, Latin hypercube),
+:mod:`~radtree.sweep.settings` (the ``[sweep]`` table, field checks), :mod:`~radtree.sweep.run`
+(case folders, dask execution, resume, merged table), :mod:`~radtree.sweep.sensitivity`
+(metrics, effect ranges, tornado plot, report fragment), :mod:`~radtree.sweep.cli` (the command).
+"""
+
+from __future__ import annotations
+
+import importlib
+from typing import Any
+
+# Lazy exports (PEP 562): ``import radtree.sweep.cli`` stays light for ``radtree --help``.
+_EXPORTS = {
+    "Design": "design", "Parameter": "design", "full_factorial": "design",
+    "latin_hypercube": "design", "make_design": "design", "parse_param": "design",
+    "parse_spec": "design",
+    "CaseResult": "run", "CaseSpec": "run", "SweepOutcome": "run", "SweepPlan": "run",
+    "execute": "run", "merge_results": "run", "plan_sweep": "run", "run_case": "run",
+    "run_sweep": "run",
+    "case_metrics": "sensitivity", "sensitivity_table": "sensitivity",
+    "sweep_report_section": "sensitivity", "tornado_plot": "sensitivity",
+    "write_sensitivity": "sensitivity",
+}
+__all__ = sorted(_EXPORTS)
+
+
+def __getattr__(name: str) -> Any:
+    if name in _EXPORTS:
+        module = importlib.import_module(f"radtree.sweep.{_EXPORTS[name]}")
+        return getattr(module, name)
+    raise AttributeError(f"module 'radtree.sweep' has no attribute {name!r}")
+
+
+def __dir__() -> list[str]:
+    return sorted(list(globals()) + __all__)
