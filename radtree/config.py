@@ -259,7 +259,7 @@ class Louvers:
     cover_fraction: float = 1.0
     reflectance: float = 0.11
     transmittance: float = 0.5
-    specular_fraction: float = 0.5
+    specular_fraction: float = 0.9
     seed: int = 1
 
 

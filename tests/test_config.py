@@ -15,16 +15,16 @@ def test_mendoza_project_loads():
     assert p.site.latitude == -32.89 and p.site.longitude == -68.83
     assert p.site.hours == ("10:30", "11:30", "12:30", "13:30", "14:30", "15:30", "16:30")
     assert p.street.facade_azimuth_deg == 0.0
-    assert [s.name for s in p.scenarios] == ["A", "B", "C", "D", "E"]
+    assert [s.name for s in p.scenarios] == ["A", "B", "C", "D", "E", "A-sky", "F"]
     assert [s.reflection for s in p.scenarios] == ["calculated", "traced", "traced",
-                                                   "calculated", "traced"]
-    assert p.tree.louvers.layers == 4
-    assert p.engine.as_ == 512
+                                                   "calculated", "traced", "calculated", "traced"]
+    assert p.tree.louvers.layers == 5 and p.tree.louvers.specular_fraction == 0.9
+    assert p.engine.as_ == 128 and p.engine.ab == 4
 
 
 def test_params_hash_changes_with_parameters(tmp_path):
     a = load_project(MENDOZA)
-    b = load_project(MENDOZA, overrides={"tree.louvers.layers": 5})
+    b = load_project(MENDOZA, overrides={"tree.louvers.layers": 6})
     assert a.params_hash(a.scenarios[0]) != b.params_hash(b.scenarios[0])
     assert a.params_hash(a.scenarios[0]) == load_project(MENDOZA).params_hash(a.scenarios[0])
 

@@ -29,12 +29,16 @@ from radtree.trees.calibrate import PERMEABILITY_DEFINITION, calibrate, write_ca
               help="Cosine-weighted rays per sensor.")
 @click.option("--tolerance", type=click.FloatRange(1e-5, 0.05), default=0.001, show_default=True,
               help="Accepted |traced − target| (fraction).")
+@click.option("--global", "global_", is_flag=True,
+              help="Louvers: choose the integer layer count whose *global* permeability (façade "
+                   "illuminance with the crown / open street, every light path, NumPy engine) "
+                   "is closest to the target.")
 @click.option("--write/--no-write", default=False, show_default=True,
               help="Write <project>.calibrated.toml beside the project file (never the project "
                    "file itself).")
 def calibrate_command(project: Path, target: float | None, model: str, form: str | None,
                       photo_openness: bool, directions: int, tolerance: float,
-                      write: bool) -> None:
+                      global_: bool, write: bool) -> None:
     """Calibrate the crown of PROJECT (a folder with radtree.toml, or the file) to a target
     permeability by tracing straight rays from the façade sensors through the built crown.
 
@@ -45,6 +49,15 @@ def calibrate_command(project: Path, target: float | None, model: str, form: str
     """
     try:
         proj = load_project(project)
+        if global_:
+            from radtree.permeability import calibrate_layers
+
+            click.echo("Global permeability = Σ façade illuminance with the crown / Σ in the "
+                       "open street, over the project's hours (NumPy engine, every light path).")
+            cal = calibrate_layers(proj, target, echo=click.echo)
+            click.echo(f"Chosen: [tree.louvers] layers = {cal.layers} → global permeability "
+                       f"{100 * cal.permeability:.2f} % (target {100 * cal.target:.2f} %).")
+            return
         result = calibrate(proj, model=model, target=target, form=form,
                            photo_openness=photo_openness, directions=directions,
                            tolerance=tolerance)
