@@ -720,3 +720,38 @@ def parse_project(data: dict, path: Path) -> Project:
 def project_dict(project: Project) -> dict[str, Any]:
     """Plain dictionary of the project (for manifests and reports)."""
     return asdict(project)
+
+
+PROJECT_SWITCH_SECTIONS = ("site", "street", "light", "sensors", "engine")
+
+
+def effective_project(project: Project, scenario: Scenario) -> Project:
+    """The project as a scenario sees it: switches named ``street.*``, ``light.*``, ``site.*``,
+    ``sensors.*`` or ``engine.*`` replace that field (e.g. ``"street.opposite_reflectance" = 0``,
+    ``"light.diffuse_horizontal_lux" = 8000``, ``"engine.ab" = 6``). ``"street.ground_reflectance"
+    = 0.15`` also drops the per-hour table (constant reflectance). Other switches (tree.*,
+    louvers.*, reflection.*, …) are read by the code they concern."""
+    changes: dict[str, dict[str, Any]] = {}
+    for key, value in scenario.switches.items():
+        section, _, name = key.partition(".")
+        if section not in PROJECT_SWITCH_SECTIONS:
+            continue
+        target = getattr(project, section)
+        attr = "as_" if name == "as" else name
+        if not name or attr not in {f.name for f in fields(target)}:
+            raise ConfigError(f"scenario {scenario.name}: switch {key!r} names no field of "
+                              f"[{section}]", source=str(project.source), field="switches")
+        current = getattr(target, attr)
+        if isinstance(current, bool) or not isinstance(value, type(current) | int | float | None):
+            if not (current is None and isinstance(value, int | float)):
+                raise ConfigError(f"scenario {scenario.name}: switch {key!r} = {value!r} has the "
+                                  f"wrong type (expected like {current!r})",
+                                  source=str(project.source), field="switches")
+        if isinstance(current, float) and isinstance(value, int):
+            value = float(value)
+        changes.setdefault(section, {})[attr] = value
+        if section == "street" and attr == "ground_reflectance":
+            changes[section]["ground_reflectance_table"] = None
+    if not changes:
+        return project
+    return replace(project, **{s: replace(getattr(project, s), **c) for s, c in changes.items()})

@@ -13,7 +13,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from radtree.config import Project, Scenario, parse_time
+from radtree.config import Project, Scenario, effective_project, parse_time
 from radtree.errors import ConfigError
 from radtree.sky import SkyState
 from radtree.solar import local_datetime, sun_position
@@ -74,6 +74,8 @@ def hour_states(project: Project, scenario: Scenario | None = None,
     calculated`` the traced ground is black and there is no ground glow (the reflected part is
     added analytically afterwards, see :mod:`radtree.reflect`).
     """
+    if scenario is not None:
+        project = effective_project(project, scenario)
     site = project.site
     wanted = list(hours) if hours is not None else list(site.hours)
     unknown = [h for h in wanted if h not in site.hours]

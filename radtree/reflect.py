@@ -21,7 +21,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from radtree.config import Project, Scenario
+from radtree.config import Project, Scenario, effective_project
 from radtree.light import ground_reflectance_at
 from radtree.scene import SensorGrid
 from radtree.site.street import sky_view_factor_to_street
@@ -63,6 +63,7 @@ def reflection_choice(project: Project, scenario: Scenario) -> ReflectionChoice:
 def calculated_reflection(project: Project, scenario: Scenario, state: SkyState,
                           grid: SensorGrid) -> np.ndarray:
     """Lux added to each sensor of ``grid`` for this hour (0 for non-vertical sensors)."""
+    project = effective_project(project, scenario)
     choice = reflection_choice(project, scenario)
     rho = ground_reflectance_at(project, state.sun.altitude_deg)
     e_open = state.direct_horizontal_lux + state.sky_horizontal_lux
@@ -74,3 +75,27 @@ def calculated_reflection(project: Project, scenario: Scenario, state: SkyState,
         F = np.full(len(heights), 0.5)
     vertical = np.abs(grid.normals[:, 2]) < 0.1
     return np.where(vertical, rho * e_ground * F, 0.0)
+
+
+def unfiltered_ground_light(project: Project, scenario: Scenario, state: SkyState,
+                            grid: SensorGrid) -> np.ndarray:
+    """Street-reflected light reaching the façade *below* the crown, unfiltered.
+
+    Under a real crown the street's reflected light arrives at the façade from below the crown
+    almost unfiltered, whereas the sensor-dome form makes it cross the dome. The switch
+    ``"reflection.unfiltered" = s`` (0–1) adds s · ρ(α) · E_ground · F to vertical sensors, with
+    E_ground the *open* street (sunlit patches beyond the crown's shadow are what light the
+    façade from below) and F the street view factor. 0 (default) adds nothing.
+    """
+    s = float(scenario.switches.get("reflection.unfiltered", 0.0))
+    if s <= 0.0:
+        return np.zeros(len(grid))
+    if s > 1.0:
+        raise ValueError(f"scenario {scenario.name}: reflection.unfiltered must be in [0, 1]")
+    project = effective_project(project, scenario)
+    rho = ground_reflectance_at(project, state.sun.altitude_deg)
+    e_open = state.direct_horizontal_lux + state.sky_horizontal_lux
+    F = np.array([sky_view_factor_to_street(h, project.street.width_m)
+                  for h in grid.points[:, 2]])
+    vertical = np.abs(grid.normals[:, 2]) < 0.1
+    return np.where(vertical, s * rho * e_open * F, 0.0)

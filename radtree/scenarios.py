@@ -20,13 +20,13 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from radtree.config import Project, Scenario
+from radtree.config import Project, Scenario, effective_project
 from radtree.engines.base import RESULT_COLUMNS, GridResult
 from radtree.errors import ConfigError, RadtreeError
 from radtree.fileio import atomic_path, write_text
 from radtree.light import hour_states
 from radtree.manifest import manifest
-from radtree.reflect import calculated_reflection, reflection_choice
+from radtree.reflect import calculated_reflection, reflection_choice, unfiltered_ground_light
 from radtree.scene import Scene
 from radtree.sensor_grid import facade_circle, facade_dense_grid
 from radtree.site.frame import FacadeFrame
@@ -54,6 +54,7 @@ def facade_frame(project: Project) -> FacadeFrame:
 
 def make_scene(project: Project, scenario: Scenario, dense_grid: bool | None = None) -> BuiltScene:
     """The in-memory scene of one scenario: street canyon, crown model, sensor grids."""
+    project = effective_project(project, scenario)
     frame = facade_frame(project)
     materials: dict = dict(street_materials(project.street))
     meshes = street_meshes(project.street, frame)
@@ -95,8 +96,6 @@ def make_scene(project: Project, scenario: Scenario, dense_grid: bool | None = N
     geometry_seconds = time.perf_counter() - t0
     if project.engine.ab is not None:
         ab = project.engine.ab
-    if scenario.switches.get("engine.ab") is not None:
-        ab = int(scenario.switches["engine.ab"])
     scene = Scene(meshes, materials, grids, notes)
     return BuiltScene(scenario, scene, ab, notes, scene.n_triangles, geometry_seconds, info, tree)
 
@@ -128,7 +127,8 @@ def build_project(project: Project, scenarios: list[str] | None = None,
         built = make_scene(project, sc)
         t1 = time.perf_counter()
         with atomic_dir(build_root / sc.name) as tmp:
-            write_build(built.scene, states, project.engine, built.ab, tmp, install, sc.name)
+            write_build(built.scene, states, effective_project(project, sc).engine, built.ab,
+                        tmp, install, sc.name)
             if pictures and built.tree is not None:
                 from radtree.trees.picture import render_model_png
 
@@ -181,6 +181,7 @@ def _rows(project: Project, sc: Scenario, st: SkyState, scene: Scene,
         extra = np.zeros(len(grid))
         if sc.reflection == "calculated":
             extra = calculated_reflection(project, sc, st, grid)
+        extra = extra + unfiltered_ground_light(project, sc, st, grid)
         frames.append(pd.DataFrame({
             "scenario": sc.name, "model": sc.model, "datetime": st.datetime.isoformat(),
             "time": st.time, "grid": gname, "sensor": np.arange(len(grid)), "row": grid.rows,
@@ -267,7 +268,7 @@ def simulate_project(project: Project, engine: str = "auto", scenarios: list[str
         else:
             from radtree.engines.numpy.engine import trace_hour
 
-            params = replace(project.engine, ab=built.ab)
+            params = replace(effective_project(project, sc).engine, ab=built.ab)
             res = trace_hour(built.scene, st, params, grids=grids)
         if grids is not None:
             res = {g: r for g, r in res.items() if g in grids}
@@ -352,7 +353,8 @@ def _radiance_plan(project: Project, sc: Scenario, built: BuiltScene, states: li
     wanted = {s.label for s in states}
     plan = BuildPlan(folder=folder, hours=[s.label for s in states],
                      grids=list(built.scene.grids), scene_files=["materials.rad"],
-                     hour_files={}, rtrace_opts=rtrace_options(project.engine, built.ab),
+                     hour_files={}, rtrace_opts=rtrace_options(effective_project(project, sc).engine,
+                                                           built.ab),
                      states={s.label: s for s in states})
     geometry = sorted(str(p.relative_to(folder)) for p in (folder / "geometry").glob("*.rad"))
     for label in wanted:

@@ -108,7 +108,7 @@ def test_build_simulate_and_makefile(open_street):
     for col in ["scenario", "model", "datetime", "time", "grid", "sensor", "row", "x", "y", "z",
                 "lux", "lux_stderr", "engine", "params_hash"]:
         assert col in df.columns
-    assert set(df["scenario"]) == {"A", "B", "C", "D", "E"}
+    assert set(df["scenario"]) == {"A", "B", "C", "D", "E", "A-sky", "F"}
     assert set(df["engine"]) == {"radiance"}
     fac = df[(df.grid == "facade") & (df.scenario == "B") & (df.time == "13:30")]
     assert len(fac) == 8
@@ -124,7 +124,7 @@ def test_build_simulate_and_makefile(open_street):
 
     # a rerun reuses every finished hour
     r = CliRunner().invoke(main, ["simulate", str(open_street)])
-    assert "0 hours traced, 10 reused" in r.output
+    assert "0 hours traced, 14 reused" in r.output
 
 
 def test_dry_run_prints_commands(open_street):
