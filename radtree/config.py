@@ -277,7 +277,8 @@ class Tree:
 class Sensors:
     """The façade sensor circle: ``count`` points at equal angle steps on a ``radius_m`` circle
     centred ``height_m`` above the street and ``offset_m`` off the wall, normal out of the wall.
-    Rows by height: top third ``higher``, middle ``intermediate``, bottom ``lower``."""
+    Rows by height: top third ``higher``, middle ``intermediate``, bottom ``lower``. The dense
+    façade map grid (``dense_*``) is traced at ``dense_hours`` only (empty = every hour)."""
 
     height_m: float = 5.0
     count: int = 8
@@ -287,6 +288,7 @@ class Sensors:
     dense_grid: bool = True
     dense_size_m: float = 6.0
     dense_spacing_m: float = 0.5
+    dense_hours: tuple[str, ...] = ()
 
 
 @dataclass(frozen=True)
@@ -623,7 +625,17 @@ def parse_project(data: dict, path: Path) -> Project:
         _positive(se, k)
     if se.has("count"):
         se.integer("count", lo=1, hi=10000)
-    sensors = _dataclass_from(se, Sensors, base)
+    dense_hours: tuple[str, ...] = ()
+    if se.has("dense_hours"):
+        dh = se.raw("dense_hours")
+        if not isinstance(dh, list):
+            raise se.error("dense_hours", f"expected a list of 'HH:MM' times, got {dh!r}")
+        dense_hours = tuple(parse_time(h, f"sensors.dense_hours[{i}]", src)
+                            for i, h in enumerate(dh))
+        unknown = [h for h in dense_hours if h not in hours]
+        if unknown:
+            raise se.error("dense_hours", f"{', '.join(unknown)} not among site.hours")
+    sensors = _dataclass_from(se, Sensors, base, dense_hours=lambda r, k: dense_hours)
     se.check_unknown()
 
     # engine

@@ -261,17 +261,16 @@ def simulate_project(project: Project, engine: str = "auto", scenarios: list[str
         sc, st, part = item
         built, _, phash, plan = prepared[sc.name]
         t = time.perf_counter()
+        use = hour_grids(project, st.time, list(built.scene.grids), grids)
         if eng == "radiance":
             from radtree.engines.radiance.engine import run_hour
 
-            res = run_hour(plan, st.label)  # type: ignore[arg-type]
+            res = run_hour(plan, st.label, grids=use)  # type: ignore[arg-type]
         else:
             from radtree.engines.numpy.engine import trace_hour
 
             params = replace(effective_project(project, sc).engine, ab=built.ab)
-            res = trace_hour(built.scene, st, params, grids=grids)
-        if grids is not None:
-            res = {g: r for g, r in res.items() if g in grids}
+            res = trace_hour(built.scene, st, params, grids=use)
         df = _rows(project, sc, st, built.scene, res, eng, phash)
         with atomic_path(part) as tmp:
             df.to_csv(tmp, index=False)
@@ -309,6 +308,16 @@ def simulate_project(project: Project, engine: str = "auto", scenarios: list[str
         manifest(project, extra={"engine": eng, "scenarios": [s.name for s in chosen]}),
         indent=2, default=str))
     return SimulationOutcome(pd.read_csv(out), out, tdf, len(todo), reused, eng)
+
+
+def hour_grids(project: Project, time_: str, available: list[str],
+               wanted: list[str] | None) -> list[str]:
+    """Grids to trace at an hour: the dense façade map only at ``sensors.dense_hours``."""
+    use = [g for g in available if wanted is None or g in wanted]
+    dense = project.sensors.dense_hours
+    if dense and time_ not in dense:
+        use = [g for g in use if g != "facade_map"]
+    return use
 
 
 def _merge_write(out: Path, table: pd.DataFrame, chosen: list[Scenario]) -> None:

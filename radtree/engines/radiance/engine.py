@@ -25,7 +25,7 @@ DEFAULT_AB = 2
 
 
 def run_hour(plan: BuildPlan, hour: str, dry_run: bool = False,
-             echo=None) -> dict[str, GridResult]:
+             echo=None, grids: list[str] | None = None) -> dict[str, GridResult]:
     """Build the hour's octree and trace every grid; return lux per grid.
 
     With ``dry_run`` the commands are only passed to ``echo`` (e.g. print) and nothing runs.
@@ -33,7 +33,8 @@ def run_hour(plan: BuildPlan, hour: str, dry_run: bool = False,
     folder = plan.folder
     oct_rel = f"octrees/{hour}.oct"
     commands: list[tuple[list[str], str | None, str]] = [(plan.oconv_command(hour), None, oct_rel)]
-    for g in plan.grids:
+    use = [g for g in plan.grids if grids is None or g in grids]
+    for g in use:
         commands.append((plan.rtrace_command(hour), f"grids/{g}.pts", f"results/{hour}_{g}.rgb"))
     if dry_run:
         for argv, stdin, stdout in commands:
@@ -54,7 +55,7 @@ def run_hour(plan: BuildPlan, hour: str, dry_run: bool = False,
         finally:
             if tmp.exists():
                 tmp.unlink()
-    for g in plan.grids:
+    for g in use:
         rgb_path = folder / f"results/{hour}_{g}.rgb"
         lux = read_rgb_as_lux(rgb_path, expected=None)
         lux_path = folder / f"results/{hour}_{g}.lux"
