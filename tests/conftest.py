@@ -26,6 +26,7 @@ def copy_project(dst: Path, replace: dict[str, str] | None = None,
     if hours is not None:
         text = re.sub(r"^hours = \[.*\]$", "hours = [" + ", ".join(f'"{h}"' for h in hours) + "]",
                       text, flags=re.M)
+        text = re.sub(r"^dense_hours = .*$", "", text, flags=re.M)
     toml.write_text(text)
     return dst
 
