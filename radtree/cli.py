@@ -143,7 +143,6 @@ def simulate(project: str, scenarios: tuple[str, ...], engine: str, hours: tuple
     p = load_project(project)
     if convergence:
         from radtree.convergence import convergence_table
-
         from radtree.fileio import atomic_path
 
         table = convergence_table(p, list(scenarios) or None, list(hours) or None,

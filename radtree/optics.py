@@ -42,7 +42,11 @@ def transmissivity_from_transmittance(tn: float) -> float:
             f"transmittance {tn} is above {MAX_GLASS_TRANSMITTANCE}, where the glass "
             "transmissivity would exceed 1"
         )
-    return (math.sqrt(_A + _B * tn * tn) - _C) / _D / tn
+    # (√(A + B·Tn²) − C) written as (A + B·Tn² − C²)/(√(A + B·Tn²) + C), with A = C² as the
+    # derivation (Fresnel at n = 1.52) has it — the published 10-digit A and C differ by 5e-11,
+    # which made the textbook form negative for Tn < 1e-4. Same values elsewhere (< 1e-9).
+    root = math.sqrt(_A + _B * tn * tn)
+    return _B * tn / (root + _C) / _D
 
 
 @dataclass(frozen=True)
