@@ -148,10 +148,10 @@ def simulate(project: str, scenarios: tuple[str, ...], engine: str, hours: tuple
         table = convergence_table(p, list(scenarios) or None, list(hours) or None,
                                   echo=click.echo)
         click.echo(table.to_string(index=False))
-        out = p.results_dir / "convergence.csv"
-        with atomic_path(out) as tmp:
+        conv_path = p.results_dir / "convergence.csv"
+        with atomic_path(conv_path) as tmp:
             table.to_csv(tmp, index=False)
-        click.echo(f"convergence table → {out}")
+        click.echo(f"convergence table → {conv_path}")
         return
     eng = choose_engine(engine if engine != "auto" else p.engine.name)
     click.echo(f"engine: {eng}" + (" (auto)" if engine == "auto" else ""))

@@ -16,6 +16,7 @@ from collections.abc import Callable
 from concurrent.futures import ThreadPoolExecutor, as_completed
 from dataclasses import dataclass, field, replace
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 import pandas as pd
@@ -45,7 +46,7 @@ class BuiltScene:
     triangles: int
     geometry_seconds: float
     info: dict[str, float] = field(default_factory=dict)
-    tree: object | None = None
+    tree: Any = None
 
 
 def facade_frame(project: Project) -> FacadeFrame:
