@@ -1,0 +1,313 @@
+"""First-hit ray–triangle queries: Embree (trimesh + embreex) or a vectorised NumPy BVH.
+
+Both backends answer the same question for batches of rays: which triangle does each ray hit
+first, and at what distance (``-1`` / ``inf`` for a miss). Triangles are two-sided. Distances
+are recomputed in float64 from the hit triangle's plane (Embree works in float32).
+
+The NumPy BVH is the fallback when embreex is not installed: a median-split bounding-volume
+hierarchy traversed with one small stack per ray, all rays of a chunk stepping together, so
+that memory stays bounded whatever the batch size (10⁴–10⁵ rays/s — use Embree for real
+work). Select a backend with :func:`make_caster` or the environment variable
+``RADTREE_RAY_BACKEND`` = ``embree`` | ``numpy-bvh``.
+"""
+
+from __future__ import annotations
+
+import os
+from concurrent.futures import ThreadPoolExecutor
+from typing import Protocol
+
+import numpy as np
+
+BACKENDS = ("embree", "numpy-bvh")
+
+
+class RayCaster(Protocol):
+    name: str
+    rays_cast: int  # rays queried so far (statistics)
+
+    def first_hit(self, origins: np.ndarray, directions: np.ndarray
+                  ) -> tuple[np.ndarray, np.ndarray]:
+        """(triangle index or -1, distance or inf) per ray; directions must be unit vectors."""
+        ...
+
+
+def embree_available() -> bool:
+    try:
+        import embreex  # noqa: F401
+        from trimesh.ray import ray_pyembree  # noqa: F401
+    except ImportError:
+        return False
+    return True
+
+
+def _plane_distance(tris_v0: np.ndarray, normals: np.ndarray, centroids: np.ndarray,
+                    origins: np.ndarray, directions: np.ndarray, idx: np.ndarray) -> np.ndarray:
+    """Distance along each ray to the plane of its hit triangle (float64)."""
+    n = normals[idx]
+    denom = np.einsum("ij,ij->i", directions, n)
+    num = np.einsum("ij,ij->i", tris_v0[idx] - origins, n)
+    grazing = np.abs(denom) < 1e-12
+    with np.errstate(divide="ignore", invalid="ignore"):
+        t = np.where(grazing, np.einsum("ij,ij->i", centroids[idx] - origins, directions),
+                     num / np.where(grazing, 1.0, denom))
+    return np.maximum(t, 0.0)
+
+
+class EmbreeCaster:
+    """trimesh's ``RayMeshIntersector`` (embreex) with the batch split over worker threads."""
+
+    name = "embree"
+
+    def __init__(self, vertices: np.ndarray, faces: np.ndarray, workers: int = 2,
+                 chunk: int = 1 << 17):
+        import trimesh
+        from trimesh.ray.ray_pyembree import RayMeshIntersector
+
+        self.mesh = trimesh.Trimesh(vertices=vertices, faces=faces, process=False,
+                                    validate=False)
+        self._intersector = RayMeshIntersector(self.mesh)
+        tris = np.asarray(vertices, float)[np.asarray(faces)]
+        self._v0 = tris[:, 0]
+        self._centroids = tris.mean(axis=1)
+        self._normals = _unit_normals(tris)
+        self.workers = max(1, int(workers))
+        self.chunk = chunk
+        self._pool = ThreadPoolExecutor(self.workers) if self.workers > 1 else None
+        self.rays_cast = 0
+        # build the Embree scene now (trimesh builds it lazily on first query)
+        self._intersector.intersects_first(np.zeros((1, 3)), np.array([[0.0, 0.0, 1.0]]))
+
+    def _query(self, o: np.ndarray, d: np.ndarray) -> np.ndarray:
+        return np.asarray(self._intersector.intersects_first(o, d), dtype=np.int64)
+
+    def first_hit(self, origins: np.ndarray, directions: np.ndarray
+                  ) -> tuple[np.ndarray, np.ndarray]:
+        n = len(origins)
+        if n == 0:
+            return np.zeros(0, np.int64), np.zeros(0)
+        self.rays_cast += n
+        if self._pool is not None and n >= 4096:
+            step = min(self.chunk, -(-n // self.workers))
+            parts = [slice(i, min(i + step, n)) for i in range(0, n, step)]
+            idx = np.concatenate(list(self._pool.map(
+                lambda s: self._query(origins[s], directions[s]), parts)))
+        else:
+            idx = self._query(origins, directions)
+        t = np.full(n, np.inf)
+        hit = idx >= 0
+        if hit.any():
+            t[hit] = _plane_distance(self._v0, self._normals, self._centroids, origins[hit],
+                                     directions[hit], idx[hit])
+        return idx, t
+
+
+def _unit_normals(tris: np.ndarray) -> np.ndarray:
+    n = np.cross(tris[:, 1] - tris[:, 0], tris[:, 2] - tris[:, 0])
+    length = np.linalg.norm(n, axis=1)
+    bad = length < 1e-300
+    n[bad] = (0.0, 0.0, 1.0)
+    length[bad] = 1.0
+    return n / length[:, None]
+
+
+class BVHCaster:
+    """Vectorised NumPy BVH (median split, ``leaf_size`` triangles per leaf).
+
+    Traversal is the classic stack-based one, run for ``ray_chunk`` rays at once: every ray
+    owns a small stack (tree depth + 2 entries), each step pops one node per active ray,
+    tests leaves' triangles or pushes the children whose boxes the ray enters (the nearer
+    one on top, so the closest hits are found first and prune the rest). Memory is bounded by
+    ``ray_chunk`` × (depth + 2) stack entries plus per-step arrays of ``ray_chunk`` rows.
+    """
+
+    name = "numpy-bvh"
+
+    def __init__(self, vertices: np.ndarray, faces: np.ndarray, leaf_size: int = 4,
+                 ray_chunk: int = 32768):
+        tris = np.asarray(vertices, float)[np.asarray(faces)]
+        self.n_tris = len(tris)
+        self.leaf_size = leaf_size
+        self.ray_chunk = ray_chunk
+        self._v0 = tris[:, 0].copy()
+        self._e1 = tris[:, 1] - tris[:, 0]
+        self._e2 = tris[:, 2] - tris[:, 0]
+        self._build(tris)
+        self.rays_cast = 0
+
+    def _build(self, tris: np.ndarray) -> None:
+        m = len(tris)
+        lo_t, hi_t = tris.min(axis=1), tris.max(axis=1)
+        cent = tris.mean(axis=1)
+        order = np.arange(m)
+        lo: list[np.ndarray] = []
+        hi: list[np.ndarray] = []
+        left: list[int] = []
+        right: list[int] = []
+        start: list[int] = []
+        count: list[int] = []
+        depth = 0
+
+        def new_node(s: int, e: int) -> int:
+            sub = order[s:e]
+            lo.append(lo_t[sub].min(axis=0) if e > s else np.full(3, np.inf))
+            hi.append(hi_t[sub].max(axis=0) if e > s else np.full(3, -np.inf))
+            left.append(-1)
+            right.append(-1)
+            start.append(s)
+            count.append(e - s)
+            return len(lo) - 1
+
+        stack = [(new_node(0, m), 0, m, 0)]
+        while stack:
+            node, s, e, level = stack.pop()
+            depth = max(depth, level)
+            if e - s <= self.leaf_size:
+                continue
+            sub = order[s:e]
+            c = cent[sub]
+            axis = int(np.argmax(c.max(axis=0) - c.min(axis=0)))
+            mid = (e - s) // 2
+            part = np.argpartition(c[:, axis], mid)
+            order[s:e] = sub[part]
+            ln = new_node(s, s + mid)
+            rn = new_node(s + mid, e)
+            left[node], right[node] = ln, rn
+            count[node] = 0
+            stack.append((ln, s, s + mid, level + 1))
+            stack.append((rn, s + mid, e, level + 1))
+        self._lo = np.array(lo)
+        self._hi = np.array(hi)
+        self._left = np.array(left, np.int64)
+        self._right = np.array(right, np.int64)
+        self._start = np.array(start, np.int64)
+        self._count = np.array(count, np.int64)
+        self._order = order
+        self.n_nodes = len(lo)
+        self.depth = depth
+
+    def _triangles(self, o: np.ndarray, d: np.ndarray, tri: np.ndarray) -> np.ndarray:
+        """Möller–Trumbore for ray/triangle pairs; distance or inf (two-sided)."""
+        e1, e2 = self._e1[tri], self._e2[tri]
+        p = np.cross(d, e2)
+        det = np.einsum("ij,ij->i", e1, p)
+        ok = np.abs(det) > 1e-14
+        inv = 1.0 / np.where(ok, det, 1.0)
+        s = o - self._v0[tri]
+        u = np.einsum("ij,ij->i", s, p) * inv
+        q = np.cross(s, e1)
+        v = np.einsum("ij,ij->i", d, q) * inv
+        t = np.einsum("ij,ij->i", e2, q) * inv
+        ok &= (u >= 0.0) & (v >= 0.0) & (u + v <= 1.0) & (t > 0.0)
+        return np.where(ok, t, np.inf)
+
+    def _boxes(self, o: np.ndarray, inv: np.ndarray, nd: np.ndarray
+               ) -> tuple[np.ndarray, np.ndarray]:
+        """Entry distance into each node's box and whether the ray enters it at all."""
+        t1 = (self._lo[nd] - o) * inv
+        t2 = (self._hi[nd] - o) * inv
+        tmin = np.maximum(np.minimum(t1, t2).max(axis=1), 0.0)
+        tmax = np.maximum(t1, t2).min(axis=1)
+        return tmin, tmax >= tmin
+
+    def first_hit(self, origins: np.ndarray, directions: np.ndarray
+                  ) -> tuple[np.ndarray, np.ndarray]:
+        n = len(origins)
+        self.rays_cast += n
+        best_t = np.full(n, np.inf)
+        best_tri = np.full(n, -1, np.int64)
+        if n == 0 or self.n_tris == 0:
+            return best_tri, best_t
+        d_safe = np.where(np.abs(directions) < 1e-15, 1e-15, directions)
+        inv_d = 1.0 / d_safe
+        width = self.depth + 3
+        for c0 in range(0, n, self.ray_chunk):
+            rays = np.arange(c0, min(n, c0 + self.ray_chunk))
+            k = len(rays)
+            node_stack = np.zeros((k, width), np.int64)
+            tmin_stack = np.zeros((k, width))
+            sp = np.zeros(k, np.int64)
+            t0, hit0 = self._boxes(origins[rays], inv_d[rays], np.zeros(k, np.int64))
+            tmin_stack[:, 0] = t0
+            sp[hit0] = 1
+            act = np.flatnonzero(hit0)  # local indices of rays with work left
+            while len(act):
+                sp[act] -= 1
+                popped = act
+                nd = node_stack[act, sp[act]]
+                tn = tmin_stack[act, sp[act]]
+                g = rays[act]
+                live = tn < best_t[g]
+                act, nd, g = act[live], nd[live], g[live]
+                leaf = self._left[nd] < 0
+                if leaf.any():
+                    la, ln = act[leaf], nd[leaf]
+                    cnt = self._count[ln]
+                    total = int(cnt.sum())
+                    if total:
+                        rr = np.repeat(rays[la], cnt)
+                        offs = np.arange(total) - np.repeat(np.cumsum(cnt) - cnt, cnt)
+                        tri = self._order[np.repeat(self._start[ln], cnt) + offs]
+                        t = self._triangles(origins[rr], directions[rr], tri)
+                        hit = t < best_t[rr]
+                        rr, t, tri = rr[hit], t[hit], tri[hit]
+                        if len(rr):
+                            np.minimum.at(best_t, rr, t)
+                            win = t == best_t[rr]
+                            best_tri[rr[win]] = tri[win]
+                inner = ~leaf
+                if inner.any():
+                    ia, inn, ig = act[inner], nd[inner], g[inner]
+                    o, inv = origins[ig], inv_d[ig]
+                    lc, rc = self._left[inn], self._right[inn]
+                    tl, hl = self._boxes(o, inv, lc)
+                    tr, hr = self._boxes(o, inv, rc)
+                    bt = best_t[ig]
+                    hl &= tl < bt
+                    hr &= tr < bt
+                    near_left = tl <= tr
+                    # push the far child first, then the near one (popped first)
+                    far_n = np.where(near_left, rc, lc)
+                    far_t = np.where(near_left, tr, tl)
+                    far_h = np.where(near_left, hr, hl)
+                    near_n = np.where(near_left, lc, rc)
+                    near_t = np.where(near_left, tl, tr)
+                    near_h = np.where(near_left, hl, hr)
+                    for nn, tt, hh in ((far_n, far_t, far_h), (near_n, near_t, near_h)):
+                        a = ia[hh]
+                        node_stack[a, sp[a]] = nn[hh]
+                        tmin_stack[a, sp[a]] = tt[hh]
+                        sp[a] += 1
+                act = popped[sp[popped] > 0]
+        return best_tri, best_t
+
+
+class NullCaster:
+    """No geometry: every ray misses."""
+
+    name = "none"
+    rays_cast = 0
+
+    def first_hit(self, origins: np.ndarray, directions: np.ndarray
+                  ) -> tuple[np.ndarray, np.ndarray]:
+        n = len(origins)
+        self.rays_cast += n
+        return np.full(n, -1, np.int64), np.full(n, np.inf)
+
+
+def make_caster(vertices: np.ndarray, faces: np.ndarray, backend: str = "auto",
+                workers: int = 2) -> RayCaster:
+    """A first-hit ray caster for a triangle soup: Embree when available (``auto``)."""
+    if len(faces) == 0:
+        return NullCaster()
+    if backend == "auto":
+        backend = os.environ.get("RADTREE_RAY_BACKEND", "auto")
+    if backend == "auto":
+        backend = "embree" if embree_available() else "numpy-bvh"
+    if backend not in BACKENDS:
+        raise ValueError(f"ray backend must be one of {BACKENDS} or 'auto', got {backend!r}")
+    if backend == "embree":
+        if not embree_available():
+            raise ValueError("the embree ray backend needs the 'embreex' package")
+        return EmbreeCaster(vertices, faces, workers=workers)
+    return BVHCaster(vertices, faces)

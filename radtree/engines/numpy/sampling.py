@@ -1,0 +1,55 @@
+"""Vectorised direction sampling for the Monte Carlo engine (all arrays (n, 3), unit vectors)."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+
+def orthonormal_basis(n: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Two unit tangents (t, b) with (t, b, n) right-handed, for unit normals n (k, 3).
+
+    Branch-free construction of Duff et al. (2017), stable for every direction.
+    """
+    nx, ny, nz = n[:, 0], n[:, 1], n[:, 2]
+    sign = np.where(nz >= 0.0, 1.0, -1.0)
+    a = -1.0 / (sign + nz)
+    b = nx * ny * a
+    t = np.stack([1.0 + sign * nx * nx * a, sign * b, -sign * nx], axis=1)
+    bb = np.stack([b, sign + ny * ny * a, -ny], axis=1)
+    return t, bb
+
+
+def cosine_hemisphere(normals: np.ndarray, rng: np.random.Generator) -> np.ndarray:
+    """Directions distributed ∝ cos θ about each normal (pdf cos θ / π)."""
+    k = len(normals)
+    u1 = rng.random(k)
+    u2 = rng.random(k)
+    r = np.sqrt(u1)
+    phi = 2.0 * math.pi * u2
+    x = r * np.cos(phi)
+    y = r * np.sin(phi)
+    z = np.sqrt(np.maximum(0.0, 1.0 - u1))
+    t, b = orthonormal_basis(normals)
+    return t * x[:, None] + b * y[:, None] + normals * z[:, None]
+
+
+def uniform_cone(axis: np.ndarray, half_angle_rad: float, k: int,
+                 rng: np.random.Generator) -> np.ndarray:
+    """``k`` directions uniform in solid angle within a cone about one unit ``axis`` (3,)."""
+    axis = np.asarray(axis, float) / np.linalg.norm(axis)
+    cos_max = math.cos(half_angle_rad)
+    u1 = rng.random(k)
+    u2 = rng.random(k)
+    cz = 1.0 - u1 * (1.0 - cos_max)
+    s = np.sqrt(np.maximum(0.0, 1.0 - cz * cz))
+    phi = 2.0 * math.pi * u2
+    t, b = orthonormal_basis(axis[None, :])
+    return (t * (s * np.cos(phi))[:, None] + b * (s * np.sin(phi))[:, None]
+            + axis[None, :] * cz[:, None])
+
+
+def mirror(d: np.ndarray, n: np.ndarray) -> np.ndarray:
+    """Mirror reflection of directions d about normals n."""
+    return d - 2.0 * np.einsum("ij,ij->i", d, n)[:, None] * n
