@@ -270,7 +270,9 @@ def simulate_project(project: Project, engine: str = "auto", scenarios: list[str
         else:
             from radtree.engines.numpy.engine import trace_hour
 
-            params = replace(effective_project(project, sc).engine, ab=built.ab)
+            # like-for-like with Radiance: as many diffuse bounces as -ab
+            params = replace(effective_project(project, sc).engine, ab=built.ab,
+                             max_bounces=built.ab)
             res = trace_hour(built.scene, st, params, grids=use)
         df = _rows(project, sc, st, built.scene, res, eng, phash)
         with atomic_path(part) as tmp:

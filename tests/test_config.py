@@ -19,7 +19,7 @@ def test_mendoza_project_loads():
     assert [s.reflection for s in p.scenarios] == ["calculated", "traced", "traced",
                                                    "calculated", "traced", "calculated", "traced"]
     assert p.tree.louvers.layers == 5 and p.tree.louvers.specular_fraction == 0.9
-    assert p.engine.as_ == 128 and p.engine.ab == 4
+    assert p.engine.as_ == 0 and p.engine.aa == 0 and p.engine.ab is None
 
 
 def test_params_hash_changes_with_parameters(tmp_path):

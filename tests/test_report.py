@@ -60,10 +60,12 @@ description = "free-standing louvers crowns, clear Perez sky"
 
 def make_project(root: Path, measured: bool = True) -> Path:
     p = copy_project(root, replace={r"^facade_azimuth_deg = 0\.0": "facade_azimuth_deg = 15.0",
-                                    r"^offset_m = 0\.01": "offset_m = 0.01\ndense_size_m = 2.0\n"
-                                                          "dense_spacing_m = 0.5"})
+                                    r"^dense_size_m = .*$": "dense_size_m = 2.0",
+                                    r"^dense_spacing_m = .*$": "dense_spacing_m = 0.5"})
     toml = p / "radtree.toml"
-    text = toml.read_text() + FREE_SCENARIO
+    text = toml.read_text()
+    if 'name = "F"' not in text:
+        text += FREE_SCENARIO
     if not measured:
         text = re.sub(r"^measured = .*$", "", text, flags=re.M)
     toml.write_text(text)
@@ -408,7 +410,7 @@ def test_report_on_a_real_open_street_simulation(open_street: Path):
              if not ln[:2].isdigit() or ln.startswith(("10:30", "13:30"))]
     data.write_text("\n".join(lines) + "\n")
     toml = open_street / "radtree.toml"  # a 3 × 3 dense grid keeps rtrace short
-    toml.write_text(re.sub(r"^offset_m = 0\.01$", "offset_m = 0.01\ndense_size_m = 1.0",
+    toml.write_text(re.sub(r"^dense_size_m = .*$", "dense_size_m = 1.0",
                            toml.read_text(), flags=re.M))
     p = load_project(open_street)
     simulate_project(p, "radiance", scenarios=["A", "B"], echo=lambda s: None, progress=False)
