@@ -1,0 +1,50 @@
+"""Wall time of the full reference reproduction (scenarios A–E × 7 hours) with Radiance.
+
+Prints build and tracing times, the façade means and the statistics against the measured data.
+Run: .venv/bin/python benchmarks/reproduction.py  (target: under 2 minutes on 2 cores)
+"""
+
+from __future__ import annotations
+
+import shutil
+import tempfile
+import time
+from pathlib import Path
+
+import pandas as pd
+
+from radtree.config import load_project
+from radtree.measurements import load_measured
+from radtree.scenarios import build_project, simulate_project
+from radtree.stats import compare
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+def main() -> None:
+    with tempfile.TemporaryDirectory() as tmp:
+        dst = Path(tmp) / "mendoza"
+        shutil.copytree(ROOT / "examples" / "mendoza-street", dst,
+                        ignore=shutil.ignore_patterns("build", "results", "report"))
+        project = load_project(dst, overrides={"sensors.dense_grid": False})
+        scenarios = ["A", "B", "C", "D", "E"]
+        t0 = time.perf_counter()
+        build_project(project, scenarios, echo=lambda s: None, progress=False, pictures=False)
+        t1 = time.perf_counter()
+        out = simulate_project(project, "radiance", scenarios, echo=lambda s: None,
+                               progress=False, workers=2)
+        t2 = time.perf_counter()
+        assert out is not None
+        measured, _ = load_measured(project.measured)
+        cmp = compare(out.table, measured)
+        print(f"build {t1 - t0:.1f} s, tracing {t2 - t1:.1f} s, total {t2 - t0:.1f} s "
+              f"for {len(scenarios)} scenarios × {len(project.site.hours)} hours (Radiance, "
+              "2 workers, façade sensors only)")
+        pd.set_option("display.width", 120)
+        print(cmp.stats[["scenario", "model", "reflection", "rmse", "rmse_low", "rmse_high",
+                         "mbe", "r2"]].round(3).to_string(index=False))
+        print(out.timing.round(2).to_string(index=False))
+
+
+if __name__ == "__main__":
+    main()
