@@ -310,7 +310,7 @@ class Office:
     height_m: float = 2.5
     depth_m: float = 6.0
     storey_height_m: float = 2.5
-    ground_floor_m: float = 2.5
+    ground_floor_m: float = 1.25
     glazing_transmittance: float = 0.8
     frame_fraction: float = 0.1
     window_sill_m: float = 0.0

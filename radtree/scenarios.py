@@ -74,10 +74,6 @@ def make_scene(project: Project, scenario: Scenario, dense_grid: bool | None = N
         materials.update(o_materials)
         grids = o_grids
         notes += o_notes
-    if project.extra_geometry:
-        from radtree.site.user_geometry import load_user_meshes
-
-        meshes = meshes + load_user_meshes(project.extra_geometry)
     t0 = time.perf_counter()
     ab = 2
     info: dict[str, float] = {}
@@ -95,6 +91,14 @@ def make_scene(project: Project, scenario: Scenario, dense_grid: bool | None = N
         ab = int(tree.recommended_ab)
         info = dict(tree.info)
     geometry_seconds = time.perf_counter() - t0
+    if project.extra_geometry:
+        from radtree.site.user_geometry import load_user_meshes
+
+        meshes = meshes + load_user_meshes(project.extra_geometry, materials)
+    if project.office is not None:
+        from radtree.site.office import RECOMMENDED_AB
+
+        ab = max(ab, RECOMMENDED_AB)   # rooms need ~6 bounces (see the office notes)
     if project.engine.ab is not None:
         ab = project.engine.ab
     scene = Scene(meshes, materials, grids, notes)
@@ -307,6 +311,10 @@ def simulate_project(project: Project, engine: str = "auto", scenarios: list[str
     _merge_write(out, table, chosen)
     tdf = pd.DataFrame([{"scenario": k, "engine": eng, **v} for k, v in timing.items()])
     _merge_timing(project.results_dir / "timing.csv", tdf)
+    if project.office is not None:
+        from radtree.office_summary import write_summary
+
+        write_summary(project, maps=False)
     write_text(project.results_dir / "manifest.json", json.dumps(
         manifest(project, extra={"engine": eng, "scenarios": [s.name for s in chosen]}),
         indent=2, default=str))

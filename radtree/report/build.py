@@ -503,6 +503,58 @@ def _environment(autoescape: bool) -> Environment:
     return env
 
 
+def extra_sections(project: Project, out: Path, echo: Callable[[str], None]) -> list[str]:
+    """HTML sections of the studies that exist for this project: office block, sweep,
+    diagnosis, annual. Their figures are written into ``out`` (the report folder)."""
+    parts: list[str] = []
+    if project.office is not None:
+        from radtree.office_summary import (
+            office_report_section,
+            read_results,
+            summarise,
+            write_hourly_charts,
+            write_maps,
+            write_summary,
+        )
+
+        write_summary(project, maps=False)
+        table = read_results(project)
+        write_maps(project, table, out / "office")
+        write_hourly_charts(project, summarise(table), out / "office")
+        parts.append(office_report_section(project))
+        echo("  office block: summary table and false-colour maps")
+    from radtree.sweep.sensitivity import sweep_report_section
+
+    sweep = sweep_report_section(project.root)
+    if sweep:
+        parts.append(sweep)
+        echo("  sweep: sensitivity section")
+    diag = project.root / "diagnose" / "index.html"
+    if diag.exists():
+        parts.append("<section id='diagnose'><h2>Diagnosis</h2><p>The model–measurement "
+                     "discrepancy workflow's report: <a href='../diagnose/index.html'>"
+                     "diagnose/index.html</a>.</p></section>")
+    annual = project.results_dir / "annual_summary.csv"
+    if annual.exists():
+        try:
+            from radtree.annual.report import annual_report_section
+        except ImportError:
+            annual_report_section = None  # type: ignore[assignment]
+        if annual_report_section is not None:
+            parts.append(annual_report_section(project))
+    return parts
+
+
+def _with_extra_sections(project: Project, html: str, out: Path,
+                         echo: Callable[[str], None]) -> str:
+    parts = extra_sections(project, out, echo)
+    if not parts:
+        return html
+    marker = '<section id="provenance">'
+    block = "\n".join(parts) + "\n"
+    return html.replace(marker, block + marker, 1) if marker in html else html + block
+
+
 def build_report(project: Project, echo: Callable[[str], None] = print) -> Path:
     """Write ``PROJECT/report/`` (index.html, index.md, CSVs, figures); return index.html.
 
@@ -555,6 +607,7 @@ def build_report(project: Project, echo: Callable[[str], None] = print) -> Path:
         if rf is not None:
             rf.to_csv(tmp / "rows.csv", index=False)
         html = _environment(True).get_template("report.html.j2").render(c=ctx)
+        html = _with_extra_sections(project, html, tmp, echo)
         md = _environment(False).get_template("report.md.j2").render(c=ctx)
         (tmp / "index.html").write_text(html, encoding="utf-8")
         (tmp / "index.md").write_text(md, encoding="utf-8")
