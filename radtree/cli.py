@@ -174,10 +174,12 @@ def _register_commands() -> None:
     """Commands that live beside their subject (hemi, report, …)."""
     from radtree.hemi.cli import hemi_command
     from radtree.report.cli import report_command
+    from radtree.diagnose.cli import diagnose_command
     from radtree.sweep.cli import sweep_command
     from radtree.trees.cli import calibrate_command
 
-    for cmd in (hemi_command, report_command, calibrate_command, sweep_command):
+    for cmd in (hemi_command, report_command, calibrate_command, sweep_command,
+                diagnose_command):
         main.add_command(cmd)
 
 

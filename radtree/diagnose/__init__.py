@@ -1,0 +1,49 @@
+"""Model–measurement discrepancy workflow (SPEC §6): ``radtree diagnose``.
+
+Find where simulation and measurement disagree (by hour, by sensor row, by sun altitude), name
+the physical effect most likely missing, add it to the model, re-simulate, and show the gap
+shrink — and prove the workflow on synthetic data in which a known effect was hidden.
+
+    from radtree.diagnose import diagnose, selftest, EFFECTS
+    res = diagnose("examples/mendoza-street", scenario="B")   # → PROJECT/diagnose/
+    res.steps                                                 # steps.csv as a DataFrame
+    st = selftest("examples/mendoza-street", scenario="B", noise=0.03)
+    st.passed, st.table()
+
+Modules: :mod:`.effects` (the catalogue), :mod:`.simulate` (cached, seeded façade-grid runs),
+:mod:`.residuals` (disagreement map and its rules), :mod:`.attribution` (signatures, fits,
+leave-one-hour-out ranking), :mod:`.loop` (the loop, measurements, step project files),
+:mod:`.run` (:func:`diagnose` and its outputs), :mod:`.hidden`, :mod:`.report`, :mod:`.cli`.
+"""
+
+from __future__ import annotations
+
+import importlib
+from typing import Any
+
+# Lazy exports (PEP 562): ``import radtree.diagnose.cli`` stays light for ``radtree --help``.
+_EXPORTS = {
+    "Attribution": "attribution", "CandidateFit": "attribution", "Signature": "attribution",
+    "attribute": "attribution",
+    "EFFECTS": "effects", "EFFECT_NAMES": "effects", "Context": "effects", "Effect": "effects",
+    "Strength": "effects", "candidates": "effects", "catalogue_lines": "effects",
+    "get_effect": "effects", "parse_effects": "effects",
+    "LoopResult": "loop", "Measured": "loop", "Step": "loop", "load_measurements": "loop",
+    "run_loop": "loop",
+    "DisagreementMap": "residuals", "disagreement_map": "residuals",
+    "DiagnoseResult": "run", "diagnose": "run",
+    "HiddenCase": "hidden", "SelftestResult": "hidden", "selftest": "hidden",
+    "Run": "simulate", "Simulator": "simulate",
+}
+__all__ = sorted(_EXPORTS)
+
+
+def __getattr__(name: str) -> Any:
+    module = _EXPORTS.get(name)
+    if module is None:
+        raise AttributeError(f"module 'radtree.diagnose' has no attribute {name!r}")
+    return getattr(importlib.import_module(f"radtree.diagnose.{module}"), name)
+
+
+def __dir__() -> list[str]:
+    return sorted(list(globals()) + __all__)

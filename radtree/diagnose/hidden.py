@@ -1,0 +1,281 @@
+"""Hidden-effect self-test: can the loop find an effect we hid in synthetic measurements?
+
+For each effect X of the catalogue (or of ``effects``) that applies to the scenario:
+
+1. the *base* is the scenario with X off (switched off if the scenario has it);
+2. the *truth* is the base with X on at its reference strength, simulated with a different seed
+   (``seed + TRUTH_SEED_OFFSET``: the model never sees the truth's Monte Carlo noise), and the
+   synthetic measurement is the truth's hourly grid mean × (1 + noise · N(0, 1)) (seeded; the
+   per-row daily means likewise from the hourly row means) — written to
+   ``PROJECT/diagnose/selftest/<X>.csv`` and read back through
+   :func:`radtree.measurements.load_measured`;
+3. **before any loop runs**, X is declared *distinguishable* when its signature's RMS over the
+   hours is ≥ ``SNR_MIN`` × the noise RMS and its signature's (uncentred) correlation with every
+   other candidate's is below ``TIE_CORR``. Noise RMS = √mean_h((noise·E_h)² + 2·se_h²), E_h the
+   expected truth and se_h the Monte Carlo standard error of the hourly mean (the truth's and
+   the model's own noise);
+4. the diagnosis loop runs from the base against the synthetic measurement.
+
+The test passes when every distinguishable X is named by the first step; the table also shows
+the effects named for the others, whether the gap shrank at each step, and the fitted strength.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+import time
+from collections.abc import Iterable
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pandas as pd
+
+from radtree.config import Project, Scenario
+from radtree.diagnose.attribution import (
+    DEFAULT_MARGIN,
+    TIE_CORR,
+    compute_signatures,
+    cosine,
+)
+from radtree.diagnose.effects import EFFECTS, Context, Effect, candidates
+from radtree.diagnose.loop import (
+    DEFAULT_MAX_STEPS,
+    LoopResult,
+    Measured,
+    load_measurements,
+    run_loop,
+)
+from radtree.diagnose.run import Echo, pick_scenario, resolve_project
+from radtree.diagnose.simulate import Simulator
+from radtree.errors import RadtreeError
+from radtree.fileio import atomic_path, write_text
+
+DEFAULT_NOISE = 0.03
+SNR_MIN = 3.0
+TRUTH_SEED_OFFSET = 7919
+SELFTEST_COLUMNS = ["hidden_effect", "distinguishable", "named_effect", "rmse_before",
+                    "rmse_after"]
+
+
+@dataclass
+class HiddenCase:
+    """One hidden effect: the decision made before the run, then what the loop did."""
+
+    effect: str
+    base: Scenario
+    truth: Scenario
+    strength_true: float | None
+    strength_text: str
+    signature_rms_lux: float
+    noise_rms_lux: float
+    max_correlation: float
+    most_correlated_with: str
+    distinguishable: bool
+    reason: str
+    loop: LoopResult | None = None
+    measured: Measured | None = None
+
+    @property
+    def named(self) -> str:
+        return self.loop.named() if self.loop is not None else ""
+
+    @property
+    def correct(self) -> bool:
+        return self.named == self.effect
+
+    @property
+    def gap_shrinks(self) -> bool:
+        return self.loop is not None and all(s.rmse_after < s.rmse_before
+                                             for s in self.loop.steps)
+
+    def record(self) -> dict[str, Any]:
+        lp = self.loop
+        first = lp.steps[0] if lp is not None and lp.steps else None
+        return {
+            "hidden_effect": self.effect, "distinguishable": self.distinguishable,
+            "named_effect": self.named,
+            "rmse_before": lp.start_map.stats["nrmse"] if lp else math.nan,
+            "rmse_after": lp.final_map.stats["nrmse"] if lp else math.nan,
+            "correct": self.correct,
+            "named_or_tied": self.correct or (first is not None
+                                              and self.effect in first.tie_with),
+            "tie_with": ";".join(first.tie_with) if first else "",
+            "steps": " + ".join(s.effect for s in lp.steps) if lp else "",
+            "gap_shrinks": self.gap_shrinks,
+            "strength_true": self.strength_true if self.strength_true is not None else math.nan,
+            "strength_fitted": (first.strength if first is not None and first.strength
+                                is not None and first.effect == self.effect else math.nan),
+            "signature_rms_lux": self.signature_rms_lux, "noise_rms_lux": self.noise_rms_lux,
+            "snr": self.signature_rms_lux / self.noise_rms_lux if self.noise_rms_lux > 0
+            else math.nan,
+            "max_correlation": self.max_correlation,
+            "most_correlated_with": self.most_correlated_with, "reason": self.reason,
+            "base": self.base.name if not self.base.switches else
+            self.base.name + " with " + ", ".join(f"{k}={v}" for k, v in
+                                                 self.base.switches.items()),
+        }
+
+
+@dataclass
+class SelftestResult:
+    project: Project
+    scenario: Scenario
+    noise: float
+    cases: list[HiddenCase]
+    skipped: dict[str, str]
+    seconds: float
+    simulations: int
+    out_dir: Path | None = None
+    files: list[Path] = field(default_factory=list)
+    engine: str = "numpy"
+    rays: int | None = None
+    seed: int | None = None
+
+    @property
+    def passed(self) -> bool:
+        return all(c.correct for c in self.cases if c.distinguishable)
+
+    @property
+    def misnamed(self) -> list[HiddenCase]:
+        return [c for c in self.cases if c.distinguishable and not c.correct]
+
+    def table(self) -> pd.DataFrame:
+        recs = [c.record() for c in self.cases]
+        if not recs:
+            return pd.DataFrame(columns=SELFTEST_COLUMNS)
+        cols = SELFTEST_COLUMNS + [k for k in recs[0] if k not in SELFTEST_COLUMNS]
+        return pd.DataFrame(recs, columns=cols)
+
+
+def _decide(sim: Simulator, ctx: Context, effect: Effect, start: Scenario, noise: float,
+            echo: Echo | None) -> HiddenCase:
+    base = effect.switch_off(ctx, start) if effect.is_on(ctx, start) else start
+    if base is not start:
+        base = Scenario(f"{start.name}-no-{effect.name}", base.model, base.reflection, base.sky,
+                        base.form, f"{start.name} with {effect.name} off", base.switches)
+    ref = effect.reference(ctx, base)
+    truth = effect.switch_on(ctx, base, ref)
+    base_run = sim.run(base)
+    cands, _ = candidates(ctx, base)
+    if effect not in cands:
+        raise RadtreeError(f"self-test: {effect.name} is still on after switching it off "
+                           "(catalogue bug)")
+    sigs = compute_signatures(sim, ctx, base, base_run, cands, echo)
+    sx = sigs[effect.name].reference_hourly()
+    expected = base_run.lux + sx
+    se = np.nan_to_num(base_run.stderr, nan=0.0)
+    noise_rms = float(np.sqrt(np.mean((noise * expected) ** 2 + 2 * se ** 2)))
+    rms = float(np.sqrt(np.mean(sx ** 2)))
+    corr = {n: cosine(sx, s.reference_hourly()) for n, s in sigs.items() if n != effect.name}
+    corr = {k: v for k, v in corr.items() if math.isfinite(v)}
+    most = max(corr, key=lambda k: corr[k]) if corr else ""
+    cmax = corr[most] if most else math.nan
+    reasons = []
+    if not rms >= SNR_MIN * noise_rms:
+        reasons.append(f"signature RMS {rms:.0f} lx < {SNR_MIN:g} × noise RMS {noise_rms:.0f} lx")
+    if most and cmax >= TIE_CORR:
+        reasons.append(f"correlates {cmax:.2f} with {most}")
+    st = effect.strength(ctx, base)
+    stext = "on" if st is None or ref is None else st.text(ref)
+    return HiddenCase(effect.name, base, truth, ref, stext, rms, noise_rms, cmax, most,
+                      not reasons, "; ".join(reasons) or
+                      f"signature RMS {rms:.0f} lx = {rms / noise_rms:.1f} × noise, max "
+                      f"correlation {cmax:.2f} ({most or 'no other candidate'})")
+
+
+def _synthetic(truth_sim: Simulator, case: HiddenCase, noise: float, seed: int, index: int,
+               folder: Path | None, project: Project) -> Measured:
+    run = truth_sim.run(case.truth)
+    rng = np.random.default_rng([int(seed), 4242, index])
+    hourly = run.lux * (1.0 + noise * rng.standard_normal(len(run.lux)))
+    rows_h = run.rows * (1.0 + noise * rng.standard_normal(run.rows.shape))
+    counts = truth_sim.sensors_per_row()
+    rows = pd.DataFrame({"row": list(rows_h.columns),
+                         "sensors": [counts.get(r, 1) for r in rows_h.columns],
+                         "measured_mean_lux": rows_h.mean(axis=0).to_numpy(float)})
+    times = truth_sim.hours
+    if folder is None:
+        return Measured(tuple(times), hourly, f"synthetic ({case.effect})", "lux", "mean",
+                        rows, None)
+    folder.mkdir(parents=True, exist_ok=True)
+    mpath = folder / f"{case.effect}.csv"
+    rpath = folder / f"{case.effect}_rows.csv"
+    head = (f"# Synthetic measurement: {case.base.name} + {case.effect} ({case.strength_text}),"
+            f" seed {seed}, noise {noise:.1%}\n# Units: lux\n")
+    write_text(mpath, head + "time,measured_lux\n"
+               + "".join(f"{t},{v:.1f}\n" for t, v in zip(times, hourly)))
+    write_text(rpath, head + "row,sensors,measured_mean_lux\n" + "".join(
+        f"{r.row},{int(r.sensors)},{r.measured_mean_lux:.1f}\n" for r in rows.itertuples()))
+    return load_measurements(project, mpath, None, counts, rows_path=rpath)
+
+
+def selftest(project: str | os.PathLike | Project, scenario: str | None = None,
+             effects: Iterable[Effect] | None = None, noise: float = DEFAULT_NOISE,
+             engine: str = "numpy", rays: int | None = None, seed: int | None = None,
+             margin: float = DEFAULT_MARGIN, max_steps: int = DEFAULT_MAX_STEPS,
+             out_dir: str | os.PathLike | None = None, write: bool = True,
+             echo: Echo | None = print) -> SelftestResult:
+    """Hide each effect in synthetic measurements and check the loop names it."""
+    if not 0 <= noise < 1:
+        raise RadtreeError(f"noise must be a fraction in [0, 1), got {noise}")
+    t0 = time.perf_counter()
+    say = echo or (lambda s: None)
+    proj = resolve_project(project)
+    start = pick_scenario(proj, scenario)
+    ctx = Context(proj, engine)
+    out = Path(out_dir) if out_dir is not None else proj.root / "diagnose"
+    hours = tuple(proj.site.hours)
+    sim = Simulator(proj, hours, engine, rays, seed, workdir=out / "work")
+    truth_sim = Simulator(proj, hours, engine, sim.rays, int(sim.seed or 0) + TRUTH_SEED_OFFSET,
+                          workdir=out / "work")
+    chosen = tuple(effects) if effects is not None else EFFECTS
+    skipped: dict[str, str] = {}
+    say(f"self-test {proj.name}: scenario {start.name}, noise {noise:.1%}, engine {engine}"
+        + (f", {sim.rays} rays/sensor, seed {sim.seed} (truth seed {truth_sim.seed})"
+           if engine == "numpy" else ""))
+    say("  deciding which hidden effects are distinguishable (before any diagnosis runs):")
+    cases: list[HiddenCase] = []
+    for e in chosen:
+        why = e.applies(ctx, start)
+        if why:
+            skipped[e.name] = why
+            say(f"  {e.name}: skipped ({why})")
+            continue
+        case = _decide(sim, ctx, e, start, noise, None)
+        cases.append(case)
+        say(f"  {e.name:26s} {'distinguishable' if case.distinguishable else 'not distinguishable'}"
+            f": {case.reason}")
+    for i, case in enumerate(cases):
+        say(f"  hidden {case.effect} ({case.strength_text}) in {case.base.name}:")
+        meas = _synthetic(truth_sim, case, noise, int(sim.seed or 0), i,
+                          out / "selftest" if write else None, proj)
+        case.measured = meas
+        case.loop = run_loop(sim, ctx, case.base, meas, margin, max_steps, EFFECTS,
+                             echo=None)
+        lp = case.loop
+        verdict = ("correct" if case.correct else
+                   ("MISNAMED" if case.distinguishable else "not distinguishable"))
+        say(f"    named {case.named}"
+            + (f" (tie: {', '.join(lp.steps[0].tie_with)})" if lp.steps and lp.steps[0].tie_with
+               else "")
+            + f" — {verdict}; nRMSE {lp.start_map.stats['nrmse']:.3f} → "
+            f"{lp.final_map.stats['nrmse']:.3f}"
+            + (f" via {' + '.join(s.effect for s in lp.steps)}" if lp.steps else ""))
+    res = SelftestResult(proj, start, noise, cases, skipped, time.perf_counter() - t0,
+                         sim.traced_runs + truth_sim.traced_runs, out if write else None,
+                         engine=engine, rays=sim.rays if engine == "numpy" else None,
+                         seed=sim.seed if engine == "numpy" else None)
+    if write:
+        from radtree.diagnose.report import write_selftest_report
+
+        out.mkdir(parents=True, exist_ok=True)
+        path = out / "selftest.csv"
+        with atomic_path(path) as tmp:
+            res.table().to_csv(tmp, index=False, float_format="%.6g")
+        res.files = [path] + write_selftest_report(res, out)
+        res.seconds = time.perf_counter() - t0
+        say(f"  wrote {path}")
+    return res

@@ -1,0 +1,243 @@
+"""Simulations for the diagnosis: façade grid only, fixed seed, cached per scenario.
+
+:class:`Simulator` traces a scenario's façade sensor grid (no dense map) at the diagnosed hours
+and returns a :class:`Run`: the hourly grid mean, its Monte Carlo standard error, the hourly
+row means and the per-sensor values. With the NumPy engine every scenario is traced with the
+same seed (common random numbers), so the difference between a base run and a switched run —
+an effect's *signature* — carries much less noise than either run.
+
+Caching inside a run: the traced part is keyed by everything that changes the tracing (the
+project, model, form, sky, reflection mode and the switches other than ``reflection.*``), the
+crown geometry by what changes the scene; the analytic ground terms (``reflection = calculated``
+and the ``reflection.unfiltered`` switch, :mod:`radtree.reflect`) are added afresh each time, so
+fitting those costs no tracing. With ``engine = "radiance"`` each scenario runs through
+:func:`radtree.scenarios.simulate_project` in a work folder (``PROJECT/diagnose/work/``), whose
+resumable parts act as a cache across runs.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import time
+from collections.abc import Callable
+from dataclasses import dataclass, field, replace
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pandas as pd
+
+from radtree.config import Project, Scenario, effective_project
+from radtree.errors import RadtreeError
+from radtree.stats import mean_stderr
+
+#: Rays per sensor for NumPy-engine diagnosis unless given (MC SE ≈ 8 lx on Mendoza's hourly
+#: mean of 8 sensors; common random numbers make signatures less noisy still).
+DEFAULT_RAYS = 1024
+FACADE = "facade"
+
+
+@dataclass
+class Run:
+    """One scenario simulated at the diagnosed hours (façade grid).
+
+    ``lux``/``stderr``: hourly grid mean and its MC standard error (lx, NaN SE for Radiance);
+    ``rows``: DataFrame indexed by time, one column per sensor row (lx); ``sensors``:
+    (hours × sensors) lx; ``seconds``: wall time spent tracing for this run (0 if cached).
+    """
+
+    times: tuple[str, ...]
+    lux: np.ndarray
+    stderr: np.ndarray
+    rows: pd.DataFrame
+    sensors: np.ndarray
+    seconds: float = 0.0
+
+    def row_daily(self) -> pd.Series:
+        """Daily mean per row over the hours (lx)."""
+        return self.rows.mean(axis=0)
+
+
+@dataclass
+class _Traced:
+    lux: np.ndarray  # hours × sensors, traced part
+    stderr: np.ndarray  # hours × sensors
+    seconds: float
+    grid: Any  # the façade SensorGrid
+
+
+def _canonical(project: Project, sc: Scenario) -> Scenario:
+    return Scenario(name="diagnose", model=sc.model, reflection=sc.reflection,
+                    sky=sc.sky or project.light.sky, form=sc.form or project.tree.form,
+                    description="", switches=dict(sorted(sc.switches.items())))
+
+
+def scenario_key(project: Project, sc: Scenario) -> str:
+    """Hash of everything that changes a scenario's numbers (name and description aside)."""
+    return project.params_hash(_canonical(project, sc))
+
+
+@dataclass
+class Simulator:
+    """Simulates scenarios of one project at fixed hours; caches runs inside one diagnosis."""
+
+    project: Project
+    hours: tuple[str, ...]
+    engine: str = "numpy"
+    rays: int | None = None
+    seed: int | None = None
+    workdir: Path | None = None
+    echo: Callable[[str], None] | None = None
+    traced_runs: int = 0
+    cache_hits: int = 0
+    trace_seconds: float = 0.0
+    _runs: dict[str, Run] = field(default_factory=dict, repr=False)
+    _traced: dict[str, _Traced] = field(default_factory=dict, repr=False)
+    _scenes: dict[str, Any] = field(default_factory=dict, repr=False)
+    _grid: Any = field(default=None, repr=False)
+
+    def __post_init__(self) -> None:
+        if self.engine not in ("numpy", "radiance"):
+            raise RadtreeError(f"diagnosis engine must be numpy or radiance, got {self.engine!r}")
+        unknown = [h for h in self.hours if h not in self.project.site.hours]
+        if unknown:
+            raise RadtreeError(f"hour(s) {', '.join(unknown)} are not among the project's "
+                               f"site.hours ({', '.join(self.project.site.hours)})")
+        if not self.hours:
+            raise RadtreeError("no hours to simulate")
+        if self.rays is None:
+            self.rays = DEFAULT_RAYS
+        if self.seed is None:
+            self.seed = int(self.project.engine.seed)
+        # façade grid only
+        self.project = replace(self.project,
+                               sensors=replace(self.project.sensors, dense_grid=False))
+
+    # ------------------------------------------------------------------ public
+    def key(self, sc: Scenario) -> str:
+        return scenario_key(self.project, sc)
+
+    def grid(self, sc: Scenario | None = None):
+        """The façade sensor grid (points, normals, row labels)."""
+        if self._grid is None:
+            sc = sc or Scenario("diagnose", "none")
+            built = self._scene(replace(sc, model="none", switches={
+                k: v for k, v in sc.switches.items() if k.startswith("sensors.")}))
+            self._grid = built.scene.grids[FACADE]
+        return self._grid
+
+    def sensors_per_row(self) -> dict[str, int]:
+        rows = pd.Series(self.grid().rows, dtype=str).str.lower()
+        return {str(k): int(v) for k, v in rows.value_counts().items()}
+
+    def run(self, sc: Scenario) -> Run:
+        """The scenario's run (from the cache when the same numbers were simulated before)."""
+        key = self.key(sc)
+        if key in self._runs:
+            self.cache_hits += 1
+            hit = self._runs[key]
+            return replace(hit, seconds=0.0)
+        t0 = time.perf_counter()
+        if self.engine == "numpy":
+            run = self._numpy_run(sc)
+        else:
+            run = self._radiance_run(sc)
+        run.seconds = time.perf_counter() - t0
+        self._runs[key] = run
+        return run
+
+    # ------------------------------------------------------------------ numpy engine
+    def _scene_key(self, sc: Scenario) -> str:
+        keep = {k: v for k, v in sc.switches.items()
+                if not k.startswith(("reflection.", "light.", "engine."))}
+        payload = {"model": sc.model, "form": sc.form or self.project.tree.form,
+                   "switches": sorted(keep.items())}
+        return hashlib.sha256(json.dumps(payload, default=str).encode()).hexdigest()
+
+    def _scene(self, sc: Scenario):
+        from radtree.scenarios import make_scene
+
+        key = self._scene_key(sc)
+        if key not in self._scenes:
+            self._scenes[key] = make_scene(self.project, sc, dense_grid=False)
+        return self._scenes[key]
+
+    def _traced_key(self, sc: Scenario) -> str:
+        keep = {k: v for k, v in sc.switches.items() if not k.startswith("reflection.")}
+        return scenario_key(self.project, replace(sc, switches=keep))
+
+    def _numpy_run(self, sc: Scenario) -> Run:
+        from radtree.engines.numpy.engine import trace_hour
+        from radtree.light import hour_states
+        from radtree.reflect import calculated_reflection, unfiltered_ground_light
+
+        states = hour_states(self.project, sc, list(self.hours))
+        tkey = self._traced_key(sc)
+        traced = self._traced.get(tkey)
+        if traced is not None:
+            self.cache_hits += 1  # only the analytic ground terms differ
+        else:
+            t0 = time.perf_counter()
+            built = self._scene(sc)
+            # as radtree simulate: as many diffuse bounces as the model's -ab (the scene is
+            # cached without engine switches, so take -ab from the switched project first)
+            eng = effective_project(self.project, sc).engine
+            tree = getattr(built, "tree", None)
+            ab = int(eng.ab if eng.ab is not None else
+                     (tree.recommended_ab if tree is not None else built.ab))
+            params = replace(eng, rays=int(self.rays or 1), seed=int(self.seed or 0), ab=ab,
+                             max_bounces=ab)
+            lux, se = [], []
+            for st in states:
+                res = trace_hour(built.scene, st, params, grids=[FACADE])[FACADE]
+                lux.append(res.lux)
+                se.append(res.stderr if res.stderr is not None
+                          else np.full(len(res.lux), np.nan))
+            traced = _Traced(np.array(lux), np.array(se), time.perf_counter() - t0,
+                             built.scene.grids[FACADE])
+            self._traced[tkey] = traced
+            self.traced_runs += 1
+            self.trace_seconds += traced.seconds
+        grid = traced.grid
+        extra = np.zeros_like(traced.lux)
+        for i, st in enumerate(states):
+            e = unfiltered_ground_light(self.project, sc, st, grid)
+            if sc.reflection == "calculated":
+                e = e + calculated_reflection(self.project, sc, st, grid)
+            extra[i] = e
+        return self._make_run(traced.lux + extra, traced.stderr, list(grid.rows))
+
+    def _make_run(self, sensors: np.ndarray, stderr: np.ndarray, rows: list[str]) -> Run:
+        rows_l = pd.Series(rows, dtype=str).str.lower().to_numpy()
+        names = sorted(set(rows_l))
+        row_means = pd.DataFrame({r: sensors[:, rows_l == r].mean(axis=1) for r in names},
+                                 index=pd.Index(self.hours, name="time"))
+        lux = sensors.mean(axis=1)
+        se = np.array([mean_stderr(s) for s in stderr])
+        return Run(tuple(self.hours), lux, se, row_means, sensors)
+
+    # ------------------------------------------------------------------ radiance engine
+    def _radiance_run(self, sc: Scenario) -> Run:
+        from radtree.scenarios import simulate_project
+
+        key = self.key(sc)
+        root = (self.workdir or (self.project.root / "diagnose" / "work")) / key
+        name = "diagnose"
+        project = replace(self.project, root=root, scenarios=(replace(sc, name=name),))
+        t0 = time.perf_counter()
+        out = simulate_project(project, engine="radiance", scenarios=[name],
+                               hours=list(self.hours), echo=self.echo or (lambda s: None),
+                               progress=False, grids=[FACADE])
+        if out is None:  # pragma: no cover - dry_run is never asked for here
+            raise RadtreeError("radiance simulation returned nothing")
+        self.traced_runs += 1
+        self.trace_seconds += time.perf_counter() - t0
+        df = out.table
+        df = df[(df["scenario"].astype(str) == name) & (df["grid"] == FACADE)]
+        df = df.assign(time=df["time"].astype(str).str.zfill(5))
+        sens = df.pivot(index="time", columns="sensor", values="lux").loc[list(self.hours)]
+        se = df.pivot(index="time", columns="sensor", values="lux_stderr").loc[list(self.hours)]
+        rows = (df[df["time"] == self.hours[0]].sort_values("sensor")["row"].astype(str)
+                .tolist())
+        return self._make_run(sens.to_numpy(float), se.to_numpy(float), rows)
