@@ -536,12 +536,10 @@ def extra_sections(project: Project, out: Path, echo: Callable[[str], None]) -> 
                      "diagnose/index.html</a>.</p></section>")
     annual = project.results_dir / "annual_summary.csv"
     if annual.exists():
-        try:
-            from radtree.annual.report import annual_report_section
-        except ImportError:
-            annual_report_section = None  # type: ignore[assignment]
-        if annual_report_section is not None:
-            parts.append(annual_report_section(project))
+        from radtree.annual import annual_report_section
+
+        parts.append(annual_report_section(project))
+        echo("  annual: metric maps and month × hour heat maps")
     return parts
 
 

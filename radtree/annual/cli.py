@@ -1,0 +1,74 @@
+"""``radtree annual PROJECT``: climate-based daylight over a year, with and without the tree."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import click
+
+from radtree.annual.schedule import (
+    DEFAULT_LEAF_OFF,
+    DEFAULT_LEAF_ON,
+    LeafSchedule,
+    parse_occupancy,
+)
+
+
+@click.command("annual", context_settings={"help_option_names": ["-h", "--help"],
+                                           "max_content_width": 100})
+@click.argument("project", type=click.Path(exists=True, path_type=Path))
+@click.option("--leaf-on", default=DEFAULT_LEAF_ON, show_default=True, metavar="MM-DD",
+              help="First day the crown is in leaf (Morus alba in Mendoza: an assumption).")
+@click.option("--leaf-off", default=DEFAULT_LEAF_OFF, show_default=True, metavar="MM-DD",
+              help="First day the crown is bare (branches only).")
+@click.option("--mf", default=1, show_default=True, type=click.IntRange(1, 8),
+              help="Reinhart sky subdivision (1 = 145 patches + ground).")
+@click.option("--sun-mf", default=1, show_default=True, type=click.IntRange(1, 8),
+              help="Reinhart subdivision of the unit suns for reflected sunlight.")
+@click.option("--occupancy", default="8-18", show_default=True, metavar="START-END",
+              help="Occupied hours, local standard time, every day.")
+@click.option("--epw", type=click.Path(exists=True, dir_okay=False, path_type=Path),
+              help="Weather file (default: [light] epw, else a generated clear-sky year).")
+@click.option("--with", "with_scenario", metavar="SCENARIO",
+              help="Scenario with the leafed tree (default: the project's louvers scenario).")
+@click.option("--without", "without_scenario", metavar="SCENARIO",
+              help="Scenario without tree (default: the project's model 'none' scenario).")
+@click.option("--ab", type=click.IntRange(0, 20), help="Ambient bounces (default: project).")
+@click.option("--ad", type=click.IntRange(1, 1_000_000), help="Ambient divisions.")
+@click.option("--lw", type=float, help="Ray weight limit.")
+@click.option("-j", "--processes", default=2, show_default=True, type=click.IntRange(1, 64),
+              help="rcontrib processes.")
+@click.option("--no-figures", is_flag=True, help="Skip the PNG figures.")
+def annual_command(project: Path, leaf_on: str, leaf_off: str, mf: int, sun_mf: int,
+                   occupancy: str, epw: Path | None, with_scenario: str | None,
+                   without_scenario: str | None, ab: int | None, ad: int | None,
+                   lw: float | None, processes: int, no_figures: bool) -> None:
+    """Annual daylight (8760 h) with a deciduous tree: UDI, DA, sDA, ASE, monthly means.
+
+    Writes PROJECT/results/annual.csv, annual_summary.csv, annual_monthly.csv and
+    results/annual/ (hourly arrays, coefficients, figures).
+    """
+    from radtree.annual.run import AnnualOptions, run_annual
+    from radtree.config import load_project
+
+    proj = load_project(project)
+    options = AnnualOptions(
+        leaf=LeafSchedule(leaf_on, leaf_off), mf=mf, sun_mf=sun_mf,
+        occupancy=parse_occupancy(occupancy), ab=ab, ad=ad, lw=lw, nproc=processes,
+        with_scenario=with_scenario, without_scenario=without_scenario, epw=epw)
+    click.echo(f"annual: {proj.name}")
+    out = run_annual(proj, options, echo=click.echo, progress=True,
+                     figures=not no_figures)
+    from radtree.annual.report import grid_summary
+
+    for row in grid_summary(proj).itertuples(index=False):
+        click.echo(f"  {row.grid:>10} {row.tree:>7} tree: sDA300/50% {row.sda_300_50:5.1f} %, "
+                   f"ASE1000,250 {row.ase_1000_250:5.1f} %, UDI <100 {row.udi_below_100:5.1f} "
+                   f"/ 100–300 {row.udi_100_300:5.1f} / 300–3000 {row.udi_300_3000:5.1f} / "
+                   f">3000 {row.udi_above_3000:5.1f} %")
+    if out.result.weather.generated:
+        click.secho("  weather: GENERATED clear-sky year (not measured): "
+                    f"{out.result.weather.path}", fg="yellow")
+    click.echo(f"→ {out.annual_csv}\n→ {out.summary_csv}\n→ {out.monthly_csv}")
+    for f in out.figures:
+        click.echo(f"→ {f}")

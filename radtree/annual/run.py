@@ -1,0 +1,465 @@
+"""The annual run: three scenes, their coefficients, 8760 hours of illuminance, the metrics.
+
+Method (daylight coefficients with a separate direct-sun treatment)
+-------------------------------------------------------------------
+For every sensor and hour h, in lux (179 · (0.265 R + 0.670 G + 0.065 B) of the visible
+irradiance):
+
+    E(h) = Σ_p C_sky[p] · S_sky[p, h]                       sky (and ground glow), -ab N
+         + C_dir[h] · L_sun(h)                               direct sun, -ab 0, exact sun
+         + Σ_j w_j(h) · (C_N[v_j] − C_0[v_j]) · L_sun(h)     inter-reflected sun, -ab N
+
+* ``S_sky`` — ``gendaymtx -s`` (the Perez sky *without* the sun, visible radiance,
+  Reinhart MF patches, ground patch ρ·E_global/π) from the EPW via ``epw2wea``;
+  ``C_sky`` — ``rcontrib`` sky-patch coefficients (``reinhartb.cal``), all bounces.
+* ``L_sun(h)`` and the sun direction — ``gendaymtx -D`` (the same solar position and Perez
+  luminous efficacy gendaymtx uses for the sky); ``C_dir`` — a unit 0.533° sun exactly at
+  each hour's position, ``-ab 0``: the direct sunlight of IES LM-83 (ASE uses this term
+  alone).
+* inter-reflected sun — unit suns at the Reinhart patch centres (``sun_mf``) around the
+  sun's path, ``-ab N`` minus ``-ab 0`` (the direct part is deterministic, so the
+  difference is exactly the reflected part); each hour interpolates between the three
+  centres around its sun with weights that reproduce every sunlit plane's n·d exactly
+  (:func:`radtree.annual.skymatrix.sun_patch_weights`). Each of these unit suns is a light
+  source every ambient hit must test (a shadow ray per sun and hit), so this run is traced
+  with coarser sampling than the sky (default ``-ad`` ÷ 4, ``-lw`` ≥ 1e-3): reflected
+  sunlight is a smaller, smoother share than the direct sun, and its sampling noise is
+  spread over the many hours each patch serves. Reinhart MF 1 patches with this
+  interpolation agree with point-in-time ``rtrace`` within 2 % on an open ground plane.
+
+Why not ``gendaymtx -5 0.533 -d`` (the five-phase sun matrix)? The Radiance shipped in the
+pyradiance wheel has no ``-5`` option; ``-D`` gives each hour's sun exactly, and with
+``-ab 0`` 4 400 suns cost seconds, so the direct term needs no patch approximation at all.
+The sky matrix ``gendaymtx -s`` has no sun, so nothing is counted twice.
+
+Deciduous tree: three scenes are traced — without the tree, with the leafed crown (the
+project's louvers scenario) and with the bare crown (:mod:`radtree.annual.branches`); the
+"with tree" year takes each day from the leaf-on or the leaf-off coefficients by the
+:class:`~radtree.annual.schedule.LeafSchedule`.
+"""
+
+from __future__ import annotations
+
+import json
+import time
+from collections.abc import Callable
+from dataclasses import asdict, dataclass, field, replace
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+from radtree.annual import metrics
+from radtree.annual.branches import BranchParams, build_leaf_off
+from radtree.annual.coefficients import CoefficientRunner, TraceParams
+from radtree.annual.schedule import (
+    DEFAULT_OCCUPANCY,
+    LeafSchedule,
+    occupied,
+    parse_occupancy,
+)
+from radtree.annual.skymatrix import (
+    Suns,
+    Wea,
+    epw_to_wea,
+    reinhart_directions,
+    sky_matrix,
+    sun_patch_weights,
+    sun_positions,
+)
+from radtree.annual.weather import WeatherSource, find_weather
+from radtree.config import Project, Scenario, effective_project
+from radtree.errors import ConfigError
+from radtree.fileio import atomic_path, write_text
+from radtree.scene import Scene
+
+PHOTOPIC = np.array([0.265, 0.670, 0.065])
+LUX = 179.0 * PHOTOPIC
+VARIANTS = ("without", "leaf_on", "leaf_off")
+TREES = ("with", "without")
+ANNUAL_COLUMNS = ["grid", "sensor", "tree", "udi_below_100", "udi_100_300", "udi_300_3000",
+                  "udi_above_3000", "da_300", "ase_hours"]
+SUMMARY_COLUMNS = ["grid", "tree", "sda_300_50", "ase_1000_250", "month", "mean_lux"]
+SUN_LW_MIN = 1e-3
+METHOD_NOTES = [
+    "Sky model: gendaymtx's Perez sky patches do not blend the sky into the ground near the "
+    "horizon as gendaylit's perezlum.cal does (the point-in-time runs); sensors that see "
+    "mostly low sky get a few per cent (up to ≈ 8 % in a test box) more sky light here.",
+    "Reflected sunlight is interpolated between unit suns at Reinhart patch centres: on the "
+    "office work plane within ≈ 2–7 % of rcontrib with the exact sun (benchmarks/annual.py); "
+    "the direct sun (ASE) is exact for every hour.",
+]
+MONTHLY_COLUMNS = ["grid", "tree", "month", "mean_lux", "mean_direct_lux", "leaf_on_days",
+                   "days", "crown"]
+
+
+@dataclass(frozen=True)
+class AnnualOptions:
+    """Settings of an annual run (None = from the project)."""
+
+    leaf: LeafSchedule = field(default_factory=LeafSchedule)
+    mf: int = 1
+    sun_mf: int = 1
+    occupancy: tuple[float, float] = DEFAULT_OCCUPANCY
+    ab: int | None = None
+    ad: int | None = None
+    lw: float | None = None
+    sun_ad: int | None = None
+    sun_lw: float | None = None
+    nproc: int = 2
+    with_scenario: str | None = None
+    without_scenario: str | None = None
+    epw: Path | None = None
+    grids: tuple[str, ...] | None = None
+    branches: BranchParams = field(default_factory=BranchParams)
+
+    def __post_init__(self) -> None:
+        if self.mf < 1 or self.sun_mf < 1:
+            raise ConfigError(f"sky subdivision must be ≥ 1 (got --mf {self.mf}, "
+                              f"sun MF {self.sun_mf})")
+        parse_occupancy(self.occupancy)
+        if self.nproc < 1:
+            raise ConfigError("processes must be ≥ 1")
+
+
+@dataclass
+class AnnualResult:
+    """Hourly illuminance of the year and what produced it."""
+
+    project: Project
+    options: AnnualOptions
+    weather: WeatherSource
+    wea: Wea
+    grids: dict[str, dict[str, np.ndarray]]  # grid → points, normals
+    total: dict[str, dict[str, np.ndarray]]  # variant/tree → grid → (sensors, 8760) lux
+    direct: dict[str, dict[str, np.ndarray]]
+    in_leaf: np.ndarray  # (8760,) bool
+    occupied: np.ndarray  # (8760,) bool
+    scenarios: dict[str, str]
+    trace: TraceParams
+    sun_trace: TraceParams
+    ground_reflectance: float
+    notes: list[str]
+    timing: dict[str, float]
+
+
+# ---------------------------------------------------------------- scene choice
+def choose_scenarios(project: Project, options: AnnualOptions
+                     ) -> tuple[Scenario, Scenario, list[str]]:
+    """The leafed-tree scenario and the no-tree scenario of the annual run."""
+    notes = []
+    if options.with_scenario:
+        with_sc = project.scenario(options.with_scenario)
+        if with_sc.model == "none":
+            raise ConfigError(f"scenario {with_sc.name!r} has no crown (model 'none'): choose "
+                              "a scenario with a tree for --with", source=str(project.source))
+    else:
+        trees = [s for s in project.scenarios if s.model != "none"]
+        if not trees:
+            raise ConfigError("the project has no scenario with a crown model: the annual "
+                              "run compares a tree with no tree", source=str(project.source))
+
+        def rank(s: Scenario) -> tuple[int, int, int]:
+            return (s.model != "louvers", (s.form or project.tree.form) != "free",
+                    s.reflection != "traced")
+
+        with_sc = sorted(trees, key=rank)[0]
+    if options.without_scenario:
+        without_sc = project.scenario(options.without_scenario)
+        if without_sc.model != "none":
+            raise ConfigError(f"scenario {without_sc.name!r} has a crown ({without_sc.model}); "
+                              "--without needs model 'none'", source=str(project.source))
+    else:
+        nones = [s for s in project.scenarios if s.model == "none"]
+        if nones:
+            without_sc = nones[0]
+        else:
+            without_sc = replace(with_sc, name=f"{with_sc.name}-no-tree", model="none",
+                                 description="the leafed scenario without its crown")
+            notes.append(f"No scenario without a tree in the project: the annual run uses "
+                         f"'{with_sc.name}' with its crown removed.")
+    if with_sc.reflection == "calculated":
+        notes.append(f"Scenario '{with_sc.name}' calculates the ground-reflected light "
+                     "analytically for single hours; the annual run traces it (the street "
+                     "is part of the coefficients).")
+    notes.append("The annual sky comes from the weather file (Perez sky + sun every hour); "
+                 "a scenario's own sky setting applies to the point-in-time runs only.")
+    return with_sc, without_sc, notes
+
+
+def annual_ground_reflectance(project: Project) -> float:
+    """The street's reflectance for a whole year: the constant, or the mean of the
+    sun-angle table (coefficients need one fixed material)."""
+    table = project.street.ground_reflectance_table
+    if table is None:
+        return float(project.street.ground_reflectance)
+    from radtree.light import read_table
+
+    df = read_table(table, ("angle_deg", "reflectance"), "ground reflectance table")
+    return float(df["reflectance"].mean())
+
+
+def annual_scenes(project: Project, with_sc: Scenario, without_sc: Scenario,
+                  branches: BranchParams, grids: tuple[str, ...] | None
+                  ) -> tuple[dict[str, Scene], list[str], int, list[str]]:
+    """Scenes of the three variants, the grids to trace, the recommended -ab and notes."""
+    from radtree.scenarios import facade_frame, make_scene
+
+    b_on = make_scene(project, with_sc, dense_grid=False)
+    b_none = make_scene(project, without_sc, dense_grid=False)
+    bare = make_scene(project, replace(with_sc, model="none"), dense_grid=False)
+    crown = build_leaf_off(effective_project(project, with_sc), with_sc,
+                           facade_frame(effective_project(project, with_sc)), branches)
+    materials = dict(bare.scene.materials)
+    for k, v in crown.materials.items():
+        materials.setdefault(k, v)
+    off = Scene(bare.scene.meshes + crown.meshes, materials, bare.scene.grids,
+                bare.scene.notes + crown.notes, bare.scene.ground_material)
+    scenes = {"without": b_none.scene, "leaf_on": b_on.scene, "leaf_off": off}
+    available = list(b_on.scene.grids)
+    use = list(grids) if grids else available
+    unknown = [g for g in use if g not in available]
+    if unknown:
+        raise ConfigError(f"unknown grid(s) {', '.join(unknown)} (have: {', '.join(available)})")
+    for name, sc in scenes.items():
+        for g in use:
+            if g not in sc.grids or not np.allclose(sc.grids[g].points,
+                                                    b_on.scene.grids[g].points):
+                raise ConfigError(f"grid {g!r} differs between the annual scenes ({name})")
+    ab = max(b_on.ab, b_none.ab)
+    if project.office is not None:
+        from radtree.site.office import RECOMMENDED_AB
+
+        ab = max(ab, RECOMMENDED_AB)
+    notes = list(crown.notes)
+    return scenes, use, ab, notes
+
+
+# ---------------------------------------------------------------- combination
+def combine(c_sky: np.ndarray, sky: np.ndarray, c_dir: np.ndarray, suns: Suns,
+            c_ind: np.ndarray, verts: np.ndarray, weights: np.ndarray, n_hours: int
+            ) -> tuple[np.ndarray, np.ndarray]:
+    """(total, direct) lux, each (sensors, hours).
+
+    ``c_sky`` (sensors, patches, 3), ``sky`` (patches, hours, 3); ``c_dir`` (sensors, suns,
+    3); ``c_ind`` (sensors, patch vertices, 3) inter-reflected-sun coefficients indexed like
+    :func:`reinhart_directions` (row 0, the nadir, zero); ``verts``/``weights`` (suns, 3).
+    """
+    n = c_sky.shape[0]
+    total = np.zeros((n, n_hours), np.float64)
+    for ch in range(3):
+        total += LUX[ch] * (c_sky[:, :, ch].astype(np.float64) @ sky[:, :, ch].astype(np.float64))
+    direct = np.zeros((n, n_hours), np.float64)
+    if len(suns):
+        d = (c_dir.astype(np.float64) @ LUX) * suns.radiance[None, :]
+        direct[:, suns.hour_index] = d
+        ind_lux = c_ind.astype(np.float64) @ LUX  # (sensors, vertices)
+        ind = np.einsum("skj,kj->sk", ind_lux[:, verts], weights) * suns.radiance[None, :]
+        total[:, suns.hour_index] += d + ind
+    return total.astype(np.float32), direct.astype(np.float32)
+
+
+# ---------------------------------------------------------------- the run
+def compute_annual(project: Project, options: AnnualOptions | None = None,
+                   echo: Callable[[str], None] = print, progress: bool = False
+                   ) -> AnnualResult:
+    """Trace the three scenes and assemble 8760 hours of illuminance per sensor."""
+    options = options or AnnualOptions()
+    timing: dict[str, float] = {}
+    t0 = time.perf_counter()
+    with_sc, without_sc, notes = choose_scenarios(project, options)
+    scenes, grids, rec_ab, crown_notes = annual_scenes(project, with_sc, without_sc,
+                                                       options.branches, options.grids)
+    notes += crown_notes
+    eng = effective_project(project, with_sc).engine
+    ab = options.ab if options.ab is not None else (eng.ab if eng.ab is not None else rec_ab)
+    trace = TraceParams(ab=ab, ad=options.ad or eng.ad, lw=options.lw or eng.lw,
+                        nproc=options.nproc)
+    sun_trace = TraceParams(ab=ab, ad=options.sun_ad or max(128, trace.ad // 4),
+                            lw=options.sun_lw or max(trace.lw, SUN_LW_MIN), nproc=options.nproc)
+    rho = annual_ground_reflectance(project)
+    timing["scenes_s"] = time.perf_counter() - t0
+
+    t1 = time.perf_counter()
+    weather = find_weather(project, options.epw, echo)
+    work = project.results_dir / "annual"
+    wea = epw_to_wea(weather.path, work / "weather" / "year.wea")
+    site = project.site
+    if abs(wea.latitude - site.latitude) > 0.5 or abs(-wea.longitude_west - site.longitude) > 0.5:
+        raise ConfigError(f"weather {weather.path} is for {wea.latitude}, {-wea.longitude_west} "
+                          f"but the site is at {site.latitude}, {site.longitude}")
+    sky = sky_matrix(wea, options.mf, rho)
+    suns = sun_positions(wea, work / "weather")
+    verts, weights = sun_patch_weights(suns.direction, options.sun_mf)
+    need = np.unique(verts)
+    need = need[need > 0]
+    patch_dirs = reinhart_directions(options.sun_mf)
+    timing["weather_s"] = time.perf_counter() - t1
+    echo(f"  weather: {weather.description}; {int((wea.dni + wea.dhi > 0).sum())} daylight "
+         f"hours, {len(suns)} sun positions, {len(need)} sun patches (MF {options.sun_mf})")
+    echo(f"  rcontrib: -ab {trace.ab} -ad {trace.ad} -lw {trace.lw:g} (sky, MF {options.mf}); "
+         f"-ad {sun_trace.ad} -lw {sun_trace.lw:g} (reflected sun); {trace.nproc} "
+         f"process(es); ground ρ {rho:.3f}")
+
+    total: dict[str, dict[str, np.ndarray]] = {}
+    direct: dict[str, dict[str, np.ndarray]] = {}
+    items = list(VARIANTS)
+    bar = None
+    if progress:
+        from tqdm import tqdm
+
+        bar = tqdm(total=len(items), desc="annual", unit="scene", leave=False)
+    try:
+        for variant in items:
+            tv = time.perf_counter()
+            scene = scenes[variant]
+            echo(f"  {variant}: {scene.n_triangles} triangles, "
+                 f"{sum(len(scene.grids[g]) for g in grids)} sensors")
+            runner = CoefficientRunner(scene, grids, work / "coefficients" / variant, rho,
+                                       echo=echo)
+            c_sky = runner.sky(options.mf, trace)
+            c_dir = runner.suns("direct", suns.direction, 0, trace)
+            c_n = runner.suns(f"patch{options.sun_mf}_ab{trace.ab}", patch_dirs[need],
+                              trace.ab, sun_trace)
+            c_0 = runner.suns(f"patch{options.sun_mf}_ab0", patch_dirs[need], 0, sun_trace)
+            c_ind = np.zeros((runner.n_sensors, len(patch_dirs), 3), np.float32)
+            c_ind[:, need] = c_n - c_0
+            tot, dire = combine(c_sky, sky, c_dir, suns, c_ind, verts, weights, wea.n_hours)
+            total[variant], direct[variant] = {}, {}
+            start = 0
+            for g in grids:
+                n = len(scene.grids[g])
+                total[variant][g] = tot[start:start + n]
+                direct[variant][g] = dire[start:start + n]
+                start += n
+            timing[f"{variant}_s"] = time.perf_counter() - tv
+            if bar is not None:
+                bar.update(1)
+    finally:
+        if bar is not None:
+            bar.close()
+
+    in_leaf = options.leaf.in_leaf(wea.month, wea.day)
+    for store in (total, direct):
+        store["with"] = {g: np.where(in_leaf[None, :], store["leaf_on"][g], store["leaf_off"][g])
+                         for g in grids}
+    occ = occupied(wea.hour, options.occupancy)
+    grid_geo = {g: {"points": scenes["leaf_on"].grids[g].points,
+                    "normals": scenes["leaf_on"].grids[g].normals} for g in grids}
+    notes.append(f"Crown {options.leaf.describe()}.")
+    notes += METHOD_NOTES
+    timing["total_s"] = time.perf_counter() - t0
+    return AnnualResult(project=project, options=options, weather=weather, wea=wea,
+                        grids=grid_geo, total=total, direct=direct, in_leaf=in_leaf,
+                        occupied=occ, scenarios={"with": with_sc.name,
+                                                 "without": without_sc.name},
+                        trace=trace, sun_trace=sun_trace, ground_reflectance=rho, notes=notes, timing=timing)
+
+
+# ---------------------------------------------------------------- tables
+def annual_tables(result: AnnualResult) -> tuple[pd.DataFrame, pd.DataFrame, pd.DataFrame]:
+    """annual.csv, annual_summary.csv and annual_monthly.csv as data frames."""
+    rows, summary, monthly = [], [], []
+    wea = result.wea
+    days_in_month = np.array([31, 28, 31, 30, 31, 30, 31, 31, 30, 31, 30, 31])
+    leaf_days = np.array([int(np.sum(result.in_leaf[(wea.month == m) & (wea.hour < 1)]))
+                          for m in range(1, 13)])
+    for g in result.grids:
+        for tree in TREES:
+            lux, dire = result.total[tree][g], result.direct[tree][g]
+            t = metrics.sensor_table(lux, dire, result.occupied)
+            t.insert(0, "tree", tree)
+            t.insert(0, "sensor", np.arange(len(t)))
+            t.insert(0, "grid", g)
+            rows.append(t)
+            sda = metrics.spatial_daylight_autonomy(t["da_300"].to_numpy())
+            ase = metrics.annual_sunlight_exposure(t["ase_hours"].to_numpy())
+            means = metrics.monthly_mean(lux, result.occupied, wea.month)
+            dmeans = metrics.monthly_mean(dire, result.occupied, wea.month)
+            for m in range(12):
+                summary.append({"grid": g, "tree": tree, "sda_300_50": sda,
+                                "ase_1000_250": ase, "month": m + 1, "mean_lux": means[m]})
+                ld = int(leaf_days[m]) if tree == "with" else 0
+                crown = ("none" if tree == "without" else "leaf" if ld == days_in_month[m]
+                         else "bare" if ld == 0 else "mixed")
+                monthly.append({"grid": g, "tree": tree, "month": m + 1, "mean_lux": means[m],
+                                "mean_direct_lux": dmeans[m], "leaf_on_days": ld,
+                                "days": int(days_in_month[m]), "crown": crown})
+    annual = pd.concat(rows, ignore_index=True)[ANNUAL_COLUMNS]
+    return (annual, pd.DataFrame(summary)[SUMMARY_COLUMNS],
+            pd.DataFrame(monthly)[MONTHLY_COLUMNS])
+
+
+@dataclass
+class AnnualOutcome:
+    result: AnnualResult
+    annual_csv: Path
+    summary_csv: Path
+    monthly_csv: Path
+    hourly: Path
+    meta: Path
+    figures: list[Path]
+
+
+def _write_csv(df: pd.DataFrame, path: Path) -> Path:
+    with atomic_path(path) as tmp:
+        df.to_csv(tmp, index=False, float_format="%.6g")
+    return path
+
+
+def write_annual(result: AnnualResult, figures: bool = True) -> AnnualOutcome:
+    """Write the tables, the hourly arrays, the run's facts and the figures."""
+    project = result.project
+    res = project.results_dir
+    annual, summary, monthly = annual_tables(result)
+    a = _write_csv(annual, res / "annual.csv")
+    s = _write_csv(summary, res / "annual_summary.csv")
+    m = _write_csv(monthly, res / "annual_monthly.csv")
+    hourly = res / "annual" / "hourly.npz"
+    arrays: dict[str, np.ndarray] = {
+        "month": result.wea.month, "day": result.wea.day, "hour": result.wea.hour,
+        "in_leaf": result.in_leaf, "occupied": result.occupied,
+    }
+    for g, geo in result.grids.items():
+        arrays[f"points__{g}"] = geo["points"]
+        arrays[f"normals__{g}"] = geo["normals"]
+        for key in ("with", "without", "leaf_on", "leaf_off"):
+            arrays[f"total__{key}__{g}"] = result.total[key][g]
+            arrays[f"direct__{key}__{g}"] = result.direct[key][g]
+    hourly.parent.mkdir(parents=True, exist_ok=True)
+    with atomic_path(hourly) as tmp:
+        with open(tmp, "wb") as fh:
+            np.savez_compressed(fh, **arrays)  # type: ignore[arg-type]
+    o = result.options
+    meta = {
+        "weather": {"path": str(result.weather.path), "generated": result.weather.generated,
+                    "description": result.weather.description},
+        "scenarios": result.scenarios,
+        "leaf_on": o.leaf.leaf_on, "leaf_off": o.leaf.leaf_off,
+        "leaf_days": o.leaf.leaf_days(),
+        "occupancy": list(o.occupancy), "occupied_hours": int(result.occupied.sum()),
+        "sky_mf": o.mf, "sun_mf": o.sun_mf,
+        "rcontrib": {"ab": result.trace.ab, "ad": result.trace.ad, "lw": result.trace.lw,
+                     "sun_ad": result.sun_trace.ad, "sun_lw": result.sun_trace.lw,
+                     "processes": result.trace.nproc},
+        "ground_reflectance": result.ground_reflectance,
+        "branches": asdict(o.branches),
+        "grids": {g: len(v["points"]) for g, v in result.grids.items()},
+        "notes": result.notes, "timing": result.timing,
+    }
+    mp = write_text(res / "annual" / "annual_meta.json", json.dumps(meta, indent=2,
+                                                                     default=str))
+    figs: list[Path] = []
+    if figures:
+        from radtree.annual.report import write_figures
+
+        figs = write_figures(project)
+    return AnnualOutcome(result, a, s, m, hourly, mp, figs)
+
+
+def run_annual(project: Project, options: AnnualOptions | None = None,
+               echo: Callable[[str], None] = print, progress: bool = False,
+               figures: bool = True) -> AnnualOutcome:
+    """Compute and write the annual results (the Python API of ``radtree annual``)."""
+    result = compute_annual(project, options, echo, progress)
+    return write_annual(result, figures=figures)
