@@ -227,3 +227,13 @@ def test_plastic_range(rho):
     else:
         with pytest.raises(ValueError):
             Plastic("p", rho)
+
+
+# ---------------------------------------------------------------- diagnose
+def test_diagnose_bad_measurements(proj, tmp_path):
+    bad = tmp_path / "m.csv"
+    bad.write_text("# Units: lux\ntime,measured_lux\n12:30,1600\n13:30,-4\n")
+    assert_clear_failure(run(["diagnose", str(proj), "--measured", str(bad)]), "line")
+    assert_clear_failure(run(["diagnose", str(proj), "--measured", str(tmp_path / "no.csv")]))
+    assert_clear_failure(run(["diagnose", str(tmp_path / "nothing")]))
+    assert not (proj / "diagnose" / "steps.csv").exists()
