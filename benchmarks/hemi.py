@@ -13,7 +13,7 @@ import tempfile
 import time
 from pathlib import Path
 
-PHOTO = Path("/work/shared/data/fisheye/chestnut_coolpix4500_fc-e8.jpg")
+PHOTO = Path(__file__).resolve().parents[2] / "shared/data/fisheye/chestnut_coolpix4500_fc-e8.jpg"
 REPEAT = 5
 TARGET_S = 2.0
 

@@ -23,7 +23,7 @@ from radtree.hemi import (
 from radtree.hemi.cli import hemi_command
 from radtree.hemi.mask import CircularMask
 
-PHOTO = Path("/work/shared/data/fisheye/chestnut_coolpix4500_fc-e8.jpg")
+PHOTO = Path(__file__).resolve().parents[2] / "shared/data/fisheye/chestnut_coolpix4500_fc-e8.jpg"
 pytestmark = pytest.mark.skipif(not PHOTO.exists(), reason="shared test photo not available")
 GRID = RingGrid(5, 8, 0.0, 75.0)
 
