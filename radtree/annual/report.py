@@ -17,12 +17,12 @@ from pathlib import Path
 
 import numpy as np
 import pandas as pd
-from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.colors import LogNorm
 from matplotlib.figure import Figure
 
 from radtree.annual import metrics
 from radtree.config import Project
+from radtree.figures import new_figure, save_png
 
 DPI = 150
 MONTHS = ["Jan", "Feb", "Mar", "Apr", "May", "Jun", "Jul", "Aug", "Sep", "Oct", "Nov", "Dec"]
@@ -37,15 +37,11 @@ def _paths(project: Project) -> dict[str, Path]:
 
 
 def _figure(w: float, h: float) -> Figure:
-    fig = Figure(figsize=(w, h), dpi=DPI, layout="constrained")
-    FigureCanvasAgg(fig)
-    return fig
+    return new_figure(w, h, DPI)
 
 
 def _save(fig: Figure, path: Path) -> Path:
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(path, dpi=DPI, format="png", metadata={"Software": None})
-    return path
+    return save_png(fig, path, DPI)
 
 
 def plane_coordinates(points: np.ndarray, normals: np.ndarray) -> tuple[np.ndarray, np.ndarray,

@@ -15,14 +15,14 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 from jinja2 import Environment, PackageLoader, StrictUndefined
 from matplotlib import colormaps
-from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 
 from radtree import __version__
 from radtree.diagnose.attribution import TIE_CORR
 from radtree.diagnose.effects import EFFECTS, Context, candidates
 from radtree.diagnose.residuals import RULES, DisagreementMap
-from radtree.fileio import atomic_path, write_text
+from radtree.figures import new_figure, save_png
+from radtree.fileio import write_text
 
 if TYPE_CHECKING:
     from radtree.diagnose.hidden import SelftestResult
@@ -34,15 +34,11 @@ LUX = "lx"
 
 
 def _fig(w: float, h: float) -> Figure:
-    fig = Figure(figsize=(w, h), dpi=DPI, layout="constrained")
-    FigureCanvasAgg(fig)
-    return fig
+    return new_figure(w, h, DPI)
 
 
 def _save(fig: Figure, path: Path) -> str:
-    with atomic_path(path) as tmp:
-        fig.savefig(tmp, dpi=DPI, format="png", metadata={"Software": None})
-    return path.name
+    return save_png(fig, path, DPI).name
 
 
 def _hour(t: str) -> float:

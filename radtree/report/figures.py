@@ -20,6 +20,7 @@ from matplotlib.colors import LogNorm, Normalize
 from matplotlib.figure import Figure
 from matplotlib.ticker import FixedLocator, FuncFormatter, LogLocator, NullFormatter
 
+from radtree.figures import new_figure, save_png
 from radtree.report.data import (
     MAP_GRID,
     TIMING_PARTS,
@@ -38,14 +39,11 @@ MAP_CMAP = "viridis"
 
 
 def _new_figure(width: float, height: float) -> Figure:
-    fig = Figure(figsize=(width, height), dpi=DPI, layout="constrained")
-    FigureCanvasAgg(fig)
-    return fig
+    return new_figure(width, height, DPI)
 
 
 def _save(fig: Figure, path: Path) -> None:
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(path, dpi=DPI, format="png", metadata={"Software": None})
+    save_png(fig, path, DPI)
 
 
 def scenario_colours(names: list[str]) -> dict[str, tuple[float, ...]]:
