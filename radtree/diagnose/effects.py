@@ -213,7 +213,22 @@ def _louvers_only(sc: Scenario) -> str | None:
 
 
 # --------------------------------------------------------------------------- the effects
-class UnfilteredGround(Effect):
+class _ZeroIsOff(Effect):
+    """An effect set by one numeric switch ``key`` whose value 0 means off."""
+
+    key: str
+
+    def is_on(self, ctx: Context, sc: Scenario) -> bool:
+        return (self.current(ctx, sc) or 0.0) > 0.0
+
+    def switch_on(self, ctx: Context, sc: Scenario, strength: float | None = None) -> Scenario:
+        return with_switches(sc, {self.key: float(self._value(ctx, sc, strength))})
+
+    def switch_off(self, ctx: Context, sc: Scenario) -> Scenario:
+        return with_switches(sc, {self.key: 0.0})
+
+
+class UnfilteredGround(_ZeroIsOff):
     name = "unfiltered_ground"
     title = "Ground-reflected light arriving unfiltered below the crown"
     physics = ("street-lit concrete reflects ρ(α)·E_open onto the façade from below the crown "
@@ -227,12 +242,6 @@ class UnfilteredGround(Effect):
 
     def current(self, ctx: Context, sc: Scenario) -> float:
         return float(sc.switches.get(self.key, 0.0))
-
-    def is_on(self, ctx: Context, sc: Scenario) -> bool:
-        return self.current(ctx, sc) > 0.0
-
-    def switch_on(self, ctx: Context, sc: Scenario, strength: float | None = None) -> Scenario:
-        return with_switches(sc, {self.key: float(self._value(ctx, sc, strength))})
 
     def switch_off(self, ctx: Context, sc: Scenario) -> Scenario:
         return with_switches(sc, drop=[self.key])
@@ -294,7 +303,7 @@ class SkyDiffuse(Effect):
         return with_switches(sc, drop=[self.key], sky="none")
 
 
-class OppositeFacade(Effect):
+class OppositeFacade(_ZeroIsOff):
     name = "opposite_facade"
     title = "Interreflection with the opposite façade"
     physics = ("the sunlit façade across the street reflects light back onto the studied "
@@ -310,14 +319,6 @@ class OppositeFacade(Effect):
     def current(self, ctx: Context, sc: Scenario) -> float:
         return float(effective_project(ctx.project, sc).street.opposite_reflectance)
 
-    def is_on(self, ctx: Context, sc: Scenario) -> bool:
-        return self.current(ctx, sc) > 0.0
-
-    def switch_on(self, ctx: Context, sc: Scenario, strength: float | None = None) -> Scenario:
-        return with_switches(sc, {self.key: float(self._value(ctx, sc, strength))})
-
-    def switch_off(self, ctx: Context, sc: Scenario) -> Scenario:
-        return with_switches(sc, {self.key: 0.0})
 
 
 class AmbientBounces(Effect):
@@ -352,7 +353,7 @@ class AmbientBounces(Effect):
         return with_switches(sc, drop=[self.key])
 
 
-class SpecularTransmission(Effect):
+class SpecularTransmission(_ZeroIsOff):
     name = "specular_transmission"
     title = "Specular (direct) transmission through the slats"
     physics = ("part of each slat layer's transmission passes undeviated (sun through leaf "
@@ -372,14 +373,6 @@ class SpecularTransmission(Effect):
     def current(self, ctx: Context, sc: Scenario) -> float:
         return float(ctx.louvers(sc).specular_fraction)
 
-    def is_on(self, ctx: Context, sc: Scenario) -> bool:
-        return self.current(ctx, sc) > 0.0
-
-    def switch_on(self, ctx: Context, sc: Scenario, strength: float | None = None) -> Scenario:
-        return with_switches(sc, {self.key: float(self._value(ctx, sc, strength))})
-
-    def switch_off(self, ctx: Context, sc: Scenario) -> Scenario:
-        return with_switches(sc, {self.key: 0.0})
 
 
 class CrownGaps(Effect):
