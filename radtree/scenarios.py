@@ -132,8 +132,10 @@ def build_project(project: Project, scenarios: list[str] | None = None,
         built = make_scene(project, sc)
         t1 = time.perf_counter()
         with atomic_dir(build_root / sc.name) as tmp:
+            names = list(built.scene.grids)
+            at = {st.label: hour_grids(project, st.time, names, None) for st in states}
             write_build(built.scene, states, effective_project(project, sc).engine, built.ab,
-                        tmp, install, sc.name)
+                        tmp, install, sc.name, grids_at=lambda st, at=at: at[st.label])
             if pictures and built.tree is not None:
                 from radtree.trees.picture import render_model_png
 

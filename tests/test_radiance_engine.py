@@ -139,3 +139,15 @@ def test_unknown_hour_is_an_error(open_street):
     r = CliRunner().invoke(main, ["simulate", str(open_street), "--hour", "12:00"])
     assert r.exit_code == 2
     assert "unknown hour(s) 12:00" in r.output
+
+
+def test_makefile_traces_dense_map_only_at_dense_hours(open_street):
+    toml = open_street / "radtree.toml"
+    text = toml.read_text().replace("[sensors]\n", '[sensors]\ndense_hours = ["13:30"]\n')
+    toml.write_text(text)
+    r = CliRunner().invoke(main, ["build", str(open_street), "--no-pictures", "-s", "B"])
+    assert r.exit_code == 0, r.output
+    make = (open_street / "build" / "B" / "Makefile").read_text()
+    assert "\n1030: results/1030_facade.lux\n" in make
+    assert "\n1330: results/1330_facade.lux results/1330_facade_map.lux\n" in make
+    assert "results/1030_facade_map" not in make

@@ -14,6 +14,7 @@ build/<scenario>/
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -92,6 +93,11 @@ class BuildPlan:
     hour_files: dict[str, list[str]]
     rtrace_opts: list[str]
     states: dict[str, SkyState] = field(default_factory=dict)
+    hour_grids: dict[str, list[str]] = field(default_factory=dict)   # default: every grid
+
+    def grids_at(self, hour: str) -> list[str]:
+        """Grids the Makefile traces at ``hour`` (label HHMM)."""
+        return self.hour_grids.get(hour, self.grids)
 
     def oconv_command(self, hour: str) -> list[str]:
         return ["oconv", *self.scene_files, *self.hour_files[hour]]
@@ -101,8 +107,11 @@ class BuildPlan:
 
 
 def write_build(scene: Scene, states: list[SkyState], params: EngineParams, ab: int,
-                folder: Path, install: RadianceInstall | None, scenario: str = "scene") -> BuildPlan:
-    """Write the scene, the hours' skies, the grids and the Makefile into ``folder``."""
+                folder: Path, install: RadianceInstall | None, scenario: str = "scene",
+                grids_at: Callable[[SkyState], list[str]] | None = None) -> BuildPlan:
+    """Write the scene, the hours' skies, the grids and the Makefile into ``folder``.
+
+    ``grids_at(state)`` names the grids the Makefile traces at that hour (default: all)."""
     folder.mkdir(parents=True, exist_ok=True)
     (folder / "geometry").mkdir(exist_ok=True)
     (folder / "grids").mkdir(exist_ok=True)
@@ -145,7 +154,8 @@ def write_build(scene: Scene, states: list[SkyState], params: EngineParams, ab: 
     plan = BuildPlan(folder=folder, hours=[s.label for s in states], grids=list(scene.grids),
                      scene_files=scene_files, hour_files=hour_files,
                      rtrace_opts=rtrace_options(params, ab),
-                     states={s.label: s for s in states})
+                     states={s.label: s for s in states},
+                     hour_grids={s.label: grids_at(s) for s in states} if grids_at else {})
     write_makefile(plan, install, scenario)
     return plan
 
@@ -155,6 +165,7 @@ def write_makefile(plan: BuildPlan, install: RadianceInstall | None, scenario: s
                       keep_trailing_newline=True)
     text = env.get_template("Makefile.j2").render(
         version=radtree.__version__, scenario=scenario, hours=plan.hours, grids=plan.grids,
+        hour_grids={h: plan.grids_at(h) for h in plan.hours},
         scene_files=plan.scene_files, hour_files=plan.hour_files,
         rtrace_opts=" ".join(plan.rtrace_opts),
         bin_dir=str(install.bin_dir) if install else "/usr/local/bin",
