@@ -135,7 +135,7 @@ def build_project(project: Project, scenarios: list[str] | None = None,
             names = list(built.scene.grids)
             at = {st.label: hour_grids(project, st.time, names, None) for st in states}
             write_build(built.scene, states, effective_project(project, sc).engine, built.ab,
-                        tmp, install, sc.name, grids_at=lambda st, at=at: at[st.label])
+                        tmp, install, sc.name, hour_grids=at)
             if pictures and built.tree is not None:
                 from radtree.trees.picture import render_model_png
 

@@ -14,7 +14,6 @@ build/<scenario>/
 
 from __future__ import annotations
 
-from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -108,10 +107,11 @@ class BuildPlan:
 
 def write_build(scene: Scene, states: list[SkyState], params: EngineParams, ab: int,
                 folder: Path, install: RadianceInstall | None, scenario: str = "scene",
-                grids_at: Callable[[SkyState], list[str]] | None = None) -> BuildPlan:
+                hour_grids: dict[str, list[str]] | None = None) -> BuildPlan:
     """Write the scene, the hours' skies, the grids and the Makefile into ``folder``.
 
-    ``grids_at(state)`` names the grids the Makefile traces at that hour (default: all)."""
+    ``hour_grids`` maps an hour label (HHMM) to the grids the Makefile traces then (default:
+    every grid at every hour)."""
     folder.mkdir(parents=True, exist_ok=True)
     (folder / "geometry").mkdir(exist_ok=True)
     (folder / "grids").mkdir(exist_ok=True)
@@ -155,7 +155,7 @@ def write_build(scene: Scene, states: list[SkyState], params: EngineParams, ab: 
                      scene_files=scene_files, hour_files=hour_files,
                      rtrace_opts=rtrace_options(params, ab),
                      states={s.label: s for s in states},
-                     hour_grids={s.label: grids_at(s) for s in states} if grids_at else {})
+                     hour_grids=dict(hour_grids or {}))
     write_makefile(plan, install, scenario)
     return plan
 
