@@ -175,12 +175,13 @@ def _register_commands() -> None:
     from radtree.annual.cli import annual_command
     from radtree.diagnose.cli import diagnose_command
     from radtree.hemi.cli import hemi_command
+    from radtree.permeability_cli import permeability_command
     from radtree.report.cli import report_command
     from radtree.sweep.cli import sweep_command
     from radtree.trees.cli import calibrate_command
 
     for cmd in (hemi_command, report_command, calibrate_command, sweep_command,
-                diagnose_command, annual_command):
+                diagnose_command, annual_command, permeability_command):
         main.add_command(cmd)
 
 

@@ -202,6 +202,25 @@ def _rows(project: Project, sc: Scenario, st: SkyState, scene: Scene,
     return pd.concat(frames, ignore_index=True)
 
 
+def trace_numpy(project: Project, sc: Scenario, rays: int | None = None, seed: int | None = None,
+                grids: list[str] | None = None) -> pd.DataFrame:
+    """Every hour of one scenario with the NumPy engine, in memory: the rows ``simulate``
+    would write (calculated reflection included), nothing written to disk."""
+    from radtree.engines.numpy.engine import trace_hour
+
+    built = make_scene(project, sc, dense_grid=False)
+    eng = effective_project(project, sc).engine
+    params = replace(eng, ab=built.ab, max_bounces=built.ab, rays=rays or eng.rays,
+                     seed=eng.seed if seed is None else seed)
+    phash = project.params_hash(sc)
+    frames = []
+    for st in hour_states(project, sc):
+        use = [g for g in built.scene.grids if grids is None or g in grids]
+        res = trace_hour(built.scene, st, params, grids=use)
+        frames.append(_rows(project, sc, st, built.scene, res, "numpy", phash))
+    return pd.concat(frames, ignore_index=True)
+
+
 @dataclass
 class SimulationOutcome:
     table: pd.DataFrame

@@ -529,6 +529,12 @@ def extra_sections(project: Project, out: Path, echo: Callable[[str], None]) -> 
     if sweep:
         parts.append(sweep)
         echo("  sweep: sensitivity section")
+    from radtree.permeability_scan import scan_report_section
+
+    scan = scan_report_section(project, out)
+    if scan:
+        parts.append(scan)
+        echo("  permeability scan section")
     diag = project.root / "diagnose" / "index.html"
     if diag.exists():
         parts.append("<section id='diagnose'><h2>Diagnosis</h2><p>The model–measurement "
