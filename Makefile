@@ -21,6 +21,7 @@ demo: $(STAMP)
 	$(BIN)/radtree doctor
 	$(BIN)/radtree build $(EXAMPLE)
 	$(BIN)/radtree simulate $(EXAMPLE)
+	$(BIN)/radtree permeability $(EXAMPLE) -s A --rays 1024
 	$(BIN)/radtree report $(EXAMPLE)
 	@echo ""
 	@echo "Results: $(EXAMPLE)/results/illuminance.csv"
