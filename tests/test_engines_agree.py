@@ -48,7 +48,7 @@ def canyon(extra=(), materials=None) -> Scene:
                  {"facade": facade_circle(SENSORS, FRAME)})
 
 
-def compare(scene: Scene, state, p: EngineParams, tol: float = 0.05):
+def assert_engines_agree(scene: Scene, state, p: EngineParams, tol: float = 0.05):
     from radtree.engines.radiance.engine import trace_hour as radiance_trace
 
     a = numpy_trace(scene, state, p)["facade"]
@@ -68,12 +68,12 @@ def compare(scene: Scene, state, p: EngineParams, tol: float = 0.05):
 
 def test_open_canyon_perez_sky():
     st = sky_state("perez", dni=70000, dhi=12000, ground_reflectance=0.3, **MORNING)
-    compare(canyon(), st, params(6, 20000))
+    assert_engines_agree(canyon(), st, params(6, 20000))
 
 
 def test_open_canyon_overcast_sky_without_sun():
     st = sky_state("cie_overcast", zenith_luminance=4000, ground_reflectance=0.2)
-    compare(canyon(), st, params(6, 20000))
+    assert_engines_agree(canyon(), st, params(6, 20000))
 
 
 def test_translucent_shell():
@@ -81,7 +81,7 @@ def test_translucent_shell():
     radius 3 m against the façade, centred on the sensors."""
     shell = hemisphere_shell("crown", "shell", radius=3.0, centre=CENTRE, axis=FRAME.normal)
     st = sky_state("perez", dni=70000, dhi=12000, ground_reflectance=0.3, **MORNING)
-    compare(canyon([shell], {"shell": Trans("shell", 0.10, 0.25, 0.05)}), st, params(8, 20000))
+    assert_engines_agree(canyon([shell], {"shell": Trans("shell", 0.10, 0.25, 0.05)}), st, params(8, 20000))
 
 
 def test_louvers_slat_crown():
@@ -91,12 +91,12 @@ def test_louvers_slat_crown():
                        facade_normal=FRAME.normal, size=0.3, inclination_deg=30,
                        rng=np.random.default_rng(2), inner_radius=0.6)
     st = sky_state("perez", dni=70000, dhi=12000, ground_reflectance=0.3, **MORNING)
-    compare(canyon([slats], {"leaf": Trans("leaf", 0.11, 0.30, 0.10)}), st, params(8, 20000))
+    assert_engines_agree(canyon([slats], {"leaf": Trans("leaf", 0.11, 0.30, 0.10)}), st, params(8, 20000))
 
 
 def test_glass_shell_sun_only():
     """Glass dome (T_n 0.5): specular transmission and Fresnel reflection, sun only."""
     shell = hemisphere_shell("crown", "pane", radius=3.0, centre=CENTRE, axis=FRAME.normal)
     st = sky_state("none", dni=70000, ground_reflectance=0.3, **MORNING)
-    compare(canyon([shell], {"pane": Glass.from_transmittance("pane", 0.5)}), st,
+    assert_engines_agree(canyon([shell], {"pane": Glass.from_transmittance("pane", 0.5)}), st,
             params(4, 20000))

@@ -40,7 +40,7 @@ def scene(meshes, materials, *grids: SensorGrid) -> Scene:
     return Scene(list(meshes), mats, {g.name: g for g in grids})
 
 
-def within(result: GridResult, expected, k: float = 4.0, rel: float = 1e-3):
+def assert_within(result: GridResult, expected, k: float = 4.0, rel: float = 1e-3):
     expected = np.broadcast_to(np.asarray(expected, float), result.lux.shape)
     assert result.stderr is not None
     tol = k * result.stderr + rel * np.abs(expected) + 1e-9
@@ -78,7 +78,7 @@ def test_cosine_and_overcast_skies_horizontal():
     for model, expected in [("cosine", 2 * math.pi * L0 / 3), ("cie_overcast", 7 * math.pi * L0 / 9)]:
         st = sky_state(model, zenith_luminance=L0, ground_glow=False)
         r = trace_hour(scene([], [], g), st, EngineParams(rays=40000))["g"]
-        within(r, expected)
+        assert_within(r, expected)
         assert st.sky_horizontal_lux == pytest.approx(expected)
 
 
@@ -89,12 +89,12 @@ def test_vertical_sensors_see_half_sky_and_ground_glow():
     Lg = rho * math.pi * L0 / math.pi  # ρ E_h / π with E_h = π L
     assert st.ground_luminance == pytest.approx(Lg)
     r = trace_hour(scene([], [], g), st, EngineParams(rays=40000))["g"]
-    within(r, math.pi * L0 / 2 + math.pi * Lg / 2)
+    assert_within(r, math.pi * L0 / 2 + math.pi * Lg / 2)
     # cosine sky: ∫ L0 cosθ_z · cosθ_n dω over the upper quarter sphere = 2 L0 / 3
     st = sky_state("cosine", zenith_luminance=L0, ground_reflectance=rho)
     Lg = rho * (2 * math.pi * L0 / 3) / math.pi
     r = trace_hour(scene([], [], g), st, EngineParams(rays=40000))["g"]
-    within(r, 2 * L0 / 3 + math.pi * Lg / 2)
+    assert_within(r, 2 * L0 / 3 + math.pi * Lg / 2)
 
 
 def test_collimated_sun_is_exact():
@@ -121,7 +121,7 @@ def test_sensor_in_front_of_a_wall_does_not_hit_it():
     st = sky_state("uniform", zenith_luminance=L0, ground_glow=False, altitude=40, azimuth=0,
                    dni=50000)
     r = trace_hour(scene([wall], [Plastic("paint", 0.9)], g), st, EngineParams(rays=40000))["g"]
-    within(r, math.pi * L0 / 2 + 50000 * st.sun.vector[1])
+    assert_within(r, math.pi * L0 / 2 + 50000 * st.sun.vector[1])
 
 
 def test_holes_are_ignored():
@@ -142,8 +142,8 @@ def test_translucent_slab_under_uniform_sky():
     g = grid([[0, 0, 0], [3, -2, 0]], UP)
     sc = scene([slab], [Trans("leafy", 0.2, 0.3, 0.1)], g)
     st = sky_state("uniform", zenith_luminance=L0, ground_glow=False)
-    within(trace_hour(sc, st, EngineParams(rays=20000, max_bounces=3))["g"], 0.4 * math.pi * L0)
-    within(trace_hour(sc, st, EngineParams(rays=4000, max_bounces=1))["g"], 0.1 * math.pi * L0)
+    assert_within(trace_hour(sc, st, EngineParams(rays=20000, max_bounces=3))["g"], 0.4 * math.pi * L0)
+    assert_within(trace_hour(sc, st, EngineParams(rays=4000, max_bounces=1))["g"], 0.1 * math.pi * L0)
 
 
 def test_two_plates_interreflection():
@@ -153,7 +153,7 @@ def test_two_plates_interreflection():
                [Trans("slabmat", 0.5, 0.4, 0.0)], grid([[0, 0, 1]], UP))
     st = sky_state("uniform", zenith_luminance=L0, ground_reflectance=0.6, ground_glow=False)
     r = trace_hour(sc, st, EngineParams(rays=60000, max_bounces=30))["g"]
-    within(r, 0.4 * math.pi * L0 / (1 - 0.5 * 0.6), rel=3e-3)
+    assert_within(r, 0.4 * math.pi * L0 / (1 - 0.5 * 0.6), rel=3e-3)
 
 
 def test_ground_reflectance_comes_from_the_hour():
@@ -162,7 +162,7 @@ def test_ground_reflectance_comes_from_the_hour():
     st = sky_state("none", altitude=55, azimuth=10, dni=90000, ground_reflectance=0.5,
                    ground_glow=False)
     r = trace_hour(sc, st, EngineParams(rays=4000, max_bounces=1))["g"]
-    within(r, 0.5 * st.direct_horizontal_lux, rel=2e-3)
+    assert_within(r, 0.5 * st.direct_horizontal_lux, rel=2e-3)
 
 
 def test_sun_through_specular_transmission_and_glass():

@@ -47,7 +47,7 @@ void brightfunc skyfunc
 """
 
 
-def _close(mine: PerezSky, ref: PerezSky) -> None:
+def assert_parameters_close(mine: PerezSky, ref: PerezSky) -> None:
     # gendaylit prints A1, A2 with 4 significant digits (%.3e), coefficients with 6 decimals
     assert mine.diffuse_norm == pytest.approx(ref.diffuse_norm, rel=6e-4, abs=1e-9)
     assert mine.ground_brightness == pytest.approx(ref.ground_brightness, rel=6e-4, abs=1e-9)
@@ -59,7 +59,7 @@ def test_matches_recorded_gendaylit_output():
     ref = parse_gendaylit(REFERENCE_TEXT)
     assert ref.epsilon == pytest.approx(8.5390)
     mine = perez_parameters(80000, 12000, 60.0, 20.0, ground_reflectance=0.2)
-    _close(mine, ref)
+    assert_parameters_close(mine, ref)
     assert mine.epsilon == pytest.approx(8.5390, abs=6e-5)
     assert mine.delta == pytest.approx(0.0727, abs=6e-5)
 
@@ -125,7 +125,7 @@ def test_against_gendaylit(case):
         cmd.append("-s")
     ref = parse_gendaylit(run(cmd).decode())
     mine = perez_parameters(dni, dhi, alt, az, ground_reflectance=g, sun=sun)
-    _close(mine, ref)
+    assert_parameters_close(mine, ref)
 
 
 @pytest.mark.radiance
@@ -137,7 +137,7 @@ def test_state_command_agrees(alt, az, dni):
     st = sky_state("perez", altitude=alt, azimuth=az, dni=dni, dhi=12000,
                    ground_reflectance=0.28)
     ref = parse_gendaylit(run(gendaylit_command(st)).decode())
-    _close(perez_sky(st), ref)
+    assert_parameters_close(perez_sky(st), ref)
 
 
 @pytest.mark.radiance
