@@ -22,6 +22,7 @@ demo: $(STAMP)
 	$(BIN)/radtree build $(EXAMPLE)
 	$(BIN)/radtree simulate $(EXAMPLE)
 	$(BIN)/radtree permeability $(EXAMPLE) -s A --rays 1024
+	$(BIN)/radtree diagnose $(EXAMPLE) -s A
 	$(BIN)/radtree report $(EXAMPLE)
 	@echo ""
 	@echo "Results: $(EXAMPLE)/results/illuminance.csv"
@@ -42,4 +43,4 @@ bench: $(STAMP)
 	for b in benchmarks/*.py; do $(BIN)/python $$b || exit 1; done
 
 clean:
-	rm -rf $(EXAMPLE)/build $(EXAMPLE)/results $(EXAMPLE)/report
+	rm -rf $(EXAMPLE)/build $(EXAMPLE)/results $(EXAMPLE)/report $(EXAMPLE)/diagnose

@@ -423,3 +423,19 @@ def test_report_on_a_real_open_street_simulation(open_street: Path):
     assert list(stats["scenario"]) == ["A", "B"]
     assert np.isfinite(stats["rmse"]).all() and (stats["n_hours"] == 2).all()
     assert math.isfinite(float(stats["mbe"].iloc[0]))
+
+
+def test_diagnose_section_shows_fitted_strength_and_cv(tmp_path):
+    from radtree.report.build import diagnose_section
+
+    pd.DataFrame([{"step": 1, "effect": "sky_diffuse", "explained_fraction": 0.9,
+                   "strength": 14900.0, "rmse_before": 0.198, "rmse_after": 0.064,
+                   "cv_rmse_before": 0.198, "cv_rmse_after": 0.075,
+                   "strength_text": "diffuse horizontal 14 900 lx"}]).to_csv(
+        tmp_path / "steps.csv", index=False)
+    html = diagnose_section(tmp_path)
+    assert "fitted" in html and "sky_diffuse" in html and "diffuse horizontal 14 900 lx" in html
+    assert "<td>0.198 → 0.064</td><td>0.198 → 0.075</td>" in html
+    assert "<td>90</td>" in html
+    (tmp_path / "steps.csv").unlink()
+    assert "<table>" not in diagnose_section(tmp_path)

@@ -503,6 +503,36 @@ def _environment(autoescape: bool) -> Environment:
     return env
 
 
+def diagnose_section(folder: Path) -> str:
+    """The diagnosis in the main report: its steps as *fitted* parameters, each with its
+    leave-one-hour-out cross-validated nRMSE (kept apart from the fixed-parameter scenarios)."""
+    import html
+
+    intro = ("<section id='diagnose'><h2>Diagnosis: fitted effects (reported separately)</h2>"
+             "<p>The model–measurement discrepancy workflow (<code>radtree diagnose</code>) adds "
+             "the missing physical effect it names and <em>fits its strength to the measured "
+             "hours</em>; these numbers are therefore not comparable with the fixed-parameter "
+             "scenarios above. Leave-one-hour-out cross-validation (LOHO-CV) refits without "
+             "each hour and predicts it. Full report: <a href='../diagnose/index.html'>"
+             "diagnose/index.html</a>.</p>")
+    steps_csv = folder / "steps.csv"
+    if not steps_csv.exists():
+        return intro + "</section>"
+    steps = pd.read_csv(steps_csv)
+    if steps.empty:
+        return intro + "<p>No effect was added: nothing explained the residual.</p></section>"
+    rows = "".join(
+        f"<tr><td>{int(r['step'])}</td><td>{html.escape(str(r['effect']))}</td>"
+        f"<td>{html.escape(str(r.get('strength_text', '')))}</td>"
+        f"<td>{100 * float(r['explained_fraction']):.0f}</td>"
+        f"<td>{float(r['rmse_before']):.3f} → {float(r['rmse_after']):.3f}</td>"
+        f"<td>{float(r['cv_rmse_before']):.3f} → {float(r['cv_rmse_after']):.3f}</td></tr>"
+        for _, r in steps.iterrows())
+    return (intro + "<table><thead><tr><th>step</th><th>effect</th><th>fitted strength</th>"
+            "<th>residual explained (%)</th><th>nRMSE</th><th>LOHO-CV nRMSE</th></tr></thead>"
+            f"<tbody>{rows}</tbody></table></section>")
+
+
 def extra_sections(project: Project, out: Path, echo: Callable[[str], None]) -> list[str]:
     """HTML sections of the studies that exist for this project: office block, sweep,
     diagnosis, annual. Their figures are written into ``out`` (the report folder)."""
@@ -537,9 +567,7 @@ def extra_sections(project: Project, out: Path, echo: Callable[[str], None]) -> 
         echo("  permeability scan section")
     diag = project.root / "diagnose" / "index.html"
     if diag.exists():
-        parts.append("<section id='diagnose'><h2>Diagnosis</h2><p>The model–measurement "
-                     "discrepancy workflow's report: <a href='../diagnose/index.html'>"
-                     "diagnose/index.html</a>.</p></section>")
+        parts.append(diagnose_section(project.root / "diagnose"))
     annual = project.results_dir / "annual_summary.csv"
     if annual.exists():
         from radtree.annual import annual_report_section
