@@ -23,6 +23,7 @@ from radtree.errors import ConfigError
 TIME_RE = re.compile(r"^([01]\d|2[0-3]):([0-5]\d)$")
 CROWN_MODELS = ("homogeneous", "perforated", "louvers", "none")
 TREE_FORMS = ("dome", "free")
+LOUVER_ARRANGEMENTS = ("layers", "volume")
 REFLECTION_MODES = ("traced", "calculated")
 SKY_CHOICES = ("none", "perez")
 ENGINES = ("auto", "radiance", "numpy")
@@ -250,6 +251,11 @@ class Louvers:
     centres on a triangular grid along branches inclined ``branch_inclination_deg``; each layer
     covers ``cover_fraction`` of the horizontal plane. Slat optics: reflectance, total
     transmittance, and the fraction of that transmittance that is specular (undeviated).
+
+    ``arrangement`` (free-standing crowns only): ``"layers"`` — nested lens-shaped layers, every
+    vertical line crosses ``layers`` slats; ``"volume"`` — slat centres uniform at random in the
+    crown, azimuths random, density such that a vertical line through the crown centre crosses
+    ``crossings`` slats on average (0: use ``layers``), times ``cover_fraction``.
     """
 
     layers: int = 4
@@ -261,6 +267,8 @@ class Louvers:
     transmittance: float = 0.5
     specular_fraction: float = 0.9
     seed: int = 1
+    arrangement: str = "layers"
+    crossings: float = 0.0
 
 
 @dataclass(frozen=True)
@@ -612,6 +620,10 @@ def parse_project(data: dict, path: Path) -> Project:
         lr.number("slat_size_m", lo=0.02, hi=3.0)
     if lr.has("inclination_deg"):
         lr.number("inclination_deg", lo=0.0, hi=90.0)
+    if lr.has("arrangement"):
+        lr.string("arrangement", choices=LOUVER_ARRANGEMENTS)
+    if lr.has("crossings"):
+        lr.number("crossings", lo=0.0, hi=60.0)
     louv = _dataclass_from(lr, Louvers, base)
     if louv.reflectance + louv.transmittance > 1:
         raise lr.error("transmittance", f"reflectance {louv.reflectance} + transmittance "
