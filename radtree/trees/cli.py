@@ -30,15 +30,19 @@ from radtree.trees.calibrate import PERMEABILITY_DEFINITION, calibrate, write_ca
 @click.option("--tolerance", type=click.FloatRange(1e-5, 0.05), default=0.001, show_default=True,
               help="Accepted |traced − target| (fraction).")
 @click.option("--global", "global_", is_flag=True,
-              help="Louvers: choose the integer layer count whose *global* permeability (façade "
-                   "illuminance with the crown / open street, every light path, NumPy engine) "
-                   "is closest to the target.")
+              help="Louvers: choose the integer layer count (dome, layered crowns) or the "
+                   "slat density `crossings` (free crowns, arrangement = \"volume\") whose "
+                   "*global* permeability (façade illuminance with the crown / open street, "
+                   "every light path, NumPy engine) is closest to the target.")
+@click.option("--realisations", type=click.IntRange(1, 64), default=8, show_default=True,
+              help="--global with free volume crowns: crown realisations (louvers.seed 1…N) "
+                   "averaged per density (one realisation scatters by ≈ 10 %).")
 @click.option("--write/--no-write", default=False, show_default=True,
               help="Write <project>.calibrated.toml beside the project file (never the project "
                    "file itself).")
 def calibrate_command(project: Path, target: float | None, model: str, form: str | None,
                       photo_openness: bool, directions: int, tolerance: float,
-                      global_: bool, write: bool) -> None:
+                      global_: bool, realisations: int, write: bool) -> None:
     """Calibrate the crown of PROJECT (a folder with radtree.toml, or the file) to a target
     permeability by tracing straight rays from the façade sensors through the built crown.
 
@@ -50,10 +54,20 @@ def calibrate_command(project: Path, target: float | None, model: str, form: str
     try:
         proj = load_project(project)
         if global_:
-            from radtree.permeability import calibrate_layers
+            from radtree.permeability import calibrate_crossings, calibrate_layers
 
             click.echo("Global permeability = Σ façade illuminance with the crown / Σ in the "
                        "open street, over the project's hours (NumPy engine, every light path).")
+            if (form or proj.tree.form) == "free" and proj.tree.louvers.arrangement == "volume":
+                cc = calibrate_crossings(proj, target, rays=512,
+                                         seeds=tuple(range(1, realisations + 1)),
+                                         echo=click.echo)
+                click.echo(f"Chosen: [tree.louvers] crossings = {cc.crossings:g} → global "
+                           f"permeability {100 * cc.permeability:.2f} % ± "
+                           f"{100 * cc.realisation_se:.2f} over {realisations} realisation(s) "
+                           f"(target {100 * cc.target:.2f} %"
+                           f"{'' if cc.converged else '; not converged'}).")
+                return
             cal = calibrate_layers(proj, target, echo=click.echo)
             click.echo(f"Chosen: [tree.louvers] layers = {cal.layers} → global permeability "
                        f"{100 * cal.permeability:.2f} % (target {100 * cal.target:.2f} %).")
