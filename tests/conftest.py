@@ -37,6 +37,22 @@ def radiance_available() -> bool:
     return find_radiance() is not None
 
 
+@pytest.fixture(scope="module")
+def project():
+    """The shipped Mendoza example project (read-only)."""
+    from radtree.config import load_project
+
+    return load_project(MENDOZA)
+
+
+@pytest.fixture(scope="module")
+def frame(project):
+    """The Mendoza façade frame."""
+    from radtree.site.frame import FacadeFrame
+
+    return FacadeFrame(project.street.facade_azimuth_deg)
+
+
 needs_radiance = pytest.mark.skipif(not radiance_available(), reason="Radiance not found")
 
 

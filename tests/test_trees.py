@@ -3,12 +3,11 @@
 from __future__ import annotations
 
 from dataclasses import replace
-from pathlib import Path
 
 import numpy as np
 import pytest
 
-from radtree.config import Scenario, load_project
+from radtree.config import Scenario
 from radtree.errors import ConfigError, RadtreeError
 from radtree.scene import Scene
 from radtree.sensor_grid import facade_circle, facade_dense_grid
@@ -19,21 +18,9 @@ from radtree.trees.envelope import CLIP_MARGIN_M, crown_row_spec
 from radtree.trees.louvers import dome_layer_radii, dome_slat_bound, free_slat_bound
 from radtree.trees.picture import render_model_png
 
-ROOT = Path(__file__).resolve().parents[1]
-EXAMPLE = ROOT / "examples" / "mendoza-street"
 MODELS = ("homogeneous", "perforated", "louvers")
 FORMS = ("dome", "free")
 STREET_NAMES = {"facade_paint", "ground", "opposite_facade"}
-
-
-@pytest.fixture(scope="module")
-def project():
-    return load_project(EXAMPLE)
-
-
-@pytest.fixture(scope="module")
-def frame(project):
-    return FacadeFrame(project.street.facade_azimuth_deg)
 
 
 @pytest.fixture(scope="module")

@@ -25,7 +25,6 @@ import pytest
 
 from radtree.config import load_project
 from radtree.scene import Mesh
-from radtree.site.frame import FacadeFrame
 from radtree.trees.build import apply_switches, build_crown
 from radtree.trees.envelope import crown_row_spec
 from radtree.trees.geometry import fibonacci_hemisphere, hemisphere_mesh, triangle_solid_angles
@@ -42,11 +41,6 @@ def project():
     # pinned optics (the analytic values below are written for 4 layers, specular share 0.5)
     return load_project(EXAMPLE, overrides={"tree.louvers.layers": 4,
                                             "tree.louvers.specular_fraction": 0.5})
-
-
-@pytest.fixture(scope="module")
-def frame(project):
-    return FacadeFrame(project.street.facade_azimuth_deg)
 
 
 @pytest.fixture(scope="module")

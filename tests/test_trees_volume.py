@@ -16,7 +16,6 @@ from radtree.errors import ConfigError
 from radtree.optics import Plastic, Trans
 from radtree.permeability import calibrate_crossings
 from radtree.scene import Mesh
-from radtree.site.frame import FacadeFrame
 from radtree.trees.build import build_tree
 from radtree.trees.envelope import CrownRowSpec, crown_row_spec
 from radtree.trees.geometry import polygons_to_mesh
@@ -32,16 +31,6 @@ from radtree.trees.volume import (
 ROOT = Path(__file__).resolve().parents[1]
 EXAMPLE = ROOT / "examples" / "mendoza-street"
 VOLUME = {"louvers.arrangement": "volume", "louvers.crossings": 12}
-
-
-@pytest.fixture(scope="module")
-def project():
-    return load_project(EXAMPLE)
-
-
-@pytest.fixture(scope="module")
-def frame(project):
-    return FacadeFrame(project.street.facade_azimuth_deg)
 
 
 # ---------------------------------------------------------------- Beer–Lambert
