@@ -256,6 +256,8 @@ class Louvers:
     vertical line crosses ``layers`` slats; ``"volume"`` — slat centres uniform at random in the
     crown, azimuths random, density such that a vertical line through the crown centre crosses
     ``crossings`` slats on average (0: use ``layers``), times ``cover_fraction``.
+    ``realisations``: how many random crowns (``seed``, ``seed`` + 1, …) ``simulate`` traces
+    and averages; the results' ``lux_stderr`` is then the standard error over them.
     """
 
     layers: int = 4
@@ -269,6 +271,7 @@ class Louvers:
     seed: int = 1
     arrangement: str = "layers"
     crossings: float = 0.0
+    realisations: int = 1
 
 
 @dataclass(frozen=True)
@@ -624,6 +627,8 @@ def parse_project(data: dict, path: Path) -> Project:
         lr.string("arrangement", choices=LOUVER_ARRANGEMENTS)
     if lr.has("crossings"):
         lr.number("crossings", lo=0.0, hi=60.0)
+    if lr.has("realisations"):
+        lr.integer("realisations", lo=1, hi=64)
     louv = _dataclass_from(lr, Louvers, base)
     if louv.reflectance + louv.transmittance > 1:
         raise lr.error("transmittance", f"reflectance {louv.reflectance} + transmittance "

@@ -105,10 +105,82 @@ def make_scene(project: Project, scenario: Scenario, dense_grid: bool | None = N
     return BuiltScene(scenario, scene, ab, notes, scene.n_triangles, geometry_seconds, info, tree)
 
 
+REALISATION_MARK = "@"   # "F@3": the third random crown of scenario F
+
+
+def realisations_of(project: Project, sc: Scenario) -> list[Scenario]:
+    """The scenario as traced: itself or, for a louvers crown with ``louvers.realisations``
+    N > 1, N copies named ``<name>@k`` whose ``louvers.seed`` is seed + k − 1 (k = 1…N);
+    ``simulate`` averages them back into ``<name>``."""
+    if sc.model != "louvers":
+        return [sc]
+    from radtree.trees.build import apply_switches
+
+    tree, _ = apply_switches(project.tree, dict(sc.switches), source=str(project.source))
+    n = tree.louvers.realisations
+    if n <= 1:
+        return [sc]
+    return [replace(sc, name=f"{sc.name}{REALISATION_MARK}{k}",
+                    switches={**sc.switches, "louvers.seed": tree.louvers.seed + k - 1,
+                              "louvers.realisations": 1})
+            for k in range(1, n + 1)]
+
+
+def parent_name(name: str) -> str:
+    """``F@3`` → ``F``; other names unchanged."""
+    return str(name).partition(REALISATION_MARK)[0]
+
+
 def selected(project: Project, names: list[str] | None) -> list[Scenario]:
-    if not names:
-        return list(project.scenarios)
-    return [project.scenario(n) for n in names]
+    """The scenarios to build or trace, each expanded into its crown realisations; a name may
+    also pick one realisation (``F@2``)."""
+    out: list[Scenario] = []
+    for name in names or [sc.name for sc in project.scenarios]:
+        parent, mark, k = name.partition(REALISATION_MARK)
+        subs = realisations_of(project, project.scenario(parent))
+        if not mark:
+            out.extend(subs)
+        elif k.isdigit() and len(subs) > 1 and 1 <= int(k) <= len(subs):
+            out.append(subs[int(k) - 1])
+        else:
+            raise ConfigError(f"scenario {parent!r} has no realisation {name!r} "
+                              f"(it has {len(subs) if len(subs) > 1 else 'no'} realisations)",
+                              source=str(project.source), field="scenario")
+    return out
+
+
+def merge_realisations(table: pd.DataFrame, hashes: dict[str, str]
+                       ) -> tuple[pd.DataFrame, pd.DataFrame | None]:
+    """Average the rows of ``<name>@k`` realisations into ``<name>``: ``lux``/``lux_traced`` are
+    the means over realisations, ``lux_stderr`` the standard error over them (s.d./√n, which
+    includes the tracing noise), ``lux_realisation_sd`` and ``realisations`` are added; a grid
+    traced in one realisation only (the dense map) keeps its values. ``hashes`` maps a parent
+    name to its parameter hash. Returns (merged table, the per-realisation rows or None)."""
+    names = table["scenario"].astype(str)
+    is_sub = names.str.contains(REALISATION_MARK, regex=False)
+    if not is_sub.any():
+        return table, None
+    sub = table[is_sub].copy()
+    parts = names[is_sub].str.partition(REALISATION_MARK)
+    sub["scenario"] = parts[0]
+    sub["realisation"] = parts[2].astype(int)
+    keys = ["scenario", "time", "grid", "sensor"]
+    g = sub.groupby(keys, sort=False)
+    stats = pd.DataFrame({"lux": g["lux"].mean(), "lux_traced": g["lux_traced"].mean(),
+                          "sd": g["lux"].std(ddof=1), "n": g["lux"].size()})
+    merged = (sub.sort_values("realisation").drop_duplicates(keys).drop(columns="realisation")
+              .set_index(keys))
+    stats = stats.reindex(merged.index)
+    merged["lux"] = stats["lux"]
+    merged["lux_traced"] = stats["lux_traced"]
+    several = stats["n"] > 1
+    merged["lux_stderr"] = np.where(several, stats["sd"] / np.sqrt(stats["n"]),
+                                    merged["lux_stderr"])
+    merged["lux_realisation_sd"] = np.where(several, stats["sd"], np.nan)
+    merged["realisations"] = stats["n"]
+    merged = merged.reset_index()
+    merged["params_hash"] = merged["scenario"].map(hashes).fillna(merged["params_hash"])
+    return pd.concat([table[~is_sub], merged], ignore_index=True), sub
 
 
 # ---------------------------------------------------------------- build
@@ -133,7 +205,7 @@ def build_project(project: Project, scenarios: list[str] | None = None,
         t1 = time.perf_counter()
         with atomic_dir(build_root / sc.name) as tmp:
             names = list(built.scene.grids)
-            at = {st.label: hour_grids(project, st.time, names, None) for st in states}
+            at = {st.label: hour_grids(project, st.time, names, None, sc) for st in states}
             write_build(built.scene, states, effective_project(project, sc).engine, built.ab,
                         tmp, install, sc.name, hour_grids=at)
             if pictures and built.tree is not None:
@@ -152,9 +224,23 @@ def build_project(project: Project, scenarios: list[str] | None = None,
                 manifest(project, extra={"build": facts[sc.name]}), indent=2, default=str))
         echo(f"  {sc.name}: {sc.model} ({facts[sc.name]['form']}), {built.triangles} triangles, "
              f"-ab {built.ab}, geometry {built.geometry_seconds:.2f} s → {build_root / sc.name}")
-    _write_top_makefile(project, [s.name for s in project.scenarios
+    _remove_stale_builds(project, chosen)
+    _write_top_makefile(project, [s.name for s in selected(project, None)
                                   if (build_root / s.name).exists()])
     return facts
+
+
+def _remove_stale_builds(project: Project, built: list[Scenario]) -> None:
+    """A scenario is built either as one folder or as realisation folders (``F@k``): remove
+    the other kind, and realisations beyond the current count, so no stale crown is reported."""
+    import shutil
+
+    for parent in dict.fromkeys(parent_name(sc.name) for sc in built):
+        current = {sc.name for sc in realisations_of(project, project.scenario(parent))}
+        for folder in [project.build_dir / parent,
+                       *project.build_dir.glob(f"{parent}{REALISATION_MARK}*")]:
+            if folder.is_dir() and folder.name not in current:
+                shutil.rmtree(folder)
 
 
 def _write_top_makefile(project: Project, names: list[str]) -> None:
@@ -287,7 +373,7 @@ def simulate_project(project: Project, engine: str = "auto", scenarios: list[str
         sc, st, part = item
         built, _, phash, plan = prepared[sc.name]
         t = time.perf_counter()
-        use = hour_grids(project, st.time, list(built.scene.grids), grids)
+        use = hour_grids(project, st.time, list(built.scene.grids), grids, sc)
         if eng == "radiance":
             from radtree.engines.radiance.engine import run_hour
 
@@ -323,14 +409,24 @@ def simulate_project(project: Project, engine: str = "auto", scenarios: list[str
                 if bar is not None:
                     bar.close()
     table = pd.concat(frames, ignore_index=True)
+    parents = list(dict.fromkeys(parent_name(sc.name) for sc in chosen))
+    table, per_realisation = merge_realisations(
+        table, {p: project.params_hash(project.scenario(p)) for p in parents})
+    if per_realisation is not None:
+        _merge_write(project.results_dir / "realisations.csv", per_realisation, parents)
     order = {s.name: i for i, s in enumerate(project.scenarios)}
     table = table.sort_values(["scenario", "time", "grid", "sensor"],
                               key=lambda c: c.map(order) if c.name == "scenario" else c)
     cols = RESULT_COLUMNS + [c for c in table.columns if c not in RESULT_COLUMNS]
     table = table[cols].reset_index(drop=True)
     out = project.results_dir / "illuminance.csv"
-    _merge_write(out, table, chosen)
-    tdf = pd.DataFrame([{"scenario": k, "engine": eng, **v} for k, v in timing.items()])
+    _merge_write(out, table, parents)
+    summed: dict[str, dict[str, float]] = {}
+    for name, v in timing.items():
+        acc = summed.setdefault(parent_name(name), dict.fromkeys(v, 0.0))
+        for k, x in v.items():
+            acc[k] += x
+    tdf = pd.DataFrame([{"scenario": k, "engine": eng, **v} for k, v in summed.items()])
     _merge_timing(project.results_dir / "timing.csv", tdf)
     if project.office is not None:
         from radtree.office_summary import write_summary
@@ -343,20 +439,22 @@ def simulate_project(project: Project, engine: str = "auto", scenarios: list[str
 
 
 def hour_grids(project: Project, time_: str, available: list[str],
-               wanted: list[str] | None) -> list[str]:
-    """Grids to trace at an hour: the dense façade map only at ``sensors.dense_hours``."""
+               wanted: list[str] | None, sc: Scenario | None = None) -> list[str]:
+    """Grids to trace at an hour: the dense façade map only at ``sensors.dense_hours``, and
+    only in the first crown realisation (``F@1``) of a scenario with several."""
     use = [g for g in available if wanted is None or g in wanted]
     dense = project.sensors.dense_hours
-    if dense and time_ not in dense:
+    later = sc is not None and sc.name.partition(REALISATION_MARK)[2] not in ("", "1")
+    if (dense and time_ not in dense) or later:
         use = [g for g in use if g != "facade_map"]
     return use
 
 
-def _merge_write(out: Path, table: pd.DataFrame, chosen: list[Scenario]) -> None:
-    """Replace the chosen scenarios' rows in an existing table, keep the others."""
+def _merge_write(out: Path, table: pd.DataFrame, names: list[str]) -> None:
+    """Replace the named scenarios' rows in an existing table, keep the others."""
     if out.exists():
         old = pd.read_csv(out)
-        old = old[~old["scenario"].astype(str).isin([s.name for s in chosen])]
+        old = old[~old["scenario"].astype(str).isin(names)]
         table = pd.concat([old, table], ignore_index=True) if len(old) else table
     with atomic_path(out) as tmp:
         table.to_csv(tmp, index=False)

@@ -229,6 +229,8 @@ def scenario_infos(project: Project, results: pd.DataFrame,
         hashes = _unique(rows["params_hash"]) if "params_hash" in rows.columns else []
         engines = _unique(rows["engine"]) if "engine" in rows.columns else []
         folder = project.build_dir / name
+        if not folder.exists() and (project.build_dir / f"{name}@1").exists():
+            folder = project.build_dir / f"{name}@1"   # crown realisations: the first one
         mf = _read_json(folder / "manifest.json", notes)
         build = mf.get("build", {}) if mf else {}
         build = build if isinstance(build, dict) else {}

@@ -193,6 +193,8 @@ def check_louvers(lv: Louvers, source: str | None = None) -> None:
 
     if lv.layers < 1:
         raise err("layers", f"got {lv.layers}, expected at least 1")
+    if not 1 <= lv.realisations <= 64:
+        raise err("realisations", f"got {lv.realisations}, expected 1–64")
     for name in ("cover_fraction", "reflectance", "transmittance", "specular_fraction"):
         v = getattr(lv, name)
         if not 0.0 <= v <= 1.0:
