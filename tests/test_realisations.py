@@ -111,3 +111,12 @@ def test_build_removes_the_other_kind_of_folder(reduced):
     build_project(proj, ["F"], echo=lambda s: None, progress=False, pictures=False)
     assert (proj.build_dir / "F").is_dir()
     assert not list(proj.build_dir.glob("F@*"))
+
+
+def test_annual_says_it_uses_the_first_crown(reduced):
+    from radtree.annual.run import AnnualOptions, choose_scenarios
+
+    proj = load_project(reduced)
+    with_sc, _, notes = choose_scenarios(proj, AnnualOptions(with_scenario="F"))
+    assert with_sc.name == "F"
+    assert any("averages 3 random crowns" in n and "louvers.seed 1" in n for n in notes)

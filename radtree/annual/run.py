@@ -178,6 +178,13 @@ def choose_scenarios(project: Project, options: AnnualOptions
                                  description="the leafed scenario without its crown")
             notes.append(f"No scenario without a tree in the project: the annual run uses "
                          f"'{with_sc.name}' with its crown removed.")
+    from radtree.scenarios import realisations_of
+
+    crowns = realisations_of(project, with_sc)
+    if len(crowns) > 1:
+        notes.append(f"Scenario '{with_sc.name}' averages {len(crowns)} random crowns in "
+                     f"point-in-time runs; the annual run uses the first one "
+                     f"(louvers.seed {crowns[0].switches['louvers.seed']}).")
     if with_sc.reflection == "calculated":
         notes.append(f"Scenario '{with_sc.name}' calculates the ground-reflected light "
                      "analytically for single hours; the annual run traces it (the street "
