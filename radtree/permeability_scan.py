@@ -221,9 +221,10 @@ def scan_report_section(project: Project, out: Path) -> str:
     scan = PermeabilityScan(str(t["scenario"].iloc[0]), str(t["field"].iloc[0]),
                             t.drop(columns=["scenario", "field"]), [])
     rows = "".join(
-        f"<tr><td>{r['value']:g}</td><td>{100 * r['permeability_street']:.2f}</td>"
-        f"<td>{100 * r['permeability_unobstructed']:.2f}</td><td>{r['nrmse']:.3f}</td>"
-        f"<td>{r['nmbe']:+.3f}</td><td>{r['r']:.3f}</td></tr>" for _, r in t.iterrows())
+        "<tr>" + "".join(f"<td class='num'>{v}</td>" for v in (
+            f"{r['value']:g}", f"{100 * r['permeability_street']:.2f}",
+            f"{100 * r['permeability_unobstructed']:.2f}", f"{r['nrmse']:.3f}",
+            f"{r['nmbe']:+.3f}", f"{r['r']:.3f}")) + "</tr>" for _, r in t.iterrows())
     fig = ""
     if png.exists():
         shutil.copyfile(png, out / "permeability_scan.png")
@@ -234,7 +235,7 @@ def scan_report_section(project: Project, out: Path) -> str:
             f"(<code>radtree permeability</code>, NumPy engine): the crown's global "
             f"permeability under two references, and the scenario's fit. The measured "
             f"permeability is 5–6 %; nothing here is chosen from the hourly measurements.</p>"
-            f"<ul>{items}</ul>{fig}<table><thead><tr><th>{html.escape(scan.field)}</th>"
+            f"<ul>{items}</ul>{fig}<div class='tablewrap' id='t-permeability_scan'><table><thead><tr><th>{html.escape(scan.field)}</th>"
             f"<th>permeability, street (%)</th><th>permeability, unobstructed (%)</th>"
             f"<th>nRMSE</th><th>nMBE</th><th>r</th></tr></thead><tbody>{rows}</tbody></table>"
-            f"</section>")
+            f"</div></section>")

@@ -155,7 +155,27 @@ def built(tmp_path_factory: pytest.TempPathFactory) -> tuple[Project, Path]:
     """One report built for the read-only tests (building takes a few seconds)."""
     p = load_project(make_project(tmp_path_factory.mktemp("report") / "proj"))
     write_results(p)
+    write_scan_and_diagnosis(p)
     return p, build_report(p, echo=lambda s: None)
+
+
+def write_scan_and_diagnosis(p: Project) -> None:
+    """A permeability scan (results/) and a diagnosis (diagnose/steps.csv) to report."""
+    from radtree.permeability_scan import PermeabilityScan, write_scan
+
+    scan = pd.DataFrame({"value": [0.5, 0.52], "permeability_street": [0.06, 0.073],
+                         "permeability_street_se": [2e-4, 2e-4],
+                         "permeability_unobstructed": [0.049, 0.06],
+                         "permeability_unobstructed_se": [1e-4, 1e-4],
+                         "nrmse": [0.2, 0.107], "nmbe": [0.19, 0.056], "r": [0.92, 0.92]})
+    write_scan(PermeabilityScan("A", "louvers.transmittance", scan, []), p.results_dir)
+    (p.root / "diagnose").mkdir(exist_ok=True)
+    (p.root / "diagnose" / "index.html").write_text("<html></html>")
+    pd.DataFrame([{"step": 1, "effect": "sky_diffuse", "explained_fraction": 0.9,
+                   "strength": 14900.0, "rmse_before": 0.198, "rmse_after": 0.064,
+                   "cv_rmse_before": 0.198, "cv_rmse_after": 0.075,
+                   "strength_text": "14,900 lx"}]).to_csv(p.root / "diagnose" / "steps.csv",
+                                                          index=False)
 
 
 # --------------------------------------------------------------------------- HTML parsing
@@ -262,7 +282,8 @@ def test_report_tables_figures_and_pictures(built: tuple[Project, Path]):
     assert any("free-standing" in g for g in groups) and any("dome" in g for g in groups)
 
     for key in ("scenarios", "rows", "rows_between", "timing", "reflection", "convergence",
-                "convergence_summary", "provenance", "hashes", "inputs", "parameters"):
+                "convergence_summary", "provenance", "hashes", "inputs", "parameters",
+                "permeability_scan", "diagnose_steps"):
         assert body(table(parser, key)), key
     timing = {r[0][2]: r for r in body(table(parser, "timing"))}
     assert number(timing["C"][5][2]) == pytest.approx(0.12 + 2 + 1.0 + 16.0, abs=0.06)
@@ -280,6 +301,12 @@ def test_report_tables_figures_and_pictures(built: tuple[Project, Path]):
     assert "models/A.png" in parser.images
     for key in ("hourly", "scatter", "facade_map", "facade_map_all", "timing", "convergence"):
         assert f"figures/{key}.png" in parser.images
+    assert "permeability_scan.png" in parser.images
+    md = (project.report_dir / "index.md").read_text()
+    assert "| 0.52 | 7.30 | 6.00 | 0.107 | +0.056 | 0.920 |" in md
+    assert "| 1 | sky_diffuse | 14,900 lx | 90 | 0.198 → 0.064 | 0.198 → 0.075 |" in md
+    scan = body(table(parser, "permeability_scan"))
+    assert [number(r[3][2]) for r in scan] == [0.2, 0.107]
     text = " ".join(parser.text)
     assert text.count("no picture") == len(SCENARIOS) - 1
     assert "crown reading of F" in text  # build notes
@@ -436,6 +463,6 @@ def test_diagnose_section_shows_fitted_strength_and_cv(tmp_path):
     html = diagnose_section(tmp_path)
     assert "fitted" in html and "sky_diffuse" in html and "diffuse horizontal 14 900 lx" in html
     assert "<td>0.198 → 0.064</td><td>0.198 → 0.075</td>" in html
-    assert "<td>90</td>" in html
+    assert "<td class='num'>90</td>" in html
     (tmp_path / "steps.csv").unlink()
     assert "<table>" not in diagnose_section(tmp_path)

@@ -522,15 +522,50 @@ def diagnose_section(folder: Path) -> str:
     if steps.empty:
         return intro + "<p>No effect was added: nothing explained the residual.</p></section>"
     rows = "".join(
-        f"<tr><td>{int(r['step'])}</td><td>{html.escape(str(r['effect']))}</td>"
+        f"<tr><td class='num'>{int(r['step'])}</td><td>{html.escape(str(r['effect']))}</td>"
         f"<td>{html.escape(str(r.get('strength_text', '')))}</td>"
-        f"<td>{100 * float(r['explained_fraction']):.0f}</td>"
+        f"<td class='num'>{100 * float(r['explained_fraction']):.0f}</td>"
         f"<td>{float(r['rmse_before']):.3f} → {float(r['rmse_after']):.3f}</td>"
         f"<td>{float(r['cv_rmse_before']):.3f} → {float(r['cv_rmse_after']):.3f}</td></tr>"
         for _, r in steps.iterrows())
-    return (intro + "<table><thead><tr><th>step</th><th>effect</th><th>fitted strength</th>"
+    return (intro + "<div class='tablewrap' id='t-diagnose_steps'><table><thead><tr>"
+            "<th>step</th><th>effect</th><th>fitted strength</th>"
             "<th>residual explained (%)</th><th>nRMSE</th><th>LOHO-CV nRMSE</th></tr></thead>"
-            f"<tbody>{rows}</tbody></table></section>")
+            f"<tbody>{rows}</tbody></table></div></section>")
+
+
+def markdown_extras(project: Project) -> str:
+    """The permeability scan and the fitted diagnosis steps as Markdown ("" when neither)."""
+    parts = []
+    scan_csv = project.results_dir / "permeability_scan.csv"
+    if scan_csv.exists():
+        from radtree.permeability_scan import PermeabilityScan
+
+        t = pd.read_csv(scan_csv)
+        scan = PermeabilityScan(str(t["scenario"].iloc[0]), str(t["field"].iloc[0]),
+                                t.drop(columns=["scenario", "field"]), [])
+        lines = [f"\n## Scenario {scan.scenario} against the crown's permeability\n",
+                 *[f"- {x}" for x in scan.summary()], "",
+                 f"| {scan.field} | permeability, street (%) | permeability, unobstructed (%) "
+                 "| nRMSE | nMBE | r |", "|---|---|---|---|---|---|"]
+        lines += [f"| {r['value']:g} | {100 * r['permeability_street']:.2f} | "
+                  f"{100 * r['permeability_unobstructed']:.2f} | {r['nrmse']:.3f} | "
+                  f"{r['nmbe']:+.3f} | {r['r']:.3f} |" for _, r in t.iterrows()]
+        parts.append("\n".join(lines) + "\n")
+    steps_csv = project.root / "diagnose" / "steps.csv"
+    if steps_csv.exists():
+        st = pd.read_csv(steps_csv)
+        lines = ["\n## Diagnosis: fitted effects (reported separately)\n",
+                 "Strengths fitted to the measured hours; LOHO-CV = leave-one-hour-out "
+                 "cross-validated nRMSE.", "",
+                 "| step | effect | fitted strength | explained (%) | nRMSE | LOHO-CV nRMSE |",
+                 "|---|---|---|---|---|---|"]
+        lines += [f"| {int(r['step'])} | {r['effect']} | {r.get('strength_text', '')} | "
+                  f"{100 * float(r['explained_fraction']):.0f} | {float(r['rmse_before']):.3f} → "
+                  f"{float(r['rmse_after']):.3f} | {float(r['cv_rmse_before']):.3f} → "
+                  f"{float(r['cv_rmse_after']):.3f} |" for _, r in st.iterrows()]
+        parts.append("\n".join(lines) + "\n")
+    return "".join(parts)
 
 
 def extra_sections(project: Project, out: Path, echo: Callable[[str], None]) -> list[str]:
@@ -641,6 +676,7 @@ def build_report(project: Project, echo: Callable[[str], None] = print) -> Path:
         html = _environment(True).get_template("report.html.j2").render(c=ctx)
         html = _with_extra_sections(project, html, tmp, echo)
         md = _environment(False).get_template("report.md.j2").render(c=ctx)
+        md += markdown_extras(project)
         (tmp / "index.html").write_text(html, encoding="utf-8")
         (tmp / "index.md").write_text(md, encoding="utf-8")
     index = target / "index.html"
