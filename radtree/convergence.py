@@ -16,7 +16,7 @@ import pandas as pd
 from radtree.config import Project
 from radtree.engines.radiance.engine import trace_hour
 from radtree.light import hour_states
-from radtree.scenarios import make_scene, selected
+from radtree.scenarios import REALISATION_MARK, make_scene, selected
 
 AB_LADDER = (1, 2, 3, 4, 6, 8)
 
@@ -24,9 +24,13 @@ AB_LADDER = (1, 2, 3, 4, 6, 8)
 def convergence_table(project: Project, scenarios: list[str] | None = None,
                       hours: list[str] | None = None, ab_values: tuple[int, ...] = AB_LADDER,
                       echo: Callable[[str], None] = print) -> pd.DataFrame:
-    """One row per scenario × hour × -ab: façade mean lux and relative change from the step before."""
+    """One row per scenario × hour × -ab: façade mean lux and relative change from the step before.
+    A scenario with several crown realisations is checked on its first one."""
     rows = []
     for sc in selected(project, scenarios):
+        name, _, k = sc.name.partition(REALISATION_MARK)
+        if k not in ("", "1"):
+            continue
         built = make_scene(project, sc, dense_grid=False)
         states = hour_states(project, sc, hours or [project.site.hours[0]])
         for st in states:
@@ -36,11 +40,11 @@ def convergence_table(project: Project, scenarios: list[str] | None = None,
                 lux = trace_hour(built.scene, st, params, grids=["facade"], ab=ab)["facade"].lux
                 mean = float(lux.mean())
                 change = (mean - prev) / prev if prev else float("nan")
-                rows.append({"scenario": sc.name, "model": sc.model, "time": st.time, "ab": ab,
+                rows.append({"scenario": name, "model": sc.model, "time": st.time, "ab": ab,
                              "ad": project.engine.ad, "facade_mean_lux": round(mean, 1),
                              "change": round(change, 4) if prev else None,
                              "model_recommended_ab": built.ab})
-                echo(f"  {sc.name} {st.time} -ab {ab}: {mean:.0f} lx"
+                echo(f"  {name} {st.time} -ab {ab}: {mean:.0f} lx"
                      + (f" ({change:+.1%})" if prev else ""))
                 prev = mean
     return pd.DataFrame(rows)

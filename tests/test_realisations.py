@@ -120,3 +120,13 @@ def test_annual_says_it_uses_the_first_crown(reduced):
     with_sc, _, notes = choose_scenarios(proj, AnnualOptions(with_scenario="F"))
     assert with_sc.name == "F"
     assert any("averages 3 random crowns" in n and "louvers.seed 1" in n for n in notes)
+
+
+@needs_radiance
+def test_convergence_checks_the_first_crown_only(reduced):
+    from radtree.convergence import convergence_table
+
+    proj = load_project(reduced)
+    t = convergence_table(proj, ["F"], ["13:30"], ab_values=(1, 2), echo=lambda s: None)
+    assert t["scenario"].tolist() == ["F", "F"] and t["ab"].tolist() == [1, 2]
+    assert t["facade_mean_lux"].iloc[1] > t["facade_mean_lux"].iloc[0] > 0
