@@ -534,6 +534,65 @@ def diagnose_section(folder: Path) -> str:
             f"<tbody>{rows}</tbody></table></div></section>")
 
 
+def realisation_frame(project: Project) -> pd.DataFrame | None:
+    """Per scenario with crown realisations, per realisation: façade hourly means, nRMSE and
+    nMBE against the measured hourly means (None without ``results/realisations.csv``)."""
+    path = project.results_dir / "realisations.csv"
+    if not path.exists():
+        return None
+    from radtree.measurements import grid_mean, load_measured
+    from radtree.stats import nmbe, nrmse
+
+    per = pd.read_csv(path)
+    per = per[per["grid"] == "facade"]
+    if per.empty:
+        return None
+    hourly = per.groupby(["scenario", "realisation", "time"])["lux"].mean().unstack("time")
+    measured = None
+    if project.measured is not None:
+        frame, shape = load_measured(project.measured)
+        if shape.kind != "row":
+            measured = grid_mean(frame).set_index("time")["measured_lux"].astype(float)
+    out = hourly.reset_index()
+    if measured is not None and set(hourly.columns) <= set(measured.index):
+        m = measured.reindex(hourly.columns).to_numpy()
+        out["nrmse"] = [nrmse(m, row) for row in hourly.to_numpy()]
+        out["nmbe"] = [nmbe(m, row) for row in hourly.to_numpy()]
+    return out
+
+
+def realisations_section(project: Project) -> str:
+    """HTML: each crown realisation of a scenario alone, beside their mean ("" when none)."""
+    import html
+
+    t = realisation_frame(project)
+    if t is None:
+        return ""
+    hours = [c for c in t.columns if c not in ("scenario", "realisation", "nrmse", "nmbe")]
+    head = "".join(f"<th>{html.escape(str(h))}</th>" for h in hours)
+    stats_head = "<th>nRMSE</th><th>nMBE</th>" if "nrmse" in t.columns else ""
+    rows = []
+    for _, r in t.iterrows():
+        cells = "".join(f"<td class='num'>{r[h]:.0f}</td>" for h in hours)
+        if "nrmse" in t.columns:
+            cells += f"<td class='num'>{r['nrmse']:.3f}</td><td class='num'>{r['nmbe']:+.3f}</td>"
+        rows.append(f"<tr><td>{html.escape(str(r['scenario']))}</td>"
+                    f"<td class='num'>{int(r['realisation'])}</td>{cells}</tr>")
+    spread = ""
+    if "nrmse" in t.columns:
+        spread = " ".join(
+            f"Scenario {html.escape(str(name))}: single crowns give nRMSE "
+            f"{g['nrmse'].min():.3f}–{g['nrmse'].max():.3f} (mean {g['nrmse'].mean():.3f})."
+            for name, g in t.groupby("scenario"))
+    return ("<section id='realisations'><h2>Crown realisations</h2><p>Scenarios with "
+            "<code>louvers.realisations</code> &gt; 1 trace several random crowns "
+            "(<code>louvers.seed</code>, seed + 1, …); the tables above show their mean, with "
+            "the standard error over crowns. Each crown alone (façade mean, lux): "
+            f"{spread}</p><div class='tablewrap' id='t-realisations'><table><thead><tr>"
+            f"<th>scenario</th><th>realisation</th>{head}{stats_head}</tr></thead><tbody>"
+            f"{''.join(rows)}</tbody></table></div></section>")
+
+
 def markdown_extras(project: Project) -> str:
     """The permeability scan and the fitted diagnosis steps as Markdown ("" when neither)."""
     parts = []
@@ -594,6 +653,10 @@ def extra_sections(project: Project, out: Path, echo: Callable[[str], None]) -> 
     if sweep:
         parts.append(sweep)
         echo("  sweep: sensitivity section")
+    crowns = realisations_section(project)
+    if crowns:
+        parts.append(crowns)
+        echo("  crown realisations section")
     from radtree.permeability_scan import scan_report_section
 
     scan = scan_report_section(project, out)
