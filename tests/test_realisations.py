@@ -90,6 +90,10 @@ def test_simulate_averages_realisations(reduced):
     np.testing.assert_allclose(crowns["nrmse"], np.abs(1592.0 - crowns["13:30"]) / 1592.0)
     html = realisations_section(proj)
     assert html.count("<tr><td>F</td>") == 3 and "single crowns give nRMSE" in html
+    from radtree.report.build import markdown_extras
+
+    md = markdown_extras(proj)
+    assert "## Crown realisations" in md and md.count("\n| F | ") == 3
 
 
 @needs_radiance

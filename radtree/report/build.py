@@ -594,8 +594,20 @@ def realisations_section(project: Project) -> str:
 
 
 def markdown_extras(project: Project) -> str:
-    """The permeability scan and the fitted diagnosis steps as Markdown ("" when neither)."""
+    """Crown realisations, the permeability scan and the fitted diagnosis steps as Markdown
+    ("" when none of them exists)."""
     parts = []
+    crowns = realisation_frame(project)
+    if crowns is not None:
+        cols = [c for c in crowns.columns if c not in ("scenario", "realisation")]
+        lines = ["\n## Crown realisations\n", "Each random crown alone (façade mean, lux; "
+                 "nRMSE/nMBE against the measured hourly means).", "",
+                 "| scenario | realisation | " + " | ".join(cols) + " |",
+                 "|---|---|" + "---|" * len(cols)]
+        lines += ["| " + " | ".join([str(r["scenario"]), str(int(r["realisation"]))]
+                                    + [f"{r[c]:.3f}" if c in ("nrmse", "nmbe") else f"{r[c]:.0f}"
+                                       for c in cols]) + " |" for _, r in crowns.iterrows()]
+        parts.append("\n".join(lines) + "\n")
     scan_csv = project.results_dir / "permeability_scan.csv"
     if scan_csv.exists():
         from radtree.permeability_scan import PermeabilityScan
