@@ -21,6 +21,7 @@ demo: $(STAMP)
 	$(BIN)/radtree doctor
 	$(BIN)/radtree build $(EXAMPLE)
 	$(BIN)/radtree simulate $(EXAMPLE)
+	$(BIN)/radtree simulate $(EXAMPLE) --convergence -s A -s C -s E -s F
 	$(BIN)/radtree permeability $(EXAMPLE) -s A --rays 1024
 	$(BIN)/radtree diagnose $(EXAMPLE) -s A
 	$(BIN)/radtree report $(EXAMPLE)

@@ -35,7 +35,7 @@ def convergence_table(project: Project, scenarios: list[str] | None = None,
         states = hour_states(project, sc, hours or [project.site.hours[0]])
         for st in states:
             prev = None
-            for ab in ab_values:
+            for ab in sorted(set(ab_values) | {built.ab}):   # always the -ab simulate uses
                 params = replace(project.engine, ab=ab)
                 lux = trace_hour(built.scene, st, params, grids=["facade"], ab=ab)["facade"].lux
                 mean = float(lux.mean())

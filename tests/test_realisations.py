@@ -141,5 +141,6 @@ def test_convergence_checks_the_first_crown_only(reduced):
 
     proj = load_project(reduced)
     t = convergence_table(proj, ["F"], ["13:30"], ab_values=(1, 2), echo=lambda s: None)
-    assert t["scenario"].tolist() == ["F", "F"] and t["ab"].tolist() == [1, 2]
-    assert t["facade_mean_lux"].iloc[1] > t["facade_mean_lux"].iloc[0] > 0
+    # the ladder asked for, plus the -ab simulate uses for this crown (6)
+    assert t["scenario"].tolist() == ["F"] * 3 and t["ab"].tolist() == [1, 2, 6]
+    assert t["facade_mean_lux"].iloc[2] > t["facade_mean_lux"].iloc[1] > t["facade_mean_lux"].iloc[0]
