@@ -144,3 +144,20 @@ def test_convergence_checks_the_first_crown_only(reduced):
     # the ladder asked for, plus the -ab simulate uses for this crown (6)
     assert t["scenario"].tolist() == ["F"] * 3 and t["ab"].tolist() == [1, 2, 6]
     assert t["facade_mean_lux"].iloc[2] > t["facade_mean_lux"].iloc[1] > t["facade_mean_lux"].iloc[0]
+
+
+@pytest.mark.parametrize("value", [0, 65, 2.5])
+def test_bad_realisations_are_named(tmp_path, value):
+    p = copy_project(tmp_path / "proj", replace={r"^slat_size_m = 0.3":
+                                                  f"slat_size_m = 0.3\nrealisations = {value}"})
+    with pytest.raises(ConfigError, match="realisations"):
+        load_project(p)
+
+
+def test_bad_realisations_switch_is_named(reduced):
+    toml = reduced / "radtree.toml"
+    toml.write_text(toml.read_text().replace('"louvers.realisations" = 3',
+                                             '"louvers.realisations" = 0'))
+    proj = load_project(reduced)
+    with pytest.raises(ConfigError, match="realisations"):
+        build_project(proj, ["F"], echo=lambda s: None, progress=False, pictures=False)
