@@ -16,7 +16,7 @@ import pandas as pd
 from radtree.config import Project
 from radtree.engines.radiance.engine import trace_hour
 from radtree.light import hour_states
-from radtree.scenarios import REALISATION_MARK, make_scene, selected
+from radtree.scenarios import is_later_realisation, make_scene, parent_name, selected
 
 AB_LADDER = (1, 2, 3, 4, 6, 8)
 
@@ -28,9 +28,9 @@ def convergence_table(project: Project, scenarios: list[str] | None = None,
     A scenario with several crown realisations is checked on its first one."""
     rows = []
     for sc in selected(project, scenarios):
-        name, _, k = sc.name.partition(REALISATION_MARK)
-        if k not in ("", "1"):
+        if is_later_realisation(sc.name):
             continue
+        name = parent_name(sc.name)
         built = make_scene(project, sc, dense_grid=False)
         states = hour_states(project, sc, hours or [project.site.hours[0]])
         for st in states:

@@ -369,3 +369,12 @@ def grid_mean(measured: pd.DataFrame,
             raise RadtreeError(f"measured grid means repeat hour(s) {', '.join(dupes)}")
         out = out.sort_values("time", kind="stable")
     return out.reset_index(drop=True)
+
+
+def hourly_grid_means(path: str | os.PathLike) -> pd.Series | None:
+    """The measured hourly façade-grid means (lux, indexed by time) of a mean- or sensor-shaped
+    file; None for a per-row file (its grid mean needs the sensors per row)."""
+    frame, shape = load_measured(path)
+    if shape.kind == "row":
+        return None
+    return grid_mean(frame).set_index("time")["measured_lux"].astype(float)

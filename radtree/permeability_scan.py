@@ -31,23 +31,21 @@ from radtree.config import Project, Scenario
 from radtree.errors import ConfigError, RadtreeError
 from radtree.figures import new_figure, save_png
 from radtree.fileio import atomic_path
-from radtree.measurements import grid_mean, load_measured
+from radtree.measurements import hourly_grid_means
 from radtree.scenarios import trace_numpy
 from radtree.stats import nmbe, nrmse, pearson_r
 
 MEASURED_BAND = (0.05, 0.06)   # SPEC.md §1: canopy permeability 5–6 %
 TARGET_NRMSE = 0.10            # the reference study's scenario A reached 0.09
 UNOBSTRUCTED_WIDTH_M = 2000.0  # a flat ground this wide is "to the horizon" for a 5 m sensor
-SCAN_COLUMNS = ["value", "permeability_street", "permeability_street_se",
-                "permeability_unobstructed", "permeability_unobstructed_se",
-                "nrmse", "nmbe", "r"]
 
 
 @dataclass
 class PermeabilityScan:
     scenario: str
     field: str
-    table: pd.DataFrame            # SCAN_COLUMNS + one column per hour (façade mean, lux)
+    table: pd.DataFrame            # value, permeability_street(_se), permeability_unobstructed(_se),
+    #                                nrmse, nmbe, r, one column per hour (façade mean, lux)
     hours: list[str]
 
     def band_nrmse(self, column: str = "permeability_unobstructed") -> tuple[float, float] | None:
@@ -130,11 +128,10 @@ def scan_permeability(project: Project, scenario: str = "A",
     if project.measured is None:
         raise RadtreeError(f"{project.source}: no measured data ([project] measured) to "
                            "compare the scan with")
-    frame, shape = load_measured(project.measured)
-    if shape.kind == "row":
+    m = hourly_grid_means(project.measured)
+    if m is None:
         raise RadtreeError(f"{project.measured}: the scan needs hourly façade means (or per-sensor "
                            "values), not per-row values")
-    m = grid_mean(frame).set_index("time")["measured_lux"].astype(float)
     unmeasured = [h for h in project.site.hours if h not in m.index]
     if unmeasured:
         raise RadtreeError(f"{project.measured}: no measured value at {', '.join(unmeasured)} "
@@ -207,19 +204,27 @@ def write_scan(scan: PermeabilityScan, folder: Path) -> tuple[Path, Path]:
     return csv, png
 
 
+def read_scan(project: Project) -> PermeabilityScan | None:
+    """The scan ``radtree permeability`` wrote in ``results/`` (None when none was run)."""
+    csv = project.results_dir / "permeability_scan.csv"
+    if not csv.exists():
+        return None
+    t = pd.read_csv(csv)
+    return PermeabilityScan(str(t["scenario"].iloc[0]), str(t["field"].iloc[0]),
+                            t.drop(columns=["scenario", "field"]), [])
+
+
 def scan_report_section(project: Project, out: Path) -> str:
     """HTML section on ``results/permeability_scan.csv`` ("" when no scan was run); copies the
     figure into the report folder ``out``."""
     import html
     import shutil
 
-    csv = project.results_dir / "permeability_scan.csv"
     png = project.results_dir / "permeability_scan.png"
-    if not csv.exists():
+    scan = read_scan(project)
+    if scan is None:
         return ""
-    t = pd.read_csv(csv)
-    scan = PermeabilityScan(str(t["scenario"].iloc[0]), str(t["field"].iloc[0]),
-                            t.drop(columns=["scenario", "field"]), [])
+    t = scan.table
     rows = "".join(
         "<tr>" + "".join(f"<td class='num'>{v}</td>" for v in (
             f"{r['value']:g}", f"{100 * r['permeability_street']:.2f}",

@@ -131,6 +131,11 @@ def parent_name(name: str) -> str:
     return str(name).partition(REALISATION_MARK)[0]
 
 
+def is_later_realisation(name: str) -> bool:
+    """True for ``F@2``, ``F@3``, …: crowns after the first (maps and checks use the first)."""
+    return str(name).partition(REALISATION_MARK)[2] not in ("", "1")
+
+
 def selected(project: Project, names: list[str] | None) -> list[Scenario]:
     """The scenarios to build or trace, each expanded into its crown realisations; a name may
     also pick one realisation (``F@2``)."""
@@ -444,8 +449,7 @@ def hour_grids(project: Project, time_: str, available: list[str],
     only in the first crown realisation (``F@1``) of a scenario with several."""
     use = [g for g in available if wanted is None or g in wanted]
     dense = project.sensors.dense_hours
-    later = sc is not None and sc.name.partition(REALISATION_MARK)[2] not in ("", "1")
-    if (dense and time_ not in dense) or later:
+    if (dense and time_ not in dense) or (sc is not None and is_later_realisation(sc.name)):
         use = [g for g in use if g != "facade_map"]
     return use
 

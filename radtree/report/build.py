@@ -540,7 +540,7 @@ def realisation_frame(project: Project) -> pd.DataFrame | None:
     path = project.results_dir / "realisations.csv"
     if not path.exists():
         return None
-    from radtree.measurements import grid_mean, load_measured
+    from radtree.measurements import hourly_grid_means
     from radtree.stats import nmbe, nrmse
 
     per = pd.read_csv(path)
@@ -548,11 +548,7 @@ def realisation_frame(project: Project) -> pd.DataFrame | None:
     if per.empty:
         return None
     hourly = per.groupby(["scenario", "realisation", "time"])["lux"].mean().unstack("time")
-    measured = None
-    if project.measured is not None:
-        frame, shape = load_measured(project.measured)
-        if shape.kind != "row":
-            measured = grid_mean(frame).set_index("time")["measured_lux"].astype(float)
+    measured = hourly_grid_means(project.measured) if project.measured is not None else None
     out = hourly.reset_index()
     if measured is not None and set(hourly.columns) <= set(measured.index):
         m = measured.reindex(hourly.columns).to_numpy()
@@ -608,13 +604,11 @@ def markdown_extras(project: Project) -> str:
                                     + [f"{r[c]:.3f}" if c in ("nrmse", "nmbe") else f"{r[c]:.0f}"
                                        for c in cols]) + " |" for _, r in crowns.iterrows()]
         parts.append("\n".join(lines) + "\n")
-    scan_csv = project.results_dir / "permeability_scan.csv"
-    if scan_csv.exists():
-        from radtree.permeability_scan import PermeabilityScan
+    from radtree.permeability_scan import read_scan
 
-        t = pd.read_csv(scan_csv)
-        scan = PermeabilityScan(str(t["scenario"].iloc[0]), str(t["field"].iloc[0]),
-                                t.drop(columns=["scenario", "field"]), [])
+    scan = read_scan(project)
+    if scan is not None:
+        t = scan.table
         lines = [f"\n## Scenario {scan.scenario} against the crown's permeability\n",
                  *[f"- {x}" for x in scan.summary()], "",
                  f"| {scan.field} | permeability, street (%) | permeability, unobstructed (%) "
