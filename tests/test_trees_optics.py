@@ -185,18 +185,23 @@ def test_louvers_free_study_reading_exact(project, frame):
     assert tr.transmission(org, d).mean() == pytest.approx(0.25**4, rel=1e-3)
 
 
+def direct_transmission(tm, form, project, frame, tree, centre, dirs) -> np.ndarray:
+    """Direct transmission of a built crown: from the dome centre over ``dirs`` (dome), or
+    along vertical rays through the crowns (free)."""
+    tr = DirectTracer(tm.meshes, tm.materials)
+    if form == "dome":
+        return tr.transmission(centre, dirs)
+    org, d, _ = vertical_rays(project, frame, tree)
+    return tr.transmission(org, d)
+
+
 @pytest.mark.parametrize("form", ["dome", "free"])
 def test_louvers_single_layer_cover(project, frame, centre, dirs, form):
     """One layer of cover 0.6: the beam meets a slat with probability 0.6."""
     tree, _ = apply_switches(project.tree, {"louvers.layers": 1, "louvers.cover_fraction": 0.6,
                                             "louvers.specular_fraction": 0.0})
     tm = build_crown(project, "louvers", form, frame, tree)
-    tr = DirectTracer(tm.meshes, tm.materials)
-    if form == "dome":
-        t = tr.transmission(centre, dirs)
-    else:
-        org, d, _ = vertical_rays(project, frame, tree)
-        t = tr.transmission(org, d)
+    t = direct_transmission(tm, form, project, frame, tree, centre, dirs)
     assert t.mean() == pytest.approx(0.4, abs=0.01)
     assert tm.info["tau_layer_direct"] == pytest.approx(0.4)
 
@@ -215,11 +220,5 @@ def test_louvers_random_cover_expectation(project, frame, centre, dirs, form, sw
         tree, _ = apply_switches(project.tree, dict(switches, **{"louvers.seed": seed}))
         tm = build_crown(project, "louvers", form, frame, tree)
         assert tm.info["tau_crown_direct"] == pytest.approx(analytic)
-        tr = DirectTracer(tm.meshes, tm.materials)
-        if form == "dome":
-            t = tr.transmission(centre, dirs)
-        else:
-            org, d, _ = vertical_rays(project, frame, tree)
-            t = tr.transmission(org, d)
-        values.append(t.mean())
+        values.append(direct_transmission(tm, form, project, frame, tree, centre, dirs).mean())
     assert np.mean(values) == pytest.approx(analytic, rel=rel)
