@@ -52,15 +52,19 @@ def _maps(loop: LoopResult) -> list[tuple[str, DisagreementMap]]:
     return out
 
 
+def _step_colour(i: int, n: int, first: str) -> Any:
+    """Colour of step ``i`` of ``n`` maps: ``first`` for the start, then viridis."""
+    return first if i == 0 else colormaps["viridis"](0.15 + 0.7 * i / max(1, n - 1))
+
+
 def fig_residual_steps(loop: LoopResult, path: Path) -> str:
     fig = _fig(7.5, 4.2)
     ax = fig.add_subplot()
     maps = _maps(loop)
-    cmap = colormaps["viridis"]
     for i, (label, dm) in enumerate(maps):
         h = dm.hourly
         x = [_hour(t) for t in h["time"]]
-        c = "black" if i == 0 else cmap(0.15 + 0.7 * i / max(1, len(maps) - 1))
+        c = _step_colour(i, len(maps), "black")
         ax.errorbar(x, h["residual_lux"], yerr=2 * h["simulated_se_lux"].fillna(0), marker="o",
                     color=c, lw=2.2 if i in (0, len(maps) - 1) else 1.2, capsize=3,
                     label=f"{label}: nRMSE {dm.stats['nrmse']:.3f}")
@@ -79,9 +83,8 @@ def fig_measured(loop: LoopResult, path: Path) -> str:
     h0 = maps[0][1].hourly
     x = [_hour(t) for t in h0["time"]]
     ax.plot(x, h0["measured_lux"], "o-", color="black", lw=2.4, label="measured", zorder=5)
-    cmap = colormaps["viridis"]
     for i, (label, dm) in enumerate(maps):
-        c = "tab:red" if i == 0 else cmap(0.15 + 0.7 * i / max(1, len(maps) - 1))
+        c = _step_colour(i, len(maps), "tab:red")
         ax.plot(x, dm.hourly["simulated_lux"], "s--", color=c, label=label)
     ax.set_xlabel("local clock time (h)")
     ax.set_ylabel("vertical illuminance, façade grid mean (lx)")
