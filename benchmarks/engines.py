@@ -7,7 +7,7 @@ Prints (no timing assertions):
 2. wall time of one hour of the NumPy engine on a louvers-like slat scene (3000 slats of 0.3 m
    inclined 30°, random azimuth, in a 4 m sensor dome on the façade of the Mendoza canyon;
    Perez sky + sun of 11:30) at the default budget, and on the Mendoza project's own louvers
-   crown (``radtree.scenarios.make_scene``) when that builds;
+   crown (``radtree.pipeline.assemble.make_scene``) when that builds;
 3. when Radiance is available, the per-row relative difference NumPy − Radiance on the slat
    scene, with Radiance at ``-ab 8 -ad 8192 -as 0 -aa 0`` and with ambient super-sampling
    (``-as 4096``, biased low here); ``--with-defaults`` adds the project's ``-as 512 -aa 0.1``.
@@ -129,7 +129,7 @@ def engine_hour(quick: bool) -> Scene:
     try:
         from radtree.config import load_project
         from radtree.light import hour_states
-        from radtree.scenarios import make_scene
+        from radtree.pipeline.assemble import make_scene
 
         project = load_project(ROOT / "examples" / "mendoza-street")
         scenario = next(s for s in project.scenarios if s.model == "louvers"

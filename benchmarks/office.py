@@ -37,7 +37,9 @@ def main(argv: list[str] | None = None) -> int:
     from radtree.config import load_project
     from radtree.engines.radiance.binaries import find_radiance
     from radtree.office_summary import summarise
-    from radtree.scenarios import build_project, make_scene, simulate_project
+    from radtree.pipeline.assemble import make_scene
+    from radtree.pipeline.build import build_project
+    from radtree.pipeline.simulate import simulate_project
 
     if find_radiance() is None:
         print("Radiance not found: nothing to benchmark")

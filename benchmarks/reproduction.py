@@ -15,7 +15,8 @@ import pandas as pd
 
 from radtree.config import load_project
 from radtree.measurements import load_measured
-from radtree.scenarios import build_project, simulate_project
+from radtree.pipeline.build import build_project
+from radtree.pipeline.simulate import simulate_project
 from radtree.stats import compare
 
 ROOT = Path(__file__).resolve().parents[1]

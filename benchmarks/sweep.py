@@ -38,7 +38,7 @@ PARAMS = ["tree.dome.radius_m=3.5:4.7:4", "tree.louvers.layers=3,4,5",
 def crown_models_work(project: Path) -> str | None:
     """None when scenario A's crown can be built, else the reason."""
     from radtree.config import load_project
-    from radtree.scenarios import make_scene
+    from radtree.pipeline.assemble import make_scene
 
     try:
         p = load_project(project)

@@ -15,6 +15,7 @@ import traceback
 import click
 
 from radtree import __version__
+from radtree.engines.registry import ENGINE_CHOICES
 from radtree.errors import RadtreeError
 
 CONTEXT = {"help_option_names": ["-h", "--help"], "max_content_width": 100}
@@ -107,7 +108,7 @@ def build(project: str, scenarios: tuple[str, ...], no_pictures: bool) -> None:
     import time
 
     from radtree.config import load_project
-    from radtree.scenarios import build_project
+    from radtree.pipeline.build import build_project
 
     t = time.perf_counter()
     p = load_project(project)
@@ -119,7 +120,7 @@ def build(project: str, scenarios: tuple[str, ...], no_pictures: bool) -> None:
 @main.command(context_settings=CONTEXT)
 @click.argument("project", type=click.Path())
 @_scenarios_option
-@click.option("--engine", type=click.Choice(["auto", "radiance", "numpy"]), default="auto",
+@click.option("--engine", type=click.Choice(ENGINE_CHOICES), default="auto",
               show_default=True, help="auto = Radiance when found, else the NumPy engine.")
 @click.option("--hour", "hours", multiple=True, help="Only this hour HH:MM (repeatable).")
 @click.option("--workers", type=int, default=None, help="Parallel hours (default: engine.workers).")
@@ -138,7 +139,7 @@ def simulate(project: str, scenarios: tuple[str, ...], engine: str, hours: tuple
     import time
 
     from radtree.config import load_project
-    from radtree.scenarios import choose_engine, simulate_project
+    from radtree.pipeline.simulate import resolve_engine, simulate_project
 
     p = load_project(project)
     if convergence:
@@ -153,8 +154,8 @@ def simulate(project: str, scenarios: tuple[str, ...], engine: str, hours: tuple
             table.to_csv(tmp, index=False)
         click.echo(f"convergence table → {conv_path}")
         return
-    eng = choose_engine(engine if engine != "auto" else p.engine.name)
-    click.echo(f"engine: {eng}" + (" (auto)" if engine == "auto" else ""))
+    eng = resolve_engine(p, engine)
+    click.echo(f"engine: {eng.name}" + (" (auto)" if engine == "auto" else ""))
     t = time.perf_counter()
     out = simulate_project(p, eng, list(scenarios) or None, list(hours) or None, workers,
                            dry_run=dry_run, echo=click.echo, resume=not fresh)
@@ -166,6 +167,10 @@ def simulate(project: str, scenarios: tuple[str, ...], engine: str, hours: tuple
     click.echo(means.round(0).to_string())
     click.echo(f"{out.computed} hours traced, {out.reused} reused, "
                f"{time.perf_counter() - t:.1f} s → {out.path}")
+    if p.office is not None:
+        from radtree.office_summary import write_summary
+
+        click.echo(f"office summary → {write_summary(p, maps=False)}")
 
 
 

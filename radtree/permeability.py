@@ -23,28 +23,20 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 
 import numpy as np
 import pandas as pd
 
 from radtree.config import Project, Scenario
-from radtree.light import hour_states
-from radtree.scenarios import make_scene
+from radtree.engines.registry import seeded_engine
+from radtree.pipeline.trace import facade_total
 
 
 def _facade_sum(project: Project, scenario: Scenario, rays: int, seed: int) -> tuple[float, float]:
-    from radtree.engines.numpy.engine import trace_hour
-
-    built = make_scene(project, scenario, dense_grid=False)
-    params = replace(project.engine, rays=rays, seed=seed)
-    total, var = 0.0, 0.0
-    for st in hour_states(project, scenario):
-        g = trace_hour(built.scene, st, params, grids=["facade"])["facade"]
-        total += float(g.lux.mean())
-        if g.stderr is not None:
-            var += float(np.sum(g.stderr ** 2)) / len(g.lux) ** 2
-    return total, math.sqrt(var)
+    """Σ_h façade mean (lux) and its s.e., traced as ``simulate`` traces (the scene's -ab, the
+    scenario's switches) on the seeded engine (common random numbers across crowns)."""
+    return facade_total(project, scenario, seeded_engine(), rays, seed)
 
 
 def global_permeability(project: Project, model: str = "louvers",

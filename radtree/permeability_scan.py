@@ -28,11 +28,12 @@ import numpy as np
 import pandas as pd
 
 from radtree.config import Project, Scenario
+from radtree.engines.registry import seeded_engine
 from radtree.errors import ConfigError, RadtreeError
 from radtree.figures import new_figure, save_png
 from radtree.fileio import atomic_path
 from radtree.measurements import hourly_grid_means
-from radtree.scenarios import trace_numpy
+from radtree.pipeline.trace import facade_total, trace_scenario
 from radtree.stats import nmbe, nrmse, pearson_r
 
 MEASURED_BAND = (0.05, 0.06)   # SPEC.md §1: canopy permeability 5–6 %
@@ -98,13 +99,7 @@ def unobstructed_project(project: Project) -> Project:
 
 def _sum(project: Project, sc: Scenario, rays: int, seed: int) -> tuple[float, float]:
     """Σ over hours of the façade sensors' mean traced illuminance, and its standard error."""
-    df = trace_numpy(project, sc, rays, seed, grids=["facade"])
-    g = df.groupby("time")
-    total = float(g["lux_traced"].mean().sum())
-    n = g.size().to_numpy()
-    var = float(np.sum(g["lux_stderr"].apply(lambda s: float(np.sum(s.to_numpy() ** 2)))
-                       .to_numpy() / n ** 2))
-    return total, math.sqrt(var) if math.isfinite(var) else float("nan")
+    return facade_total(project, sc, seeded_engine(), rays, seed)
 
 
 def _ratio(num: tuple[float, float], den: tuple[float, float]) -> tuple[float, float]:
@@ -158,7 +153,8 @@ def scan_permeability(project: Project, scenario: str = "A",
                          switches=sw)
         p_street = _ratio(_sum(project, crown, rays, seed), open_street)
         p_unob = _ratio(_sum(sky_project, crown, rays, seed), unob)
-        sim = trace_numpy(project, replace(sc0, switches=sw), rays, seed, grids=["facade"])
+        sim = trace_scenario(project, replace(sc0, switches=sw), seeded_engine(), rays, seed,
+                             grids=["facade"])
         hourly = sim.groupby("time")["lux"].mean()
         hours = list(m.index)
         s = hourly.reindex(m.index).to_numpy()

@@ -99,3 +99,25 @@ def unfiltered_ground_light(project: Project, scenario: Scenario, state: SkyStat
                   for h in grid.points[:, 2]])
     vertical = np.abs(grid.normals[:, 2]) < 0.1
     return np.where(vertical, s * rho * e_open * F, 0.0)
+
+
+def ground_terms(project: Project, scenario: Scenario, state: SkyState,
+                 grid: SensorGrid) -> np.ndarray:
+    """Every calculated (not traced) ground term added to the sensors of ``grid`` this hour (lux):
+    the analytic ground reflection of ``reflection = "calculated"`` plus the unfiltered street
+    light of the ``reflection.unfiltered`` switch."""
+    extra = np.zeros(len(grid))
+    if scenario.reflection == "calculated":
+        extra = calculated_reflection(project, scenario, state, grid)
+    return extra + unfiltered_ground_light(project, scenario, state, grid)
+
+
+def reflection_notes(project: Project) -> dict[str, str]:
+    """Per scenario, how ground-reflected light is handled (for reports)."""
+    out = {}
+    for sc in project.scenarios:
+        if sc.reflection == "calculated":
+            out[sc.name] = "calculated: " + reflection_choice(project, sc).describe()
+        else:
+            out[sc.name] = "traced: sun → street → façade through the crown model"
+    return out

@@ -67,7 +67,7 @@ def _tidy(table: pd.DataFrame) -> pd.DataFrame:
 def mendoza_table(engine: str, workdir: Path) -> pd.DataFrame:
     """The reduced Mendoza results table (every scenario) with one engine."""
     from radtree.config import load_project
-    from radtree.scenarios import simulate_project
+    from radtree.pipeline.simulate import simulate_project
 
     overrides = dict(MENDOZA_OVERRIDES)
     if engine == "radiance":
@@ -83,12 +83,14 @@ def mendoza_table(engine: str, workdir: Path) -> pd.DataFrame:
 def office_summary(engine: str, workdir: Path) -> pd.DataFrame:
     """The reduced office block's hourly summary (results/summary.csv) with one engine."""
     from radtree.config import load_project
-    from radtree.scenarios import simulate_project
+    from radtree.office_summary import write_summary
+    from radtree.pipeline.simulate import simulate_project
 
     proj = load_project(_copy("office-block", workdir / f"office-{engine}"),
                         overrides=OFFICE_OVERRIDES)
     simulate_project(proj, engine=engine, echo=lambda _m: None, progress=False, resume=False)
-    return pd.read_csv(proj.results_dir / "summary.csv", dtype={"time": str})
+    path = write_summary(proj, maps=False)
+    return pd.read_csv(path, dtype={"time": str})
 
 
 CASES = {

@@ -58,7 +58,7 @@ def test_catalogue_complete_and_documented():
 
 @pytest.mark.parametrize("name", EFFECT_NAMES)
 def test_effects_switch_on_and_off(mendoza, name):
-    ctx = Context(mendoza, "numpy")
+    ctx = Context(mendoza)
     e = get_effect(name)
     for sc in mendoza.scenarios:
         if e.applies(ctx, sc):
@@ -80,7 +80,7 @@ def test_effects_switch_on_and_off(mendoza, name):
 
 
 def test_effect_status_in_mendoza(mendoza):
-    ctx = Context(mendoza, "numpy")
+    ctx = Context(mendoza)
     a, b = mendoza.scenario("A"), mendoza.scenario("B")
     cands_a = {e.name for e in candidates(ctx, a)[0]}
     cands_b = {e.name for e in candidates(ctx, b)[0]}
@@ -348,7 +348,7 @@ def test_selftest_cli_exit_code(reduced, monkeypatch):
 def test_simulator_matches_simulate_project(tmp_path):
     """The diagnosis runs give the numbers `radtree simulate` writes (same seed and rays)."""
     from radtree.diagnose.simulate import Simulator
-    from radtree.scenarios import simulate_project
+    from radtree.pipeline.simulate import simulate_project
 
     p = copy_project(tmp_path / "p", {r"^rays = 4096": "rays = 64",
                                       r"^dense_hours = .*$": "dense_grid = false"},

@@ -184,7 +184,7 @@ def test_bad_office_is_a_config_error(project, changes, field):
 
 
 def test_make_scene_replaces_street_facade_and_grids(project):
-    from radtree.scenarios import make_scene
+    from radtree.pipeline.assemble import make_scene
 
     built = make_scene(project, project.scenario("without"))
     assert set(built.scene.grids) == {"facade", "workplane"}
@@ -221,7 +221,7 @@ def test_user_meshes_obj_stl_ply_and_rad(tmp_path):
 def test_user_geometry_enters_the_scene(tmp_path, project):
     import trimesh
 
-    from radtree.scenarios import make_scene
+    from radtree.pipeline.assemble import make_scene
 
     path = tmp_path / "kiosk.stl"
     trimesh.creation.box(extents=(2.0, 2.0, 2.5)).apply_translation([5, 8, 1.25]).export(str(path))
@@ -409,7 +409,7 @@ def test_tree_lowers_facade_illuminance_every_hour(tmp_path):
     from radtree.engines.radiance.engine import run_hour
     from radtree.engines.radiance.writer import write_build
     from radtree.light import hour_states
-    from radtree.scenarios import make_scene
+    from radtree.pipeline.assemble import make_scene
 
     proj = load_project(copy_office(tmp_path / "office"))
     params = replace(proj.engine, ad=256)

@@ -9,7 +9,9 @@ import pytest
 
 from radtree.config import load_project
 from radtree.errors import ConfigError
-from radtree.scenarios import build_project, merge_realisations, selected, simulate_project
+from radtree.pipeline.build import build_project
+from radtree.pipeline.realisations import merge_realisations, selected
+from radtree.pipeline.simulate import simulate_project
 
 from .conftest import copy_project, needs_radiance
 

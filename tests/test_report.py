@@ -430,7 +430,7 @@ def test_facade_coordinates_follow_a_rotated_facade():
 @needs_radiance
 @pytest.mark.radiance
 def test_report_on_a_real_open_street_simulation(open_street: Path):
-    from radtree.scenarios import simulate_project
+    from radtree.pipeline.simulate import simulate_project
 
     data = open_street / "data" / "measured_vertical_illuminance.csv"
     lines = [ln for ln in data.read_text().splitlines()

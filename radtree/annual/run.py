@@ -178,7 +178,7 @@ def choose_scenarios(project: Project, options: AnnualOptions
                                  description="the leafed scenario without its crown")
             notes.append(f"No scenario without a tree in the project: the annual run uses "
                          f"'{with_sc.name}' with its crown removed.")
-    from radtree.scenarios import realisations_of
+    from radtree.pipeline.realisations import realisations_of
 
     crowns = realisations_of(project, with_sc)
     if len(crowns) > 1:
@@ -210,7 +210,7 @@ def annual_scenes(project: Project, with_sc: Scenario, without_sc: Scenario,
                   branches: BranchParams, grids: tuple[str, ...] | None
                   ) -> tuple[dict[str, Scene], list[str], int, list[str]]:
     """Scenes of the three variants, the grids to trace, the recommended -ab and notes."""
-    from radtree.scenarios import facade_frame, make_scene
+    from radtree.pipeline.assemble import facade_frame, make_scene
 
     b_on = make_scene(project, with_sc, dense_grid=False)
     b_none = make_scene(project, without_sc, dense_grid=False)

@@ -12,6 +12,8 @@ from __future__ import annotations
 
 import click
 
+from radtree.engines.registry import ENGINES
+
 CONTEXT = {"help_option_names": ["-h", "--help"], "max_content_width": 100}
 
 
@@ -23,8 +25,9 @@ CONTEXT = {"help_option_names": ["-h", "--help"], "max_content_width": 100}
 @click.option("--units", type=click.Choice(["lux", "klux"]),
               help="Units of the measured file when it does not state them ('# Units: lux').")
 @click.option("-s", "--scenario", help="Scenario to start from. Default: the project's first.")
-@click.option("--engine", type=click.Choice(["numpy", "radiance"]), default="numpy",
-              show_default=True, help="Engine for the diagnosis runs.")
+@click.option("--engine", type=click.Choice(list(ENGINES)), default=None,
+              help="Engine for the diagnosis runs. Default: numpy (seeded: one seed gives "
+                   "every switched run the same random numbers, so signatures carry little noise).")
 @click.option("--rays", type=click.IntRange(min=1),
               help="NumPy engine rays per sensor (default 1024).")
 @click.option("--seed", type=int, help="Seed of every run (default: the project's engine.seed).")
@@ -41,7 +44,7 @@ CONTEXT = {"help_option_names": ["-h", "--help"], "max_content_width": 100}
               help="Output folder. Default: PROJECT/diagnose.")
 @click.option("--list-effects", is_flag=True, help="Print the effect catalogue and exit.")
 def diagnose_command(project: str | None, measured: str | None, units: str | None,
-                     scenario: str | None, engine: str, rays: int | None, seed: int | None,
+                     scenario: str | None, engine: str | None, rays: int | None, seed: int | None,
                      margin: float, max_steps: int, effects: str | None, selftest: bool,
                      noise: float, out: str | None, list_effects: bool) -> None:
     """Find where simulation and measurement disagree, name the missing effect, add it.
@@ -60,7 +63,7 @@ def diagnose_command(project: str | None, measured: str | None, units: str | Non
             from radtree.config import load_project
 
             proj = load_project(project)
-            ctx = Context(proj, engine)
+            ctx = Context(proj)
             sc = proj.scenario(scenario) if scenario else proj.scenarios[0]
         for line in catalogue_lines(ctx, sc):
             click.echo(line)

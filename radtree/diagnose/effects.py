@@ -32,23 +32,16 @@ from typing import Any
 from radtree.config import Louvers, Project, Scenario, effective_project
 from radtree.errors import RadtreeError
 
-ENGINE_CHOICES = ("numpy", "radiance")
-#: The "few bounces" (``engine.ab``) that ``ambient_bounces`` switches off to (NumPy engine).
+#: The "few bounces" (``engine.ab``) that ``ambient_bounces`` switches off to.
 LOW_BOUNCES = 2
 
 
 @dataclass(frozen=True)
 class Context:
-    """What an effect needs besides the scenario: the project and the engine in use."""
+    """What an effect needs besides the scenario: the project (effects know no engine)."""
 
     project: Project
-    engine: str = "numpy"
     _ab_cache: dict[str, int] = field(default_factory=dict, compare=False, repr=False)
-
-    def __post_init__(self) -> None:
-        if self.engine not in ENGINE_CHOICES:
-            raise RadtreeError(f"engine must be one of {', '.join(ENGINE_CHOICES)}, "
-                               f"got {self.engine!r}")
 
     def louvers(self, sc: Scenario) -> Louvers:
         """The scenario's louvers parameters after its switches."""
@@ -72,7 +65,7 @@ class Context:
             if sc.model == "none":
                 self._ab_cache[key] = 2
             else:
-                from radtree.scenarios import facade_frame
+                from radtree.pipeline.assemble import facade_frame
 
                 proj = effective_project(self.project, base)
                 tree = build_tree(proj, base, facade_frame(proj))
@@ -326,31 +319,24 @@ class AmbientBounces(Effect):
     title = "Extra diffuse (ambient) bounces"
     physics = ("light reaches the sensors after several diffuse reflections and transmissions "
                "(slats, wall, street); too few bounces drop that interreflected part")
-    switch = (f"switches.engine.ab (both engines trace that many diffuse bounces). NumPy: off = "
+    switch = (f"switches.engine.ab (every engine traces that many diffuse bounces): off = "
               f"{LOW_BOUNCES}, on = the model's -ab (project engine.ab, else the crown's "
-              f"recommendation), at least {LOW_BOUNCES + 2}; Radiance: on = the model's -ab + 2, "
-              "off = the model's -ab")
+              f"recommendation), at least {LOW_BOUNCES + 2}")
     key = "engine.ab"
 
-    def _numpy_on(self, ctx: Context, sc: Scenario) -> int:
+    def _on_ab(self, ctx: Context, sc: Scenario) -> int:
         ab = ctx.default_ab(sc)
         return ab if ab > LOW_BOUNCES else LOW_BOUNCES + 2
 
     def is_on(self, ctx: Context, sc: Scenario) -> bool:
-        if ctx.engine == "numpy":
-            ab = sc.switches.get(self.key)
-            return int(ab if ab is not None else ctx.default_ab(sc)) > LOW_BOUNCES
-        return self.key in sc.switches and int(sc.switches[self.key]) > ctx.default_ab(sc)
+        ab = sc.switches.get(self.key)
+        return int(ab if ab is not None else ctx.default_ab(sc)) > LOW_BOUNCES
 
     def switch_on(self, ctx: Context, sc: Scenario, strength: float | None = None) -> Scenario:
-        if ctx.engine == "numpy":
-            return with_switches(sc, {self.key: self._numpy_on(ctx, sc)})
-        return with_switches(sc, {self.key: ctx.default_ab(sc) + 2})
+        return with_switches(sc, {self.key: self._on_ab(ctx, sc)})
 
     def switch_off(self, ctx: Context, sc: Scenario) -> Scenario:
-        if ctx.engine == "numpy":
-            return with_switches(sc, {self.key: LOW_BOUNCES})
-        return with_switches(sc, drop=[self.key])
+        return with_switches(sc, {self.key: LOW_BOUNCES})
 
 
 class SpecularTransmission(_ZeroIsOff):
@@ -601,4 +587,3 @@ def _static_strength(e: Effect) -> Strength | None:
 @dataclass(frozen=True)
 class _FakeContext:
     project: Any
-    engine: str = "numpy"

@@ -130,7 +130,7 @@ class SelftestResult:
     simulations: int
     out_dir: Path | None = None
     files: list[Path] = field(default_factory=list)
-    engine: str = "numpy"
+    engine: str = ""
     rays: int | None = None
     seed: int | None = None
 
@@ -214,7 +214,7 @@ def _synthetic(truth_sim: Simulator, case: HiddenCase, noise: float, seed: int, 
 
 def selftest(project: str | os.PathLike | Project, scenario: str | None = None,
              effects: Iterable[Effect] | None = None, noise: float = DEFAULT_NOISE,
-             engine: str = "numpy", rays: int | None = None, seed: int | None = None,
+             engine: str | None = None, rays: int | None = None, seed: int | None = None,
              margin: float = DEFAULT_MARGIN, max_steps: int = DEFAULT_MAX_STEPS,
              out_dir: str | os.PathLike | None = None, write: bool = True,
              echo: Echo | None = print) -> SelftestResult:
@@ -225,17 +225,16 @@ def selftest(project: str | os.PathLike | Project, scenario: str | None = None,
     say = echo or (lambda s: None)
     proj = resolve_project(project)
     start = pick_scenario(proj, scenario)
-    ctx = Context(proj, engine)
+    ctx = Context(proj)
     out = Path(out_dir) if out_dir is not None else proj.root / "diagnose"
     hours = tuple(proj.site.hours)
-    sim = Simulator(proj, hours, engine, rays, seed, workdir=out / "work")
-    truth_sim = Simulator(proj, hours, engine, sim.rays, int(sim.seed or 0) + TRUTH_SEED_OFFSET,
-                          workdir=out / "work")
+    sim = Simulator(proj, hours, engine, rays, seed)
+    truth_sim = Simulator(proj, hours, engine, sim.rays, int(sim.seed or 0) + TRUTH_SEED_OFFSET)
     chosen = tuple(effects) if effects is not None else EFFECTS
     skipped: dict[str, str] = {}
-    say(f"self-test {proj.name}: scenario {start.name}, noise {noise:.1%}, engine {engine}"
+    say(f"self-test {proj.name}: scenario {start.name}, noise {noise:.1%}, engine {sim.engine_name}"
         + (f", {sim.rays} rays/sensor, seed {sim.seed} (truth seed {truth_sim.seed})"
-           if engine == "numpy" else ""))
+           if sim.seeded else ""))
     say("  deciding which hidden effects are distinguishable (before any diagnosis runs):")
     cases: list[HiddenCase] = []
     for e in chosen:
@@ -266,8 +265,8 @@ def selftest(project: str | os.PathLike | Project, scenario: str | None = None,
             + (f" via {' + '.join(s.effect for s in lp.steps)}" if lp.steps else ""))
     res = SelftestResult(proj, start, noise, cases, skipped, time.perf_counter() - t0,
                          sim.traced_runs + truth_sim.traced_runs, out if write else None,
-                         engine=engine, rays=sim.rays if engine == "numpy" else None,
-                         seed=sim.seed if engine == "numpy" else None)
+                         engine=sim.engine_name, rays=sim.rays if sim.seeded else None,
+                         seed=sim.seed if sim.seeded else None)
     if write:
         from radtree.diagnose.report import write_selftest_report
 

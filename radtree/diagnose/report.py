@@ -245,7 +245,7 @@ def write_diagnose_report(res: DiagnoseResult, out: Path) -> list[Path]:
                 stale.unlink()
         except ValueError:
             continue
-    ctx = Context(res.project, res.engine)
+    ctx = Context(res.project)
     c = {
         "kind": "diagnose", "project": res.project, "scenario": res.scenario, "res": res,
         "measured": res.measured, "figs": figs, "steps": steps, "last": last,
@@ -290,7 +290,7 @@ def write_selftest_report(res: SelftestResult, out: Path) -> list[Path]:
         "kind": "selftest", "project": res.project, "scenario": res.scenario, "res": res,
         "table": _records(res.table()), "fig": fig, "skipped": res.skipped,
         "snr_min": SNR_MIN, "tie_corr": TIE_CORR, "version": __version__,
-        "catalogue": _catalogue(Context(res.project, res.engine), res.scenario),
+        "catalogue": _catalogue(Context(res.project), res.scenario),
         "created": datetime.now(timezone.utc).isoformat(timespec="seconds"),
     }
     html = _env().get_template("diagnose.html.j2").render(c=c)

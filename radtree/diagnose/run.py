@@ -67,7 +67,7 @@ def pick_scenario(project: Project, name: str | None) -> Scenario:
 
 
 def diagnose(project: str | os.PathLike | Project, measured: str | os.PathLike | None = None,
-             units: str | None = None, scenario: str | None = None, engine: str = "numpy",
+             units: str | None = None, scenario: str | None = None, engine: str | None = None,
              rays: int | None = None, seed: int | None = None, margin: float = DEFAULT_MARGIN,
              max_steps: int = DEFAULT_MAX_STEPS, effects: Iterable[Effect] = EFFECTS,
              out_dir: str | os.PathLike | None = None, write: bool = True,
@@ -75,23 +75,22 @@ def diagnose(project: str | os.PathLike | Project, measured: str | os.PathLike |
     """Run the discrepancy loop from ``scenario`` (default: the project's first) against the
     measurements (default: ``[project] measured``) and write ``PROJECT/diagnose/``.
 
-    ``engine``: ``numpy`` (default; ``rays`` per sensor, default 1024, fixed ``seed``, default
-    the project's) or ``radiance``. ``margin``: relative CV improvement a step must bring.
+    ``engine``: a registered engine name (default: the seeded engine — ``rays`` per sensor,
+    default 1024, fixed ``seed``, default the project's — so switched runs share random numbers). ``margin``: relative CV improvement a step must bring.
     """
     t0 = time.perf_counter()
     say = echo or (lambda s: None)
     proj = resolve_project(project)
     sc = pick_scenario(proj, scenario)
     out = Path(out_dir) if out_dir is not None else proj.root / "diagnose"
-    ctx = Context(proj, engine)
-    sim = Simulator(proj, tuple(proj.site.hours), engine, rays, seed,
-                    workdir=out / "work", echo=None)
+    ctx = Context(proj)
+    sim = Simulator(proj, tuple(proj.site.hours), engine, rays, seed)
     meas = load_measurements(proj, measured, units, sim.sensors_per_row())
     for note in meas.notes():
         say(f"  note: {note}")
-    sim = Simulator(proj, meas.times, engine, sim.rays, sim.seed, workdir=out / "work")
+    sim = Simulator(proj, meas.times, engine, sim.rays, sim.seed)
     say(f"diagnose {proj.name}: scenario {sc.name} ({sc.model}, {sc.reflection}), engine "
-        f"{engine}" + (f", {sim.rays} rays/sensor, seed {sim.seed}" if engine == "numpy" else "")
+        f"{sim.engine_name}" + (f", {sim.rays} rays/sensor, seed {sim.seed}" if sim.seeded else "")
         + f", {len(meas.times)} hours, measured mean {meas.mean:.0f} lx")
     _, why = candidates(ctx, sc, effects)
 
@@ -105,8 +104,8 @@ def diagnose(project: str | os.PathLike | Project, measured: str | os.PathLike |
         return write_step_project(proj, new, path, header), path
 
     loop = run_loop(sim, ctx, sc, meas, margin, max_steps, effects, echo=echo, on_step=on_step)
-    res = DiagnoseResult(proj, sc, engine, sim.rays if engine == "numpy" else None,
-                         sim.seed if engine == "numpy" else None, meas, loop,
+    res = DiagnoseResult(proj, sc, sim.engine_name, sim.rays if sim.seeded else None,
+                         sim.seed if sim.seeded else None, meas, loop,
                          out if write else None, 0.0, sim.traced_runs, sim.cache_hits, why,
                          margin=margin)
     say(f"  stop: {loop.stop_reason}")

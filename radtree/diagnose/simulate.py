@@ -10,9 +10,9 @@ Caching inside a run: the traced part is keyed by everything that changes the tr
 project, model, form, sky, reflection mode and the switches other than ``reflection.*``), the
 crown geometry by what changes the scene; the analytic ground terms (``reflection = calculated``
 and the ``reflection.unfiltered`` switch, :mod:`radtree.reflect`) are added afresh each time, so
-fitting those costs no tracing. With ``engine = "radiance"`` each scenario runs through
-:func:`radtree.scenarios.simulate_project` in a work folder (``PROJECT/diagnose/work/``), whose
-resumable parts act as a cache across runs.
+fitting those costs no tracing. Any registered engine may trace (default: the seeded engine,
+whose fixed seed gives common random numbers); tracing goes through
+:func:`radtree.pipeline.trace.trace_hours`, exactly as ``simulate`` traces.
 """
 
 from __future__ import annotations
@@ -20,16 +20,20 @@ from __future__ import annotations
 import hashlib
 import json
 import time
-from collections.abc import Callable
 from dataclasses import dataclass, field, replace
-from pathlib import Path
 from typing import Any
 
 import numpy as np
 import pandas as pd
 
-from radtree.config import Project, Scenario, effective_project
+from radtree.config import Project, Scenario
+from radtree.engines.base import Engine
+from radtree.engines.registry import engine_named
 from radtree.errors import RadtreeError
+from radtree.light import hour_states
+from radtree.pipeline.assemble import make_scene
+from radtree.pipeline.trace import trace_hours
+from radtree.reflect import ground_terms
 from radtree.stats import mean_stderr
 
 #: Rays per sensor for NumPy-engine diagnosis unless given (MC SE ≈ 8 lx on Mendoza's hourly
@@ -84,11 +88,9 @@ class Simulator:
 
     project: Project
     hours: tuple[str, ...]
-    engine: str = "numpy"
+    engine: str | None = None   # None: the seeded engine (common random numbers)
     rays: int | None = None
     seed: int | None = None
-    workdir: Path | None = None
-    echo: Callable[[str], None] | None = None
     traced_runs: int = 0
     cache_hits: int = 0
     trace_seconds: float = 0.0
@@ -96,10 +98,11 @@ class Simulator:
     _traced: dict[str, _Traced] = field(default_factory=dict, repr=False)
     _scenes: dict[str, Any] = field(default_factory=dict, repr=False)
     _grid: Any = field(default=None, repr=False)
+    _engine: Engine = field(init=False, repr=False)
 
     def __post_init__(self) -> None:
-        if self.engine not in ("numpy", "radiance"):
-            raise RadtreeError(f"diagnosis engine must be numpy or radiance, got {self.engine!r}")
+        self._engine = engine_named(self.engine)
+        self.engine = self._engine.name
         unknown = [h for h in self.hours if h not in self.project.site.hours]
         if unknown:
             raise RadtreeError(f"hour(s) {', '.join(unknown)} are not among the project's "
@@ -115,6 +118,16 @@ class Simulator:
                                sensors=replace(self.project.sensors, dense_grid=False))
 
     # ------------------------------------------------------------------ public
+    @property
+    def engine_name(self) -> str:
+        """The registry name of the engine tracing the runs."""
+        return self._engine.name
+
+    @property
+    def seeded(self) -> bool:
+        """True when ``rays`` and ``seed`` set the engine's noise (e.g. the NumPy engine)."""
+        return self._engine.seeded
+
     def key(self, sc: Scenario) -> str:
         return scenario_key(self.project, sc)
 
@@ -139,15 +152,12 @@ class Simulator:
             hit = self._runs[key]
             return replace(hit, seconds=0.0)
         t0 = time.perf_counter()
-        if self.engine == "numpy":
-            run = self._numpy_run(sc)
-        else:
-            run = self._radiance_run(sc)
+        run = self._traced_run(sc)
         run.seconds = time.perf_counter() - t0
         self._runs[key] = run
         return run
 
-    # ------------------------------------------------------------------ numpy engine
+    # ------------------------------------------------------------------ tracing
     def _scene_key(self, sc: Scenario) -> str:
         keep = {k: v for k, v in sc.switches.items()
                 if not k.startswith(("reflection.", "light.", "engine."))}
@@ -156,8 +166,6 @@ class Simulator:
         return hashlib.sha256(json.dumps(payload, default=str).encode()).hexdigest()
 
     def _scene(self, sc: Scenario):
-        from radtree.scenarios import make_scene
-
         key = self._scene_key(sc)
         if key not in self._scenes:
             self._scenes[key] = make_scene(self.project, sc, dense_grid=False)
@@ -167,11 +175,7 @@ class Simulator:
         keep = {k: v for k, v in sc.switches.items() if not k.startswith("reflection.")}
         return scenario_key(self.project, replace(sc, switches=keep))
 
-    def _numpy_run(self, sc: Scenario) -> Run:
-        from radtree.engines.numpy.engine import trace_hour
-        from radtree.light import hour_states
-        from radtree.reflect import calculated_reflection, unfiltered_ground_light
-
+    def _traced_run(self, sc: Scenario) -> Run:
         states = hour_states(self.project, sc, list(self.hours))
         tkey = self._traced_key(sc)
         traced = self._traced.get(tkey)
@@ -179,33 +183,25 @@ class Simulator:
             self.cache_hits += 1  # only the analytic ground terms differ
         else:
             t0 = time.perf_counter()
-            built = self._scene(sc)
-            # as radtree simulate: as many diffuse bounces as the model's -ab (the scene is
-            # cached without engine switches, so take -ab from the switched project first)
-            eng = effective_project(self.project, sc).engine
-            tree = getattr(built, "tree", None)
-            ab = int(eng.ab if eng.ab is not None else
-                     (tree.recommended_ab if tree is not None else built.ab))
-            params = replace(eng, rays=int(self.rays or 1), seed=int(self.seed or 0), ab=ab,
-                             max_bounces=ab)
+            # as radtree simulate: the scene's -ab rule and engine switches (the scene is cached
+            # without them; trace_hours takes -ab afresh from the switched project)
+            out = trace_hours(self.project, sc, self._engine, list(self.hours), [FACADE],
+                              rays=int(self.rays or 1), seed=int(self.seed or 0),
+                              built=self._scene(sc))
             lux, se = [], []
-            for st in states:
-                res = trace_hour(built.scene, st, params, grids=[FACADE])[FACADE]
-                lux.append(res.lux)
-                se.append(res.stderr if res.stderr is not None
-                          else np.full(len(res.lux), np.nan))
+            for res in out.results:
+                g = res[FACADE]
+                lux.append(g.lux)
+                se.append(g.stderr if g.stderr is not None else np.full(len(g.lux), np.nan))
             traced = _Traced(np.array(lux), np.array(se), time.perf_counter() - t0,
-                             built.scene.grids[FACADE])
+                             out.built.scene.grids[FACADE])
             self._traced[tkey] = traced
             self.traced_runs += 1
             self.trace_seconds += traced.seconds
         grid = traced.grid
         extra = np.zeros_like(traced.lux)
         for i, st in enumerate(states):
-            e = unfiltered_ground_light(self.project, sc, st, grid)
-            if sc.reflection == "calculated":
-                e = e + calculated_reflection(self.project, sc, st, grid)
-            extra[i] = e
+            extra[i] = ground_terms(self.project, sc, st, grid)
         return self._make_run(traced.lux + extra, traced.stderr, list(grid.rows))
 
     def _make_run(self, sensors: np.ndarray, stderr: np.ndarray, rows: list[str]) -> Run:
@@ -216,28 +212,3 @@ class Simulator:
         lux = sensors.mean(axis=1)
         se = np.array([mean_stderr(s) for s in stderr])
         return Run(tuple(self.hours), lux, se, row_means, sensors)
-
-    # ------------------------------------------------------------------ radiance engine
-    def _radiance_run(self, sc: Scenario) -> Run:
-        from radtree.scenarios import simulate_project
-
-        key = self.key(sc)
-        root = (self.workdir or (self.project.root / "diagnose" / "work")) / key
-        name = "diagnose"
-        project = replace(self.project, root=root, scenarios=(replace(sc, name=name),))
-        t0 = time.perf_counter()
-        out = simulate_project(project, engine="radiance", scenarios=[name],
-                               hours=list(self.hours), echo=self.echo or (lambda s: None),
-                               progress=False, grids=[FACADE])
-        if out is None:  # pragma: no cover - dry_run is never asked for here
-            raise RadtreeError("radiance simulation returned nothing")
-        self.traced_runs += 1
-        self.trace_seconds += time.perf_counter() - t0
-        df = out.table
-        df = df[(df["scenario"].astype(str) == name) & (df["grid"] == FACADE)]
-        df = df.assign(time=df["time"].astype(str).str.zfill(5))
-        sens = df.pivot(index="time", columns="sensor", values="lux").loc[list(self.hours)]
-        se = df.pivot(index="time", columns="sensor", values="lux_stderr").loc[list(self.hours)]
-        rows = (df[df["time"] == self.hours[0]].sort_values("sensor")["row"].astype(str)
-                .tolist())
-        return self._make_run(sens.to_numpy(float), se.to_numpy(float), rows)

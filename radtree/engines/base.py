@@ -1,15 +1,28 @@
-"""What every engine returns, and the tidy results table built from it."""
+"""The one engine interface: what every estimator offers and what it returns.
+
+An engine takes a :class:`radtree.scene.Scene` (plain data: meshes, materials, sensor grids),
+the hours' :class:`SkyState` and the tracing parameters, *prepares* a plan (a Radiance build
+folder, an in-memory tracer…) and *traces* one hour on named grids, returning illuminance per
+sensor (lux) as :class:`GridResult`. The pipeline turns those into the one results table
+(:mod:`radtree.pipeline.results`); nothing above ``engines/`` knows which engine ran.
+Engines register by name in :mod:`radtree.engines.registry`.
+"""
 
 from __future__ import annotations
 
+import tempfile
+from abc import ABC, abstractmethod
+from collections.abc import Callable
 from dataclasses import dataclass
+from pathlib import Path
+from typing import TYPE_CHECKING, Any, ClassVar
 
 import numpy as np
 
-RESULT_COLUMNS = [
-    "scenario", "model", "datetime", "time", "grid", "sensor", "row", "x", "y", "z",
-    "lux", "lux_stderr", "engine", "params_hash",
-]
+if TYPE_CHECKING:
+    from radtree.config import EngineParams
+    from radtree.scene import Scene
+    from radtree.sky import SkyState
 
 
 @dataclass
@@ -26,3 +39,72 @@ class GridResult:
             self.stderr = np.asarray(self.stderr, float)
             if self.stderr.shape != self.lux.shape:
                 raise ValueError("stderr must have the shape of lux")
+
+
+class Engine(ABC):
+    """An estimator of sensor illuminance behind one interface.
+
+    ``name``: the registry name (``--engine NAME``). ``uses_build_folder``: the engine runs from
+    the scenario's inspectable build folder (``PROJECT/build/<scenario>/``), which the pipeline
+    (re)writes before preparing; other engines keep their plan in memory. ``seeded``: the
+    engine's noise is set by ``engine.rays`` and ``engine.seed`` (a fixed seed gives common
+    random numbers across scenarios)."""
+
+    name: ClassVar[str]
+    missing_hint: ClassVar[str] = "it is not available here"
+    uses_build_folder: ClassVar[bool] = False
+    seeded: ClassVar[bool] = False
+
+    @classmethod
+    @abstractmethod
+    def available(cls) -> bool:
+        """True when the engine can run on this machine."""
+
+    @abstractmethod
+    def version(self) -> str | None:
+        """The engine's version text (None when unknown)."""
+
+    @abstractmethod
+    def describe(self) -> str:
+        """One line for ``radtree doctor`` and reports."""
+
+    def sampling(self, params: EngineParams) -> str:
+        """How the engine samples, for logs and reports (e.g. ``4096 rays/sensor, seed 1``)."""
+        return ""
+
+    @abstractmethod
+    def prepare(self, scene: Scene, states: list[SkyState], params: EngineParams, ab: int,
+                folder: Path | None = None) -> Any:
+        """A plan to trace ``states`` (their ``label`` HHMM names an hour) of ``scene`` with
+        ``ab`` diffuse bounces (``-ab``; every engine counts bounces like rtrace). ``folder``: the
+        scenario's build folder when ``uses_build_folder`` (already written by the pipeline),
+        else a work folder the engine may use, or None."""
+
+    @abstractmethod
+    def trace(self, plan: Any, label: str, grids: list[str] | None = None
+              ) -> dict[str, GridResult]:
+        """Trace hour ``label`` of a plan on ``grids`` (default every grid): lux per grid."""
+
+    @abstractmethod
+    def commands(self, plan: Any, label: str) -> list[str]:
+        """What :meth:`trace` would run for hour ``label``, as lines to print (``--dry-run``)."""
+
+    def write_folder(self, scene: Scene, states: list[SkyState], params: EngineParams, ab: int,
+                     folder: Path, scenario: str, hour_grids: dict[str, list[str]]) -> None:
+        """Write the scenario's inspectable build folder (engines with ``uses_build_folder``);
+        ``hour_grids`` maps an hour label to the grids traced then."""
+        raise NotImplementedError(f"engine {self.name!r} writes no build folder")
+
+    def write_index(self, build_dir: Path, scenarios: list[str]) -> None:
+        """Write what runs every scenario's folder at once (e.g. a top-level Makefile)."""
+        raise NotImplementedError(f"engine {self.name!r} writes no build folder")
+
+    def trace_once(self, scene: Scene, state: SkyState, params: EngineParams, ab: int,
+                   grids: list[str] | None = None) -> dict[str, GridResult]:
+        """Prepare and trace one hour in a temporary work folder (nothing kept)."""
+        with tempfile.TemporaryDirectory(prefix="radtree-") as tmp:
+            plan = self.prepare(scene, [state], params, ab, Path(tmp))
+            return self.trace(plan, state.label, grids)
+
+
+Echo = Callable[[str], None]

@@ -190,7 +190,7 @@ def _unique(series: pd.Series) -> list[str]:
 
 
 def _reflection_notes(project: Project, notes: list[str]) -> dict[str, str]:
-    from radtree.scenarios import reflection_notes
+    from radtree.reflect import reflection_notes
 
     try:
         return reflection_notes(project)

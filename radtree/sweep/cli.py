@@ -6,6 +6,7 @@ import time
 
 import click
 
+from radtree.engines.registry import ENGINE_CHOICES
 from radtree.errors import ConfigError
 
 CONTEXT = {"help_option_names": ["-h", "--help"], "max_content_width": 100}
@@ -46,7 +47,7 @@ def _fixed(values: tuple[str, ...]) -> dict[str, object]:
 @click.option("-s", "--scenario", "scenarios", multiple=True,
               help="Only this scenario (repeatable). Default: all.")
 @click.option("--hour", "hours", multiple=True, help="Only this hour HH:MM (repeatable).")
-@click.option("--engine", type=click.Choice(["auto", "radiance", "numpy"]), default=None,
+@click.option("--engine", type=click.Choice(ENGINE_CHOICES), default=None,
               help="auto = Radiance when found, else NumPy. [default: engine.name]")
 @click.option("--scheduler", default=None, metavar="ADDRESS",
               help="A dask scheduler (tcp://host:port), 'local' (a LocalCluster on this "

@@ -168,12 +168,14 @@ def _log_writer(path: Path) -> Callable[[str], None]:
 def run_case(spec: CaseSpec) -> CaseResult:
     """Build and simulate one case as an ordinary project in its folder; never raises.
 
-    Writes ``radtree.toml`` (if it differs), runs :func:`radtree.scenarios.simulate_project`
+    Writes ``radtree.toml`` (if it differs), runs :func:`radtree.pipeline.simulate.simulate_project`
     (after building with pictures off for Radiance), then ``result.csv`` atomically and
     ``case.json``. Any exception becomes a ``failed`` result carrying its message.
     """
     from radtree.config import load_project
-    from radtree.scenarios import build_project, simulate_project
+    from radtree.engines.registry import get_engine
+    from radtree.pipeline.build import build_project
+    from radtree.pipeline.simulate import simulate_project
 
     t0 = time.perf_counter()
     folder = Path(spec.folder)
@@ -190,7 +192,7 @@ def run_case(spec: CaseSpec) -> CaseResult:
         project = load_project(folder)
         scenarios = list(spec.scenarios) if spec.scenarios else None
         hours = list(spec.hours) if spec.hours else None
-        if spec.engine == "radiance":
+        if get_engine(spec.engine).uses_build_folder:   # build without model pictures
             build_project(project, scenarios, echo=log, progress=False, pictures=False)
         out = simulate_project(project, spec.engine, scenarios, hours, workers=1, echo=log,
                                progress=False)
@@ -270,7 +272,7 @@ def plan_sweep(project: str | Path, params: Sequence[str | Parameter] | None = N
                ) -> SweepPlan:
     """Read the project (and its ``[sweep]`` table), check the fields, make the design and the
     case specs. Arguments given here win over the table; ``params`` replaces its parameters."""
-    from radtree.scenarios import choose_engine
+    from radtree.engines.registry import get_engine
 
     path, base, settings, project0 = load_base(project)
     root = path.parent
@@ -308,7 +310,7 @@ def plan_sweep(project: str | Path, params: Sequence[str | Parameter] | None = N
                               field="site.hours")
         hrs = list(dict.fromkeys(hrs))
     eng_name = engine or settings.engine or project0.engine.name
-    eng = choose_engine(eng_name)
+    eng = get_engine(eng_name).name
     out_dir = Path(out) if out is not None else (
         root / settings.out if settings.out else root / "sweep")
     out_dir = out_dir if out_dir.is_absolute() else (Path.cwd() / out_dir)

@@ -35,6 +35,7 @@ from typing import Any
 import tomllib
 
 from radtree.config import Project, find_project_file, parse_project, set_dotted
+from radtree.engines.registry import ENGINE_CHOICES
 from radtree.errors import ConfigError
 from radtree.sweep.design import DESIGNS, Parameter, parse_spec
 
@@ -138,8 +139,8 @@ def parse_sweep_table(table: dict[str, Any], source: str) -> SweepSettings:
             if not isinstance(table[key], str) or not table[key]:
                 raise err(key, f"expected text, got {table[key]!r}")
             setattr(s, key, table[key])
-    if s.engine is not None and s.engine not in ("auto", "radiance", "numpy"):
-        raise err("engine", f"got {s.engine!r}, expected auto, radiance or numpy")
+    if s.engine is not None and s.engine not in ENGINE_CHOICES:
+        raise err("engine", f"got {s.engine!r}, expected {', '.join(ENGINE_CHOICES)}")
     return s
 
 

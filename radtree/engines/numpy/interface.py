@@ -1,0 +1,63 @@
+"""The built-in NumPy Monte Carlo engine behind the engine interface."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, replace
+from pathlib import Path
+from typing import TYPE_CHECKING
+
+from radtree.engines.base import Engine, GridResult
+from radtree.engines.numpy.engine import describe, trace_hour
+from radtree.engines.numpy.raycast import embree_available
+
+if TYPE_CHECKING:
+    from radtree.config import EngineParams
+    from radtree.scene import Scene
+    from radtree.sky import SkyState
+
+
+@dataclass
+class NumpyPlan:
+    """A scene, its hours by label (HHMM) and the parameters, ready to trace in memory."""
+
+    scene: Scene
+    states: dict[str, SkyState]
+    params: EngineParams
+
+
+class NumpyEngine(Engine):
+    """Vectorised backward path tracing (Embree first-hit queries when available). Like for
+    like with Radiance: ``max_bounces`` = the scene's ``-ab``."""
+
+    name = "numpy"
+    missing_hint = "NumPy engine failed to load"
+    seeded = True
+
+    @classmethod
+    def available(cls) -> bool:
+        return True
+
+    def version(self) -> str | None:
+        import numpy
+
+        return f"numpy {numpy.__version__}" + (", embree" if embree_available() else "")
+
+    def describe(self) -> str:
+        return describe()
+
+    def sampling(self, params: EngineParams) -> str:
+        return f"{params.rays} rays/sensor, seed {params.seed}"
+
+    def prepare(self, scene: Scene, states: list[SkyState], params: EngineParams, ab: int,
+                folder: Path | None = None) -> NumpyPlan:
+        return NumpyPlan(scene, {s.label: s for s in states},
+                         replace(params, ab=ab, max_bounces=ab))
+
+    def trace(self, plan: NumpyPlan, label: str, grids: list[str] | None = None
+              ) -> dict[str, GridResult]:
+        return trace_hour(plan.scene, plan.states[label], plan.params, grids=grids)
+
+    def commands(self, plan: NumpyPlan, label: str) -> list[str]:
+        st = plan.states[label]
+        return [f"numpy engine: {st.time}, {plan.scene.n_triangles} triangles, "
+                f"{plan.params.rays} rays/sensor, -ab {plan.params.max_bounces}"]

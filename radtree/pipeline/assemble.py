@@ -1,0 +1,95 @@
+"""A scenario's scene: street canyon (or office block), crown model, sensor grids, and the one
+rule for its diffuse bounces (``-ab``)."""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, field
+from typing import Any
+
+from radtree.config import Project, Scenario, effective_project
+from radtree.errors import RadtreeError
+from radtree.scene import Scene
+from radtree.sensor_grid import facade_circle, facade_dense_grid
+from radtree.site.frame import FacadeFrame
+from radtree.site.street import street_materials, street_meshes
+
+#: -ab of a scene without a crown model (direct + one interreflection)
+OPEN_STREET_AB = 2
+
+
+@dataclass
+class BuiltScene:
+    """A scenario's scene plus what the build learnt about it (``ab``: its diffuse bounces)."""
+
+    scenario: Scenario
+    scene: Scene
+    ab: int
+    notes: list[str]
+    triangles: int
+    geometry_seconds: float
+    info: dict[str, float] = field(default_factory=dict)
+    tree: Any = None
+
+
+def facade_frame(project: Project) -> FacadeFrame:
+    """The studied façade's local frame (x east, y north, z up; azimuth clockwise from north)."""
+    return FacadeFrame(azimuth_deg=project.street.facade_azimuth_deg)
+
+
+def scene_ab(project: Project, tree_ab: int | None) -> int:
+    """The scene's ``-ab``: ``engine.ab`` when set (after the scenario's switches), else the
+    crown model's recommendation (open street: 2), at least the rooms' 6 for an office block."""
+    if project.engine.ab is not None:
+        return int(project.engine.ab)
+    ab = OPEN_STREET_AB if tree_ab is None else int(tree_ab)
+    if project.office is not None:
+        from radtree.site.office import RECOMMENDED_AB
+
+        ab = max(ab, RECOMMENDED_AB)   # rooms need ~6 bounces (see the office notes)
+    return ab
+
+
+def make_scene(project: Project, scenario: Scenario, dense_grid: bool | None = None) -> BuiltScene:
+    """The in-memory scene of one scenario: street canyon, crown model, sensor grids."""
+    project = effective_project(project, scenario)
+    frame = facade_frame(project)
+    materials: dict = dict(street_materials(project.street))
+    meshes = street_meshes(project.street, frame)
+    grids = {"facade": facade_circle(project.sensors, frame)}
+    use_dense = project.sensors.dense_grid if dense_grid is None else dense_grid
+    if use_dense:
+        grids["facade_map"] = facade_dense_grid(project.sensors, frame)
+    notes = [f"street canyon {project.street.width_m:g} m wide, façade looks "
+             f"{project.street.facade_azimuth_deg:g}° (compass), façade ρ "
+             f"{project.street.facade_reflectance:g}"]
+    if project.office is not None:
+        from radtree.site.office import office_parts
+
+        o_meshes, o_materials, o_grids, o_notes = office_parts(project, frame)
+        meshes = [m for m in meshes if m.name != "facade"] + o_meshes
+        materials.update(o_materials)
+        grids = o_grids
+        notes += o_notes
+    t0 = time.perf_counter()
+    info: dict[str, float] = {}
+    tree = None
+    if scenario.model != "none":
+        from radtree.trees.build import build_tree
+
+        tree = build_tree(project, scenario, frame)
+        clash = set(tree.materials) & set(materials)
+        if clash:
+            raise RadtreeError(f"crown model materials clash with the street's: {clash}")
+        materials.update(tree.materials)
+        meshes = meshes + list(tree.meshes)
+        notes += list(tree.notes)
+        info = dict(tree.info)
+    geometry_seconds = time.perf_counter() - t0
+    if project.extra_geometry:
+        from radtree.site.user_geometry import load_user_meshes
+
+        meshes = meshes + load_user_meshes(project.extra_geometry, materials)
+    ab = scene_ab(project, None if tree is None else tree.recommended_ab)
+    scene = Scene(meshes, materials, grids, notes)
+    return BuiltScene(scenario, scene, ab, notes, scene.n_triangles, geometry_seconds, info, tree)

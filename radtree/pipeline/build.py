@@ -1,0 +1,124 @@
+"""Build folders: ``PROJECT/build/<scenario>/`` (or ``<scenario>@k`` per crown realisation).
+
+Each holds the scene as the folder engine (Radiance) writes it — ``materials.rad``,
+``geometry/``, ``skies/``, ``grids/*.pts``, a Makefile per hour — plus ``model.png`` and a
+``manifest.json`` carrying the scenario's parameter hash, by which a stale folder is detected;
+``build/Makefile`` runs them all.
+"""
+
+from __future__ import annotations
+
+import json
+import shutil
+import time
+from collections.abc import Callable, Iterable
+from pathlib import Path
+from typing import Any
+
+from radtree.config import Project, Scenario, effective_project
+from radtree.engines.registry import folder_engine
+from radtree.fileio import atomic_dir, write_text
+from radtree.light import hour_states
+from radtree.manifest import manifest
+from radtree.pipeline.assemble import make_scene
+from radtree.pipeline.realisations import (
+    REALISATION_MARK,
+    is_later_realisation,
+    parent_name,
+    realisations_of,
+    selected,
+)
+
+
+def hour_grids(project: Project, time_: str, available: list[str],
+               wanted: list[str] | None, sc: Scenario | None = None) -> list[str]:
+    """Grids to trace at an hour: the dense façade map only at ``sensors.dense_hours``, and
+    only in the first crown realisation (``F@1``) of a scenario with several."""
+    use = [g for g in available if wanted is None or g in wanted]
+    dense = project.sensors.dense_hours
+    if (dense and time_ not in dense) or (sc is not None and is_later_realisation(sc.name)):
+        use = [g for g in use if g != "facade_map"]
+    return use
+
+
+def build_project(project: Project, scenarios: list[str] | None = None,
+                  echo: Callable[[str], None] = print, progress: bool = True,
+                  pictures: bool = True) -> dict[str, dict]:
+    """Write the build folders of the selected scenarios; return per-scenario build facts."""
+    engine = folder_engine()
+    chosen = selected(project, scenarios)
+    facts: dict[str, dict] = {}
+    build_root = project.build_dir
+    build_root.mkdir(parents=True, exist_ok=True)
+    for sc in progress_bar(chosen, "build", progress, unit="scenario"):
+        t0 = time.perf_counter()
+        states = hour_states(project, sc)
+        prep = time.perf_counter() - t0
+        built = make_scene(project, sc)
+        t1 = time.perf_counter()
+        with atomic_dir(build_root / sc.name) as tmp:
+            names = list(built.scene.grids)
+            at = {st.label: hour_grids(project, st.time, names, None, sc) for st in states}
+            engine.write_folder(built.scene, states, effective_project(project, sc).engine,
+                                built.ab, tmp, sc.name, at)
+            if pictures and built.tree is not None:
+                from radtree.trees.picture import render_model_png
+
+                render_model_png(built.tree, built.scene, tmp / "model.png")
+            facts[sc.name] = {
+                "scenario": sc.name, "model": sc.model, "reflection": sc.reflection,
+                "form": sc.form or project.tree.form, "ab": built.ab,
+                "triangles": built.triangles, "notes": built.notes, "info": built.info,
+                "params_hash": project.params_hash(sc),
+                "seconds": {"preparation": prep, "geometry": built.geometry_seconds,
+                            "writing": time.perf_counter() - t1},
+            }
+            write_text(tmp / "manifest.json", json.dumps(
+                manifest(project, extra={"build": facts[sc.name]}), indent=2, default=str))
+        echo(f"  {sc.name}: {sc.model} ({facts[sc.name]['form']}), {built.triangles} triangles, "
+             f"-ab {built.ab}, geometry {built.geometry_seconds:.2f} s → {build_root / sc.name}")
+    _remove_stale_builds(project, chosen)
+    engine.write_index(build_root, [s.name for s in selected(project, None)
+                                    if (build_root / s.name).exists()])
+    return facts
+
+
+def build_is_current(project: Project, sc: Scenario) -> bool:
+    """True when ``build/<scenario>/manifest.json`` was written for the scenario's parameters."""
+    try:
+        mf = json.loads((project.build_dir / sc.name / "manifest.json").read_text())
+        return bool(mf["build"]["params_hash"] == project.params_hash(sc))
+    except (OSError, ValueError, KeyError, TypeError):
+        return False
+
+
+def ensure_built(project: Project, sc: Scenario, echo: Callable[[str], None]) -> Path:
+    """The scenario's build folder, (re)built first when missing or stale."""
+    if not build_is_current(project, sc):
+        echo(f"  build/{sc.name} is missing or out of date: building it")
+        build_project(project, [sc.name], echo=echo, progress=False)
+    return project.build_dir / sc.name
+
+
+def _remove_stale_builds(project: Project, built: list[Scenario]) -> None:
+    """A scenario is built either as one folder or as realisation folders (``F@k``): remove
+    the other kind, and realisations beyond the current count, so no stale crown is reported."""
+    for parent in dict.fromkeys(parent_name(sc.name) for sc in built):
+        current = {sc.name for sc in realisations_of(project, project.scenario(parent))}
+        for folder in [project.build_dir / parent,
+                       *project.build_dir.glob(f"{parent}{REALISATION_MARK}*")]:
+            if folder.is_dir() and folder.name not in current:
+                shutil.rmtree(folder)
+
+
+def progress_bar(items: Iterable | None, desc: str, enabled: bool, total: int | None = None,
+                 unit: str = "hour") -> Any:
+    """A tqdm progress bar on stderr over ``items`` (or of ``total`` steps), or the plain
+    iterable / None when disabled."""
+    if not enabled:
+        return items
+    from tqdm import tqdm
+
+    if items is None:
+        return tqdm(total=total, desc=desc, unit=unit, leave=False)
+    return tqdm(items, desc=desc, unit=unit, leave=False)

@@ -1,0 +1,107 @@
+"""The one results table: schema, path, rows from engine output, validated read, atomic write.
+
+``PROJECT/results/illuminance.csv`` holds one row per scenario × hour × grid × sensor:
+illuminance ``lux`` (traced + calculated ground terms), its Monte Carlo standard error
+``lux_stderr`` (NaN when the engine gives none), sensor position ``x y z`` (m, x east, y north,
+z up), the ``engine`` that traced it and the scenario's ``params_hash``; then ``lux_traced``,
+``lux_reflected_calc`` and ``reflection`` (and, for crown realisations, ``lux_realisation_sd``
+and ``realisations``). Statistics, reports and diagnosis read only this table.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+from radtree.config import Project, Scenario
+from radtree.engines.base import GridResult
+from radtree.errors import RadtreeError
+from radtree.fileio import atomic_path
+from radtree.measurements import normalise_time
+from radtree.reflect import ground_terms
+from radtree.scene import Scene
+from radtree.sky import SkyState
+
+#: the written column order (extra columns follow)
+RESULT_COLUMNS = [
+    "scenario", "model", "datetime", "time", "grid", "sensor", "row", "x", "y", "z",
+    "lux", "lux_stderr", "engine", "params_hash",
+]
+#: what a table must have to be read back
+REQUIRED_COLUMNS = ("scenario", "model", "time", "grid", "sensor", "row", "lux")
+_DTYPES = {"scenario": str, "time": str, "row": str, "grid": str, "params_hash": str,
+           "engine": str, "model": str, "reflection": str}
+
+
+def results_path(project: Project) -> Path:
+    """``PROJECT/results/illuminance.csv``."""
+    return project.results_dir / "illuminance.csv"
+
+
+def hour_rows(project: Project, sc: Scenario, st: SkyState, scene: Scene,
+              res: dict[str, GridResult], engine: str, phash: str) -> pd.DataFrame:
+    """The tidy rows of one traced hour: engine lux plus the calculated ground terms."""
+    frames = []
+    for gname, gr in res.items():
+        grid = scene.grids[gname]
+        extra = ground_terms(project, sc, st, grid)
+        frames.append(pd.DataFrame({
+            "scenario": sc.name, "model": sc.model, "datetime": st.datetime.isoformat(),
+            "time": st.time, "grid": gname, "sensor": np.arange(len(grid)), "row": grid.rows,
+            "x": grid.points[:, 0], "y": grid.points[:, 1], "z": grid.points[:, 2],
+            "lux": gr.lux + extra,
+            "lux_stderr": gr.stderr if gr.stderr is not None else np.nan,
+            "engine": engine, "params_hash": phash,
+            "lux_traced": gr.lux, "lux_reflected_calc": extra,
+            "reflection": sc.reflection,
+        }))
+    return pd.concat(frames, ignore_index=True)
+
+
+def in_column_order(table: pd.DataFrame, scenario_order: list[str]) -> pd.DataFrame:
+    """Rows sorted by scenario (project order), time, grid, sensor; columns in schema order."""
+    order = {s: i for i, s in enumerate(scenario_order)}
+    table = table.sort_values(["scenario", "time", "grid", "sensor"],
+                              key=lambda c: c.map(order) if c.name == "scenario" else c)
+    cols = RESULT_COLUMNS + [c for c in table.columns if c not in RESULT_COLUMNS]
+    return table[cols].reset_index(drop=True)
+
+
+def read_table(path: Path, hint: str = "") -> pd.DataFrame:
+    """A results table read from ``path`` and checked (columns, clock times); RadtreeError
+    naming the file otherwise. ``hint``: what to run when the file is missing or empty."""
+    if not path.is_file():
+        raise RadtreeError(f"no results: {path} not found" + (f"; {hint}" if hint else ""))
+    try:
+        df = pd.read_csv(path, dtype=_DTYPES)  # type: ignore[arg-type]
+    except (OSError, ValueError) as exc:
+        raise RadtreeError(f"{path}: cannot read the results table ({exc})") from exc
+    missing = [c for c in REQUIRED_COLUMNS if c not in df.columns]
+    if missing:
+        raise RadtreeError(f"{path}: results table lacks column(s) {', '.join(missing)}")
+    if df.empty:
+        raise RadtreeError(f"{path}: results table is empty" + (f"; {hint}" if hint else ""))
+    try:
+        df["time"] = [normalise_time(str(t)) for t in df["time"]]
+    except RadtreeError as exc:
+        raise RadtreeError(f"{path}: {exc}") from None
+    if "lux_stderr" not in df.columns:
+        df["lux_stderr"] = np.nan
+    return df
+
+
+def read_results(project: Project) -> pd.DataFrame:
+    """The project's results table, validated; RadtreeError if ``simulate`` has not run."""
+    return read_table(results_path(project), f"run `radtree simulate {project.root}` first")
+
+
+def merge_write(out: Path, table: pd.DataFrame, names: list[str]) -> None:
+    """Replace the named scenarios' rows in the table at ``out`` (keep the others), atomically."""
+    if out.exists():
+        old = pd.read_csv(out, dtype=_DTYPES)  # type: ignore[arg-type]
+        old = old[~old["scenario"].astype(str).isin(names)]
+        table = pd.concat([old, table], ignore_index=True) if len(old) else table
+    with atomic_path(out) as tmp:
+        table.to_csv(tmp, index=False)

@@ -1,0 +1,179 @@
+"""Simulate: every selected scenario × hour on one engine → ``results/illuminance.csv``.
+
+Finished (scenario, hour) parts are kept in ``results/parts/`` keyed by the engine and the
+scenario's parameter hash, so an interrupted run resumes where it stopped. Crown realisations
+(``F@k``) are averaged back into their scenario (:mod:`radtree.pipeline.realisations`).
+"""
+
+from __future__ import annotations
+
+import json
+import threading
+import time
+from collections.abc import Callable
+from concurrent.futures import ThreadPoolExecutor, as_completed
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import pandas as pd
+
+from radtree.config import Project, Scenario, effective_project
+from radtree.engines.base import Engine
+from radtree.engines.registry import get_engine
+from radtree.fileio import atomic_path, write_text
+from radtree.light import hour_states
+from radtree.manifest import manifest
+from radtree.pipeline.assemble import BuiltScene, make_scene
+from radtree.pipeline.build import ensure_built, hour_grids, progress_bar
+from radtree.pipeline.realisations import merge_realisations, parent_name, selected
+from radtree.pipeline.results import hour_rows, in_column_order, merge_write, results_path
+from radtree.sky import SkyState
+
+
+@dataclass
+class SimulationOutcome:
+    """What ``simulate`` wrote: the results ``table`` (read back from ``path``), per-scenario
+    ``timing`` (s), hours ``computed`` and ``reused`` from earlier parts, the ``engine`` name."""
+
+    table: pd.DataFrame
+    path: Path
+    timing: pd.DataFrame
+    computed: int
+    reused: int
+    engine: str
+
+
+@dataclass
+class _Prepared:
+    built: BuiltScene
+    states: list[SkyState]
+    phash: str
+    plan: Any
+    seconds: float   # hour states (sun, sky, weather)
+
+
+def resolve_engine(project: Project, engine: str | Engine = "auto") -> Engine:
+    """The engine to run: an instance as given, or by name (``auto`` → the project's
+    ``engine.name``, itself ``auto`` → Radiance when found, else NumPy)."""
+    if isinstance(engine, Engine):
+        return engine
+    return get_engine(engine if engine != "auto" else project.engine.name)
+
+
+def prepare_scenario(project: Project, sc: Scenario, engine: Engine,
+                     hours: list[str] | None = None, echo: Callable[[str], None] = print
+                     ) -> _Prepared:
+    """A scenario's scene, hour states, parameter hash and the engine's plan."""
+    t0 = time.perf_counter()
+    states = hour_states(project, sc, hours)
+    seconds = time.perf_counter() - t0
+    built = make_scene(project, sc)
+    folder = ensure_built(project, sc, echo) if engine.uses_build_folder else None
+    plan = engine.prepare(built.scene, states, effective_project(project, sc).engine, built.ab,
+                          folder)
+    return _Prepared(built, states, project.params_hash(sc), plan, seconds)
+
+
+def simulate_project(project: Project, engine: str | Engine = "auto",
+                     scenarios: list[str] | None = None, hours: list[str] | None = None,
+                     workers: int | None = None, dry_run: bool = False,
+                     echo: Callable[[str], None] = print, progress: bool = True,
+                     resume: bool = True, grids: list[str] | None = None
+                     ) -> SimulationOutcome | None:
+    """Trace every selected scenario × hour and write ``results/illuminance.csv``."""
+    eng = resolve_engine(project, engine)
+    chosen = selected(project, scenarios)
+    workers = workers or project.engine.workers
+    parts_dir = project.results_dir / "parts"
+    timing: dict[str, dict[str, float]] = {}
+    prepared: dict[str, _Prepared] = {}
+    tasks: list[tuple[Scenario, SkyState]] = []
+    for sc in chosen:
+        prep = prepare_scenario(project, sc, eng, hours, echo)
+        prepared[sc.name] = prep
+        timing[sc.name] = {"preparation_s": prep.seconds,
+                           "geometry_s": prep.built.geometry_seconds, "tracing_s": 0.0}
+        tasks.extend((sc, st) for st in prep.states)
+    if dry_run:
+        for sc, st in tasks:
+            for line in eng.commands(prepared[sc.name].plan, st.label):
+                echo(f"{sc.name}: {line}" if not eng.uses_build_folder else line)
+        return None
+
+    parts_dir.mkdir(parents=True, exist_ok=True)
+    lock = threading.Lock()
+    frames: list[pd.DataFrame] = []
+    todo = []
+    reused = 0
+    for sc, st in tasks:
+        part = parts_dir / f"{sc.name}_{st.label}_{eng.name}_{prepared[sc.name].phash}.csv"
+        if resume and part.exists():
+            frames.append(pd.read_csv(part))
+            reused += 1
+        else:
+            todo.append((sc, st, part))
+
+    def work(item: tuple[Scenario, SkyState, Path]) -> pd.DataFrame:
+        sc, st, part = item
+        prep = prepared[sc.name]
+        t = time.perf_counter()
+        use = hour_grids(project, st.time, list(prep.built.scene.grids), grids, sc)
+        res = eng.trace(prep.plan, st.label, use)
+        df = hour_rows(project, sc, st, prep.built.scene, res, eng.name, prep.phash)
+        with atomic_path(part) as tmp:
+            df.to_csv(tmp, index=False)
+        with lock:
+            timing[sc.name]["tracing_s"] += time.perf_counter() - t
+        return df
+
+    if todo:
+        bar = progress_bar(None, f"simulate ({eng.name})", progress, total=len(todo))
+        with ThreadPoolExecutor(max_workers=max(1, workers)) as pool:
+            futures = {pool.submit(work, item): item for item in todo}
+            try:
+                for fut in as_completed(futures):
+                    frames.append(fut.result())
+                    if bar is not None:
+                        bar.update(1)
+            except BaseException:
+                for f in futures:
+                    f.cancel()
+                raise
+            finally:
+                if bar is not None:
+                    bar.close()
+    table = pd.concat(frames, ignore_index=True)
+    parents = list(dict.fromkeys(parent_name(sc.name) for sc in chosen))
+    table, per_realisation = merge_realisations(
+        table, {p: project.params_hash(project.scenario(p)) for p in parents})
+    if per_realisation is not None:
+        merge_write(project.results_dir / "realisations.csv", per_realisation, parents)
+    table = in_column_order(table, [s.name for s in project.scenarios])
+    out = results_path(project)
+    merge_write(out, table, parents)
+    tdf = _timing_table(timing, eng.name)
+    _merge_timing(project.results_dir / "timing.csv", tdf)
+    write_text(project.results_dir / "manifest.json", json.dumps(
+        manifest(project, extra={"engine": eng.name, "scenarios": [s.name for s in chosen]}),
+        indent=2, default=str))
+    return SimulationOutcome(pd.read_csv(out), out, tdf, len(todo), reused, eng.name)
+
+
+def _timing_table(timing: dict[str, dict[str, float]], engine: str) -> pd.DataFrame:
+    """Seconds per scenario (realisations summed into their scenario)."""
+    summed: dict[str, dict[str, float]] = {}
+    for name, v in timing.items():
+        acc = summed.setdefault(parent_name(name), dict.fromkeys(v, 0.0))
+        for k, x in v.items():
+            acc[k] += x
+    return pd.DataFrame([{"scenario": k, "engine": engine, **v} for k, v in summed.items()])
+
+
+def _merge_timing(out: Path, tdf: pd.DataFrame) -> None:
+    if out.exists():
+        old = pd.read_csv(out)
+        old = old[~old["scenario"].astype(str).isin(tdf["scenario"].astype(str))]
+        tdf = pd.concat([old, tdf], ignore_index=True)
+    with atomic_path(out) as tmp:
+        tdf.to_csv(tmp, index=False)
