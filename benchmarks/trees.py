@@ -3,7 +3,7 @@
 Run: ``.venv/bin/python benchmarks/trees.py [PROJECT]`` (default: examples/mendoza-street).
 Prints one table for the configured models, one for the slat size of the louvers, and one for
 the two readings of the louvers optics. "permeability" is the direct (specular) crown
-transmission seen by the façade sensors (cosine-weighted; see radtree.trees.calibrate).
+transmission seen by the façade sensors (cosine-weighted; see radtree.calibrate.direct).
 """
 
 from __future__ import annotations
@@ -12,10 +12,10 @@ import sys
 import time
 from pathlib import Path
 
+from radtree.calibrate.direct import sensor_permeability
 from radtree.config import load_project
 from radtree.site.frame import FacadeFrame
 from radtree.trees.build import apply_switches, build_crown
-from radtree.trees.calibrate import sensor_permeability
 
 ROOT = Path(__file__).resolve().parents[1]
 

@@ -26,11 +26,11 @@ import pandas as pd
 
 from radtree.errors import RadtreeError
 from radtree.measurements import grid_mean, normalise_time
+from radtree.pipeline.results import REQUIRED_COLUMNS
 
 FloatArray = npt.NDArray[np.float64]
 
 FACADE_GRID = "facade"
-RESULT_COLUMNS = ("scenario", "model", "time", "grid", "sensor", "row", "lux")
 STATS_COLUMNS = ["scenario", "model", "reflection", "rmse", "rmse_low", "rmse_high", "mbe", "r",
                  "r2", "n_hours", "rmse_lux", "mbe_lux", "rmse_mc_se"]
 
@@ -198,7 +198,7 @@ def nrmse_stderr(measured: npt.ArrayLike, simulated: npt.ArrayLike,
 
 def _check_results(results: pd.DataFrame, grid: str) -> pd.DataFrame:
     """Return the rows of ``grid`` with normalised times; raise on missing columns or bad data."""
-    missing = [c for c in RESULT_COLUMNS if c not in results.columns]
+    missing = [c for c in REQUIRED_COLUMNS if c not in results.columns]
     if missing:
         raise RadtreeError(f"results table lacks column(s) {', '.join(missing)} "
                            f"(has {', '.join(map(str, results.columns))})")

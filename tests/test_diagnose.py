@@ -17,7 +17,7 @@ from radtree.diagnose.cli import diagnose_command
 from radtree.diagnose.effects import (
     EFFECT_NAMES,
     EFFECTS,
-    Context,
+    EffectContext,
     candidates,
     get_effect,
     parse_effects,
@@ -58,7 +58,7 @@ def test_catalogue_complete_and_documented():
 
 @pytest.mark.parametrize("name", EFFECT_NAMES)
 def test_effects_switch_on_and_off(mendoza, name):
-    ctx = Context(mendoza)
+    ctx = EffectContext(mendoza)
     e = get_effect(name)
     for sc in mendoza.scenarios:
         if e.applies(ctx, sc):
@@ -80,7 +80,7 @@ def test_effects_switch_on_and_off(mendoza, name):
 
 
 def test_effect_status_in_mendoza(mendoza):
-    ctx = Context(mendoza)
+    ctx = EffectContext(mendoza)
     a, b = mendoza.scenario("A"), mendoza.scenario("B")
     cands_a = {e.name for e in candidates(ctx, a)[0]}
     cands_b = {e.name for e in candidates(ctx, b)[0]}
@@ -192,7 +192,7 @@ def _sig(effect: str, kind: str, strengths, hourly, ref=None) -> Signature:
     e = get_effect(effect)
     hourly = np.atleast_2d(np.asarray(hourly, float))
     st = None if kind == "binary" else replace(
-        e.strength(Context(load_project(MENDOZA)), Scenario("x", "louvers")),
+        e.strength(EffectContext(load_project(MENDOZA)), Scenario("x", "louvers")),
         mode=kind, grid=tuple(strengths), reference=float(ref or strengths[0]))
     return Signature(e, kind, st, np.asarray(strengths, float), hourly,
                      np.zeros((len(hourly), 3)), ["higher", "intermediate", "lower"],
@@ -200,7 +200,7 @@ def _sig(effect: str, kind: str, strengths, hourly, ref=None) -> Signature:
 
 
 def test_linear_fit_recovers_strength_and_cv(mendoza):
-    ctx = Context(mendoza)
+    ctx = EffectContext(mendoza)
     x = np.array([200.0, 210, 190, 180, 190, 200, 215])
     r = 1.5 * x
     f = fit_candidate(_sig("sky_diffuse", "linear", [12000.0], x), r, ctx,
@@ -217,7 +217,7 @@ def test_linear_fit_recovers_strength_and_cv(mendoza):
 def test_cross_validation_penalises_flexible_signature(mendoza):
     """A 1-D search over many differently shaped signatures bends through seven noisy points
     in-sample, but loses to a one-amplitude signature once cross-validated."""
-    ctx = Context(mendoza)
+    ctx = EffectContext(mendoza)
     rng = np.random.default_rng(1)
     r = 100 + 20 * rng.standard_normal(7)
     grid = list(np.round(np.linspace(0.01, 0.2, 20), 3))
@@ -232,7 +232,7 @@ def test_cross_validation_penalises_flexible_signature(mendoza):
 
 
 def test_search_fit_interpolates(mendoza):
-    ctx = Context(mendoza)
+    ctx = EffectContext(mendoza)
     base = np.array([100.0, 150, 200, 250, 200, 150, 100])
     sig = _sig("crown_gaps", "search", [0.02, 0.05, 0.1], [base * 0.3, base, base * 1.5],
                ref=0.05)
@@ -245,7 +245,7 @@ def test_search_fit_interpolates(mendoza):
 # --------------------------------------------------------------------------- project files
 def test_step_project_file_round_trip(tmp_path):
     proj = load_project(copy_project(tmp_path / "p"))
-    ctx = Context(proj)
+    ctx = EffectContext(proj)
     sc = get_effect("sky_diffuse").switch_on(ctx, proj.scenario("B"), 9000)
     sc = replace(sc, name="B-diag1", description="test")
     out = proj.root / "diagnose" / "radtree.step1.toml"

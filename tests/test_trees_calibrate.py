@@ -8,11 +8,11 @@ from pathlib import Path
 import pytest
 from click.testing import CliRunner
 
+from radtree.calibrate.direct import calibrate, calibrated_path, sensor_permeability
 from radtree.config import load_project
 from radtree.errors import RadtreeError
 from radtree.site.frame import FacadeFrame
 from radtree.trees.build import build_crown
-from radtree.trees.calibrate import calibrate, calibrated_path, sensor_permeability
 from radtree.trees.cli import calibrate_command
 
 ROOT = Path(__file__).resolve().parents[1]

@@ -11,10 +11,10 @@ import numpy as np
 import pytest
 from scipy.stats import poisson
 
+from radtree.calibrate.permeability import calibrate_crossings
 from radtree.config import Louvers, Scenario, load_project
 from radtree.errors import ConfigError
 from radtree.optics import Plastic, Trans
-from radtree.permeability import calibrate_crossings
 from radtree.scene import Mesh
 from radtree.trees.build import build_tree
 from radtree.trees.envelope import CrownRowSpec, crown_row_spec

@@ -25,7 +25,7 @@ from typing import Any
 _EXPORTS = {
     "Attribution": "attribution", "CandidateFit": "attribution", "Signature": "attribution",
     "attribute": "attribution",
-    "EFFECTS": "effects", "EFFECT_NAMES": "effects", "Context": "effects", "Effect": "effects",
+    "EFFECTS": "effects", "EFFECT_NAMES": "effects", "EffectContext": "effects", "Effect": "effects",
     "Strength": "effects", "candidates": "effects", "catalogue_lines": "effects",
     "get_effect": "effects", "parse_effects": "effects",
     "LoopResult": "loop", "Measured": "loop", "Step": "loop", "load_measurements": "loop",

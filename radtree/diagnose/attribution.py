@@ -33,7 +33,7 @@ import numpy as np
 import pandas as pd
 
 from radtree.config import Scenario
-from radtree.diagnose.effects import EFFECTS, Context, Effect, Strength, candidates
+from radtree.diagnose.effects import EFFECTS, Effect, EffectContext, Strength, candidates
 from radtree.diagnose.simulate import Run, Simulator
 
 TIE_CORR = 0.9
@@ -153,7 +153,7 @@ class Attribution:
 
 
 # --------------------------------------------------------------------------- signatures
-def compute_signatures(sim: Simulator, ctx: Context, base: Scenario, base_run: Run,
+def compute_signatures(sim: Simulator, ctx: EffectContext, base: Scenario, base_run: Run,
                        effects: Iterable[Effect],
                        echo: Callable[[str], None] | None = None) -> dict[str, Signature]:
     """Simulate each effect switched on at its strengths; return the signatures."""
@@ -202,7 +202,7 @@ def _fit(sig: Signature, r: np.ndarray, idx: np.ndarray) -> tuple[float | None, 
     return float(xs[k]), preds[k]
 
 
-def fit_candidate(sig: Signature, r: np.ndarray, ctx: Context, base: Scenario,
+def fit_candidate(sig: Signature, r: np.ndarray, ctx: EffectContext, base: Scenario,
                   row_residual: np.ndarray | None) -> CandidateFit:
     """In-sample fit (all hours) and leave-one-hour-out CV of one signature."""
     n = len(r)
@@ -237,7 +237,7 @@ def fit_candidate(sig: Signature, r: np.ndarray, ctx: Context, base: Scenario,
     return fit
 
 
-def attribute(sim: Simulator, ctx: Context, base: Scenario, base_run: Run, measured: np.ndarray,
+def attribute(sim: Simulator, ctx: EffectContext, base: Scenario, base_run: Run, measured: np.ndarray,
               row_residual: np.ndarray | None = None, catalogue: Iterable[Effect] = EFFECTS,
               margin: float = DEFAULT_MARGIN, echo: Callable[[str], None] | None = None,
               exclude: Iterable[str] = ()) -> Attribution:

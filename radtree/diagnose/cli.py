@@ -54,7 +54,7 @@ def diagnose_command(project: str | None, measured: str | None, units: str | Non
     radtree.step<k>.toml (the user's project file is never changed). With --selftest:
     selftest.csv and selftest.html.
     """
-    from radtree.diagnose.effects import Context, catalogue_lines, parse_effects
+    from radtree.diagnose.effects import EffectContext, catalogue_lines, parse_effects
     from radtree.errors import RadtreeError
 
     if list_effects:
@@ -63,7 +63,7 @@ def diagnose_command(project: str | None, measured: str | None, units: str | Non
             from radtree.config import load_project
 
             proj = load_project(project)
-            ctx = Context(proj)
+            ctx = EffectContext(proj)
             sc = proj.scenario(scenario) if scenario else proj.scenarios[0]
         for line in catalogue_lines(ctx, sc):
             click.echo(line)

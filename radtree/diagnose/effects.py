@@ -26,199 +26,20 @@ Effects (``EFFECTS``, in this order): ``unfiltered_ground``, ``calculated_reflec
 from __future__ import annotations
 
 from collections.abc import Iterable
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, replace
 from typing import Any
 
-from radtree.config import Louvers, Project, Scenario, effective_project
+from radtree.config import Scenario, effective_project
+from radtree.diagnose.effect import (
+    LOW_BOUNCES,
+    Effect,
+    EffectContext,
+    Strength,
+    _louvers_only,
+    _ZeroIsOff,
+    with_switches,
+)
 from radtree.errors import RadtreeError
-
-#: The "few bounces" (``engine.ab``) that ``ambient_bounces`` switches off to.
-LOW_BOUNCES = 2
-
-
-@dataclass(frozen=True)
-class Context:
-    """What an effect needs besides the scenario: the project (effects know no engine)."""
-
-    project: Project
-    _ab_cache: dict[str, int] = field(default_factory=dict, compare=False, repr=False)
-
-    def louvers(self, sc: Scenario) -> Louvers:
-        """The scenario's louvers parameters after its switches."""
-        from radtree.trees.build import apply_switches
-
-        tree, _ = apply_switches(self.project.tree, sc.switches, source=str(self.project.source),
-                                 root=self.project.root)
-        return tree.louvers
-
-    def default_ab(self, sc: Scenario) -> int:
-        """Diffuse bounces (``-ab``; the NumPy engine traces as many) the scenario uses without
-        an ``engine.ab`` switch: the project's ``engine.ab``, else the crown's recommendation."""
-        if self.project.engine.ab is not None:
-            return int(self.project.engine.ab)
-        base = replace(sc, switches={k: v for k, v in sc.switches.items() if k != "engine.ab"})
-        key = repr((sc.model, sc.form, sorted((k, repr(v)) for k, v in base.switches.items()
-                                              if not k.startswith(("light.", "reflection.")))))
-        if key not in self._ab_cache:
-            from radtree.trees.build import build_tree
-
-            if sc.model == "none":
-                self._ab_cache[key] = 2
-            else:
-                from radtree.pipeline.assemble import facade_frame
-
-                proj = effective_project(self.project, base)
-                tree = build_tree(proj, base, facade_frame(proj))
-                self._ab_cache[key] = int(tree.recommended_ab)
-        return self._ab_cache[key]
-
-
-@dataclass(frozen=True)
-class Strength:
-    """A strength parameter: what it is, its bounds and how it acts.
-
-    ``mode`` is ``"linear"`` (change ∝ strength; fitted as a non-negative amplitude of the
-    signature at ``reference``) or ``"search"`` (re-simulated at ``grid``; 1-D search).
-    ``decimals``: the strength written to a project file is rounded to this many decimals
-    (negative: to tens, hundreds…).
-    """
-
-    label: str
-    unit: str
-    lo: float
-    hi: float
-    reference: float
-    mode: str = "linear"
-    grid: tuple[float, ...] = ()
-    integer: bool = False
-    decimals: int = 3
-
-    def __post_init__(self) -> None:
-        if self.mode not in ("linear", "search"):
-            raise ValueError(f"strength mode must be linear or search, got {self.mode!r}")
-        if not self.lo <= self.reference <= self.hi:
-            raise ValueError(f"reference strength {self.reference} outside [{self.lo}, {self.hi}]")
-
-    def clip(self, value: float) -> float:
-        return float(min(self.hi, max(self.lo, value)))
-
-    def round(self, value: float) -> float | int:
-        v = self.clip(value)
-        if self.integer:
-            return int(round(v))
-        r = round(v, self.decimals)
-        return float(r) if self.decimals > 0 else float(int(r))
-
-    def search_points(self) -> tuple[float, ...]:
-        """Strengths at which the change is simulated (within the bounds)."""
-        if self.mode == "linear":
-            return (self.reference,)
-        pts = sorted({self.clip(g) for g in self.grid} | {self.reference})
-        return tuple(p for p in pts if p > self.lo or self.integer)
-
-    def text(self, value: float | None) -> str:
-        if value is None:
-            return "on"
-        if self.integer:
-            return f"{int(round(value))} {self.unit}".strip()
-        if abs(value) >= 100:
-            return f"{value:,.0f} {self.unit}".strip()
-        return f"{value:.3g} {self.unit}".strip()
-
-
-class Effect:
-    """One physical effect that can be switched on or off in a scenario.
-
-    Subclasses set ``name`` (identifier), ``title``, ``physics`` (one line), ``switch`` (what
-    it changes in the project's words) and implement the methods.
-    """
-
-    name: str = ""
-    title: str = ""
-    physics: str = ""
-    switch: str = ""
-
-    def strength(self, ctx: Context, sc: Scenario) -> Strength | None:
-        """The strength parameter (bounds may depend on the scenario), None if on/off only."""
-        return None
-
-    def applies(self, ctx: Context, sc: Scenario) -> str | None:
-        """None if the effect can be switched in this scenario, else why not."""
-        return None
-
-    def is_on(self, ctx: Context, sc: Scenario) -> bool:
-        raise NotImplementedError
-
-    def current(self, ctx: Context, sc: Scenario) -> float | None:
-        """The strength in the scenario (None for on/off effects)."""
-        return None
-
-    def switch_on(self, ctx: Context, sc: Scenario, strength: float | None = None) -> Scenario:
-        """The scenario with the effect on (at ``strength``, default the reference)."""
-        raise NotImplementedError
-
-    def switch_off(self, ctx: Context, sc: Scenario) -> Scenario:
-        raise NotImplementedError
-
-    # helpers ----------------------------------------------------------------------------
-    def reference(self, ctx: Context, sc: Scenario) -> float | None:
-        st = self.strength(ctx, sc)
-        return None if st is None else st.reference
-
-    def _value(self, ctx: Context, sc: Scenario, strength: float | None) -> float | int:
-        st = self.strength(ctx, sc)
-        if st is None:
-            raise RadtreeError(f"effect {self.name} has no strength")
-        return st.round(st.reference if strength is None else strength)
-
-    def describe(self, ctx: Context, sc: Scenario, strength: float | None) -> str:
-        """What switching on at ``strength`` writes into the scenario, as text."""
-        on = self.switch_on(ctx, sc, strength)
-        parts = []
-        for k in ("reflection", "sky"):
-            if getattr(on, k) != getattr(sc, k):
-                parts.append(f"{k} = {getattr(on, k)!r}")
-        for k, v in on.switches.items():
-            if sc.switches.get(k, _MISSING) != v:
-                parts.append(f"{k} = {v!r}")
-        for k in sc.switches:
-            if k not in on.switches:
-                parts.append(f"{k} removed")
-        return ", ".join(parts) or "(no change)"
-
-    def __repr__(self) -> str:
-        return f"<effect {self.name}>"
-
-
-_MISSING = object()
-
-
-def with_switches(sc: Scenario, set_: dict[str, Any] | None = None,
-                  drop: Iterable[str] = (), **fields_: Any) -> Scenario:
-    """A copy of ``sc`` with switches set/dropped and scenario fields replaced."""
-    sw = {k: v for k, v in sc.switches.items() if k not in set(drop)}
-    sw.update(set_ or {})
-    return replace(sc, switches=sw, **fields_)
-
-
-def _louvers_only(sc: Scenario) -> str | None:
-    return None if sc.model == "louvers" else f"needs the louvers model (scenario has {sc.model})"
-
-
-# --------------------------------------------------------------------------- the effects
-class _ZeroIsOff(Effect):
-    """An effect set by one numeric switch ``key`` whose value 0 means off."""
-
-    key: str
-
-    def is_on(self, ctx: Context, sc: Scenario) -> bool:
-        return (self.current(ctx, sc) or 0.0) > 0.0
-
-    def switch_on(self, ctx: Context, sc: Scenario, strength: float | None = None) -> Scenario:
-        return with_switches(sc, {self.key: float(self._value(ctx, sc, strength))})
-
-    def switch_off(self, ctx: Context, sc: Scenario) -> Scenario:
-        return with_switches(sc, {self.key: 0.0})
 
 
 class UnfilteredGround(_ZeroIsOff):
@@ -229,14 +50,14 @@ class UnfilteredGround(_ZeroIsOff):
     switch = "switches.reflection.unfiltered = s (0–1): adds s·ρ(α)·E_open·F to vertical sensors"
     key = "reflection.unfiltered"
 
-    def strength(self, ctx: Context, sc: Scenario) -> Strength:
+    def strength(self, ctx: EffectContext, sc: Scenario) -> Strength:
         return Strength("share s of the open street's reflected light", "", 0.0, 1.0, 0.1,
                         "linear", decimals=3)
 
-    def current(self, ctx: Context, sc: Scenario) -> float:
+    def current(self, ctx: EffectContext, sc: Scenario) -> float:
         return float(sc.switches.get(self.key, 0.0))
 
-    def switch_off(self, ctx: Context, sc: Scenario) -> Scenario:
+    def switch_off(self, ctx: EffectContext, sc: Scenario) -> Scenario:
         return with_switches(sc, drop=[self.key])
 
 
@@ -247,13 +68,13 @@ class CalculatedReflection(Effect):
                "street under the crown's shade, instead of being traced through the crown filters")
     switch = "scenario reflection = 'calculated' (off: 'traced')"
 
-    def is_on(self, ctx: Context, sc: Scenario) -> bool:
+    def is_on(self, ctx: EffectContext, sc: Scenario) -> bool:
         return sc.reflection == "calculated"
 
-    def switch_on(self, ctx: Context, sc: Scenario, strength: float | None = None) -> Scenario:
+    def switch_on(self, ctx: EffectContext, sc: Scenario, strength: float | None = None) -> Scenario:
         return replace(sc, reflection="calculated")
 
-    def switch_off(self, ctx: Context, sc: Scenario) -> Scenario:
+    def switch_off(self, ctx: EffectContext, sc: Scenario) -> Scenario:
         return replace(sc, reflection="traced")
 
 
@@ -266,7 +87,7 @@ class SkyDiffuse(Effect):
               "(off: sky = 'none')")
     key = "light.diffuse_horizontal_lux"
 
-    def strength(self, ctx: Context, sc: Scenario) -> Strength | None:
+    def strength(self, ctx: EffectContext, sc: Scenario) -> Strength | None:
         if ctx.project.light.epw is not None:
             return None  # the hour's diffuse comes from the weather file
         ref = ctx.project.light.diffuse_horizontal_lux
@@ -274,25 +95,25 @@ class SkyDiffuse(Effect):
         return Strength("diffuse horizontal illuminance", "lx", 0.0, 40000.0, ref, "linear",
                         decimals=-1)
 
-    def _sky(self, ctx: Context, sc: Scenario) -> str:
+    def _sky(self, ctx: EffectContext, sc: Scenario) -> str:
         return sc.sky or ctx.project.light.sky
 
-    def current(self, ctx: Context, sc: Scenario) -> float:
+    def current(self, ctx: EffectContext, sc: Scenario) -> float:
         if self._sky(ctx, sc) != "perez":
             return 0.0
         return float(effective_project(ctx.project, sc).light.diffuse_horizontal_lux)
 
-    def is_on(self, ctx: Context, sc: Scenario) -> bool:
+    def is_on(self, ctx: EffectContext, sc: Scenario) -> bool:
         if self._sky(ctx, sc) != "perez":
             return False
         return ctx.project.light.epw is not None or self.current(ctx, sc) > 0.0
 
-    def switch_on(self, ctx: Context, sc: Scenario, strength: float | None = None) -> Scenario:
+    def switch_on(self, ctx: EffectContext, sc: Scenario, strength: float | None = None) -> Scenario:
         if self.strength(ctx, sc) is None:
             return with_switches(sc, sky="perez")
         return with_switches(sc, {self.key: float(self._value(ctx, sc, strength))}, sky="perez")
 
-    def switch_off(self, ctx: Context, sc: Scenario) -> Scenario:
+    def switch_off(self, ctx: EffectContext, sc: Scenario) -> Scenario:
         return with_switches(sc, drop=[self.key], sky="none")
 
 
@@ -304,12 +125,12 @@ class OppositeFacade(_ZeroIsOff):
     switch = "switches.street.opposite_reflectance = ρ (off: 0)"
     key = "street.opposite_reflectance"
 
-    def strength(self, ctx: Context, sc: Scenario) -> Strength:
+    def strength(self, ctx: EffectContext, sc: Scenario) -> Strength:
         ref = ctx.project.street.opposite_reflectance
         ref = ref if 0.0 < ref <= 0.9 else 0.35
         return Strength("opposite façade reflectance", "", 0.0, 0.9, ref, "linear", decimals=3)
 
-    def current(self, ctx: Context, sc: Scenario) -> float:
+    def current(self, ctx: EffectContext, sc: Scenario) -> float:
         return float(effective_project(ctx.project, sc).street.opposite_reflectance)
 
 
@@ -324,18 +145,18 @@ class AmbientBounces(Effect):
               f"recommendation), at least {LOW_BOUNCES + 2}")
     key = "engine.ab"
 
-    def _on_ab(self, ctx: Context, sc: Scenario) -> int:
+    def _on_ab(self, ctx: EffectContext, sc: Scenario) -> int:
         ab = ctx.default_ab(sc)
         return ab if ab > LOW_BOUNCES else LOW_BOUNCES + 2
 
-    def is_on(self, ctx: Context, sc: Scenario) -> bool:
+    def is_on(self, ctx: EffectContext, sc: Scenario) -> bool:
         ab = sc.switches.get(self.key)
         return int(ab if ab is not None else ctx.default_ab(sc)) > LOW_BOUNCES
 
-    def switch_on(self, ctx: Context, sc: Scenario, strength: float | None = None) -> Scenario:
+    def switch_on(self, ctx: EffectContext, sc: Scenario, strength: float | None = None) -> Scenario:
         return with_switches(sc, {self.key: self._on_ab(ctx, sc)})
 
-    def switch_off(self, ctx: Context, sc: Scenario) -> Scenario:
+    def switch_off(self, ctx: EffectContext, sc: Scenario) -> Scenario:
         return with_switches(sc, {self.key: LOW_BOUNCES})
 
 
@@ -347,16 +168,16 @@ class SpecularTransmission(_ZeroIsOff):
     switch = "switches.louvers.specular_fraction = f (off: 0)"
     key = "louvers.specular_fraction"
 
-    def applies(self, ctx: Context, sc: Scenario) -> str | None:
+    def applies(self, ctx: EffectContext, sc: Scenario) -> str | None:
         return _louvers_only(sc)
 
-    def strength(self, ctx: Context, sc: Scenario) -> Strength:
+    def strength(self, ctx: EffectContext, sc: Scenario) -> Strength:
         ref = ctx.project.tree.louvers.specular_fraction
         ref = ref if ref > 0 else 0.9
         return Strength("specular share of the slat transmittance", "", 0.0, 1.0, ref, "search",
                         grid=(0.3, 0.6, 0.9), decimals=2)
 
-    def current(self, ctx: Context, sc: Scenario) -> float:
+    def current(self, ctx: EffectContext, sc: Scenario) -> float:
         return float(ctx.louvers(sc).specular_fraction)
 
 
@@ -369,24 +190,24 @@ class CrownGaps(Effect):
     switch = "switches.louvers.cover_fraction = 1 − g (off: 1)"
     key = "louvers.cover_fraction"
 
-    def applies(self, ctx: Context, sc: Scenario) -> str | None:
+    def applies(self, ctx: EffectContext, sc: Scenario) -> str | None:
         return _louvers_only(sc)
 
-    def strength(self, ctx: Context, sc: Scenario) -> Strength:
+    def strength(self, ctx: EffectContext, sc: Scenario) -> Strength:
         return Strength("gap fraction g per layer", "", 0.0, 0.5, 0.05, "search",
                         grid=(0.02, 0.05, 0.1, 0.2), decimals=3)
 
-    def current(self, ctx: Context, sc: Scenario) -> float:
+    def current(self, ctx: EffectContext, sc: Scenario) -> float:
         return 1.0 - float(ctx.louvers(sc).cover_fraction)
 
-    def is_on(self, ctx: Context, sc: Scenario) -> bool:
+    def is_on(self, ctx: EffectContext, sc: Scenario) -> bool:
         return self.current(ctx, sc) > 1e-9
 
-    def switch_on(self, ctx: Context, sc: Scenario, strength: float | None = None) -> Scenario:
+    def switch_on(self, ctx: EffectContext, sc: Scenario, strength: float | None = None) -> Scenario:
         g = float(self._value(ctx, sc, strength))
         return with_switches(sc, {self.key: round(1.0 - g, 6)})
 
-    def switch_off(self, ctx: Context, sc: Scenario) -> Scenario:
+    def switch_off(self, ctx: EffectContext, sc: Scenario) -> Scenario:
         return with_switches(sc, {self.key: 1.0})
 
 
@@ -396,7 +217,7 @@ class _Stages(Effect):
     key = "louvers.layers"
     sign = -1
 
-    def applies(self, ctx: Context, sc: Scenario) -> str | None:
+    def applies(self, ctx: EffectContext, sc: Scenario) -> str | None:
         why = _louvers_only(sc)
         if why:
             return why
@@ -410,29 +231,29 @@ class _Stages(Effect):
             return "the project's crown already has the maximum of 20 layers"
         return None
 
-    def _bounds(self, ctx: Context) -> tuple[int, int]:
+    def _bounds(self, ctx: EffectContext) -> tuple[int, int]:
         base = ctx.project.tree.louvers.layers
         return (1, base - 1) if self.sign < 0 else (1, min(3, 20 - base))
 
-    def strength(self, ctx: Context, sc: Scenario) -> Strength:
+    def strength(self, ctx: EffectContext, sc: Scenario) -> Strength:
         lo, hi = self._bounds(ctx)
         hi = max(hi, lo)
         return Strength("layers " + ("removed" if self.sign < 0 else "added"), "layer(s)",
                         float(lo), float(hi), 1.0, "search", grid=(1.0, 2.0), integer=True,
                         decimals=0)
 
-    def current(self, ctx: Context, sc: Scenario) -> float:
+    def current(self, ctx: EffectContext, sc: Scenario) -> float:
         return float(max(0, (ctx.louvers(sc).layers - ctx.project.tree.louvers.layers)
                          * self.sign))
 
-    def is_on(self, ctx: Context, sc: Scenario) -> bool:
+    def is_on(self, ctx: EffectContext, sc: Scenario) -> bool:
         return self.current(ctx, sc) > 0
 
-    def switch_on(self, ctx: Context, sc: Scenario, strength: float | None = None) -> Scenario:
+    def switch_on(self, ctx: EffectContext, sc: Scenario, strength: float | None = None) -> Scenario:
         n = int(self._value(ctx, sc, strength))
         return with_switches(sc, {self.key: int(ctx.project.tree.louvers.layers + self.sign * n)})
 
-    def switch_off(self, ctx: Context, sc: Scenario) -> Scenario:
+    def switch_off(self, ctx: EffectContext, sc: Scenario) -> Scenario:
         return with_switches(sc, {self.key: int(ctx.project.tree.louvers.layers)})
 
 
@@ -463,16 +284,16 @@ class HourlyGroundReflectance(Effect):
               "street.ground_reflectance = the table's mean over the hours, a constant)")
     key = "street.ground_reflectance"
 
-    def applies(self, ctx: Context, sc: Scenario) -> str | None:
+    def applies(self, ctx: EffectContext, sc: Scenario) -> str | None:
         if ctx.project.street.ground_reflectance_table is None:
             return "the project gives a constant ground reflectance (no per-hour table)"
         return None
 
-    def is_on(self, ctx: Context, sc: Scenario) -> bool:
+    def is_on(self, ctx: EffectContext, sc: Scenario) -> bool:
         return (ctx.project.street.ground_reflectance_table is not None
                 and self.key not in sc.switches)
 
-    def constant(self, ctx: Context) -> float:
+    def constant(self, ctx: EffectContext) -> float:
         from radtree.light import ground_reflectance_at
         from radtree.solar import local_datetime, sun_position
 
@@ -484,10 +305,10 @@ class HourlyGroundReflectance(Effect):
             values.append(ground_reflectance_at(ctx.project, sun.altitude_deg))
         return round(float(sum(values) / len(values)), 4)
 
-    def switch_on(self, ctx: Context, sc: Scenario, strength: float | None = None) -> Scenario:
+    def switch_on(self, ctx: EffectContext, sc: Scenario, strength: float | None = None) -> Scenario:
         return with_switches(sc, drop=[self.key])
 
-    def switch_off(self, ctx: Context, sc: Scenario) -> Scenario:
+    def switch_off(self, ctx: EffectContext, sc: Scenario) -> Scenario:
         return with_switches(sc, {self.key: self.constant(ctx)})
 
 
@@ -522,7 +343,7 @@ def parse_effects(text: str | Iterable[str] | None) -> tuple[Effect, ...]:
     return tuple(seen)
 
 
-def candidates(ctx: Context, sc: Scenario, catalogue: Iterable[Effect] = EFFECTS
+def candidates(ctx: EffectContext, sc: Scenario, catalogue: Iterable[Effect] = EFFECTS
                ) -> tuple[list[Effect], dict[str, str]]:
     """Effects that apply to ``sc`` and are off in it, and why each other one is not a
     candidate (``{name: reason}``)."""
@@ -542,7 +363,7 @@ def candidates(ctx: Context, sc: Scenario, catalogue: Iterable[Effect] = EFFECTS
     return out, why
 
 
-def catalogue_lines(ctx: Context | None = None, scenario: Scenario | None = None) -> list[str]:
+def catalogue_lines(ctx: EffectContext | None = None, scenario: Scenario | None = None) -> list[str]:
     """One entry per effect: name, title, one line of physics, the switch and its strength
     (with a project: also whether it is on in ``scenario``, default the first)."""
     lines = []

@@ -26,9 +26,7 @@ import math
 import os
 import time
 from collections.abc import Iterable
-from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
 
 import numpy as np
 import pandas as pd
@@ -40,117 +38,30 @@ from radtree.diagnose.attribution import (
     compute_signatures,
     cosine,
 )
-from radtree.diagnose.effects import EFFECTS, Context, Effect, candidates
+from radtree.diagnose.effects import EFFECTS, Effect, EffectContext, candidates
 from radtree.diagnose.loop import (
     DEFAULT_MAX_STEPS,
-    LoopResult,
     Measured,
     load_measurements,
     run_loop,
 )
-from radtree.diagnose.run import Echo, pick_scenario, resolve_project
+from radtree.diagnose.outcome import (
+    SNR_MIN,
+    Echo,
+    HiddenCase,
+    SelftestResult,
+    pick_scenario,
+    resolve_project,
+)
 from radtree.diagnose.simulate import Simulator
 from radtree.errors import RadtreeError
 from radtree.fileio import atomic_path, write_text
 
 DEFAULT_NOISE = 0.03
-SNR_MIN = 3.0
 TRUTH_SEED_OFFSET = 7919
-SELFTEST_COLUMNS = ["hidden_effect", "distinguishable", "named_effect", "rmse_before",
-                    "rmse_after"]
 
 
-@dataclass
-class HiddenCase:
-    """One hidden effect: the decision made before the run, then what the loop did."""
-
-    effect: str
-    base: Scenario
-    truth: Scenario
-    strength_true: float | None
-    strength_text: str
-    signature_rms_lux: float
-    noise_rms_lux: float
-    max_correlation: float
-    most_correlated_with: str
-    distinguishable: bool
-    reason: str
-    loop: LoopResult | None = None
-    measured: Measured | None = None
-
-    @property
-    def named(self) -> str:
-        return self.loop.named() if self.loop is not None else ""
-
-    @property
-    def correct(self) -> bool:
-        return self.named == self.effect
-
-    @property
-    def gap_shrinks(self) -> bool:
-        return self.loop is not None and all(s.rmse_after < s.rmse_before
-                                             for s in self.loop.steps)
-
-    def record(self) -> dict[str, Any]:
-        lp = self.loop
-        first = lp.steps[0] if lp is not None and lp.steps else None
-        return {
-            "hidden_effect": self.effect, "distinguishable": self.distinguishable,
-            "named_effect": self.named,
-            "rmse_before": lp.start_map.stats["nrmse"] if lp else math.nan,
-            "rmse_after": lp.final_map.stats["nrmse"] if lp else math.nan,
-            "correct": self.correct,
-            "named_or_tied": self.correct or (first is not None
-                                              and self.effect in first.tie_with),
-            "tie_with": ";".join(first.tie_with) if first else "",
-            "steps": " + ".join(s.effect for s in lp.steps) if lp else "",
-            "gap_shrinks": self.gap_shrinks,
-            "strength_true": self.strength_true if self.strength_true is not None else math.nan,
-            "strength_fitted": (first.strength if first is not None and first.strength
-                                is not None and first.effect == self.effect else math.nan),
-            "signature_rms_lux": self.signature_rms_lux, "noise_rms_lux": self.noise_rms_lux,
-            "snr": self.signature_rms_lux / self.noise_rms_lux if self.noise_rms_lux > 0
-            else math.nan,
-            "max_correlation": self.max_correlation,
-            "most_correlated_with": self.most_correlated_with, "reason": self.reason,
-            "base": self.base.name if not self.base.switches else
-            self.base.name + " with " + ", ".join(f"{k}={v}" for k, v in
-                                                 self.base.switches.items()),
-        }
-
-
-@dataclass
-class SelftestResult:
-    project: Project
-    scenario: Scenario
-    noise: float
-    cases: list[HiddenCase]
-    skipped: dict[str, str]
-    seconds: float
-    simulations: int
-    out_dir: Path | None = None
-    files: list[Path] = field(default_factory=list)
-    engine: str = ""
-    rays: int | None = None
-    seed: int | None = None
-
-    @property
-    def passed(self) -> bool:
-        return all(c.correct for c in self.cases if c.distinguishable)
-
-    @property
-    def misnamed(self) -> list[HiddenCase]:
-        return [c for c in self.cases if c.distinguishable and not c.correct]
-
-    def table(self) -> pd.DataFrame:
-        recs = [c.record() for c in self.cases]
-        if not recs:
-            return pd.DataFrame(columns=SELFTEST_COLUMNS)
-        cols = SELFTEST_COLUMNS + [k for k in recs[0] if k not in SELFTEST_COLUMNS]
-        return pd.DataFrame(recs, columns=cols)
-
-
-def _decide(sim: Simulator, ctx: Context, effect: Effect, start: Scenario, noise: float,
+def _decide(sim: Simulator, ctx: EffectContext, effect: Effect, start: Scenario, noise: float,
             echo: Echo | None) -> HiddenCase:
     base = effect.switch_off(ctx, start) if effect.is_on(ctx, start) else start
     if base is not start:
@@ -225,7 +136,7 @@ def selftest(project: str | os.PathLike | Project, scenario: str | None = None,
     say = echo or (lambda s: None)
     proj = resolve_project(project)
     start = pick_scenario(proj, scenario)
-    ctx = Context(proj)
+    ctx = EffectContext(proj)
     out = Path(out_dir) if out_dir is not None else proj.root / "diagnose"
     hours = tuple(proj.site.hours)
     sim = Simulator(proj, hours, engine, rays, seed)

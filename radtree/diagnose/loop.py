@@ -30,7 +30,7 @@ from radtree.diagnose.attribution import (
     attribute,
     choose_winner,
 )
-from radtree.diagnose.effects import EFFECTS, Context, Effect, get_effect
+from radtree.diagnose.effects import EFFECTS, Effect, EffectContext, get_effect
 from radtree.diagnose.residuals import DisagreementMap, disagreement_map
 from radtree.diagnose.simulate import Run, Simulator
 from radtree.errors import RadtreeError
@@ -242,7 +242,7 @@ def _why(att: Attribution, w: CandidateFit, dm: DisagreementMap) -> str:
     return text
 
 
-def run_loop(sim: Simulator, ctx: Context, start: Scenario, measured: Measured,
+def run_loop(sim: Simulator, ctx: EffectContext, start: Scenario, measured: Measured,
              margin: float = DEFAULT_MARGIN, max_steps: int = DEFAULT_MAX_STEPS,
              catalogue: Iterable[Effect] = EFFECTS, echo: Echo | None = None,
              on_step: Callable[[int, Scenario], tuple[Scenario, Path | None]] | None = None

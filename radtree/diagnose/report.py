@@ -19,15 +19,14 @@ from matplotlib.figure import Figure
 
 from radtree import __version__
 from radtree.diagnose.attribution import TIE_CORR
-from radtree.diagnose.effects import EFFECTS, Context, candidates
+from radtree.diagnose.effects import EFFECTS, EffectContext, candidates
 from radtree.diagnose.residuals import RULES, DisagreementMap
 from radtree.figures import new_figure, save_png
 from radtree.fileio import write_text
 
 if TYPE_CHECKING:
-    from radtree.diagnose.hidden import SelftestResult
     from radtree.diagnose.loop import LoopResult
-    from radtree.diagnose.run import DiagnoseResult
+    from radtree.diagnose.outcome import DiagnoseResult, SelftestResult
 
 DPI = 120
 LUX = "lx"
@@ -194,7 +193,7 @@ def _map_ctx(dm: DisagreementMap) -> dict[str, Any]:
             "findings": dm.findings}
 
 
-def _catalogue(ctx: Context | None, sc: Any) -> list[dict[str, Any]]:
+def _catalogue(ctx: EffectContext | None, sc: Any) -> list[dict[str, Any]]:
     status: dict[str, str] = {}
     if ctx is not None and sc is not None:
         cands, why = candidates(ctx, sc)
@@ -245,7 +244,7 @@ def write_diagnose_report(res: DiagnoseResult, out: Path) -> list[Path]:
                 stale.unlink()
         except ValueError:
             continue
-    ctx = Context(res.project)
+    ctx = EffectContext(res.project)
     c = {
         "kind": "diagnose", "project": res.project, "scenario": res.scenario, "res": res,
         "measured": res.measured, "figs": figs, "steps": steps, "last": last,
@@ -283,14 +282,14 @@ def fig_selftest(res: SelftestResult, path: Path) -> str:
 
 
 def write_selftest_report(res: SelftestResult, out: Path) -> list[Path]:
-    from radtree.diagnose.hidden import SNR_MIN
+    from radtree.diagnose.outcome import SNR_MIN
 
     fig = fig_selftest(res, out / "selftest.png") if res.cases else None
     c = {
         "kind": "selftest", "project": res.project, "scenario": res.scenario, "res": res,
         "table": _records(res.table()), "fig": fig, "skipped": res.skipped,
         "snr_min": SNR_MIN, "tie_corr": TIE_CORR, "version": __version__,
-        "catalogue": _catalogue(Context(res.project), res.scenario),
+        "catalogue": _catalogue(EffectContext(res.project), res.scenario),
         "created": datetime.now(timezone.utc).isoformat(timespec="seconds"),
     }
     html = _env().get_template("diagnose.html.j2").render(c=c)

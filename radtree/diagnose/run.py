@@ -10,60 +10,24 @@ from __future__ import annotations
 import math
 import os
 import time
-from collections.abc import Callable, Iterable
-from dataclasses import dataclass, field
+from collections.abc import Iterable
 from pathlib import Path
 
 import pandas as pd
 
-from radtree.config import Project, Scenario, load_project
+from radtree.config import Project, Scenario
 from radtree.diagnose.attribution import DEFAULT_MARGIN
-from radtree.diagnose.effects import EFFECTS, Context, Effect, candidates
+from radtree.diagnose.effects import EFFECTS, Effect, EffectContext, candidates
 from radtree.diagnose.loop import (
     DEFAULT_MAX_STEPS,
     LoopResult,
-    Measured,
     load_measurements,
     run_loop,
     write_step_project,
 )
+from radtree.diagnose.outcome import DiagnoseResult, Echo, pick_scenario, resolve_project
 from radtree.diagnose.simulate import Simulator
-from radtree.errors import RadtreeError
 from radtree.fileio import atomic_path
-
-Echo = Callable[[str], None]
-
-
-@dataclass
-class DiagnoseResult:
-    """What :func:`diagnose` found and wrote."""
-
-    project: Project
-    scenario: Scenario
-    engine: str
-    rays: int | None
-    seed: int | None
-    measured: Measured
-    loop: LoopResult
-    out_dir: Path | None
-    seconds: float
-    simulations: int
-    cache_hits: int
-    not_candidates: dict[str, str] = field(default_factory=dict)
-    files: list[Path] = field(default_factory=list)
-    margin: float = DEFAULT_MARGIN
-
-    @property
-    def steps(self) -> pd.DataFrame:
-        return self.loop.steps_table()
-
-
-def resolve_project(project: str | os.PathLike | Project) -> Project:
-    return project if isinstance(project, Project) else load_project(Path(project))
-
-
-def pick_scenario(project: Project, name: str | None) -> Scenario:
-    return project.scenario(name) if name else project.scenarios[0]
 
 
 def diagnose(project: str | os.PathLike | Project, measured: str | os.PathLike | None = None,
@@ -83,7 +47,7 @@ def diagnose(project: str | os.PathLike | Project, measured: str | os.PathLike |
     proj = resolve_project(project)
     sc = pick_scenario(proj, scenario)
     out = Path(out_dir) if out_dir is not None else proj.root / "diagnose"
-    ctx = Context(proj)
+    ctx = EffectContext(proj)
     sim = Simulator(proj, tuple(proj.site.hours), engine, rays, seed)
     meas = load_measurements(proj, measured, units, sim.sensors_per_row())
     for note in meas.notes():
@@ -188,10 +152,3 @@ def format_steps(res: LoopResult) -> list[str]:
                      + (f"{ef:.0%}" if math.isfinite(ef) else "n/a"))
     lines.append(f"  stop: {res.stop_reason}")
     return lines
-
-
-def check_writable(out: Path) -> None:
-    try:
-        out.mkdir(parents=True, exist_ok=True)
-    except OSError as exc:
-        raise RadtreeError(f"cannot create the output folder {out}: {exc}") from exc

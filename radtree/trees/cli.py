@@ -9,9 +9,9 @@ from pathlib import Path
 
 import click
 
+from radtree.calibrate.direct import PERMEABILITY_DEFINITION, calibrate, write_calibrated_toml
 from radtree.config import load_project
 from radtree.errors import RadtreeError
-from radtree.trees.calibrate import PERMEABILITY_DEFINITION, calibrate, write_calibrated_toml
 
 
 @click.command("calibrate")
@@ -54,7 +54,7 @@ def calibrate_command(project: Path, target: float | None, model: str, form: str
     try:
         proj = load_project(project)
         if global_:
-            from radtree.permeability import calibrate_crossings, calibrate_layers
+            from radtree.calibrate.permeability import calibrate_crossings, calibrate_layers
 
             click.echo("Global permeability = Σ façade illuminance with the crown / Σ in the "
                        "open street, over the project's hours (NumPy engine, every light path).")

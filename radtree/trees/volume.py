@@ -43,7 +43,7 @@ crossing count: min(crossings + 2, :data:`VOLUME_AB_CAP`), measured with
 
 Realisations. A façade sensor sees the slats just in front of it at large solid angles, so one
 realisation (one ``louvers.seed``) of the Mendoza crowns scatters in global permeability by
-≈ 10 % (s.d. over 24 seeds at crossings 15; see :func:`radtree.permeability.calibrate_crossings`,
+≈ 10 % (s.d. over 24 seeds at crossings 15; see :func:`radtree.calibrate.permeability.calibrate_crossings`,
 which calibrates the mean over seeds). Slats are drawn in fixed blocks, so with one seed a
 larger ``crossings`` adds slats to the same crown instead of redrawing it.
 """
