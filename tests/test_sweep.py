@@ -32,7 +32,7 @@ from radtree.sweep import (
 )
 from radtree.sweep import run as sweep_run
 from radtree.sweep.cli import sweep_command
-from radtree.sweep.tomlout import dumps
+from radtree.tomlout import dumps
 
 from .conftest import MENDOZA, copy_project
 

@@ -35,7 +35,7 @@ from radtree.fileio import write_text
 from radtree.sensor_grid import facade_circle
 from radtree.site.frame import FacadeFrame
 from radtree.trees.build import build_crown
-from radtree.trees.geometry import GOLDEN_ANGLE, cosine_hemisphere
+from radtree.trees.geometry import GOLDEN_ANGLE, fibonacci_cosine_directions
 from radtree.trees.homogeneous import shell_transmittance
 from radtree.trees.louvers import required_cover
 from radtree.trees.model import TreeModel
@@ -106,7 +106,7 @@ def sensor_rays(project: Project, frame: FacadeFrame, directions: int = 2048
     grid = facade_circle(project.sensors, frame)
     origins, dirs = [], []
     for i, (p, nrm) in enumerate(zip(grid.points, grid.normals)):
-        d = cosine_hemisphere(directions, nrm, rotation=GOLDEN_ANGLE * i * 7.0)
+        d = fibonacci_cosine_directions(directions, nrm, rotation=GOLDEN_ANGLE * i * 7.0)
         dirs.append(d)
         origins.append(np.repeat(p[None, :], directions, axis=0))
     return np.vstack(origins), np.vstack(dirs)

@@ -360,7 +360,7 @@ def write_step_project(project: Project, scenario: Scenario, path: Path,
     """Write the user's project file with ``scenario`` appended (or replacing one of the same
     name) to ``path``; relative data paths are rewritten for the new folder. Returns the
     scenario as loaded back from the written file (checked to equal ``scenario``)."""
-    from radtree.sweep.tomlout import dumps
+    from radtree.tomlout import dumps
 
     src = find_project_file(project.source)
     data = tomllib.loads(src.read_text(encoding="utf-8"))

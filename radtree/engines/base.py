@@ -68,6 +68,10 @@ class Engine(ABC):
     def describe(self) -> str:
         """One line for ``radtree doctor`` and reports."""
 
+    def provenance(self) -> dict[str, str | None]:
+        """What a results manifest records about this engine (``<name>_version``, …)."""
+        return {f"{self.name}_version": self.version()}
+
     def sampling(self, params: EngineParams) -> str:
         """How the engine samples, for logs and reports (e.g. ``4096 rays/sensor, seed 1``)."""
         return ""

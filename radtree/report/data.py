@@ -24,8 +24,8 @@ from radtree.measurements import (
     grid_mean,
     load_measured,
     load_measured_rows,
-    normalise_time,
 )
+from radtree.pipeline.results import read_results, results_path
 from radtree.stats import (
     FACADE_GRID,
     Comparison,
@@ -112,37 +112,6 @@ class ReportData:
 
 
 # --------------------------------------------------------------------------- reading
-
-
-def results_path(project: Project) -> Path:
-    return project.results_dir / "illuminance.csv"
-
-
-def read_results(project: Project) -> pd.DataFrame:
-    """The tidy results table; RadtreeError if ``simulate`` has not been run."""
-    path = results_path(project)
-    if not path.is_file():
-        raise RadtreeError(f"no results: run `radtree simulate {project.root}` first "
-                           f"({path} not found)")
-    try:
-        df = pd.read_csv(path, dtype={"scenario": str, "time": str, "row": str, "grid": str,
-                                      "params_hash": str, "engine": str, "model": str,
-                                      "reflection": str})
-    except (OSError, ValueError) as exc:
-        raise RadtreeError(f"{path}: cannot read the results table ({exc})") from exc
-    for col in ("scenario", "model", "time", "grid", "sensor", "lux"):
-        if col not in df.columns:
-            raise RadtreeError(f"{path}: results table lacks column '{col}'")
-    if df.empty:
-        raise RadtreeError(f"{path}: results table is empty; run `radtree simulate "
-                           f"{project.root}` first")
-    try:
-        df["time"] = [normalise_time(str(t)) for t in df["time"]]
-    except RadtreeError as exc:
-        raise RadtreeError(f"{path}: {exc}") from None
-    if "lux_stderr" not in df.columns:
-        df["lux_stderr"] = np.nan
-    return df
 
 
 def _read_json(path: Path, notes: list[str]) -> dict[str, Any] | None:

@@ -52,7 +52,7 @@ from radtree.sweep.settings import (
     load_base,
     resolve_parameters,
 )
-from radtree.sweep.tomlout import dumps
+from radtree.tomlout import dumps
 
 # fields of the project file that hold paths (resolved against the project folder)
 PATH_FIELDS = ("project.measured", "project.measured_rows", "street.ground_reflectance",

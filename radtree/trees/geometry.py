@@ -61,7 +61,7 @@ def fibonacci_hemisphere(count: int, axis: int = 1) -> np.ndarray:
     return d
 
 
-def cosine_hemisphere(count: int, normal: np.ndarray, rotation: float = 0.0) -> np.ndarray:
+def fibonacci_cosine_directions(count: int, normal: np.ndarray, rotation: float = 0.0) -> np.ndarray:
     """``count`` deterministic cosine-weighted directions about ``normal`` (Malley's method on
     a Fibonacci disk: every direction carries the same weight in an illuminance integral).
     ``rotation`` (rad) turns the pattern about the normal."""

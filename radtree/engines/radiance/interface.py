@@ -41,6 +41,11 @@ class RadianceEngine(Engine):
             return "radiance: not found"
         return f"radiance {self.version() or '(not runnable)'} ({install.origin}: {install.bin_dir})"
 
+    def provenance(self) -> dict[str, str | None]:
+        install = find_radiance()
+        return {"radiance_version": self.version(),
+                "radiance_origin": install.origin if install else None}
+
     def sampling(self, params: EngineParams) -> str:
         return f"-ad {params.ad} -lw {params.lw:g}"
 

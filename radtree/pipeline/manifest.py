@@ -34,13 +34,12 @@ def input_files(project) -> dict[str, str]:
 
 
 def manifest(project, extra: dict[str, Any] | None = None) -> dict[str, Any]:
-    from radtree.engines.radiance.binaries import find_radiance, version
+    from radtree.engines.registry import available_engines
 
-    install = find_radiance()
-    d = {
-        "radtree_version": radtree.__version__,
-        "radiance_version": version(),
-        "radiance_origin": install.origin if install else None,
+    d: dict[str, Any] = {"radtree_version": radtree.__version__}
+    for engine in available_engines():
+        d.update(engine.provenance())
+    d.update({
         "python": platform.python_version(),
         "created": datetime.now(timezone.utc).isoformat(timespec="seconds"),
         "project": project.name,
@@ -48,7 +47,7 @@ def manifest(project, extra: dict[str, Any] | None = None) -> dict[str, Any]:
         "seeds": {"engine": project.engine.seed, "louvers": project.tree.louvers.seed},
         "inputs": input_files(project),
         "params_hash": {s.name: project.params_hash(s) for s in project.scenarios},
-    }
+    })
     if extra:
         d.update(extra)
     return d
