@@ -17,7 +17,7 @@ import pandas as pd
 
 from radtree.config import Project, Scenario, effective_project
 from radtree.engines.base import Engine, GridResult
-from radtree.engines.registry import get_engine
+from radtree.engines.registry import engine_named
 from radtree.light import hour_states
 from radtree.pipeline.assemble import BuiltScene, make_scene, scene_ab
 from radtree.pipeline.results import hour_rows
@@ -34,15 +34,17 @@ class TracedHours:
     ab: int
 
 
-def _engine(engine: str | Engine) -> Engine:
-    return engine if isinstance(engine, Engine) else get_engine(engine)
+def _engine(engine: str | Engine | None) -> Engine:
+    """An engine instance, by name, or the seeded engine (common random numbers) for None."""
+    return engine if isinstance(engine, Engine) else engine_named(engine)
 
 
-def trace_hours(project: Project, sc: Scenario, engine: str | Engine = "numpy",
+def trace_hours(project: Project, sc: Scenario, engine: str | Engine | None = None,
                 hours: list[str] | None = None, grids: list[str] | None = None,
                 rays: int | None = None, seed: int | None = None, ab: int | None = None,
                 built: BuiltScene | None = None) -> TracedHours:
-    """Trace the scenario's hours (default the project's) on ``grids`` (default every grid of
+    """Trace the scenario's hours (default the project's) with ``engine`` (a name, an instance,
+    or None for the seeded engine) on ``grids`` (default every grid of
     the scene without the dense map). ``rays``/``seed`` override ``engine.rays``/``engine.seed``
     (seeded engines); ``ab`` overrides the scene's ``-ab`` rule; ``built`` reuses a scene made
     by :func:`make_scene` (its ``-ab`` is taken afresh from the switched project)."""
@@ -60,7 +62,7 @@ def trace_hours(project: Project, sc: Scenario, engine: str | Engine = "numpy",
     return TracedHours(built, states, results, use_ab)
 
 
-def trace_scenario(project: Project, sc: Scenario, engine: str | Engine = "numpy",
+def trace_scenario(project: Project, sc: Scenario, engine: str | Engine | None = None,
                    rays: int | None = None, seed: int | None = None,
                    grids: list[str] | None = None, hours: list[str] | None = None
                    ) -> pd.DataFrame:
@@ -73,7 +75,7 @@ def trace_scenario(project: Project, sc: Scenario, engine: str | Engine = "numpy
                       for st, res in zip(traced.states, traced.results)], ignore_index=True)
 
 
-def facade_total(project: Project, sc: Scenario, engine: str | Engine = "numpy",
+def facade_total(project: Project, sc: Scenario, engine: str | Engine | None = None,
                  rays: int | None = None, seed: int | None = None,
                  grid: str = "facade") -> tuple[float, float]:
     """Σ over the project's hours of the façade grid's traced mean (lux) and its Monte Carlo
