@@ -167,10 +167,7 @@ def simulate(project: str, scenarios: tuple[str, ...], engine: str, hours: tuple
     click.echo(means.round(0).to_string())
     click.echo(f"{out.computed} hours traced, {out.reused} reused, "
                f"{time.perf_counter() - t:.1f} s → {out.path}")
-    if p.office is not None:
-        from radtree.office_summary import write_summary
 
-        click.echo(f"office summary → {write_summary(p, maps=False)}")
 
 
 
