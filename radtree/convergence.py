@@ -15,7 +15,7 @@ import pandas as pd
 
 from radtree.config import Project
 from radtree.engines.radiance.engine import trace_hour
-from radtree.light import hour_states
+from radtree.light.hours import hour_states
 from radtree.scenarios import is_later_realisation, make_scene, parent_name, selected
 
 AB_LADDER = (1, 2, 3, 4, 6, 8)

@@ -29,7 +29,7 @@ import numpy as np
 import pandas as pd
 
 from radtree.config import Project, Scenario
-from radtree.light import hour_states
+from radtree.light.hours import hour_states
 from radtree.scenarios import make_scene
 
 

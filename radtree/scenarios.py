@@ -25,14 +25,14 @@ from radtree.config import Project, Scenario, effective_project
 from radtree.engines.base import RESULT_COLUMNS, GridResult
 from radtree.errors import ConfigError, RadtreeError
 from radtree.fileio import atomic_path, write_text
-from radtree.light import hour_states
+from radtree.light.ground import calculated_reflection, reflection_choice, unfiltered_ground_light
+from radtree.light.hours import hour_states
+from radtree.light.sky import SkyState
 from radtree.manifest import manifest
-from radtree.reflect import calculated_reflection, reflection_choice, unfiltered_ground_light
 from radtree.scene import Scene
 from radtree.sensor_grid import facade_circle, facade_dense_grid
 from radtree.site.frame import FacadeFrame
 from radtree.site.street import street_materials, street_meshes
-from radtree.sky import SkyState
 
 
 @dataclass

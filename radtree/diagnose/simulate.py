@@ -9,7 +9,7 @@ an effect's *signature* — carries much less noise than either run.
 Caching inside a run: the traced part is keyed by everything that changes the tracing (the
 project, model, form, sky, reflection mode and the switches other than ``reflection.*``), the
 crown geometry by what changes the scene; the analytic ground terms (``reflection = calculated``
-and the ``reflection.unfiltered`` switch, :mod:`radtree.reflect`) are added afresh each time, so
+and the ``reflection.unfiltered`` switch, :mod:`radtree.light.ground`) are added afresh each time, so
 fitting those costs no tracing. With ``engine = "radiance"`` each scenario runs through
 :func:`radtree.scenarios.simulate_project` in a work folder (``PROJECT/diagnose/work/``), whose
 resumable parts act as a cache across runs.
@@ -169,8 +169,8 @@ class Simulator:
 
     def _numpy_run(self, sc: Scenario) -> Run:
         from radtree.engines.numpy.engine import trace_hour
-        from radtree.light import hour_states
-        from radtree.reflect import calculated_reflection, unfiltered_ground_light
+        from radtree.light.ground import calculated_reflection, unfiltered_ground_light
+        from radtree.light.hours import hour_states
 
         states = hour_states(self.project, sc, list(self.hours))
         tkey = self._traced_key(sc)
