@@ -91,7 +91,9 @@ def read_epw(path: Path) -> Epw:
     try:
         data, meta = pvlib.iotools.read_epw(io.StringIO(text))
     except (ValueError, TypeError) as exc:  # malformed LOCATION line or date/hour fields
-        raise ConfigError(f"{path}: malformed EPW file: {exc}") from exc
+        first_line = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
+        raise ConfigError(f"{path}: malformed EPW file (LOCATION line or the year, month, "
+                          f"day, hour fields of a data row): {first_line}") from exc
     generated = any(line.startswith("COMMENTS") and GENERATED_TAG in line
                     for line in lines[:_HEADER_LINES])
     return Epw(path=path, latitude=meta["latitude"], longitude=meta["longitude"],
