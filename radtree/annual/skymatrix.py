@@ -31,7 +31,6 @@ from radtree.engines.radiance.binaries import run
 from radtree.errors import ConfigError, EngineError
 
 HOURS_PER_YEAR = 8760
-SUN_ANGLE_DEG = 0.533
 _TNAZ = (30, 30, 24, 24, 18, 12, 6)
 
 

@@ -13,6 +13,7 @@ import re
 from radtree.engines.radiance.binaries import RadianceInstall, run
 from radtree.light.perez import PerezSky
 from radtree.light.sky import SkyState
+from radtree.light.sun import SUN_ANGLE_DEG
 from radtree.light.units import WHITE_EFFICACY
 
 ANALYTIC_SKY_CAL = {
@@ -36,7 +37,7 @@ def sun_radiance_text(state: SkyState) -> str:
     d = state.sun.vector
     return (
         f"void light solar\n0\n0\n3 {v} {v} {v}\n\n"
-        f"solar source sun\n0\n0\n4 {d[0]:.6f} {d[1]:.6f} {d[2]:.6f} 0.533\n"
+        f"solar source sun\n0\n0\n4 {d[0]:.6f} {d[1]:.6f} {d[2]:.6f} {SUN_ANGLE_DEG:g}\n"
     )
 
 
