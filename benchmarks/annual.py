@@ -34,8 +34,9 @@ sys.path.insert(0, str(ROOT))
 from radtree.annual.report import grid_summary  # noqa: E402
 from radtree.annual.run import AnnualOptions, AnnualResult, annual_scenes, run_annual  # noqa: E402
 from radtree.config import load_project  # noqa: E402
+from radtree.light.units import PHOTOPIC_RGB, WHITE_EFFICACY  # noqa: E402
 
-LUX = 179.0 * np.array([0.265, 0.670, 0.065])
+LUX = WHITE_EFFICACY * np.array(PHOTOPIC_RGB)
 VALIDATE_HOURS = [(12, 22, 12.5), (6, 21, 12.5), (3, 20, 9.5)]
 
 
@@ -43,7 +44,7 @@ def validate(result: AnnualResult, work: Path) -> None:
     """Point-in-time rtrace against the annual values for a few hours."""
     from radtree.annual.coefficients import points_text, scene_text
     from radtree.engines.radiance.binaries import run
-    from radtree.sky import perez_sky_suffix
+    from radtree.engines.radiance.sky import perez_sky_suffix
 
     project, wea = result.project, result.wea
     from radtree.annual.run import choose_scenarios

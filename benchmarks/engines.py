@@ -128,7 +128,7 @@ def engine_hour(quick: bool) -> Scene:
           f"stderr {100 * (r.stderr / r.lux).mean():.2f} %")
     try:
         from radtree.config import load_project
-        from radtree.light import hour_states
+        from radtree.light.hours import hour_states
         from radtree.pipeline.assemble import make_scene
 
         project = load_project(ROOT / "examples" / "mendoza-street")

@@ -140,17 +140,18 @@ def test_reinhart_bins_and_centres_match_radiance():
 
 # ---------------------------------------------------------------- weather
 def test_generated_epw_is_labelled_and_complete(tmp_path):
-    from radtree.annual.weather import epw_location, is_generated, write_generated_epw
-    from radtree.weather import read_epw
+    from radtree.light.clearsky import write_generated_epw
+    from radtree.light.weather import read_epw
 
     p = write_generated_epw(tmp_path / "g.epw", "Mendoza Argentina", -32.89, -68.83, 750.0,
                             -3.0)
     lines = p.read_text().splitlines()
     assert sum(line.startswith("COMMENTS") and "GENERATED" in line for line in lines[:8]) == 2
-    assert is_generated(p) and epw_location(p) == (-32.89, -68.83, -3.0, 750.0)
+    epw = read_epw(p)
+    assert epw.generated and epw.location == (-32.89, -68.83, -3.0, 750.0)
     rows = [r.split(",") for r in lines[8:]]
     assert len(rows) == 8760 and all(len(r) == 35 for r in rows)
-    data = read_epw(p)
+    data = epw.illuminance()
     assert data[(12, 22, 3)] == (0.0, 0.0)            # night
     dni, dhi = data[(12, 22, 14)]                     # 13:00–14:00, near solar noon
     assert 90_000 < dni < 125_000 and 5_000 < dhi < 20_000
@@ -193,7 +194,7 @@ def _tiny_scene(room: bool):
 
 
 def _patch_means(sky, mf: int, n: int = 10) -> np.ndarray:
-    """Mean radiance (visible, W sr⁻¹ m⁻²) of a :class:`radtree.perez.PerezSky` over every
+    """Mean radiance (visible, W sr⁻¹ m⁻²) of a :class:`radtree.light.perez.PerezSky` over every
     Reinhart patch (row 0: the ground brightness), equal-area sub-samples."""
     from radtree.annual.skymatrix import _rnaz
 
@@ -235,8 +236,7 @@ def test_annual_matches_point_in_time_rtrace(tmp_path, room):
     from radtree.annual.run import combine
     from radtree.annual.skymatrix import epw_to_wea, sky_matrix, sun_positions
     from radtree.engines.radiance.binaries import run
-    from radtree.perez import parse_gendaylit
-    from radtree.sky import perez_sky_suffix
+    from radtree.engines.radiance.sky import parse_gendaylit, perez_sky_suffix
 
     scene = _tiny_scene(room)
     wea = epw_to_wea(OFFICE_EPW, tmp_path / "year.wea")

@@ -15,6 +15,8 @@ import pytest
 
 from radtree.config import EngineParams, load_project
 from radtree.errors import ConfigError
+from radtree.light.sky import SkyState
+from radtree.light.sun import SunPosition, local_datetime
 from radtree.office_summary import (
     area_fractions,
     grid_statistics,
@@ -27,8 +29,6 @@ from radtree.scene import Mesh, Scene, SensorGrid
 from radtree.site.frame import FacadeFrame
 from radtree.site.office import frame_width_for, office_layout, office_parts
 from radtree.site.user_geometry import load_user_meshes, triangulate_polygon
-from radtree.sky import SkyState
-from radtree.solar import SunPosition, local_datetime
 
 from .conftest import ROOT, needs_radiance
 
@@ -408,7 +408,7 @@ def test_tree_lowers_facade_illuminance_every_hour(tmp_path):
     from radtree.engines.radiance.binaries import find_radiance
     from radtree.engines.radiance.engine import run_hour
     from radtree.engines.radiance.writer import write_build
-    from radtree.light import hour_states
+    from radtree.light.hours import hour_states
     from radtree.pipeline.assemble import make_scene
 
     proj = load_project(copy_office(tmp_path / "office"))

@@ -1,4 +1,4 @@
-"""The Perez sky of radtree.perez against real gendaylit / perezlum.cal (and fixed references)."""
+"""The Perez sky of radtree.light.perez against real gendaylit / perezlum.cal (and fixed references)."""
 
 from __future__ import annotations
 
@@ -9,16 +9,15 @@ import pytest
 
 from radtree.engines.numpy.scenes import sky_state
 from radtree.engines.radiance.binaries import find_radiance, run
-from radtree.perez import (
+from radtree.engines.radiance.sky import gendaylit_command, parse_gendaylit, perez_sky_suffix
+from radtree.light.perez import (
     GENDAYLIT_ANG_DAY_NUMBER,
     PerezSky,
     eccentricity,
-    parse_gendaylit,
     perez_indices,
     perez_parameters,
     perez_sky,
 )
-from radtree.sky import gendaylit_command, perez_sky_suffix
 
 radiance = [pytest.mark.radiance,
             pytest.mark.skipif(find_radiance() is None, reason="Radiance not found")]
@@ -133,7 +132,7 @@ def test_against_gendaylit(case):
 @pytest.mark.parametrize("alt,az,dni", [(48.67, 88.96, 62000), (80.50, 5.85, 80000),
                                         (50.43, 272.24, 0.0)])
 def test_state_command_agrees(alt, az, dni):
-    """radtree.sky.gendaylit_command (what the Radiance engine runs) ↔ perez_sky(state)."""
+    """radtree.engines.radiance.sky.gendaylit_command (what the Radiance engine runs) ↔ perez_sky(state)."""
     st = sky_state("perez", altitude=alt, azimuth=az, dni=dni, dhi=12000,
                    ground_reflectance=0.28)
     ref = parse_gendaylit(run(gendaylit_command(st)).decode())

@@ -13,9 +13,9 @@ from radtree.config import EngineParams
 from radtree.engines.radiance.engine import trace_hour
 from radtree.engines.radiance.writer import mesh_to_radiance
 from radtree.errors import EngineError
+from radtree.light.sky import SkyState
+from radtree.light.sun import SunPosition, local_datetime
 from radtree.scene import Scene, SensorGrid, quad
-from radtree.sky import SkyState
-from radtree.solar import SunPosition, local_datetime
 
 from .conftest import needs_radiance
 

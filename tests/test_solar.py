@@ -2,8 +2,9 @@ import numpy as np
 import pytest
 
 from radtree.engines.radiance.binaries import run
-from radtree.sky import SkyState, gendaylit_command
-from radtree.solar import (
+from radtree.engines.radiance.sky import gendaylit_command
+from radtree.light.sky import SkyState
+from radtree.light.sun import (
     angular_separation_deg,
     compass_to_radiance_azimuth,
     direction_vector,

@@ -1,7 +1,7 @@
 """Annual climate-based daylight with deciduous street trees (``radtree annual``).
 
-* :mod:`~radtree.annual.weather` — a generated clear-sky EPW (labelled GENERATED) and which
-  EPW a project uses;
+* the weather (the EPW a run uses, the generated clear-sky year) is in :mod:`radtree.light`
+  (:mod:`~radtree.light.weather`, :mod:`~radtree.light.clearsky`);
 * :mod:`~radtree.annual.skymatrix` — ``epw2wea``, ``gendaymtx`` sky matrix and hourly suns,
   Reinhart patches;
 * :mod:`~radtree.annual.coefficients` — ``rcontrib`` daylight coefficients (sky patches,

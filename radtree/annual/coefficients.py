@@ -30,11 +30,12 @@ from pathlib import Path
 
 import numpy as np
 
-from radtree.annual.skymatrix import SUN_ANGLE_DEG, patch_count
+from radtree.annual.skymatrix import patch_count
 from radtree.engines.radiance.binaries import run
 from radtree.engines.radiance.writer import mesh_to_radiance
 from radtree.errors import EngineError
 from radtree.fileio import atomic_path, write_text
+from radtree.light.sun import SUN_ANGLE_DEG
 from radtree.optics import Hole, Plastic, with_reflectance
 from radtree.scene import Scene
 

@@ -67,14 +67,14 @@ from radtree.annual.skymatrix import (
     sun_patch_weights,
     sun_positions,
 )
-from radtree.annual.weather import WeatherSource, find_weather
 from radtree.config import Project, Scenario, effective_project
 from radtree.errors import ConfigError
 from radtree.fileio import atomic_path, write_text
+from radtree.light.units import PHOTOPIC_RGB, WHITE_EFFICACY
+from radtree.light.weather import WeatherSource, find_weather
 from radtree.scene import Scene
 
-PHOTOPIC = np.array([0.265, 0.670, 0.065])
-LUX = 179.0 * PHOTOPIC
+LUX = WHITE_EFFICACY * np.array(PHOTOPIC_RGB)  # lux per Radiance R, G, B
 VARIANTS = ("without", "leaf_on", "leaf_off")
 TREES = ("with", "without")
 ANNUAL_COLUMNS = ["grid", "sensor", "tree", "udi_below_100", "udi_100_300", "udi_300_3000",
@@ -200,9 +200,9 @@ def annual_ground_reflectance(project: Project) -> float:
     table = project.street.ground_reflectance_table
     if table is None:
         return float(project.street.ground_reflectance)
-    from radtree.light import read_table
+    from radtree.light.tables import ground_reflectance_table
 
-    df = read_table(table, ("angle_deg", "reflectance"), "ground reflectance table")
+    df = ground_reflectance_table(table)
     return float(df["reflectance"].mean())
 
 

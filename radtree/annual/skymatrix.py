@@ -23,7 +23,6 @@ from __future__ import annotations
 import math
 import re
 from dataclasses import dataclass
-from datetime import date
 from pathlib import Path
 
 import numpy as np
@@ -32,7 +31,6 @@ from radtree.engines.radiance.binaries import run
 from radtree.errors import ConfigError, EngineError
 
 HOURS_PER_YEAR = 8760
-SUN_ANGLE_DEG = 0.533
 _TNAZ = (30, 30, 24, 24, 18, 12, 6)
 
 
@@ -109,18 +107,6 @@ def epw_to_wea(epw: Path, wea: Path) -> Wea:
         raise ConfigError(f"{epw}: {w.n_hours} hourly rows, expected {HOURS_PER_YEAR} "
                           "(a full non-leap year)")
     return w
-
-
-def write_wea(path: Path, wea: Wea, rows: np.ndarray | None = None) -> Path:
-    """Write ``wea`` (optionally only ``rows``) as a WEA file (for tests and subsets)."""
-    idx = np.arange(wea.n_hours) if rows is None else np.asarray(rows)
-    lines = [f"place {wea.place}", f"latitude {wea.latitude:.6f}",
-             f"longitude {wea.longitude_west:.6f}", f"time_zone {wea.meridian_west:g}",
-             f"site_elevation {wea.elevation_m:g}", "weather_data_file_units 1"]
-    lines += [f"{wea.month[i]} {wea.day[i]} {wea.hour[i]:.3f} {wea.dni[i]:g} {wea.dhi[i]:g}"
-              for i in idx]
-    path.write_text("\n".join(lines) + "\n", encoding="utf-8")
-    return path
 
 
 # ---------------------------------------------------------------- Reinhart patches
@@ -242,17 +228,6 @@ def sun_positions(wea: Wea, workdir: Path) -> Suns:
     if len(d):
         d = d / np.linalg.norm(d, axis=1)[:, None]
     return Suns(np.array(idx, int), d, np.array(rad, float))
-
-
-def wea_label(wea: Wea, i: int) -> str:
-    """``MM-DD HH:MM`` of row i (the middle of its hour)."""
-    h = float(wea.hour[i])
-    hh, mm = int(h), int(round((h - int(h)) * 60))
-    return f"{int(wea.month[i]):02d}-{int(wea.day[i]):02d} {hh:02d}:{mm:02d}"
-
-
-def row_date(wea: Wea, i: int, year: int = 2023) -> date:
-    return date(year, int(wea.month[i]), int(wea.day[i]))
 
 
 def sun_patch_weights(directions: np.ndarray, mf: int, chunk: int = 512

@@ -294,8 +294,8 @@ class HourlyGroundReflectance(Effect):
                 and self.key not in sc.switches)
 
     def constant(self, ctx: EffectContext) -> float:
-        from radtree.light import ground_reflectance_at
-        from radtree.solar import local_datetime, sun_position
+        from radtree.light.ground import ground_reflectance_at
+        from radtree.light.sun import local_datetime, sun_position
 
         site = ctx.project.site
         values = []

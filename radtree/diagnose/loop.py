@@ -187,7 +187,7 @@ class LoopResult:
 
 def sun_positions(project: Project, sc: Scenario, hours: Iterable[str]
                   ) -> tuple[np.ndarray, np.ndarray]:
-    from radtree.light import hour_states
+    from radtree.light.hours import hour_states
 
     states = hour_states(project, sc, list(hours))
     return (np.array([s.sun.altitude_deg for s in states]),

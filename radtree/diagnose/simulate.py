@@ -9,7 +9,7 @@ an effect's *signature* — carries much less noise than either run.
 Caching inside a run: the traced part is keyed by everything that changes the tracing (the
 project, model, form, sky, reflection mode and the switches other than ``reflection.*``), the
 crown geometry by what changes the scene; the analytic ground terms (``reflection = calculated``
-and the ``reflection.unfiltered`` switch, :mod:`radtree.reflect`) are added afresh each time, so
+and the ``reflection.unfiltered`` switch, :mod:`radtree.light.ground`) are added afresh each time, so
 fitting those costs no tracing. Any registered engine may trace (default: the seeded engine,
 whose fixed seed gives common random numbers); tracing goes through
 :func:`radtree.pipeline.trace.trace_hours`, exactly as ``simulate`` traces.
@@ -30,10 +30,10 @@ from radtree.config import Project, Scenario
 from radtree.engines.base import Engine
 from radtree.engines.registry import engine_named
 from radtree.errors import RadtreeError
-from radtree.light import hour_states
+from radtree.light.ground import ground_terms
+from radtree.light.hours import hour_states
 from radtree.pipeline.assemble import make_scene
 from radtree.pipeline.trace import trace_hours
-from radtree.reflect import ground_terms
 from radtree.stats import mean_stderr
 
 #: Rays per sensor for NumPy-engine diagnosis unless given (MC SE ≈ 8 lx on Mendoza's hourly

@@ -21,8 +21,8 @@ import numpy as np
 
 if TYPE_CHECKING:
     from radtree.config import EngineParams
+    from radtree.light.sky import SkyState
     from radtree.scene import Scene
-    from radtree.sky import SkyState
 
 
 @dataclass

@@ -18,7 +18,7 @@ from typing import Any
 from radtree.config import Project, Scenario, effective_project
 from radtree.engines.registry import folder_engine
 from radtree.fileio import atomic_dir, write_text
-from radtree.light import hour_states
+from radtree.light.hours import hour_states
 from radtree.pipeline.assemble import make_scene
 from radtree.pipeline.manifest import manifest
 from radtree.pipeline.realisations import (

@@ -19,10 +19,10 @@ from radtree.config import Project, Scenario
 from radtree.engines.base import GridResult
 from radtree.errors import RadtreeError
 from radtree.fileio import atomic_path
+from radtree.light.ground import ground_terms
+from radtree.light.sky import SkyState
 from radtree.measurements import normalise_time
-from radtree.reflect import ground_terms
 from radtree.scene import Scene
-from radtree.sky import SkyState
 
 #: the written column order (extra columns follow)
 RESULT_COLUMNS = [

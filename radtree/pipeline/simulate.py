@@ -22,13 +22,13 @@ from radtree.config import Project, Scenario, effective_project
 from radtree.engines.base import Engine
 from radtree.engines.registry import get_engine
 from radtree.fileio import atomic_path, write_text
-from radtree.light import hour_states
+from radtree.light.hours import hour_states
+from radtree.light.sky import SkyState
 from radtree.pipeline.assemble import BuiltScene, make_scene
 from radtree.pipeline.build import ensure_built, hour_grids, progress_bar
 from radtree.pipeline.manifest import manifest
 from radtree.pipeline.realisations import merge_realisations, parent_name, selected
 from radtree.pipeline.results import hour_rows, in_column_order, merge_write, results_path
-from radtree.sky import SkyState
 
 
 @dataclass

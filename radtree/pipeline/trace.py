@@ -18,10 +18,10 @@ import pandas as pd
 from radtree.config import Project, Scenario, effective_project
 from radtree.engines.base import Engine, GridResult
 from radtree.engines.registry import engine_named
-from radtree.light import hour_states
+from radtree.light.hours import hour_states
+from radtree.light.sky import SkyState
 from radtree.pipeline.assemble import BuiltScene, make_scene, scene_ab
 from radtree.pipeline.results import hour_rows
-from radtree.sky import SkyState
 
 
 @dataclass

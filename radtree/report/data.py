@@ -159,7 +159,7 @@ def _unique(series: pd.Series) -> list[str]:
 
 
 def _reflection_notes(project: Project, notes: list[str]) -> dict[str, str]:
-    from radtree.reflect import reflection_notes
+    from radtree.light.ground import reflection_notes
 
     try:
         return reflection_notes(project)

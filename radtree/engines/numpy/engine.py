@@ -17,8 +17,8 @@ Light sources and physics, chosen to behave like Radiance:
   only the *specular* part of transmissive materials (``Trans``: T_s; ``Glass``: its angular
   transmission; ``Hole`` meshes are absent). Rays that happen to point at the sun see no sun
   (as Radiance's ambient rays ignore ``light`` sources), so nothing is counted twice.
-* **Sky** — rays escaping upwards see ``radtree.sky.sky_luminance`` (uniform, cosine,
-  CIE overcast) or the Perez sky of :func:`radtree.perez.perez_sky` (the same ten
+* **Sky** — rays escaping upwards see ``radtree.light.sky.sky_luminance`` (uniform, cosine,
+  CIE overcast) or the Perez sky of :func:`radtree.light.perez.perez_sky` (the same ten
   ``perezlum.cal`` parameters gendaylit prints). Rays escaping downwards see the distant ground:
   ``state.ground_luminance`` for the analytic skies and "none", and ``perezlum.cal``'s value
   below the horizon (≈ gendaylit's ground brightness) for Perez — exactly the glows the Radiance
@@ -56,10 +56,10 @@ from radtree.engines.base import GridResult
 from radtree.engines.numpy.raycast import RayCaster, embree_available, make_caster
 from radtree.engines.numpy.sampling import cosine_hemisphere, mirror, uniform_cone
 from radtree.errors import EngineError
+from radtree.light.sky import SkyState, sky_luminance
+from radtree.light.sun import SUN_HALF_ANGLE_DEG
 from radtree.optics import Glass, Hole, Plastic, Trans
 from radtree.scene import Scene, SensorGrid
-from radtree.sky import SkyState, sky_luminance
-from radtree.solar import SUN_HALF_ANGLE_DEG
 
 ENGINE_NAME = "numpy"
 GLASS_INDEX = 1.52  # Radiance's refractive index of glass
@@ -231,7 +231,7 @@ class _Environment:
         self.state = state
         self.perez = None
         if state.sky_model == "perez":
-            from radtree.perez import perez_sky
+            from radtree.light.perez import perez_sky
 
             self.perez = perez_sky(state)
         self.ground = state.ground_luminance

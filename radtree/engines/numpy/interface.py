@@ -12,8 +12,8 @@ from radtree.engines.numpy.raycast import embree_available
 
 if TYPE_CHECKING:
     from radtree.config import EngineParams
+    from radtree.light.sky import SkyState
     from radtree.scene import Scene
-    from radtree.sky import SkyState
 
 
 @dataclass

@@ -12,9 +12,9 @@ from datetime import datetime, timezone
 
 import numpy as np
 
+from radtree.light.sky import SkyState
+from radtree.light.sun import SunPosition
 from radtree.scene import Mesh
-from radtree.sky import SkyState
-from radtree.solar import SunPosition
 
 
 def sky_state(sky_model: str = "none", *, altitude: float = 60.0, azimuth: float = 0.0,

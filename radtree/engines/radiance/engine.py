@@ -17,8 +17,8 @@ from radtree.engines.base import GridResult
 from radtree.engines.radiance.binaries import require_radiance, run
 from radtree.engines.radiance.writer import BuildPlan, rgb_to_lux, write_build
 from radtree.errors import EngineError
+from radtree.light.sky import SkyState
 from radtree.scene import Scene
-from radtree.sky import SkyState
 
 ENGINE_NAME = "radiance"
 DEFAULT_AB = 2

@@ -14,8 +14,8 @@ from radtree.fileio import write_text
 
 if TYPE_CHECKING:
     from radtree.config import EngineParams
+    from radtree.light.sky import SkyState
     from radtree.scene import Scene
-    from radtree.sky import SkyState
 
 
 class RadianceEngine(Engine):

@@ -23,18 +23,12 @@ from jinja2 import Environment, PackageLoader, StrictUndefined
 import radtree
 from radtree.config import EngineParams
 from radtree.engines.radiance.binaries import RadianceInstall
+from radtree.engines.radiance.sky import ANALYTIC_SKY_CAL, sky_text
 from radtree.fileio import write_text
+from radtree.light.sky import SkyState
+from radtree.light.units import PHOTOPIC_RGB, WHITE_EFFICACY
 from radtree.optics import Hole, Plastic, with_reflectance
 from radtree.scene import Mesh, Scene
-from radtree.sky import (
-    ANALYTIC_SKY_CAL,
-    SkyState,
-    analytic_sky_text,
-    gendaylit_command,
-    ground_glow_text,
-    perez_sky_suffix,
-    sun_radiance_text,
-)
 
 
 def mesh_to_radiance(mesh: Mesh) -> str:
@@ -54,31 +48,6 @@ def rtrace_options(params: EngineParams, ab: int) -> list[str]:
         "-h", "-I", "-u-", "-ab", str(ab), "-ad", str(params.ad), "-as", str(params.as_),
         "-ar", str(params.ar), "-aa", f"{params.aa:g}", "-lw", f"{params.lw:g}",
     ]
-
-
-def sky_text(state: SkyState, install: RadianceInstall | None) -> str:
-    """The hour's light in Radiance: sun (if on), sky (if any) and distant ground glow."""
-    header = (f"# {state.time} local ({state.datetime.isoformat()}): sun altitude "
-              f"{state.sun.altitude_deg:.3f}°, azimuth {state.sun.azimuth_deg:.3f}° "
-              f"(compass; Radiance {state.sun.radiance_azimuth_deg:.3f}° west of south)\n"
-              f"# direct normal {state.direct_normal_lux:g} lx, sky model {state.sky_model}\n\n")
-    if state.sky_model == "perez":
-        from radtree.engines.radiance.binaries import run
-
-        if install is None:
-            raise RuntimeError("a Perez sky needs gendaylit (Radiance)")
-        cmd = gendaylit_command(state)
-        text = run(cmd).decode()
-        return header + f"# {' '.join(cmd)}\n" + text + "\n" + perez_sky_suffix(state.ground_glow)
-    parts = [header]
-    if state.sun_on:
-        parts.append(sun_radiance_text(state) + "\n")
-    if state.sky_model in ("uniform", "cosine", "cie_overcast"):
-        cal = "skybright.cal" if state.sky_model != "uniform" else None
-        parts.append(analytic_sky_text(state, f"skies/{state.sky_model}.cal" if cal else None))
-        parts.append("\n")
-    parts.append(ground_glow_text(state))
-    return "".join(parts)
 
 
 @dataclass
@@ -168,6 +137,7 @@ def write_makefile(plan: BuildPlan, install: RadianceInstall | None, scenario: s
         hour_grids={h: plan.grids_at(h) for h in plan.hours},
         scene_files=plan.scene_files, hour_files=plan.hour_files,
         rtrace_opts=" ".join(plan.rtrace_opts),
+        efficacy=f"{WHITE_EFFICACY:g}", weights=[f"{w:.3f}" for w in PHOTOPIC_RGB],
         bin_dir=str(install.bin_dir) if install else "/usr/local/bin",
         raypath=install.raypath if install else ".:/usr/local/lib/ray",
     )
@@ -175,6 +145,8 @@ def write_makefile(plan: BuildPlan, install: RadianceInstall | None, scenario: s
 
 
 def rgb_to_lux(rgb: np.ndarray) -> np.ndarray:
-    """Radiance RGB irradiance → lux: 179 · (0.265 R + 0.670 G + 0.065 B)."""
+    """Radiance RGB irradiance → lux: 179 · (0.265 R + 0.670 G + 0.065 B)
+    (``WHITE_EFFICACY`` and ``PHOTOPIC_RGB`` of :mod:`radtree.light.units`)."""
     rgb = np.atleast_2d(np.asarray(rgb, float))
-    return 179.0 * (0.265 * rgb[:, 0] + 0.670 * rgb[:, 1] + 0.065 * rgb[:, 2])
+    wr, wg, wb = PHOTOPIC_RGB
+    return WHITE_EFFICACY * (wr * rgb[:, 0] + wg * rgb[:, 1] + wb * rgb[:, 2])

@@ -21,26 +21,31 @@ same function from the same ten parameters, computed here in Python by the algor
    ≈ A2, which Radiance uses for the ground glow when one is attached to ``skyfunc``.
 
 gendaylit also lowers a sun higher than 87° to 87° (sun and sky). Luminances here are in cd/m²
-(gendaylit ``-O 0`` visible radiance × 179).
+(gendaylit ``-O 0`` visible radiance × ``WHITE_EFFICACY``, :mod:`radtree.light.units`); the
+gendaylit command and the parsing of its output are in :mod:`radtree.engines.radiance.sky`.
+
+:func:`perez_efficacy` is the same Perez (1990) luminous-efficacy model in a vectorised,
+non-iterated form (irradiances in, as for the generated clear-sky year of
+:mod:`radtree.light.clearsky`).
 """
 
 from __future__ import annotations
 
 import math
-import re
 from dataclasses import dataclass
 
 import numpy as np
 
-LUMINOUS_EFFICACY = 179.0  # Radiance WHTEFFICACY
+from radtree.light.sun import SUN_SOLID_ANGLE_SR
+
 SOLAR_CONSTANT_E = 1367.0  # W/m²
 SOLAR_CONSTANT_L = 127500.0  # lux
-HALF_SUN_ANGLE_DEG = 0.2665
 MAX_ALTITUDE_DEG = 87.0
 SKYCLEAR_INF, SKYCLEAR_SUP = 1.0, 12.01
 SKYBRIG_INF, SKYBRIG_SUP = 0.01, 0.6
 GENDAYLIT_ANG_DAY_NUMBER = 0  # gendaylit -ang leaves its day number at 0
 DEW_POINT_DEFAULT = 10.97353115  # gendaylit's default dew point → 2 cm precipitable water
+PRECIPITABLE_WATER_CM = 2.0  # the same 2 cm, as the vectorised efficacy takes it
 
 # Perez et al. 1993, all-weather sky luminance model: 8 clearness bins × (a, b, c, d, e) × 4.
 # Stored as float32 as in gendaylit.c.
@@ -70,7 +75,8 @@ _DEFANGLE_PHI = np.concatenate([
     np.arange(0, 360, 20), np.arange(0, 360, 30), np.arange(0, 360, 60), [0],
 ]).astype(float)
 
-# Perez 1990 luminous efficacy models: bin bounds and (a, b, c, d) per clearness bin.
+# Perez 1990 luminous efficacy models: bin bounds and (a, b, c, d) per clearness bin — the one
+# table of radtree (gendaylit's iteration below and the generated clear-sky year both use it).
 _EFFI_BOUNDS = np.array([1.0, 1.065, 1.230, 1.500, 1.950, 2.800, 4.500, 6.200])
 _DIFFUSE_EFFI = np.array([
     [97.24, -0.46, 12.00, -8.91], [107.22, 1.15, 0.59, -3.95], [104.97, 2.96, -5.53, -8.77],
@@ -279,7 +285,7 @@ def perez_parameters(dni_lux: float, dhi_lux: float, altitude_deg: float,
     integral = float((lv * np.cos(theta)).sum() * (2.0 * math.pi / 145.0))
     diffnorm = dhi_lux / integral  # cd/m² (gendaylit -O 2 units); 0 without diffuse light
 
-    sun_luminance = dni_lux / (2.0 * math.pi * (1.0 - math.cos(math.radians(HALF_SUN_ANGLE_DEG))))
+    sun_luminance = dni_lux / SUN_SOLID_ANGLE_SR
     zenith = float(_relative_luminance(c, np.array(0.0), np.array(Z))) * diffnorm
     if eps == 1.0:
         normfactor = 0.777778
@@ -299,35 +305,38 @@ def perez_parameters(dni_lux: float, dhi_lux: float, altitude_deg: float,
 
 
 def perez_sky(state) -> PerezSky:
-    """The Perez sky of a :class:`radtree.sky.SkyState` exactly as the Radiance engine writes it
-    (``radtree.sky.gendaylit_command``: ``-ang``, ``-L``, ``-g ρ``, ``-s`` without sun)."""
+    """The Perez sky of a :class:`radtree.light.sky.SkyState` exactly as the Radiance engine
+    writes it (``radtree.engines.radiance.sky.gendaylit_command``: ``-ang``, ``-L``, ``-g ρ``,
+    ``-s`` without sun)."""
     return perez_parameters(state.direct_normal_lux, state.diffuse_horizontal_lux,
                             state.sun.altitude_deg, state.sun.radiance_azimuth_deg,
                             ground_reflectance=state.ground_reflectance, sun=state.sun_on)
 
 
-_SKYFUNC = re.compile(r"brightfunc\s+skyfunc\s+2\s+skybright\s+perezlum\.cal\s+0\s+10((?:\s+\S+){10})")
-_EPS = re.compile(r"epsilon, delta.*?:\s*(\S+)\s+(\S+)")
+def perez_efficacy(dni: np.ndarray, dhi: np.ndarray, zenith_deg: np.ndarray,
+                   day_of_year: np.ndarray, water_cm: float = PRECIPITABLE_WATER_CM
+                   ) -> tuple[np.ndarray, np.ndarray]:
+    """Direct and diffuse luminous efficacy (lm/W) of Perez et al. (1990) per hour.
 
-
-def parse_gendaylit(text: str, output_units: int = 0) -> PerezSky:
-    """The :class:`PerezSky` in gendaylit's printed output (``-O 0`` values × 179 → cd/m²)."""
-    m = _SKYFUNC.search(text)
-    if m is None:
-        raise ValueError("no 'brightfunc skyfunc ... perezlum.cal' with 10 arguments in the text")
-    v = [float(x) for x in m.group(1).split()]
-    scale = LUMINOUS_EFFICACY if output_units == 0 else 1.0
-    eps = delta = float("nan")
-    me = _EPS.search(text)
-    if me:
-        eps, delta = float(me.group(1)), float(me.group(2))
-    return PerezSky(v[0] * scale, v[1] * scale, (v[2], v[3], v[4], v[5], v[6]),
-                    (v[7], v[8], v[9]), eps, delta)
-
-
-def gendaylit_sky(state) -> PerezSky:
-    """Run the real ``gendaylit`` for a sky state (needs Radiance) and parse its sky."""
-    from radtree.engines.radiance.binaries import run
-    from radtree.sky import gendaylit_command
-
-    return parse_gendaylit(run(gendaylit_command(state)).decode(), output_units=0)
+    Irradiances ``dni``, ``dhi`` in W/m², ``zenith_deg`` the sun zenith in degrees. Unlike
+    :func:`perez_indices` (gendaylit's illuminance → irradiance iteration) the indices come
+    straight from the irradiances: ε with the 1.041 Z³ term, Δ with the Kasten–Young (1989)
+    air mass and the eccentricity 1 + 0.033 cos(2π·day/365), clamped to Δ ∈ [0.01, 0.6].
+    """
+    dni = np.asarray(dni, float)
+    dhi = np.asarray(dhi, float)
+    z = np.radians(np.clip(zenith_deg, 0.0, 90.0))
+    k = 1.041 * z**3
+    with np.errstate(divide="ignore", invalid="ignore"):
+        eps = np.where(dhi > 0, ((dhi + dni) / np.where(dhi > 0, dhi, 1.0) + k) / (1.0 + k), 1.0)
+    e0 = SOLAR_CONSTANT_E * (1.0 + 0.033 * np.cos(2.0 * np.pi * np.asarray(day_of_year) / 365.0))
+    zd = np.minimum(np.degrees(z), 89.9)
+    am = 1.0 / (np.cos(np.radians(zd)) + 0.50572 * (96.07995 - zd) ** -1.6364)
+    delta = np.clip(dhi * am / e0, 0.01, 0.6)
+    b = np.clip(np.searchsorted(_EFFI_BOUNDS, np.clip(eps, 1.0, 12.0), side="right") - 1, 0, 7)
+    d = _DIFFUSE_EFFI[b]
+    eff_dif = d[:, 0] + d[:, 1] * water_cm + d[:, 2] * np.cos(z) + d[:, 3] * np.log(delta)
+    s = _DIRECT_EFFI[b]
+    eff_dir = np.maximum(s[:, 0] + s[:, 1] * water_cm + s[:, 2] * np.exp(5.73 * z - 5.0)
+                         + s[:, 3] * delta, 0.0)
+    return eff_dir, eff_dif

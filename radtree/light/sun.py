@@ -14,6 +14,7 @@ from datetime import datetime, timedelta, timezone
 import numpy as np
 
 SUN_HALF_ANGLE_DEG = 0.2665  # the sun's disc subtends 0.533°
+SUN_ANGLE_DEG = 2.0 * SUN_HALF_ANGLE_DEG  # the disc's full angle, 0.533° (a Radiance source's)
 SUN_SOLID_ANGLE_SR = 2.0 * math.pi * (1.0 - math.cos(math.radians(SUN_HALF_ANGLE_DEG)))
 
 

@@ -1,4 +1,7 @@
-"""The *calculated* ground-reflected term (scenarios A and D of the study).
+"""The street's reflectance and the *calculated* ground-reflected term (scenarios A and D).
+
+:func:`ground_reflectance_at`: the street's reflectance at a sun altitude — the project's
+constant, or its table ``angle_deg,reflectance`` interpolated linearly and clamped at the ends.
 
 The façade sensors are traced with a black ground and no ground glow; then, per vertical
 sensor, E_refl = ρ(α) · E_ground · F is added, where
@@ -22,13 +25,26 @@ from dataclasses import dataclass
 import numpy as np
 
 from radtree.config import Project, Scenario, effective_project
-from radtree.light import ground_reflectance_at
+from radtree.errors import ConfigError
+from radtree.light.sky import SkyState
+from radtree.light.tables import ground_reflectance_table
 from radtree.scene import SensorGrid
 from radtree.site.street import sky_view_factor_to_street
-from radtree.sky import SkyState
 
 GROUND_CHOICES = ("shaded", "open")
 VIEW_FACTOR_CHOICES = ("street", "unbounded")
+
+
+def ground_reflectance_at(project: Project, altitude_deg: float) -> float:
+    """The street's reflectance for a sun altitude (table: interpolate, clamp; else constant)."""
+    table = project.street.ground_reflectance_table
+    if table is None:
+        return project.street.ground_reflectance
+    df = ground_reflectance_table(table)
+    df = df.sort_values("angle_deg")
+    if (df["reflectance"] > 1).any():
+        raise ConfigError(f"ground reflectance table {table}: reflectance above 1")
+    return float(np.interp(altitude_deg, df["angle_deg"], df["reflectance"]))
 
 
 @dataclass(frozen=True)

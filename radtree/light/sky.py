@@ -1,8 +1,10 @@
-"""The light of one hour: sun (collimated source) and sky, as data and as Radiance text.
+"""The light of one hour: sun (collimated source) and sky, as data.
 
 Illuminances in lux, luminances in cd/m². Radiance radiance units are W/(sr·m²) of its
-"visible" channel: luminance = 179 × radiance. The sun is a collimated source of the sun's
-0.533° disc; its radiance is DNI / (179 · Ω_sun).
+"visible" channel: luminance = ``WHITE_EFFICACY`` × radiance (:mod:`radtree.light.units`).
+The sun is a collimated source of the sun's 0.533° disc; its radiance is
+DNI / (``WHITE_EFFICACY`` · Ω_sun). The Radiance text of these skies is written by
+:mod:`radtree.engines.radiance.sky`.
 """
 
 from __future__ import annotations
@@ -11,9 +13,9 @@ import math
 from dataclasses import dataclass
 from datetime import datetime
 
-from radtree.solar import SUN_SOLID_ANGLE_SR, SunPosition
+from radtree.light.sun import SUN_SOLID_ANGLE_SR, SunPosition
+from radtree.light.units import WHITE_EFFICACY
 
-LUMINOUS_EFFICACY_RADIANCE = 179.0  # lm/W, Radiance's white-light efficacy
 SKY_MODELS = ("none", "perez", "uniform", "cosine", "cie_overcast")
 
 
@@ -71,7 +73,7 @@ class SkyState:
     @property
     def sun_radiance(self) -> float:
         """Radiance of the sun disc, W/(sr·m²) Radiance units."""
-        return self.direct_normal_lux / LUMINOUS_EFFICACY_RADIANCE / SUN_SOLID_ANGLE_SR
+        return self.direct_normal_lux / WHITE_EFFICACY / SUN_SOLID_ANGLE_SR
 
     @property
     def direct_horizontal_lux(self) -> float:
@@ -106,7 +108,7 @@ class SkyState:
 def sky_luminance(state: SkyState, dz):
     """Luminance (cd/m²) of the analytic test skies for direction z-components ``dz`` (array).
 
-    Perez skies are evaluated by the engines from :func:`radtree.perez.perez_sky`.
+    Perez skies are evaluated by the engines from :func:`radtree.light.perez.perez_sky`.
     """
     import numpy as np
 
@@ -120,84 +122,3 @@ def sky_luminance(state: SkyState, dz):
     if state.sky_model == "cie_overcast":
         return np.where(up, L0 * (1.0 + 2.0 * np.clip(dz, 0, 1)) / 3.0, 0.0)
     return np.zeros_like(dz)
-
-
-def _glow(name: str, radiance: float, modifier: str = "void") -> str:
-    v = f"{radiance:.6g}"
-    return f"{modifier} glow {name}\n0\n0\n4 {v} {v} {v} 0\n"
-
-
-def _source(modifier: str, name: str, direction: str, angle: float) -> str:
-    return f"{modifier} source {name}\n0\n0\n4 {direction} {angle:g}\n"
-
-
-def sun_radiance_text(state: SkyState) -> str:
-    """The collimated sun as Radiance ``light`` + ``source`` (0.533° disc)."""
-    v = f"{state.sun_radiance:.6g}"
-    d = state.sun.vector
-    return (
-        f"void light solar\n0\n0\n3 {v} {v} {v}\n\n"
-        f"solar source sun\n0\n0\n4 {d[0]:.6f} {d[1]:.6f} {d[2]:.6f} 0.533\n"
-    )
-
-
-ANALYTIC_SKY_CAL = {
-    "cosine": "skybright = if(Dz, Dz, 0);\n",
-    "cie_overcast": "skybright = if(Dz, (1 + 2*Dz)/3, 0);\n",
-}
-
-
-def analytic_sky_text(state: SkyState, cal_name: str | None = None) -> str:
-    """Radiance text of the analytic test skies; ``cal_name`` is the .cal file for non-uniform ones."""
-    L = state.zenith_luminance / LUMINOUS_EFFICACY_RADIANCE
-    if state.sky_model == "uniform":
-        return _glow("sky_glow", L) + "\n" + _source("sky_glow", "sky", "0 0 1", 180)
-    if cal_name is None:
-        raise ValueError(f"the {state.sky_model} sky needs a .cal file name")
-    return (
-        f"void brightfunc skyfunc\n2 skybright {cal_name}\n0\n0\n\n"
-        + _glow("sky_glow", L, "skyfunc")
-        + "\n"
-        + _source("sky_glow", "sky", "0 0 1", 180)
-    )
-
-
-def ground_glow_text(state: SkyState) -> str:
-    """The distant ground below the horizon (glow of radiance ρ·E_h/π), or '' when off."""
-    if not state.ground_glow or state.ground_luminance <= 0:
-        return ""
-    L = state.ground_luminance / LUMINOUS_EFFICACY_RADIANCE
-    return _glow("ground_glow", L) + "\n" + _source("ground_glow", "ground", "0 0 -1", 180)
-
-
-def perez_sky_suffix(ground_glow: bool) -> str:
-    """What follows ``gendaylit``'s output: the glow sky (and ground) using its skyfunc."""
-    text = _glow("sky_glow", 1.0, "skyfunc") + "\n" + _source("sky_glow", "sky", "0 0 1", 180)
-    if ground_glow:
-        text += "\n" + _glow("ground_glow", 1.0, "skyfunc") + "\n"
-        text += _source("ground_glow", "ground", "0 0 -1", 180)
-    return text
-
-
-def gendaylit_command(state: SkyState) -> list[str]:
-    """``gendaylit`` argument list for a Perez sky of this hour (visible output, lux inputs).
-
-    The sun position is radtree's own (``-ang`` altitude and azimuth west of south); ``-s``
-    leaves the sun out when there is no direct sun, ``-g`` sets the ground reflectance.
-    """
-    cmd = [
-        "gendaylit",
-        "-ang",
-        f"{state.sun.altitude_deg:.4f}",
-        f"{state.sun.radiance_azimuth_deg:.4f}",
-        "-L",
-        f"{state.direct_normal_lux:g}",
-        f"{state.diffuse_horizontal_lux:g}",
-        "-O",
-        "0",
-        "-g",
-        f"{state.ground_reflectance:.4f}",
-    ]
-    if not state.sun_on:
-        cmd.append("-s")
-    return cmd

@@ -1,0 +1,172 @@
+"""EPW weather files: the one reader, the illuminance of the project's hours, the annual EPW.
+
+Every EPW radtree reads goes through :func:`read_epw` (``pvlib.iotools.read_epw``, columns
+named as pvlib names them: ``direct_normal_illum``, ``diffuse_horizontal_illum`` in lux, …).
+
+EPW rows are hourly, labelled by the hour *ending* (hour 11 = 10:00–11:00). A clock time
+HH:MM is read from the row whose interval contains it (HH:30 → row HH+1); HH:00 is read from
+the row ending at HH (00:00 from row 1).
+"""
+
+from __future__ import annotations
+
+import io
+import math
+from dataclasses import dataclass
+from datetime import date as _date
+from pathlib import Path
+
+import pandas as pd
+
+from radtree.errors import ConfigError
+from radtree.light.clearsky import GENERATED_TAG, write_generated_epw
+
+MISSING_ILLUMINANCE = 999900  # EPW missing-value code of the illuminance fields is 999999
+_HEADER_LINES = 8
+
+
+@dataclass(frozen=True)
+class Epw:
+    """An EPW file as read by pvlib.
+
+    ``latitude`` north positive, ``longitude`` east positive (degrees), ``utc_offset_hours``
+    the file's time zone, ``elevation_m`` metres; ``data`` pvlib's hourly frame (one row per
+    EPW data row, in file order); ``generated`` when a ``COMMENTS`` header line carries
+    :data:`~radtree.light.clearsky.GENERATED_TAG` (a radtree clear-sky year, not measured).
+    """
+
+    path: Path
+    latitude: float
+    longitude: float
+    utc_offset_hours: float
+    elevation_m: float
+    data: pd.DataFrame
+    generated: bool
+
+    def __post_init__(self) -> None:
+        if not (-90.0 <= self.latitude <= 90.0 and -180.0 <= self.longitude <= 180.0):
+            raise ConfigError(f"{self.path}: LOCATION latitude {self.latitude}, longitude "
+                              f"{self.longitude} out of range")
+
+    @property
+    def location(self) -> tuple[float, float, float, float]:
+        """(latitude, longitude east+, UTC offset h, elevation m) of the LOCATION line."""
+        return self.latitude, self.longitude, self.utc_offset_hours, self.elevation_m
+
+    def illuminance(self) -> dict[tuple[int, int, int], tuple[float, float]]:
+        """(month, day, hour-ending) → (direct normal lux, diffuse horizontal lux).
+
+        Every row must hold both values; a missing direct normal illuminance (999999) is an
+        error naming the file line.
+        """
+        cols = ["month", "day", "hour", "direct_normal_illum", "diffuse_horizontal_illum"]
+        num = self.data[cols].apply(pd.to_numeric, errors="coerce")
+        bad = num.isna().any(axis=1).to_numpy()
+        if bad.any():
+            line = int(bad.argmax()) + _HEADER_LINES + 1
+            raise ConfigError(f"{self.path}: line {line}: malformed EPW data row")
+        missing = (num["direct_normal_illum"] >= MISSING_ILLUMINANCE).to_numpy()
+        if missing.any():
+            line = int(missing.argmax()) + _HEADER_LINES + 1
+            raise ConfigError(f"{self.path}: line {line}: direct normal illuminance is "
+                              "missing (999999)")
+        return {(int(m), int(d), int(h)): (float(dni), float(dhi))
+                for m, d, h, dni, dhi in num.itertuples(index=False, name=None)}
+
+
+def read_epw(path: Path) -> Epw:
+    """Read an EPW file with ``pvlib.iotools.read_epw``; errors name the file."""
+    path = Path(path)
+    try:
+        text = path.read_text(encoding="utf-8", errors="replace")
+    except OSError as exc:
+        raise ConfigError(f"cannot read EPW file {path}: {exc}") from exc
+    lines = text.split("\n", _HEADER_LINES + 1)
+    first = lines[0].rstrip("\r")
+    if len(lines) <= _HEADER_LINES or first.split(",")[0] != "LOCATION" \
+            or len(first.split(",")) < 10:
+        raise ConfigError(f"{path} is not an EPW file (no LOCATION header line)")
+    import pvlib
+
+    try:
+        data, meta = pvlib.iotools.read_epw(io.StringIO(text))
+    except (ValueError, TypeError) as exc:  # malformed LOCATION line or date/hour fields
+        first_line = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
+        raise ConfigError(f"{path}: malformed EPW file (LOCATION line or the year, month, "
+                          f"day, hour fields of a data row): {first_line}") from exc
+    generated = any(line.startswith("COMMENTS") and GENERATED_TAG in line
+                    for line in lines[:_HEADER_LINES])
+    return Epw(path=path, latitude=meta["latitude"], longitude=meta["longitude"],
+               utc_offset_hours=meta["TZ"], elevation_m=meta["altitude"], data=data,
+               generated=generated)
+
+
+def epw_hour_illuminance(project, hours: list[str]) -> dict[str, tuple[float, float]]:
+    """(direct normal, diffuse horizontal) lux per clock time from the project's EPW file."""
+    data = read_epw(project.light.epw).illuminance()
+    d = _date.fromisoformat(project.site.date)
+    out = {}
+    for h in hours:
+        hh, mm = (int(x) for x in h.split(":"))
+        ending = hh + 1 if mm > 0 else max(hh, 1)
+        key = (d.month, d.day, ending)
+        if key not in data:
+            raise ConfigError(f"EPW file {project.light.epw} has no row for {d} hour {ending}")
+        out[h] = data[key]
+    return out
+
+
+# ---------------------------------------------------------------- the EPW of an annual run
+@dataclass(frozen=True)
+class WeatherSource:
+    """The EPW an annual run uses, and whether it was generated by radtree."""
+
+    path: Path
+    generated: bool
+    description: str
+
+
+def _close(a: float, b: float, tol: float = 0.05) -> bool:
+    return math.isclose(a, b, abs_tol=tol)
+
+
+def find_weather(project, epw: Path | None = None, echo=None) -> WeatherSource:
+    """The EPW of an annual run.
+
+    In order: ``epw`` (command line), ``[light] epw`` of the project, a generated EPW shipped
+    in ``PROJECT/data/`` (``*generated*.epw`` whose location matches the site), else a clear-sky
+    EPW generated now into ``PROJECT/results/annual/weather/``.
+    """
+    site = project.site
+    for cand, why in ((epw, "given on the command line"), (project.light.epw, "[light] epw")):
+        if cand is not None:
+            p = Path(cand)
+            if not p.exists():
+                raise ConfigError(f"EPW file not found: {p}", field="light.epw")
+            w = read_epw(p)
+            if not (_close(w.latitude, site.latitude, 0.5)
+                    and _close(w.longitude, site.longitude, 0.5)):
+                raise ConfigError(f"EPW {p} is for latitude {w.latitude}, longitude "
+                                  f"{w.longitude}, but the site is at {site.latitude}, "
+                                  f"{site.longitude}", source=str(project.source),
+                                  field="light.epw")
+            return WeatherSource(p, w.generated, f"{p.name} ({why}"
+                                 + (", GENERATED clear sky)" if w.generated else ")"))
+    data = project.root / "data"
+    for p in sorted(data.glob("*generated*.epw")) if data.is_dir() else []:
+        w = read_epw(p)
+        if _close(w.latitude, site.latitude) and _close(w.longitude, site.longitude):
+            return WeatherSource(p, w.generated,
+                                 f"{p.name} (shipped with the project; GENERATED clear sky)")
+    out = project.results_dir / "annual" / "weather" / "generated_clear_sky.epw"
+    if out.exists():
+        w = read_epw(out)
+        if (_close(w.latitude, site.latitude) and _close(w.longitude, site.longitude)
+                and _close(w.utc_offset_hours, site.utc_offset_hours)
+                and _close(w.elevation_m, site.elevation_m, 1.0)):
+            return WeatherSource(out, True, f"{out.name} (GENERATED clear sky, cached)")
+    if echo:
+        echo(f"  no EPW given: generating a clear-sky year for the site → {out}")
+    write_generated_epw(out, site.name, site.latitude, site.longitude, site.elevation_m,
+                        site.utc_offset_hours)
+    return WeatherSource(out, True, f"{out.name} (GENERATED clear sky for the site)")
