@@ -19,6 +19,7 @@ import pytest
 import tomllib
 from click.testing import CliRunner
 
+from radtree.cli.sweep import sweep_command
 from radtree.errors import ConfigError
 from radtree.sweep import (
     full_factorial,
@@ -31,7 +32,6 @@ from radtree.sweep import (
     sweep_report_section,
 )
 from radtree.sweep import run as sweep_run
-from radtree.sweep.cli import sweep_command
 from radtree.sweep.tomlout import dumps
 
 from .conftest import MENDOZA, copy_project
@@ -291,7 +291,7 @@ def test_cli(project: Path):
     bad = runner.invoke(sweep_command, [str(project), "-p", "sensors.height_m=4:6:x"])
     assert isinstance(bad.exception, ConfigError) and "whole number" in str(bad.exception)
     # registered in the radtree group, errors become one clear line and exit code 2
-    from radtree.cli import RadtreeGroup
+    from radtree.cli.errors import RadtreeGroup
 
     group = RadtreeGroup(commands={"sweep": sweep_command})
     res = runner.invoke(group, ["sweep", str(project), "-p", "tree.crown.nope=1,2"])
