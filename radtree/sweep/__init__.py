@@ -9,7 +9,7 @@
 Modules: :mod:`~radtree.sweep.design` (parameters, full factorial, Latin hypercube),
 :mod:`~radtree.sweep.settings` (the ``[sweep]`` table, field checks), :mod:`~radtree.sweep.run`
 (case folders, dask execution, resume, merged table), :mod:`~radtree.sweep.sensitivity`
-(metrics, effect ranges, tornado plot, report fragment), :mod:`~radtree.sweep.cli` (the command).
+(metrics, effect ranges, tornado plot, report fragment); the command is :mod:`radtree.cli.sweep`.
 """
 
 from __future__ import annotations
@@ -17,7 +17,7 @@ from __future__ import annotations
 import importlib
 from typing import Any
 
-# Lazy exports (PEP 562): ``import radtree.sweep.cli`` stays light for ``radtree --help``.
+# Lazy exports (PEP 562): importing radtree.sweep stays light for ``radtree --help``.
 _EXPORTS = {
     "Design": "design", "Parameter": "design", "full_factorial": "design",
     "latin_hypercube": "design", "make_design": "design", "parse_param": "design",
