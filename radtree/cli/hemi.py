@@ -9,7 +9,8 @@ import click
 from radtree.cli.errors import BAD_INPUT
 from radtree.cli.options import CONTEXT
 from radtree.errors import ConfigError
-from radtree.hemi.analyse import HemiConfig, run_batch
+from radtree.hemi.analyse import HemiConfig
+from radtree.hemi.batch import run_batch
 from radtree.hemi.classify import ThresholdSpec
 from radtree.hemi.image import CHANNELS
 from radtree.hemi.lens import Projection, get_lens, parse_polynomial
