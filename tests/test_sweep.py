@@ -31,7 +31,7 @@ from radtree.sweep import (
     sensitivity_table,
     sweep_report_section,
 )
-from radtree.sweep import run as sweep_run
+from radtree.sweep import scheduler as sweep_scheduler
 from radtree.sweep.tomlout import dumps
 
 from .conftest import MENDOZA, copy_project
@@ -246,7 +246,7 @@ def test_resume_on_existing_cluster_recomputes_only_missing(project: Path):
 
 
 def test_interrupted_sweep_resumes(project: Path, monkeypatch):
-    real = sweep_run.run_case
+    real = sweep_scheduler.run_case
     calls: list[str] = []
 
     def flaky(spec):
@@ -255,10 +255,10 @@ def test_interrupted_sweep_resumes(project: Path, monkeypatch):
         calls.append(spec.case_id)
         return real(spec)
 
-    monkeypatch.setattr(sweep_run, "run_case", flaky)
+    monkeypatch.setattr(sweep_scheduler, "run_case", flaky)
     with pytest.raises(KeyboardInterrupt):
         sweep(project, scheduler="sequential")
-    monkeypatch.setattr(sweep_run, "run_case", real)
+    monkeypatch.setattr(sweep_scheduler, "run_case", real)
     out = sweep(project, scheduler="sequential")
     assert out.reused == calls == ["c001", "c002"]
     assert out.computed == ["c003", "c004", "c005", "c006"]

@@ -7,8 +7,10 @@
     out.sensitivity  # per scenario × parameter × metric: main-effect range, Spearman ρ
 
 Modules: :mod:`~radtree.sweep.design` (parameters, full factorial, Latin hypercube),
-:mod:`~radtree.sweep.settings` (the ``[sweep]`` table, field checks), :mod:`~radtree.sweep.run`
-(case folders, dask execution, resume, merged table), :mod:`~radtree.sweep.sensitivity`
+:mod:`~radtree.sweep.settings` (the ``[sweep]`` table, field checks), :mod:`~radtree.sweep.plan`
+(the case specs), :mod:`~radtree.sweep.cases` (one case: folder, hash, the worker function),
+:mod:`~radtree.sweep.scheduler` (dask or sequential execution), :mod:`~radtree.sweep.run`
+(the whole sweep: resume, merged table, case and failure tables), :mod:`~radtree.sweep.sensitivity`
 (metrics, effect ranges, tornado plot, report fragment); the command is :mod:`radtree.cli.sweep`.
 """
 
@@ -22,9 +24,9 @@ _EXPORTS = {
     "Design": "design", "Parameter": "design", "full_factorial": "design",
     "latin_hypercube": "design", "make_design": "design", "parse_param": "design",
     "parse_spec": "design",
-    "CaseResult": "run", "CaseSpec": "run", "SweepOutcome": "run", "SweepPlan": "run",
-    "execute": "run", "merge_results": "run", "plan_sweep": "run", "run_case": "run",
-    "run_sweep": "run",
+    "CaseResult": "cases", "CaseSpec": "cases", "run_case": "cases",
+    "SweepPlan": "plan", "plan_sweep": "plan", "execute": "scheduler",
+    "SweepOutcome": "run", "merge_results": "run", "run_sweep": "run",
     "case_metrics": "sensitivity", "sensitivity_table": "sensitivity",
     "sweep_report_section": "sensitivity", "tornado_plot": "sensitivity",
     "write_sensitivity": "sensitivity",
