@@ -1,4 +1,9 @@
-"""One error type for people: every failure radtree expects ends up as a RadtreeError."""
+"""One error type for people: every failure radtree expects ends up as a RadtreeError.
+
+The command line maps them to exit codes (:mod:`radtree.cli.errors`): :class:`EngineError` → 3,
+any other :class:`RadtreeError` (:class:`ConfigError`, unreadable input files) → 2,
+:class:`Terminated` → 143, other :class:`KeyboardInterrupt` → 130, anything else (a bug) → 1.
+"""
 
 from __future__ import annotations
 
@@ -34,3 +39,15 @@ class EngineError(RadtreeError):
         if stderr.strip():
             text += f"\n  stderr: {stderr.strip()[-2000:]}"
         super().__init__(text)
+
+
+class Terminated(KeyboardInterrupt):
+    """The process received SIGTERM (raised by the command line's signal handler).
+
+    A :class:`KeyboardInterrupt` so that every cleanup written for Ctrl-C (cancel pending
+    work, remove temporary files, keep finished parts) runs for SIGTERM too.
+    """
+
+    def __init__(self, signum: int = 15):
+        self.signum = signum
+        super().__init__(f"terminated by signal {signum}")

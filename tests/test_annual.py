@@ -387,7 +387,7 @@ def test_annual_command_writes_the_interface(tiny_project):
     from click.testing import CliRunner
 
     from radtree.annual import annual_report_section
-    from radtree.annual.cli import annual_command
+    from radtree.cli.annual import annual_command
     from radtree.config import load_project
 
     res = CliRunner().invoke(annual_command, [str(tiny_project), "--leaf-on", "10-01",

@@ -11,9 +11,9 @@ import pandas as pd
 import pytest
 from click.testing import CliRunner
 
+from radtree.cli.diagnose import diagnose_command
 from radtree.config import Scenario, load_project
 from radtree.diagnose.attribution import Signature, cosine, fit_candidate
-from radtree.diagnose.cli import diagnose_command
 from radtree.diagnose.effects import (
     EFFECT_NAMES,
     EFFECTS,

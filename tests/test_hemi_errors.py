@@ -9,9 +9,9 @@ import pytest
 from click.testing import CliRunner
 from PIL import Image
 
+from radtree.cli import main
 from radtree.errors import ConfigError, RadtreeError
 from radtree.hemi import HemiConfig, analyse_image, detect_circular_mask, render_fisheye
-from radtree.hemi.cli import hemi_command
 from radtree.hemi.image import load_image
 from radtree.hemi.mask import CircularMask
 from radtree.hemi.synthetic import default_mask, save_png
@@ -35,13 +35,13 @@ def fisheye_rgb(width: int = 600, height: int = 400, seed: int = 0) -> np.ndarra
 
 
 def run_cli(*args: str):
-    return CliRunner().invoke(hemi_command, list(args))
+    return CliRunner().invoke(main, ["hemi", *args])
 
 
 def assert_one_line_error(res, *fragments: str) -> None:
-    assert res.exit_code == 1, res.output
+    assert res.exit_code == 2, res.output  # bad input
     text = res.output.strip()
-    assert text.startswith("Error: ") and "\n" not in text, text
+    assert text.startswith("error: ") and "\n" not in text, text
     for f in fragments:
         assert f in text, text
 

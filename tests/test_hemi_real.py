@@ -12,6 +12,8 @@ import pytest
 from click.testing import CliRunner
 from PIL import Image
 
+from radtree.cli import main
+from radtree.cli.hemi import hemi_command
 from radtree.hemi import (
     HemiConfig,
     HemiResult,
@@ -20,7 +22,6 @@ from radtree.hemi import (
     get_lens,
     render_fisheye,
 )
-from radtree.hemi.cli import hemi_command
 from radtree.hemi.mask import CircularMask
 
 PHOTO = Path(__file__).resolve().parents[2] / "shared/data/fisheye/chestnut_coolpix4500_fc-e8.jpg"
@@ -173,11 +174,11 @@ def test_batch_over_a_folder(tmp_path: Path) -> None:
     (photos / "notes.txt").write_text("ignored")
     out = tmp_path / "out"
     args = [str(photos), "--mask", "200,150,150", "--no-overlay", "--out", str(out)]
-    res = CliRunner().invoke(hemi_command, args)
-    assert res.exit_code == 1 and "0_broken.jpg" in res.output
+    res = CliRunner().invoke(main, ["hemi", *args])
+    assert res.exit_code == 2 and "0_broken.jpg" in res.output  # bad input
     assert not (out / "summary.csv").exists()  # failed before writing the tables
-    res = CliRunner().invoke(hemi_command, [*args, "--keep-going"])
-    assert res.exit_code == 1 and "0_broken.jpg" in res.output
+    res = CliRunner().invoke(main, ["hemi", *args, "--keep-going"])
+    assert res.exit_code == 2 and "0_broken.jpg" in res.output
     rows = read_csv(out / "summary.csv")
     assert [r["image"] for r in rows] == ["a.png", "b.PNG"]
     for row, theta0 in zip(rows, (30.0, 50.0)):

@@ -84,6 +84,6 @@ def test_write_scan_and_report_section(scan, tmp_path):
 def test_cli_bad_values_and_unknown_scenario(tmp_path):
     p = copy_project(tmp_path / "proj", hours=["10:30"])
     r = CliRunner().invoke(main, ["permeability", str(p), "--values", "a:b"])
-    assert r.exit_code != 0 and "expected low:high:n" in r.output
+    assert r.exit_code == 2 and "expected low:high:n" in r.output
     r = CliRunner().invoke(main, ["permeability", str(p), "-s", "Z", "--values", "0.5"])
-    assert r.exit_code != 0 and "no scenario 'Z'" in r.output
+    assert r.exit_code == 2 and "no scenario 'Z'" in r.output

@@ -19,12 +19,13 @@ import pandas as pd
 import pytest
 from click.testing import CliRunner
 
+from radtree.cli import main
+from radtree.cli.report import report_command
 from radtree.config import Project, load_project
 from radtree.errors import RadtreeError
 from radtree.measurements import load_measured
 from radtree.report import build_report
 from radtree.report.build import STATISTICS_CONTRACT
-from radtree.report.cli import report_command
 from radtree.report.data import facade_coordinates
 from radtree.sensor_grid import facade_circle, facade_dense_grid
 from radtree.site.frame import FacadeFrame
@@ -411,7 +412,7 @@ def test_cli_report_replaces_the_folder_whole(project: Project):
 
 def test_cli_report_without_results(tmp_path: Path):
     p = make_project(tmp_path / "proj")
-    r = CliRunner().invoke(report_command, [str(p)])
+    r = CliRunner().invoke(main, ["report", str(p)])
     assert r.exit_code == 2
     assert "no results: run `radtree simulate" in r.output
 

@@ -19,6 +19,7 @@ import pytest
 import tomllib
 from click.testing import CliRunner
 
+from radtree.cli.sweep import sweep_command
 from radtree.errors import ConfigError
 from radtree.sweep import (
     full_factorial,
@@ -30,8 +31,7 @@ from radtree.sweep import (
     sensitivity_table,
     sweep_report_section,
 )
-from radtree.sweep import run as sweep_run
-from radtree.sweep.cli import sweep_command
+from radtree.sweep import scheduler as sweep_scheduler
 from radtree.tomlout import dumps
 
 from .conftest import MENDOZA, copy_project
@@ -246,7 +246,7 @@ def test_resume_on_existing_cluster_recomputes_only_missing(project: Path):
 
 
 def test_interrupted_sweep_resumes(project: Path, monkeypatch):
-    real = sweep_run.run_case
+    real = sweep_scheduler.run_case
     calls: list[str] = []
 
     def flaky(spec):
@@ -255,10 +255,10 @@ def test_interrupted_sweep_resumes(project: Path, monkeypatch):
         calls.append(spec.case_id)
         return real(spec)
 
-    monkeypatch.setattr(sweep_run, "run_case", flaky)
+    monkeypatch.setattr(sweep_scheduler, "run_case", flaky)
     with pytest.raises(KeyboardInterrupt):
         sweep(project, scheduler="sequential")
-    monkeypatch.setattr(sweep_run, "run_case", real)
+    monkeypatch.setattr(sweep_scheduler, "run_case", real)
     out = sweep(project, scheduler="sequential")
     assert out.reused == calls == ["c001", "c002"]
     assert out.computed == ["c003", "c004", "c005", "c006"]
@@ -291,7 +291,7 @@ def test_cli(project: Path):
     bad = runner.invoke(sweep_command, [str(project), "-p", "sensors.height_m=4:6:x"])
     assert isinstance(bad.exception, ConfigError) and "whole number" in str(bad.exception)
     # registered in the radtree group, errors become one clear line and exit code 2
-    from radtree.cli import RadtreeGroup
+    from radtree.cli.errors import RadtreeGroup
 
     group = RadtreeGroup(commands={"sweep": sweep_command})
     res = runner.invoke(group, ["sweep", str(project), "-p", "tree.crown.nope=1,2"])

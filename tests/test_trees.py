@@ -15,7 +15,8 @@ from radtree.site.frame import FacadeFrame
 from radtree.site.street import street_materials, street_meshes
 from radtree.trees.build import TreeModel, apply_switches, build_crown, build_tree
 from radtree.trees.envelope import CLIP_MARGIN_M, crown_row_spec
-from radtree.trees.louvers import dome_layer_radii, dome_slat_bound, free_slat_bound
+from radtree.trees.louvers_dome import dome_layer_radii, dome_slat_bound
+from radtree.trees.louvers_free import free_slat_bound
 from radtree.trees.picture import render_model_png
 
 MODELS = ("homogeneous", "perforated", "louvers")

@@ -9,11 +9,12 @@ import pytest
 from click.testing import CliRunner
 
 from radtree.calibrate.direct import calibrate, calibrated_path, sensor_permeability
+from radtree.cli import main
+from radtree.cli.calibrate import calibrate_command
 from radtree.config import load_project
 from radtree.errors import RadtreeError
 from radtree.site.frame import FacadeFrame
 from radtree.trees.build import build_crown
-from radtree.trees.cli import calibrate_command
 
 ROOT = Path(__file__).resolve().parents[1]
 EXAMPLE = ROOT / "examples" / "mendoza-street"
@@ -56,16 +57,16 @@ def test_calibrate_command_other_target(example):
 
 
 def test_calibrate_unreachable_target_fails_clearly(example):
-    result = CliRunner().invoke(calibrate_command, [str(example), "--form", "free", "--write",
-                                                    "--directions", "256"])
-    assert result.exit_code != 0
+    result = CliRunner().invoke(main, ["calibrate", str(example), "--form", "free", "--write",
+                                       "--directions", "256"])
+    assert result.exit_code == 2, result.output
     assert "NOT reached" in result.output and "nothing written" in result.output
     assert not (example / "radtree.calibrated.toml").exists()
 
 
 def test_calibrate_errors(example):
-    result = CliRunner().invoke(calibrate_command, [str(example), "--photo-openness"])
-    assert result.exit_code != 0 and "tree.perforated.photo" in result.output
+    result = CliRunner().invoke(main, ["calibrate", str(example), "--photo-openness"])
+    assert result.exit_code == 2 and "tree.perforated.photo" in result.output
     proj = load_project(example)
     with pytest.raises(RadtreeError):
         calibrate(proj, target=1.5)

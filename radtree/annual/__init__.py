@@ -10,8 +10,9 @@
 * :mod:`~radtree.annual.branches` — the leaf-off crown (opaque branches at 40°);
 * :mod:`~radtree.annual.metrics` — UDI, DA, sDA, ASE;
 * :mod:`~radtree.annual.run` — the run (:func:`run_annual`) and its tables;
-* :mod:`~radtree.annual.report` — figures and :func:`annual_report_section`;
-* :mod:`~radtree.annual.cli` — ``annual_command``.
+* :mod:`~radtree.annual.report` — figures and :func:`annual_report_section`.
+
+The command is :mod:`radtree.cli.annual`.
 """
 
 from __future__ import annotations

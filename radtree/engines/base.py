@@ -68,6 +68,10 @@ class Engine(ABC):
     def describe(self) -> str:
         """One line for ``radtree doctor`` and reports."""
 
+    def details(self) -> list[str]:
+        """Further lines for ``radtree doctor`` (paths, search paths)."""
+        return []
+
     def provenance(self) -> dict[str, str | None]:
         """What a results manifest records about this engine (``<name>_version``, …)."""
         return {f"{self.name}_version": self.version()}

@@ -25,7 +25,8 @@ import os
 import numpy as np
 from numpy.typing import NDArray
 
-from .analyse import HemiConfig, HemiResult, analyse_array, analyse_image, run_batch
+from .analyse import HemiConfig, HemiResult, analyse_array, analyse_image
+from .batch import run_batch
 from .classify import Classification, ThresholdSpec, classify
 from .directions import horizontal_to_world, photo_to_world, up_to_world, world_to_horizontal
 from .geometry import FisheyeGeometry, PixelField

@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
+from pathlib import Path
 from typing import Any
 
 MISSING = "—"
@@ -121,3 +122,20 @@ def text(value: Any) -> str:
     if is_missing(value) or str(value) == "":
         return MISSING
     return str(value)
+
+
+def headline_table(path: str | Path) -> str:
+    """The headline statistics of ``report/statistics.csv`` as aligned text (the CLI's summary)."""
+    import pandas as pd
+
+    stats = pd.read_csv(path, dtype={"scenario": str})
+    if stats.empty:
+        return "no measurements: no statistics (simulated values only)"
+    cols = {"scenario": "scenario", "model": "model", "reflection": "reflection",
+            "rmse": "nRMSE", "rmse_low": "low", "rmse_high": "high", "mbe": "nMBE", "r": "r",
+            "r2": "R²", "n_hours": "n"}
+    table = stats[list(cols)].rename(columns=cols)
+    table["reflection"] = table["reflection"].fillna("")
+    body = table.to_string(index=False, float_format=lambda v: f"{v:.3f}")
+    return (body + "\nnRMSE, nMBE: normalised by the mean measured value (nMBE > 0: "
+            "under-prediction); low–high: 95 % bootstrap interval on nRMSE")

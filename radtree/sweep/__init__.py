@@ -7,9 +7,11 @@
     out.sensitivity  # per scenario × parameter × metric: main-effect range, Spearman ρ
 
 Modules: :mod:`~radtree.sweep.design` (parameters, full factorial, Latin hypercube),
-:mod:`~radtree.sweep.settings` (the ``[sweep]`` table, field checks), :mod:`~radtree.sweep.run`
-(case folders, dask execution, resume, merged table), :mod:`~radtree.sweep.sensitivity`
-(metrics, effect ranges, tornado plot, report fragment), :mod:`~radtree.sweep.cli` (the command).
+:mod:`~radtree.sweep.settings` (the ``[sweep]`` table, field checks), :mod:`~radtree.sweep.plan`
+(the case specs), :mod:`~radtree.sweep.cases` (one case: folder, hash, the worker function),
+:mod:`~radtree.sweep.scheduler` (dask or sequential execution), :mod:`~radtree.sweep.run`
+(the whole sweep: resume, merged table, case and failure tables), :mod:`~radtree.sweep.sensitivity`
+(metrics, effect ranges, tornado plot, report fragment); the command is :mod:`radtree.cli.sweep`.
 """
 
 from __future__ import annotations
@@ -17,14 +19,14 @@ from __future__ import annotations
 import importlib
 from typing import Any
 
-# Lazy exports (PEP 562): ``import radtree.sweep.cli`` stays light for ``radtree --help``.
+# Lazy exports (PEP 562): importing radtree.sweep stays light for ``radtree --help``.
 _EXPORTS = {
     "Design": "design", "Parameter": "design", "full_factorial": "design",
     "latin_hypercube": "design", "make_design": "design", "parse_param": "design",
     "parse_spec": "design",
-    "CaseResult": "run", "CaseSpec": "run", "SweepOutcome": "run", "SweepPlan": "run",
-    "execute": "run", "merge_results": "run", "plan_sweep": "run", "run_case": "run",
-    "run_sweep": "run",
+    "CaseResult": "cases", "CaseSpec": "cases", "run_case": "cases",
+    "SweepPlan": "plan", "plan_sweep": "plan", "execute": "scheduler",
+    "SweepOutcome": "run", "merge_results": "run", "run_sweep": "run",
     "case_metrics": "sensitivity", "sensitivity_table": "sensitivity",
     "sweep_report_section": "sensitivity", "tornado_plot": "sensitivity",
     "write_sensitivity": "sensitivity",

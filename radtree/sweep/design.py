@@ -16,7 +16,7 @@ from __future__ import annotations
 import itertools
 import math
 import re
-from collections.abc import Sequence
+from collections.abc import Iterable, Sequence
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -50,6 +50,24 @@ def parse_scalar(text: str) -> Value:
     if isinstance(v, bool | int | float | str):
         return v
     return t  # dates, arrays, tables: keep the text
+
+
+def parse_set(values: Iterable[str]) -> dict[str, object]:
+    """``--set FIELD=VALUE`` options → {field: value}: a TOML list, else :func:`parse_scalar`."""
+    out: dict[str, object] = {}
+    for text in values:
+        if "=" not in text:
+            raise ConfigError(f"--set {text!r}: expected FIELD=VALUE, e.g. sensors.dense_grid=false")
+        key, value = text.split("=", 1)
+        v = value.strip()
+        if v.startswith("["):
+            try:
+                out[key.strip()] = tomllib.loads(f"v = {v}")["v"]
+            except tomllib.TOMLDecodeError as exc:
+                raise ConfigError(f"--set {text!r}: not a TOML list ({exc})") from None
+        else:
+            out[key.strip()] = parse_scalar(v)
+    return out
 
 
 @dataclass(frozen=True)

@@ -3,7 +3,7 @@
 Entry point: :func:`radtree.trees.build.build_tree` (``build_tree(project, scenario, frame)``
 → :class:`TreeModel`). Also: :func:`radtree.trees.build.build_crown` (a model/form without a
 scenario), :func:`radtree.calibrate.direct.calibrate` (the ``radtree calibrate`` command lives in
-:mod:`radtree.trees.cli`), :func:`radtree.trees.picture.render_model_png`, and
+:mod:`radtree.cli.calibrate`), :func:`radtree.trees.picture.render_model_png`, and
 :class:`radtree.trees.raycast.DirectTracer` (straight-ray direct transmission).
 """
 

@@ -34,17 +34,6 @@ def triangle_solid_angles(triangles: np.ndarray, point: np.ndarray) -> np.ndarra
     return 2.0 * np.arctan2(num, den)
 
 
-def rect_solid_angle(x1: np.ndarray, x2: np.ndarray, y1: np.ndarray, y2: np.ndarray
-                     ) -> np.ndarray:
-    """Solid angle of the rectangle [x1, x2] × [y1, y2] on a plane at unit distance from the
-    eye, the foot of the perpendicular at (0, 0) (closed form, exact)."""
-
-    def f(x: np.ndarray, y: np.ndarray) -> np.ndarray:
-        return np.arctan(x * y / np.sqrt(1.0 + x * x + y * y))
-
-    return f(x2, y2) - f(x1, y2) - f(x2, y1) + f(x1, y1)
-
-
 def fibonacci_hemisphere(count: int, axis: int = 1) -> np.ndarray:
     """``count`` near-uniform unit directions over the hemisphere whose pole is local axis
     ``axis`` (default 1 = n: the half-space in front of the façade). Equal-area spiral: the

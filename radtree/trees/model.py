@@ -14,6 +14,7 @@ LEAF = "leaf"
 SHELL = "crown_shell"
 TRUNK = "trunk"
 BARK_REFLECTANCE = 0.2
+MAX_SLATS = 200_000  # most slats a louvers crown may have (dome: up to 1.5 × this bound)
 
 
 @dataclass

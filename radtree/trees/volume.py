@@ -17,8 +17,8 @@ the vertical at a uniformly random azimuth. The density is
 (``crossings`` = ``louvers.crossings``, or ``layers`` when it is 0), so that a vertical line
 through the crown centre crosses ``crossings · cover_fraction`` slats on average. Each crown
 gets round(ρ · V_spheroid) slats; slats are then treated exactly like the layered free crowns'
-(:func:`radtree.trees.louvers.touches_share`, :func:`~radtree.trees.louvers.cut_to_share`,
-:func:`~radtree.trees.louvers.trunk_clash`): dropped where they would cut the trunk or lie
+(:func:`radtree.trees.crown_clip.touches_share`, :func:`~radtree.trees.crown_clip.cut_to_share`,
+:func:`~radtree.trees.crown_clip.trunk_clash`): dropped where they would cut the trunk or lie
 wholly outside the crown's share of the row, cut at the wall-side clip plane and at the planes
 shared with neighbour crowns. A slat's centre lies in its spheroid; its corners may stand out
 by up to s/√2 (the envelope is the centres').
@@ -56,8 +56,8 @@ import numpy as np
 
 from radtree.config import Louvers
 from radtree.errors import ConfigError
+from radtree.trees.crown_clip import cut_to_share, touches_share, trunk_clash
 from radtree.trees.envelope import CrownRowSpec
-from radtree.trees.louvers import cut_to_share, touches_share, trunk_clash
 
 MAX_VOLUME_SLATS = 200_000
 DRAW_BLOCK = 1024  # slats drawn per block (nested realisations, see _draw_nested)

@@ -43,7 +43,7 @@ class NumpyEngine(Engine):
         return f"numpy {numpy.__version__}" + (", embree" if embree_available() else "")
 
     def describe(self) -> str:
-        return describe()
+        return f"available ({describe()})"
 
     def sampling(self, params: EngineParams) -> str:
         return f"{params.rays} rays/sensor, seed {params.seed}"

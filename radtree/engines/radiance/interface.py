@@ -38,8 +38,12 @@ class RadianceEngine(Engine):
     def describe(self) -> str:
         install = find_radiance()
         if install is None:
-            return "radiance: not found"
-        return f"radiance {self.version() or '(not runnable)'} ({install.origin}: {install.bin_dir})"
+            return "not found"
+        return f"{self.version() or 'Radiance'} ({install.origin}: {install.bin_dir})"
+
+    def details(self) -> list[str]:
+        install = find_radiance()
+        return [f"RAYPATH: {install.raypath}"] if install is not None else []
 
     def provenance(self) -> dict[str, str | None]:
         install = find_radiance()

@@ -4,17 +4,18 @@
     radtree diagnose PROJECT --selftest [--effects a,b,c] [--noise 0.03]
     radtree diagnose --list-effects [PROJECT [--scenario B]]
 
-Expected failures raise :class:`radtree.errors.RadtreeError` (the main CLI prints one line and
-exits 2); the self-test exits 1 when a distinguishable hidden effect was misnamed.
+Expected failures raise :class:`radtree.errors.RadtreeError` (the one handler of
+:mod:`radtree.cli.errors` prints one line and exits 2, or 3 for an engine failure); the
+self-test exits 1 when a distinguishable hidden effect was misnamed.
 """
 
 from __future__ import annotations
 
 import click
 
+from radtree.cli.errors import CHECK_FAILED
+from radtree.cli.options import CONTEXT
 from radtree.engines.registry import ENGINES
-
-CONTEXT = {"help_option_names": ["-h", "--help"], "max_content_width": 100}
 
 
 @click.command("diagnose", context_settings=CONTEXT)
@@ -55,7 +56,7 @@ def diagnose_command(project: str | None, measured: str | None, units: str | Non
     selftest.csv and selftest.html.
     """
     from radtree.diagnose.effects import EffectContext, catalogue_lines, parse_effects
-    from radtree.errors import RadtreeError
+    from radtree.errors import ConfigError
 
     if list_effects:
         ctx, sc = None, None
@@ -73,7 +74,7 @@ def diagnose_command(project: str | None, measured: str | None, units: str | Non
     chosen = parse_effects(effects)
     if selftest:
         if measured is not None:
-            raise RadtreeError("--measured does not go with --selftest (the self-test makes "
+            raise ConfigError("--measured does not go with --selftest (the self-test makes "
                                "its own synthetic measurements)")
         from radtree.diagnose.hidden import selftest as run_selftest
 
@@ -93,7 +94,7 @@ def diagnose_command(project: str | None, measured: str | None, units: str | Non
         click.secho("self-test FAILED: misnamed distinguishable effect(s): "
                     + ", ".join(f"{c.effect} → {c.named}" for c in res.misnamed), fg="red",
                     err=True)
-        raise SystemExit(1)
+        raise SystemExit(CHECK_FAILED)
     from radtree.diagnose.run import diagnose, format_steps
 
     res_d = diagnose(project, measured, units, scenario, engine, rays, seed, margin, max_steps,

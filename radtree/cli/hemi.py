@@ -6,14 +6,16 @@ from pathlib import Path
 
 import click
 
-from radtree.errors import RadtreeError
-
-from .analyse import HemiConfig, run_batch
-from .classify import ThresholdSpec
-from .image import CHANNELS
-from .lens import Projection, get_lens, parse_polynomial
-from .mask import CAMERA_PRESETS, parse_mask
-from .metrics import DEFAULT_GAP_FLOOR, RingGrid
+from radtree.cli.errors import BAD_INPUT
+from radtree.cli.options import CONTEXT
+from radtree.errors import ConfigError
+from radtree.hemi.analyse import HemiConfig
+from radtree.hemi.batch import run_batch
+from radtree.hemi.classify import ThresholdSpec
+from radtree.hemi.image import CHANNELS
+from radtree.hemi.lens import Projection, get_lens, parse_polynomial
+from radtree.hemi.mask import CAMERA_PRESETS, parse_mask
+from radtree.hemi.metrics import DEFAULT_GAP_FLOOR, RingGrid
 
 HELP = f"""Analyse a fisheye photo, or every JPEG/PNG/TIFF in a folder.
 
@@ -105,18 +107,15 @@ def _hemi(
     mirror: bool | None, axis: str, gap_floor: float, outline_tolerance: float,
     min_gap_area: float, no_overlay: bool, keep_going: bool,
 ) -> None:
-    try:
-        config = _config(
-            preset, lens_name, polynomial, mask_text, full_frame, channel, gamma, threshold,
-            rings, segments, zenith_text, north, mirror, axis, gap_floor, outline_tolerance,
-            min_gap_area,
-        )
-        report = run_batch(
-            source, out_dir, config, overlay=not no_overlay, keep_going=keep_going,
-            on_error=lambda f, msg: click.echo(f"skipped {msg}", err=True),
-        )
-    except RadtreeError as exc:
-        raise click.ClickException(" ".join(str(exc).split())) from exc
+    config = _config(
+        preset, lens_name, polynomial, mask_text, full_frame, channel, gamma, threshold,
+        rings, segments, zenith_text, north, mirror, axis, gap_floor, outline_tolerance,
+        min_gap_area,
+    )
+    report = run_batch(
+        source, out_dir, config, overlay=not no_overlay, keep_going=keep_going,
+        on_error=lambda f, msg: click.echo(f"skipped {msg}", err=True),
+    )
     for row in report.rows:
         click.echo(
             f"{row['image']}: threshold {row['threshold']:.1f}  gap {row['gap_fraction']:.4f}  "
@@ -126,7 +125,7 @@ def _hemi(
     click.echo(f"wrote {len(report.written)} files to {out_dir}")
     if report.failures:
         click.echo(f"{len(report.failures)} image(s) skipped", err=True)
-        raise click.exceptions.Exit(1)
+        raise click.exceptions.Exit(BAD_INPUT)
 
 
 def _config(
@@ -140,7 +139,7 @@ def _config(
     try:
         start, end = (float(v) for v in zenith_text.split(","))
     except ValueError:
-        raise RadtreeError(
+        raise ConfigError(
             f"cannot read --zenith '{zenith_text}': expected START,END in degrees, e.g. 0,75"
         ) from None
     return HemiConfig(
@@ -152,4 +151,4 @@ def _config(
     )
 
 
-hemi_command = click.command("hemi", help=HELP)(_hemi)
+hemi_command = click.command("hemi", help=HELP, context_settings=CONTEXT)(_hemi)

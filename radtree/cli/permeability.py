@@ -7,8 +7,8 @@ from pathlib import Path
 
 import click
 
+from radtree.cli.options import CONTEXT
 from radtree.config import load_project
-from radtree.errors import RadtreeError
 
 
 def _values(text: str) -> list[float]:
@@ -26,7 +26,7 @@ def _values(text: str) -> list[float]:
         raise click.BadParameter(f"{text!r}: expected low:high:n or v1,v2,...") from None
 
 
-@click.command("permeability")
+@click.command("permeability", context_settings=CONTEXT)
 @click.argument("project", type=click.Path(exists=True, path_type=Path))
 @click.option("-s", "--scenario", default="A", show_default=True,
               help="Scenario whose fit is reported (its crown model is scanned).")
@@ -51,13 +51,10 @@ def permeability_command(project: Path, scenario: str, field: str, values_text: 
     """
     from radtree.permeability_scan import scan_permeability, write_scan
 
-    try:
-        proj = load_project(project)
-        scan = scan_permeability(proj, scenario, field, _values(values_text), rays,
-                                 echo=click.echo)
-        csv, png = write_scan(scan, proj.results_dir)
-    except RadtreeError as exc:
-        raise click.ClickException(str(exc)) from exc
+    values = _values(values_text)
+    proj = load_project(project)
+    scan = scan_permeability(proj, scenario, field, values, rays, echo=click.echo)
+    csv, png = write_scan(scan, proj.results_dir)
     for line in scan.summary():
         click.echo(line)
     click.echo(f"Wrote {csv} and {png}")

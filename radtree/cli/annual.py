@@ -12,10 +12,10 @@ from radtree.annual.schedule import (
     LeafSchedule,
     parse_occupancy,
 )
+from radtree.cli.options import CONTEXT
 
 
-@click.command("annual", context_settings={"help_option_names": ["-h", "--help"],
-                                           "max_content_width": 100})
+@click.command("annual", context_settings=CONTEXT)
 @click.argument("project", type=click.Path(exists=True, path_type=Path))
 @click.option("--leaf-on", default=DEFAULT_LEAF_ON, show_default=True, metavar="MM-DD",
               help="First day the crown is in leaf (Morus alba in Mendoza: an assumption).")

@@ -1,4 +1,4 @@
-"""``radtree sweep``: the command (registered by ``radtree.cli``)."""
+"""``radtree sweep PROJECT``: run the project once per case and rank the parameters."""
 
 from __future__ import annotations
 
@@ -6,31 +6,8 @@ import time
 
 import click
 
+from radtree.cli.options import CONTEXT
 from radtree.engines.registry import ENGINE_CHOICES
-from radtree.errors import ConfigError
-
-CONTEXT = {"help_option_names": ["-h", "--help"], "max_content_width": 100}
-
-
-def _fixed(values: tuple[str, ...]) -> dict[str, object]:
-    from radtree.sweep.design import parse_scalar
-
-    out: dict[str, object] = {}
-    for text in values:
-        if "=" not in text:
-            raise ConfigError(f"--set {text!r}: expected FIELD=VALUE, e.g. sensors.dense_grid=false")
-        key, value = text.split("=", 1)
-        v = value.strip()
-        if v.startswith("["):
-            import tomllib
-
-            try:
-                out[key.strip()] = tomllib.loads(f"v = {v}")["v"]
-            except tomllib.TOMLDecodeError as exc:
-                raise ConfigError(f"--set {text!r}: not a TOML list ({exc})") from None
-        else:
-            out[key.strip()] = parse_scalar(v)
-    return out
 
 
 @click.command("sweep", context_settings=CONTEXT)
@@ -77,13 +54,14 @@ def sweep_command(project: str, params: tuple[str, ...], design: str | None,
     case), sensitivity.csv and tornado.png. Settings may also live in a [sweep] table of the
     project file (command-line options win).
     """
+    from radtree.sweep.design import parse_set
     from radtree.sweep.run import run_sweep
 
     t = time.perf_counter()
     outcome = run_sweep(project, list(params) or None, design=design, samples=samples,
                         seed=seed, scenarios=list(scenarios) or None,
                         hours=list(hours) or None, engine=engine, scheduler=scheduler,
-                        workers=workers, out=out, fixed=_fixed(fixed),
+                        workers=workers, out=out, fixed=parse_set(fixed),
                         progress=not no_progress, echo=click.echo)
     o = outcome.out_dir
     click.echo(f"{len(outcome.computed)} cases run, {len(outcome.reused)} reused, "

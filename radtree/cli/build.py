@@ -1,0 +1,32 @@
+"""``radtree build PROJECT``: write the Radiance build folders."""
+
+from __future__ import annotations
+
+import time
+
+import click
+
+from radtree.cli.options import CONTEXT, scenarios_option
+
+
+@click.command("build", context_settings=CONTEXT)
+@click.argument("project", type=click.Path())
+@scenarios_option
+@click.option("--no-pictures", is_flag=True, help="Skip the PNG picture of each crown model.")
+def build_command(project: str, scenarios: tuple[str, ...], no_pictures: bool) -> None:
+    """Write the Radiance build folder of PROJECT.
+
+    \b
+    PROJECT/build/<scenario>/
+      materials.rad  geometry/*.rad  grids/*.pts  skies/<HHMM>.sky  Makefile  manifest.json
+    Each Makefile has one target per hour and runs without Python:
+      make -j2 -C PROJECT/build/A
+    """
+    from radtree.config import load_project
+    from radtree.pipeline.build import build_project
+
+    t = time.perf_counter()
+    p = load_project(project)
+    click.echo(f"building {p.name} ({len(p.scenarios)} scenarios, {len(p.site.hours)} hours)")
+    build_project(p, list(scenarios) or None, echo=click.echo, pictures=not no_pictures)
+    click.echo(f"build written to {p.build_dir} in {time.perf_counter() - t:.1f} s")

@@ -1,0 +1,61 @@
+"""``radtree simulate PROJECT``: trace every scenario × hour (resumable)."""
+
+from __future__ import annotations
+
+import time
+
+import click
+
+from radtree.cli.options import CONTEXT, scenarios_option
+from radtree.engines.registry import ENGINE_CHOICES
+
+
+@click.command("simulate", context_settings=CONTEXT)
+@click.argument("project", type=click.Path())
+@scenarios_option
+@click.option("--engine", type=click.Choice(ENGINE_CHOICES), default="auto",
+              show_default=True, help="auto = Radiance when found, else the NumPy engine.")
+@click.option("--hour", "hours", multiple=True, help="Only this hour HH:MM (repeatable).")
+@click.option("--workers", type=int, default=None, help="Parallel hours (default: engine.workers).")
+@click.option("--dry-run", is_flag=True, help="Print the commands, run nothing.")
+@click.option("--fresh", is_flag=True, help="Recompute every hour (ignore finished parts).")
+@click.option("--convergence", is_flag=True,
+              help="Run the façade sensors over increasing -ab/-ad and print the change per step.")
+def simulate_command(project: str, scenarios: tuple[str, ...], engine: str,
+                     hours: tuple[str, ...], workers: int | None, dry_run: bool, fresh: bool,
+                     convergence: bool) -> None:
+    """Trace every scenario × hour of PROJECT → PROJECT/results/illuminance.csv.
+
+    One row per scenario × hour × grid × sensor: scenario, model, datetime, time, grid,
+    sensor, row, x, y, z, lux, lux_stderr, engine, params_hash. Finished hours are kept
+    (results/parts/) so an interrupted run resumes; --fresh recomputes all.
+    """
+    from radtree.config import load_project
+    from radtree.pipeline.simulate import resolve_engine, simulate_project
+
+    p = load_project(project)
+    if convergence:
+        from radtree.convergence import convergence_table
+        from radtree.fileio import atomic_path
+
+        table = convergence_table(p, list(scenarios) or None, list(hours) or None,
+                                  echo=click.echo)
+        click.echo(table.to_string(index=False))
+        conv_path = p.results_dir / "convergence.csv"
+        with atomic_path(conv_path) as tmp:
+            table.to_csv(tmp, index=False)
+        click.echo(f"convergence table → {conv_path}")
+        return
+    eng = resolve_engine(p, engine)
+    click.echo(f"engine: {eng.name}" + (" (auto)" if engine == "auto" else ""))
+    t = time.perf_counter()
+    out = simulate_project(p, eng, list(scenarios) or None, list(hours) or None, workers,
+                           dry_run=dry_run, echo=click.echo, resume=not fresh)
+    if out is None:
+        return
+    facade = out.table[out.table["grid"] == "facade"]
+    means = facade.groupby(["scenario", "time"], sort=False)["lux"].mean().unstack("time")
+    click.echo("façade sensor means (lux):")
+    click.echo(means.round(0).to_string())
+    click.echo(f"{out.computed} hours traced, {out.reused} reused, "
+               f"{time.perf_counter() - t:.1f} s → {out.path}")

@@ -1,0 +1,92 @@
+"""Run the cases of a sweep on ``dask.distributed`` or in this process.
+
+Execution: a :class:`dask.distributed.LocalCluster` by default (one single-threaded worker
+process per core, loopback only, no dashboard), or ``scheduler="tcp://host:port"`` for an
+existing cluster (its workers must have radtree installed and see the output folder), or
+``scheduler="sequential"`` to run the same case function in this process. Every path submits
+:func:`run_case` once per case and collects results as they complete; a failing case is
+recorded and the others go on.
+"""
+
+from __future__ import annotations
+
+import os
+import uuid
+import warnings
+from collections.abc import Callable
+
+from radtree.errors import RadtreeError
+from radtree.sweep.cases import CaseResult, CaseSpec, run_case
+
+
+def default_workers() -> int:
+    """One worker process per CPU core."""
+    return max(1, os.cpu_count() or 1)
+
+
+def execute(specs: list[CaseSpec], scheduler: str = "local", workers: int | None = None,
+            on_result: Callable[[CaseResult], None] | None = None) -> list[CaseResult]:
+    """Run :func:`run_case` for every spec; return results in completion order.
+
+    ``scheduler``: ``"sequential"`` (this process), ``"local"`` (a LocalCluster of ``workers``
+    single-threaded processes on 127.0.0.1, default one per core), or a scheduler address.
+    """
+    results: list[CaseResult] = []
+
+    def take(res: CaseResult) -> None:
+        results.append(res)
+        if on_result is not None:
+            on_result(res)
+
+    if not specs:
+        return results
+    if scheduler == "sequential":
+        for spec in specs:
+            take(run_case(spec))
+        return results
+
+    import logging
+
+    from dask.distributed import Client, LocalCluster, as_completed
+
+    cluster = None
+    if scheduler == "local":
+        n = min(workers or default_workers(), len(specs))
+        with warnings.catch_warnings():  # "port 8787 in use": the scheduler picks another
+            warnings.simplefilter("ignore", UserWarning)
+            cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True,
+                                   dashboard_address=None, host="127.0.0.1",
+                                   silence_logs=logging.ERROR)
+        client = Client(cluster)
+    else:
+        try:
+            client = Client(scheduler, timeout=30)
+        except (OSError, TimeoutError) as exc:
+            raise RadtreeError(f"cannot connect to the dask scheduler at {scheduler}: {exc}"
+                               ) from exc
+    token = uuid.uuid4().hex[:8]
+    futures = []
+    try:
+        by_future = {}
+        for spec in specs:
+            fut = client.submit(run_case, spec, key=f"radtree-case-{spec.case_hash}-{token}",
+                                pure=False)
+            futures.append(fut)
+            by_future[fut.key] = spec
+        for fut in as_completed(futures):
+            spec = by_future[fut.key]
+            try:
+                res = fut.result()
+            except Exception as exc:  # noqa: BLE001 - a lost worker fails this case only
+                res = CaseResult(spec.case_id, spec.case_hash, dict(spec.params), "failed",
+                                 error=f"the dask task failed: {type(exc).__name__}: {exc}",
+                                 error_type=type(exc).__name__)
+            take(res)
+    finally:
+        for fut in futures:
+            if not fut.done():
+                fut.cancel()
+        client.close()
+        if cluster is not None:
+            cluster.close()
+    return results
