@@ -9,11 +9,13 @@ change per step.
 from __future__ import annotations
 
 from collections.abc import Callable
+from pathlib import Path
 
 import pandas as pd
 
 from radtree.config import Project, effective_project
 from radtree.engines.base import Engine
+from radtree.fileio import atomic_path
 from radtree.pipeline.assemble import make_scene
 from radtree.pipeline.realisations import is_later_realisation, parent_name, selected
 from radtree.pipeline.simulate import resolve_engine
@@ -53,3 +55,11 @@ def convergence_table(project: Project, scenarios: list[str] | None = None,
                      + (f" ({change:+.1%})" if prev else ""))
                 prev = mean
     return pd.DataFrame(rows)
+
+
+def write_convergence(project: Project, table: pd.DataFrame) -> Path:
+    """Write ``results/convergence.csv`` (read by the report) atomically; return its path."""
+    out = project.results_dir / "convergence.csv"
+    with atomic_path(out) as tmp:
+        table.to_csv(tmp, index=False)
+    return out

@@ -59,6 +59,10 @@ class LayerCalibration:
     layers: int
     permeability: float
 
+    def summary(self) -> str:
+        return (f"Chosen: [tree.louvers] layers = {self.layers} → global permeability "
+                f"{100 * self.permeability:.2f} % (target {100 * self.target:.2f} %).")
+
 
 def calibrate_layers(project: Project, target: float | None = None,
                      layers: range = range(3, 8), rays: int = 2048,
@@ -89,6 +93,14 @@ class CrossingsCalibration:
     stderr: float
     realisation_se: float        # nan with one realisation
     converged: bool              # |ln p/target| ≤ max(tol, 2 s.e./p) at ``crossings``
+    realisations: int = 1
+
+    def summary(self) -> str:
+        return (f"Chosen: [tree.louvers] crossings = {self.crossings:g} → global "
+                f"permeability {100 * self.permeability:.2f} % ± "
+                f"{100 * self.realisation_se:.2f} over {self.realisations} realisation(s) "
+                f"(target {100 * self.target:.2f} %"
+                f"{'' if self.converged else '; not converged'}).")
 
 
 def calibrate_crossings(project: Project, target: float | None = None,
@@ -185,4 +197,21 @@ def calibrate_crossings(project: Project, target: float | None = None,
                                                     / best["permeability"]))
     return CrossingsCalibration(target, table, float(best["crossings"]),
                                 float(best["permeability"]), float(best["stderr"]),
-                                float(best["realisation_se"]), converged)
+                                float(best["realisation_se"]), converged, len(realisations))
+
+
+#: what ``radtree calibrate --global`` prints first
+GLOBAL_DEFINITION = ("Global permeability = Σ façade illuminance with the crown / Σ in the open "
+                     "street, over the project's hours (seeded engine, every light path).")
+
+
+def calibrate_global(project: Project, target: float | None = None, form: str | None = None,
+                     realisations: int = 1, echo: Callable[[str], None] = print
+                     ) -> LayerCalibration | CrossingsCalibration:
+    """The louvers density from the measured permeability: the volume crossings of free
+    ``volume`` crowns (mean over ``realisations`` crowns, 512 rays/sensor), else the integer
+    layer count."""
+    if (form or project.tree.form) == "free" and project.tree.louvers.arrangement == "volume":
+        return calibrate_crossings(project, target, rays=512,
+                                   seeds=tuple(range(1, realisations + 1)), echo=echo)
+    return calibrate_layers(project, target, echo=echo)

@@ -51,23 +51,10 @@ def calibrate_command(project: Path, target: float | None, model: str, form: str
     """
     proj = load_project(project)
     if global_:
-        from radtree.calibrate.permeability import calibrate_crossings, calibrate_layers
+        from radtree.calibrate.permeability import GLOBAL_DEFINITION, calibrate_global
 
-        click.echo("Global permeability = Σ façade illuminance with the crown / Σ in the "
-                   "open street, over the project's hours (NumPy engine, every light path).")
-        if (form or proj.tree.form) == "free" and proj.tree.louvers.arrangement == "volume":
-            cc = calibrate_crossings(proj, target, rays=512,
-                                     seeds=tuple(range(1, realisations + 1)),
-                                     echo=click.echo)
-            click.echo(f"Chosen: [tree.louvers] crossings = {cc.crossings:g} → global "
-                       f"permeability {100 * cc.permeability:.2f} % ± "
-                       f"{100 * cc.realisation_se:.2f} over {realisations} realisation(s) "
-                       f"(target {100 * cc.target:.2f} %"
-                       f"{'' if cc.converged else '; not converged'}).")
-            return
-        cal = calibrate_layers(proj, target, echo=click.echo)
-        click.echo(f"Chosen: [tree.louvers] layers = {cal.layers} → global permeability "
-                   f"{100 * cal.permeability:.2f} % (target {100 * cal.target:.2f} %).")
+        click.echo(GLOBAL_DEFINITION)
+        click.echo(calibrate_global(proj, target, form, realisations, echo=click.echo).summary())
         return
     result = calibrate(proj, model=model, target=target, form=form,
                        photo_openness=photo_openness, directions=directions,

@@ -35,16 +35,12 @@ def simulate_command(project: str, scenarios: tuple[str, ...], engine: str,
 
     p = load_project(project)
     if convergence:
-        from radtree.convergence import convergence_table
-        from radtree.fileio import atomic_path
+        from radtree.convergence import convergence_table, write_convergence
 
         table = convergence_table(p, list(scenarios) or None, list(hours) or None,
                                   echo=click.echo)
         click.echo(table.to_string(index=False))
-        conv_path = p.results_dir / "convergence.csv"
-        with atomic_path(conv_path) as tmp:
-            table.to_csv(tmp, index=False)
-        click.echo(f"convergence table → {conv_path}")
+        click.echo(f"convergence table → {write_convergence(p, table)}")
         return
     eng = resolve_engine(p, engine)
     click.echo(f"engine: {eng.name}" + (" (auto)" if engine == "auto" else ""))
@@ -53,9 +49,9 @@ def simulate_command(project: str, scenarios: tuple[str, ...], engine: str,
                            dry_run=dry_run, echo=click.echo, resume=not fresh)
     if out is None:
         return
-    facade = out.table[out.table["grid"] == "facade"]
-    means = facade.groupby(["scenario", "time"], sort=False)["lux"].mean().unstack("time")
+    from radtree.pipeline.results import facade_means
+
     click.echo("façade sensor means (lux):")
-    click.echo(means.round(0).to_string())
+    click.echo(facade_means(out.table).round(0).to_string())
     click.echo(f"{out.computed} hours traced, {out.reused} reused, "
                f"{time.perf_counter() - t:.1f} s → {out.path}")

@@ -105,3 +105,9 @@ def merge_write(out: Path, table: pd.DataFrame, names: list[str]) -> None:
         table = pd.concat([old, table], ignore_index=True) if len(old) else table
     with atomic_path(out) as tmp:
         table.to_csv(tmp, index=False)
+
+
+def facade_means(table: pd.DataFrame, grid: str = "facade") -> pd.DataFrame:
+    """Hourly mean lux of a grid's sensors: one row per scenario, one column per hour."""
+    rows = table[table["grid"] == grid]
+    return rows.groupby(["scenario", "time"], sort=False)["lux"].mean().unstack("time")
