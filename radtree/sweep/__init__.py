@@ -26,7 +26,7 @@ _EXPORTS = {
     "execute": "run", "merge_results": "run", "plan_sweep": "run", "run_case": "run",
     "run_sweep": "run",
     "case_metrics": "sensitivity", "sensitivity_table": "sensitivity",
-    "sweep_report_section": "sensitivity", "tornado_plot": "sensitivity",
+    "sweep_section_data": "sensitivity", "tornado_plot": "sensitivity",
     "write_sensitivity": "sensitivity",
 }
 __all__ = sorted(_EXPORTS)
