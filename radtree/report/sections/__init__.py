@@ -20,6 +20,10 @@ from jinja2 import Environment
 
 from radtree.resources import template_environment
 
+#: The optional sections, in page order (each has ``sections/<name>.html.j2``; the ones the
+#: Markdown report shows also ``.md.j2``).
+OPTIONAL = ("office", "sweep", "realisations", "permeability_scan", "diagnose", "annual")
+
 
 @dataclass(frozen=True)
 class Section:
@@ -28,6 +32,14 @@ class Section:
 
     name: str
     data: dict[str, Any]
+
+    def __post_init__(self) -> None:
+        if self.name not in OPTIONAL:
+            raise ValueError(f"unknown report section {self.name!r} (known: "
+                             f"{', '.join(OPTIONAL)})")
+        if not isinstance(self.data, dict):
+            raise TypeError(f"section {self.name}: data must be a dict, got "
+                            f"{type(self.data).__name__}")
 
 
 def environment(html: bool) -> Environment:
