@@ -1,4 +1,4 @@
-"""Office-block results per hour and grid (SPEC.md §5): statistics, false-colour maps, HTML.
+"""Office-block results per hour and grid (SPEC.md §5): statistics, false-colour maps, report data.
 
 Reads only the tidy results table ``PROJECT/results/illuminance.csv`` and writes
 
@@ -14,22 +14,22 @@ Reads only the tidy results table ``PROJECT/results/illuminance.csv`` and writes
   scale shared by all hours and scenarios of the grid, lux legend, cell values written in.
 * ``PROJECT/report/office/<grid>_hourly.png`` — the hourly mean and the area bands.
 
-:func:`office_report_section` returns the HTML fragment (tables + maps) the report includes.
+:func:`office_section_data` gives the report's office section (tables + maps) as plain data.
 """
 
 from __future__ import annotations
 
-import html
 import math
 from pathlib import Path
+from typing import Any
 
-import click
 import numpy as np
 import pandas as pd
 
-from radtree.config import Project, load_project
+from radtree.config import Project
 from radtree.errors import RadtreeError
 from radtree.fileio import atomic_path
+from radtree.pipeline.results import read_results
 from radtree.site.frame import FacadeFrame
 
 LOW_LUX = 300.0
@@ -95,14 +95,6 @@ def summarise(table: pd.DataFrame) -> pd.DataFrame:
     out = out.sort_values(["grid", "time", "scenario"],
                           key=lambda c: c.map(rank) if c.name == "scenario" else c)
     return out.reset_index(drop=True)
-
-
-def read_results(project: Project) -> pd.DataFrame:
-    path = project.results_dir / "illuminance.csv"
-    if not path.exists():
-        raise RadtreeError(f"no results yet: {path} is missing (run `radtree simulate "
-                           f"{project.root}` first)")
-    return pd.read_csv(path, dtype={"time": str, "scenario": str, "grid": str, "row": str})
 
 
 def summary_path(project: Project) -> Path:
@@ -322,7 +314,7 @@ def write_hourly_charts(project: Project, summary: pd.DataFrame, out_dir: Path |
     return written
 
 
-# ---------------------------------------------------------------- HTML
+# ---------------------------------------------------------------- report section
 def _summary_for_report(project: Project) -> pd.DataFrame:
     """The summary, (re)written when missing or older than the results table."""
     results = project.results_dir / "illuminance.csv"
@@ -340,113 +332,85 @@ def _f(v: float, digits: int = 0) -> str:
     return f"{v:,.{digits}f}"
 
 
-def _grid_table(g: pd.DataFrame, scen_order: list[str]) -> str:
+#: The columns of a grid's office table per scenario: summary column, label, decimals.
+GRID_COLUMNS = [("mean_lux", "mean lx", 0), ("uniformity", "U₀ min/mean", 2),
+                ("pct_below_300", "% < 300", 0), ("pct_300_2000", "% 300–2000", 0),
+                ("pct_above_2000", "% > 2000", 0)]
+
+
+def _grid_data(g: pd.DataFrame, scen_order: list[str]) -> dict[str, Any]:
+    """One grid's consultant-style table: per hour (and the day mean) and scenario the mean,
+    uniformity and area bands, and the with / without ratio when there is one of each."""
     times = sorted(g["time"].astype(str).unique())
     scens = [s for s in scen_order if s in set(g["scenario"])]
     tree_of = {s: str(g[g["scenario"] == s]["tree"].iloc[0]) for s in scens}
     withs = [s for s in scens if tree_of[s] == "with"]
     withouts = [s for s in scens if tree_of[s] == "without"]
     pair = (withs[0], withouts[0]) if len(withs) == 1 and len(withouts) == 1 else None
-    cols = [("mean_lux", "mean lx", 0), ("uniformity", "U₀ min/mean", 2),
-            ("pct_below_300", "% < 300", 0), ("pct_300_2000", "% 300–2000", 0),
-            ("pct_above_2000", "% > 2000", 0)]
-    head1 = "<th rowspan='2'>hour</th>" + "".join(
-        f"<th colspan='{len(cols)}'>{html.escape(s)} — {tree_of[s]} tree</th>" for s in scens)
-    if pair:
-        head1 += "<th rowspan='2'>mean with / without</th>"
-    head2 = "".join(f"<th>{html.escape(c[1])}</th>" for _ in scens for c in cols)
-    body = []
+    cols = GRID_COLUMNS
+    rows = []
     idx = g.set_index(["scenario", "time"])
     for t in [*times, "day"]:
-        cells = [f"<td>{'day mean' if t == 'day' else html.escape(t)}</td>"]
+        cells: list[dict[str, Any]] = []
         means = {}
         for s in scens:
             if t == "day":
-                rows = g[g["scenario"] == s]
-                vals = {c: float(rows[c].mean()) for c, _, _ in cols}
+                sub = g[g["scenario"] == s]
+                vals = {c: float(sub[c].mean()) for c, _, _ in cols}
             else:
                 if (s, t) not in idx.index:
-                    cells.extend("<td>–</td>" for _ in cols)
+                    cells.extend({"text": "–", "num": False} for _ in cols)
                     continue
                 r = idx.loc[(s, t)]
                 vals = {c: float(r[c]) for c, _, _ in cols}
             means[s] = vals["mean_lux"]
-            cells.extend(f"<td class='num'>{_f(vals[c], d)}</td>" for c, _, d in cols)
+            cells.extend({"text": _f(vals[c], d), "num": True} for c, _, d in cols)
         if pair:
             w, wo = means.get(pair[0]), means.get(pair[1])
-            ratio = (f"{100 * w / wo:.0f} %" if w is not None and wo and wo > 0 else "–")
-            cells.append(f"<td class='num'>{ratio}</td>")
-        cls = " class='total'" if t == "day" else ""
-        body.append(f"<tr{cls}>" + "".join(cells) + "</tr>")
-    return ("<table class='office'>\n<thead><tr>" + head1 + "</tr><tr>" + head2
-            + "</tr></thead>\n<tbody>\n" + "\n".join(body) + "\n</tbody></table>")
+            cells.append({"text": f"{100 * w / wo:.0f} %" if w is not None and wo and wo > 0
+                          else "–", "num": True})
+        rows.append({"label": "day mean" if t == "day" else t, "total": t == "day",
+                     "cells": cells})
+    return {"scenarios": [{"name": s, "tree": tree_of[s]} for s in scens],
+            "columns": [c[1] for c in cols], "pair": pair is not None, "rows": rows}
 
 
-def office_report_section(project: Project, image_prefix: str = "office/") -> str:
-    """HTML fragment: per grid a consultant-style table (hour × scenario: mean, uniformity and
-    the area bands) and the false-colour maps. Image paths are ``image_prefix + name`` (maps
+def office_section_data(project: Project, image_prefix: str = "office/") -> dict[str, Any]:
+    """The report's office section as the data ``templates/sections/office.html.j2`` renders:
+    per grid a consultant-style table (hour × scenario: mean lux, uniformity and the area bands
+    in % of grid area) and the false-colour maps. Image paths are ``image_prefix + name`` (maps
     live in ``PROJECT/report/office/``, so the default suits ``PROJECT/report/*.html``)."""
     summary = _summary_for_report(project)
     scen_order = [s.name for s in project.scenarios if s.name in set(summary["scenario"])]
     scen_order += [s for s in dict.fromkeys(summary["scenario"]) if s not in scen_order]
     o = project.office
-    parts = ["<section class='office-block'>", "<h2>Office block: the central office</h2>"]
+    description = None
     if o is not None:
         from radtree.site.office import office_layout
 
         lay = office_layout(project)
         room = lay.central_room
-        parts.append(
-            "<p>" + html.escape(
-                f"{o.bays} × {o.storeys} offices ({o.width_m:g} m wide, "
-                f"{lay.room_height:g} m high, {o.depth_m:g} m deep) behind the façade, "
-                f"glazing Tn {o.glazing_transmittance:g} with {100 * o.frame_fraction:g} % "
-                f"frame; results in the central office (floor {room.z0:g} m above the street). "
-                f"Façade grid: {o.facade_grid_spacing_m:g} m cells just outside the glazing, "
-                f"facing the street. Work plane: {o.workplane_height_m:g} m above the floor, "
-                f"{o.grid_spacing_m:g} m cells, {o.wall_offset_m:g} m from the walls. "
-                "Area bands use equal-area cells: < 300 lx, 300–2000 lx (both bounds "
-                "included, 'useful'), > 2000 lx. U₀ = min/mean.") + "</p>")
-    sky = project.light.sky
-    if sky == "perez":
-        parts.append("<p>" + html.escape(
-            f"Sky: clear-sky Perez (gendaylit) with a stated diffuse horizontal illuminance of "
-            f"{project.light.diffuse_horizontal_lux:,.0f} lx (a substitute: the study gives no "
-            "hourly diffuse values), plus the measured direct normal illuminance.") + "</p>")
+        description = (
+            f"{o.bays} × {o.storeys} offices ({o.width_m:g} m wide, "
+            f"{lay.room_height:g} m high, {o.depth_m:g} m deep) behind the façade, "
+            f"glazing Tn {o.glazing_transmittance:g} with {100 * o.frame_fraction:g} % "
+            f"frame; results in the central office (floor {room.z0:g} m above the street). "
+            f"Façade grid: {o.facade_grid_spacing_m:g} m cells just outside the glazing, "
+            f"facing the street. Work plane: {o.workplane_height_m:g} m above the floor, "
+            f"{o.grid_spacing_m:g} m cells, {o.wall_offset_m:g} m from the walls. "
+            "Area bands use equal-area cells: < 300 lx, 300–2000 lx (both bounds "
+            "included, 'useful'), > 2000 lx. U₀ = min/mean.")
+    sky = None
+    if project.light.sky == "perez":
+        sky = ("Sky: clear-sky Perez (gendaylit) with a stated diffuse horizontal illuminance of "
+               f"{project.light.diffuse_horizontal_lux:,.0f} lx (a substitute: the study gives "
+               "no hourly diffuse values), plus the measured direct normal illuminance.")
+    grids = []
     for grid, g in summary.groupby("grid", sort=False):
-        title = GRID_TITLES.get(str(grid), str(grid))
-        parts.append(f"<h3>{html.escape(title)}</h3>")
-        parts.append(_grid_table(g, scen_order))
-        parts.append(f"<figure><img src='{html.escape(image_prefix)}{html.escape(str(grid))}"
-                     f"_hourly.png' alt='{html.escape(title)} hourly' style='max-width:100%'>"
-                     "<figcaption>Hourly mean (log scale) and share of grid area per band."
-                     "</figcaption></figure>")
-        imgs = []
-        for t in sorted(g["time"].astype(str).unique()):
-            name = map_filename(str(grid), t)
-            imgs.append(f"<figure style='display:inline-block;margin:4px'><img "
-                        f"src='{html.escape(image_prefix + name)}' alt='{html.escape(title)} "
-                        f"{html.escape(t)}' style='max-width:460px'><figcaption>{html.escape(t)}"
-                        "</figcaption></figure>")
-        parts.append("<div class='office-maps'>" + "".join(imgs) + "</div>")
-        parts.append("<p class='note'>False colour on a logarithmic scale shared by every hour "
-                     "and scenario of this grid; numbers are lux per cell.</p>")
-    parts.append("</section>")
-    return "\n".join(parts)
-
-
-# ---------------------------------------------------------------- command
-@click.command("summary", context_settings={"help_option_names": ["-h", "--help"]})
-@click.argument("project", type=click.Path())
-@click.option("--no-maps", is_flag=True, help="Only results/summary.csv, no PNG maps.")
-def office_summary_command(project: str, no_maps: bool) -> None:
-    """Office summary of PROJECT: results/summary.csv and report/office/*.png.
-
-    Per scenario × hour × grid: mean, min, max, uniformity (min/mean) and % of grid area
-    < 300 lx, 300–2000 lx (both included), > 2000 lx.
-    """
-    p = load_project(project)
-    out = write_summary(p, maps=not no_maps)
-    click.echo(f"summary → {out}")
-    if not no_maps:
-        click.echo(f"maps → {office_dir(p)}")
+        times = sorted(g["time"].astype(str).unique())
+        grids.append({
+            "title": GRID_TITLES.get(str(grid), str(grid)), **_grid_data(g, scen_order),
+            "hourly_image": f"{image_prefix}{grid}_hourly.png",
+            "maps": [{"src": image_prefix + map_filename(str(grid), t), "time": t}
+                     for t in times]})
+    return {"description": description, "sky": sky, "grids": grids}

@@ -23,6 +23,7 @@ import math
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, replace
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 import pandas as pd
@@ -210,33 +211,23 @@ def read_scan(project: Project) -> PermeabilityScan | None:
                             t.drop(columns=["scenario", "field"]), [])
 
 
-def scan_report_section(project: Project, out: Path) -> str:
-    """HTML section on ``results/permeability_scan.csv`` ("" when no scan was run); copies the
-    figure into the report folder ``out``."""
-    import html
+def scan_section_data(project: Project, out: Path) -> dict[str, Any] | None:
+    """The report section on ``results/permeability_scan.csv`` (None when no scan was run), as
+    the data ``templates/sections/permeability_scan.html.j2`` and ``.md.j2`` render:
+    permeabilities in %, nRMSE / nMBE as fractions. Copies the figure into the report folder
+    ``out``."""
     import shutil
 
     png = project.results_dir / "permeability_scan.png"
     scan = read_scan(project)
     if scan is None:
-        return ""
-    t = scan.table
-    rows = "".join(
-        "<tr>" + "".join(f"<td class='num'>{v}</td>" for v in (
-            f"{r['value']:g}", f"{100 * r['permeability_street']:.2f}",
-            f"{100 * r['permeability_unobstructed']:.2f}", f"{r['nrmse']:.3f}",
-            f"{r['nmbe']:+.3f}", f"{r['r']:.3f}")) + "</tr>" for _, r in t.iterrows())
-    fig = ""
+        return None
+    figure = None
     if png.exists():
         shutil.copyfile(png, out / "permeability_scan.png")
-        fig = "<figure><img src='permeability_scan.png' alt='nRMSE against permeability'></figure>"
-    items = "".join(f"<li>{html.escape(s)}</li>" for s in scan.summary())
-    return (f"<section id='permeability-scan'><h2>Scenario {html.escape(scan.scenario)} against "
-            f"the crown's permeability</h2><p>A scan of <code>{html.escape(scan.field)}</code> "
-            f"(<code>radtree permeability</code>, NumPy engine): the crown's global "
-            f"permeability under two references, and the scenario's fit. The measured "
-            f"permeability is 5–6 %; nothing here is chosen from the hourly measurements.</p>"
-            f"<ul>{items}</ul>{fig}<div class='tablewrap' id='t-permeability_scan'><table><thead><tr><th>{html.escape(scan.field)}</th>"
-            f"<th>permeability, street (%)</th><th>permeability, unobstructed (%)</th>"
-            f"<th>nRMSE</th><th>nMBE</th><th>r</th></tr></thead><tbody>{rows}</tbody></table>"
-            f"</div></section>")
+        figure = "permeability_scan.png"
+    rows = [[f"{r['value']:g}", f"{100 * r['permeability_street']:.2f}",
+             f"{100 * r['permeability_unobstructed']:.2f}", f"{r['nrmse']:.3f}",
+             f"{r['nmbe']:+.3f}", f"{r['r']:.3f}"] for _, r in scan.table.iterrows()]
+    return {"scenario": scan.scenario, "field": scan.field, "summary": scan.summary(),
+            "figure": figure, "rows": rows}

@@ -386,7 +386,7 @@ def test_leaf_dates_switch_between_leafed_and_bare_coefficients(tiny_project):
 def test_annual_command_writes_the_interface(tiny_project):
     from click.testing import CliRunner
 
-    from radtree.annual import annual_report_section
+    from radtree.annual import annual_section_data
     from radtree.cli.annual import annual_command
     from radtree.config import load_project
 
@@ -412,16 +412,20 @@ def test_annual_command_writes_the_interface(tiny_project):
     assert july.crown == "bare" and july.leaf_on_days == 0
     may = mo[(mo.tree == "with") & (mo.month == 5)].iloc[0]
     assert may.crown == "mixed" and may.leaf_on_days == 19
-    html = annual_report_section(load_project(tiny_project))
-    assert html.startswith('<section class="annual">') and html.rstrip().endswith("</section>")
+    from radtree.report.sections import Section, render_section
+
+    html = render_section(Section("annual", annual_section_data(load_project(tiny_project))))
+    assert html.startswith('<section class="annual"') and html.rstrip().endswith("</section>")
     assert "GENERATED" in html and "data:image/png;base64," in html
     for name in ("annual_maps_facade.png", "annual_heatmap_facade.png"):
         assert (results / "annual" / "figures" / name).stat().st_size > 1000
 
 
 def test_report_section_without_results(tmp_path):
-    from radtree.annual.report import annual_report_section
+    from radtree.annual.report import annual_section_data
     from radtree.config import load_project
+    from radtree.report.sections import Section, render_section
 
     p = copy_project(tmp_path / "p")
-    assert "No annual results" in annual_report_section(load_project(p))
+    data = annual_section_data(load_project(p))
+    assert "No annual results" in render_section(Section("annual", data))

@@ -20,11 +20,12 @@ from radtree.light.sun import SunPosition, local_datetime
 from radtree.office_summary import (
     area_fractions,
     grid_statistics,
-    office_report_section,
+    office_section_data,
     summarise,
     write_summary,
 )
 from radtree.optics import Glass, Plastic
+from radtree.report.sections import Section, render_section
 from radtree.scene import Mesh, Scene, SensorGrid
 from radtree.site.frame import FacadeFrame
 from radtree.site.office import frame_width_for, office_layout, office_parts
@@ -315,7 +316,7 @@ def test_summary_csv_maps_and_html(tmp_path, project):
     pngs = sorted(x.name for x in (proj.report_dir / "office").glob("*.png"))
     assert pngs == sorted(["facade_1030.png", "facade_1330.png", "workplane_1030.png",
                            "workplane_1330.png", "facade_hourly.png", "workplane_hourly.png"])
-    html = office_report_section(proj)
+    html = render_section(Section("office", office_section_data(proj)))
     assert html.count("<table") == 2 and "office/workplane_1330.png" in html
     assert "% 300–2000" in html and "day mean" in html
     assert summarise(table).shape[0] == 8

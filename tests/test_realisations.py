@@ -84,17 +84,16 @@ def test_simulate_averages_realisations(reduced):
     timing = pd.read_csv(proj.results_dir / "timing.csv")
     assert timing["scenario"].tolist() == ["F"]
     # the report lists each crown alone: nRMSE of one hour = |measured − simulated| / measured
-    from radtree.report.build import realisation_frame, realisations_section
+    from radtree.report.sections import Section, render_section
+    from radtree.report.sections.extras import realisation_frame, realisations_data
 
     crowns = realisation_frame(proj)
     assert crowns["realisation"].tolist() == [1, 2, 3]
     np.testing.assert_allclose(crowns["13:30"], wide.mean(axis=0).to_numpy(), rtol=1e-9)
     np.testing.assert_allclose(crowns["nrmse"], np.abs(1592.0 - crowns["13:30"]) / 1592.0)
-    html = realisations_section(proj)
+    html = render_section(Section("realisations", realisations_data(proj)))
     assert html.count("<tr><td>F</td>") == 3 and "single crowns give nRMSE" in html
-    from radtree.report.build import markdown_extras
-
-    md = markdown_extras(proj)
+    md = render_section(Section("realisations", realisations_data(proj)), html=False)
     assert "## Crown realisations" in md and md.count("\n| F | ") == 3
 
 

@@ -454,7 +454,11 @@ def test_report_on_a_real_open_street_simulation(open_street: Path):
 
 
 def test_diagnose_section_shows_fitted_strength_and_cv(tmp_path):
-    from radtree.report.build import diagnose_section
+    from radtree.report.sections import Section, render_section
+    from radtree.report.sections.extras import diagnose_data
+
+    def diagnose_section(folder):
+        return render_section(Section("diagnose", diagnose_data(folder)))
 
     pd.DataFrame([{"step": 1, "effect": "sky_diffuse", "explained_fraction": 0.9,
                    "strength": 14900.0, "rmse_before": 0.198, "rmse_after": 0.064,
@@ -464,6 +468,6 @@ def test_diagnose_section_shows_fitted_strength_and_cv(tmp_path):
     html = diagnose_section(tmp_path)
     assert "fitted" in html and "sky_diffuse" in html and "diffuse horizontal 14 900 lx" in html
     assert "<td>0.198 → 0.064</td><td>0.198 → 0.075</td>" in html
-    assert "<td class='num'>90</td>" in html
+    assert '<td class="num">90</td>' in html
     (tmp_path / "steps.csv").unlink()
     assert "<table>" not in diagnose_section(tmp_path)

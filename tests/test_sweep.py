@@ -21,6 +21,7 @@ from click.testing import CliRunner
 
 from radtree.cli.sweep import sweep_command
 from radtree.errors import ConfigError
+from radtree.report.sections import Section, render_section
 from radtree.sweep import (
     full_factorial,
     latin_hypercube,
@@ -29,7 +30,7 @@ from radtree.sweep import (
     plan_sweep,
     run_sweep,
     sensitivity_table,
-    sweep_report_section,
+    sweep_section_data,
 )
 from radtree.sweep import scheduler as sweep_scheduler
 from radtree.tomlout import dumps
@@ -216,7 +217,7 @@ def test_local_cluster_matches_sequential(project: Path, tmp_path: Path):
     assert lux.loc["street.ground_reflectance", "value_at_high"] == 0.3
     assert {"nrmse", "nmbe"} <= set(sens["metric"])
     assert (project / "sweep" / "tornado.png").stat().st_size > 1000
-    html = sweep_report_section(project)
+    html = render_section(Section("sweep", sweep_section_data(project)))
     assert "<section" in html and "scenario B" in html
     assert "Scenario A was not in the sweep" in html
     assert "data:image/png;base64," in html
@@ -324,4 +325,4 @@ def test_sensitivity_main_effects_and_spearman():
 
 
 def test_report_section_empty_without_sweep(project: Path):
-    assert sweep_report_section(project) == ""
+    assert sweep_section_data(project) is None

@@ -10,7 +10,7 @@
 * :mod:`~radtree.annual.branches` — the leaf-off crown (opaque branches at 40°);
 * :mod:`~radtree.annual.metrics` — UDI, DA, sDA, ASE;
 * :mod:`~radtree.annual.run` — the run (:func:`run_annual`) and its tables;
-* :mod:`~radtree.annual.report` — figures and :func:`annual_report_section`.
+* :mod:`~radtree.annual.report` — figures and :func:`annual_section_data`.
 
 The command is :mod:`radtree.cli.annual`.
 """
@@ -21,12 +21,12 @@ from radtree.annual.run import AnnualOptions, AnnualResult, compute_annual, run_
 from radtree.annual.schedule import LeafSchedule
 
 
-def annual_report_section(project) -> str:
-    """HTML fragment of the annual results (see :mod:`radtree.annual.report`)."""
-    from radtree.annual.report import annual_report_section as _section
+def annual_section_data(project) -> dict:
+    """The report section's data of the annual results (see :mod:`radtree.annual.report`)."""
+    from radtree.annual.report import annual_section_data as _section
 
     return _section(project)
 
 
-__all__ = ["AnnualOptions", "AnnualResult", "LeafSchedule", "annual_report_section",
+__all__ = ["AnnualOptions", "AnnualResult", "LeafSchedule", "annual_section_data",
            "compute_annual", "run_annual"]

@@ -4,16 +4,16 @@ Reads only what :func:`radtree.annual.run.write_annual` wrote:
 ``results/annual.csv``, ``results/annual_summary.csv``, ``results/annual_monthly.csv``,
 ``results/annual/hourly.npz`` and ``results/annual/annual_meta.json``. Figures go to
 ``results/annual/figures/`` (outside ``report/``, which the report builder replaces whole);
-:func:`annual_report_section` embeds them as inline PNG so the fragment works wherever it
+:func:`annual_section_data` embeds them as inline PNG so the section works wherever it
 is pasted.
 """
 
 from __future__ import annotations
 
 import base64
-import html
 import json
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 import pandas as pd
@@ -161,12 +161,10 @@ def write_figures(project: Project) -> list[Path]:
     return out
 
 
-def _img(path: Path, alt: str) -> str:
-    if not path.exists():
-        return f"<p><em>figure missing: {html.escape(path.name)}</em></p>"
-    b64 = base64.b64encode(path.read_bytes()).decode()
-    return (f'<figure><img alt="{html.escape(alt)}" src="data:image/png;base64,{b64}" '
-            f'style="max-width:100%"><figcaption>{html.escape(alt)}</figcaption></figure>')
+def _img(path: Path, alt: str) -> dict[str, str | None]:
+    """A figure as inline PNG: ``data`` (base64, None when the file is missing), ``alt``."""
+    data = base64.b64encode(path.read_bytes()).decode() if path.exists() else None
+    return {"alt": alt, "data": data, "file": path.name}
 
 
 def grid_summary(project: Project) -> pd.DataFrame:
@@ -182,85 +180,53 @@ def grid_summary(project: Project) -> pd.DataFrame:
     return first.merge(means, on=["grid", "tree"])
 
 
-def annual_report_section(project: Project) -> str:
-    """An HTML fragment (``<section>``) with the annual results of ``project``."""
+def annual_section_data(project: Project) -> dict[str, Any]:
+    """The annual results of ``project`` as the data ``templates/sections/annual.html.j2``
+    renders (``results`` False when there are none): metrics in % of occupied hours, monthly
+    means in lux, figures as inline PNG."""
     p = _paths(project)
     if not (p["annual"].exists() and p["summary"].exists() and p["meta"].exists()):
-        return ('<section class="annual"><h2>Annual daylight</h2><p>No annual results: run '
-                f"<code>radtree annual {html.escape(str(project.root))}</code>.</p></section>")
+        return {"results": False, "root": str(project.root)}
     meta = json.loads(p["meta"].read_text())
     if not all((p["figures"] / f"annual_maps_{g}.png").exists() for g in meta["grids"]):
         write_figures(project)
     table = grid_summary(project)
     monthly = pd.read_csv(p["monthly"])
-    w = meta["weather"]
-    esc = html.escape
-    parts = ['<section class="annual">', "<h2>Annual daylight with a deciduous tree</h2>"]
-    if w.get("generated"):
-        parts.append('<p class="warning"><strong>Weather: GENERATED clear-sky year</strong> '
-                     f"({esc(w['description'])}) — not measured data; every day is clear, so "
-                     "daylight autonomy and sunlight exposure are upper bounds. Point "
-                     "<code>[light] epw</code> at a measured or typical-year EPW.</p>")
-    else:
-        parts.append(f"<p>Weather: {esc(w['description'])}.</p>")
     r = meta["rcontrib"]
-    parts.append(
-        "<p>Method: daylight coefficients (<code>rcontrib</code>, sky in Reinhart MF "
-        f"{meta['sky_mf']} patches, <code>-ab {r['ab']} -ad {r['ad']} -lw {r['lw']:g}</code>) × "
-        "the <code>gendaymtx -s</code> sky of every hour; direct sun from a 0.533° sun at each "
-        "hour's exact position (<code>gendaymtx -D</code>, <code>-ab 0</code>); sunlight "
-        f"reflected by the scene from unit suns at Reinhart MF {meta['sun_mf']} patch centres, "
-        "interpolated to each hour's sun. All 8760 hours; night hours are 0 lx. "
-        f"Occupancy {meta['occupancy'][0]:g}–{meta['occupancy'][1]:g} h every day "
-        f"({meta['occupied_hours']} hours). Crown in leaf from {esc(meta['leaf_on'])} to "
-        f"{esc(meta['leaf_off'])} (MM-DD, {meta['leaf_days']} days; an assumption for "
-        "<em>Morus alba</em> in Mendoza), bare branches otherwise. Scenarios: with tree "
-        f"'{esc(meta['scenarios']['with'])}', without '{esc(meta['scenarios']['without'])}'."
-        "</p>")
-    parts.append("<table><thead><tr><th>grid</th><th>tree</th><th>sDA300/50% (%)</th>"
-                 "<th>ASE1000,250 (%)</th><th>UDI &lt;100</th><th>UDI 100–300</th>"
-                 "<th>UDI 300–3000</th><th>UDI &gt;3000</th><th>DA300</th>"
-                 "<th>direct-sun hours</th></tr></thead><tbody>")
-    for row in table.itertuples(index=False):
-        parts.append(
-            f"<tr><td>{esc(str(row.grid))}</td><td>{esc(TREE_LABEL.get(row.tree, row.tree))}"
-            f"</td><td>{row.sda_300_50:.1f}</td><td>{row.ase_1000_250:.1f}</td>"
-            f"<td>{row.udi_below_100:.1f}</td><td>{row.udi_100_300:.1f}</td>"
-            f"<td>{row.udi_300_3000:.1f}</td><td>{row.udi_above_3000:.1f}</td>"
-            f"<td>{row.da_300:.1f}</td><td>{row.ase_hours:.0f}</td></tr>")
-    parts.append("</tbody></table><p><small>UDI and DA: % of occupied hours, mean over the "
-                 "grid's sensors (UDI bins: E &lt; 100, 100 ≤ E &lt; 300, 300 ≤ E ≤ 3000, "
-                 "E &gt; 3000 lx). sDA and ASE are IES LM-83 metrics of the horizontal work "
-                 "plane (no blinds operated); on a façade grid they are shown for comparison "
-                 "only.</small></p>")
-    parts.append("<h3>Monthly means (occupied hours)</h3><table><thead><tr><th>grid</th>"
-                 + "".join(f"<th>{m}</th>" for m in MONTHS) + "</tr></thead><tbody>")
+    rows = [[str(row.grid), TREE_LABEL.get(row.tree, row.tree), f"{row.sda_300_50:.1f}",
+             f"{row.ase_1000_250:.1f}", f"{row.udi_below_100:.1f}", f"{row.udi_100_300:.1f}",
+             f"{row.udi_300_3000:.1f}", f"{row.udi_above_3000:.1f}", f"{row.da_300:.1f}",
+             f"{row.ase_hours:.0f}"] for row in table.itertuples(index=False)]
+    months = []
     for g in meta["grids"]:
         for tree in ("without", "with"):
             sub = monthly[(monthly.grid == g) & (monthly.tree == tree)].sort_values("month")
-            cells = "".join(
-                f"<td>{v:.0f}{'*' if tree == 'with' and c != 'leaf' else ''}</td>"
-                for v, c in zip(sub.mean_lux, sub.crown))
-            parts.append(f"<tr><td>{esc(g)}, {TREE_LABEL[tree]}</td>{cells}</tr>")
-    parts.append("</tbody></table><p><small>lx; * months with bare (or partly bare) "
-                 "crowns.</small></p>")
+            months.append({"label": f"{g}, {TREE_LABEL[tree]}", "cells": [
+                f"{v:.0f}{'*' if tree == 'with' and c != 'leaf' else ''}"
+                for v, c in zip(sub.mean_lux, sub.crown)]})
+    figures = []
     for g in meta["grids"]:
-        parts.append(_img(p["figures"] / f"annual_maps_{g}.png",
-                          f"Annual metric maps on the {g} grid, with and without the tree"))
-        parts.append(_img(p["figures"] / f"annual_heatmap_{g}.png",
-                          f"Month × hour mean illuminance on the {g} grid"))
-        parts.append(_img(p["figures"] / f"annual_monthly_{g}.png",
-                          f"Monthly mean illuminance on the {g} grid"))
-    if meta.get("notes"):
-        parts.append("<h3>Notes</h3><ul>" + "".join(f"<li>{esc(n)}</li>" for n in meta["notes"])
-                     + "</ul>")
+        figures += [
+            _img(p["figures"] / f"annual_maps_{g}.png",
+                 f"Annual metric maps on the {g} grid, with and without the tree"),
+            _img(p["figures"] / f"annual_heatmap_{g}.png",
+                 f"Month × hour mean illuminance on the {g} grid"),
+            _img(p["figures"] / f"annual_monthly_{g}.png",
+                 f"Monthly mean illuminance on the {g} grid")]
     t = meta.get("timing", {})
+    timing = None
     if t:
-        parts.append(f"<p><small>Wall time {t.get('total_s', float('nan')):.0f} s "
-                     f"(scenes {t.get('scenes_s', 0):.0f} s, weather "
-                     f"{t.get('weather_s', 0):.0f} s, "
-                     + ", ".join(f"{k[:-2]} {v:.0f} s" for k, v in t.items()
-                                 if k[:-2] in ("without", "leaf_on", "leaf_off"))
-                     + ").</small></p>")
-    parts.append("</section>")
-    return "\n".join(parts)
+        timing = (f"Wall time {t.get('total_s', float('nan')):.0f} s (scenes "
+                  f"{t.get('scenes_s', 0):.0f} s, weather {t.get('weather_s', 0):.0f} s, "
+                  + ", ".join(f"{k[:-2]} {v:.0f} s" for k, v in t.items()
+                              if k[:-2] in ("without", "leaf_on", "leaf_off")) + ").")
+    return {
+        "results": True, "weather": meta["weather"], "sky_mf": meta["sky_mf"],
+        "sun_mf": meta["sun_mf"], "rcontrib": f"-ab {r['ab']} -ad {r['ad']} -lw {r['lw']:g}",
+        "occupancy": f"{meta['occupancy'][0]:g}–{meta['occupancy'][1]:g}",
+        "occupied_hours": meta["occupied_hours"], "leaf_on": meta["leaf_on"],
+        "leaf_off": meta["leaf_off"], "leaf_days": meta["leaf_days"],
+        "scenarios": meta["scenarios"], "rows": rows, "months": list(MONTHS),
+        "monthly": months, "figures": figures, "notes": [str(n) for n in meta.get("notes", [])],
+        "timing": timing,
+    }

@@ -13,7 +13,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
-from jinja2 import Environment, PackageLoader, StrictUndefined
+from jinja2 import Environment
 from matplotlib import colormaps
 from matplotlib.figure import Figure
 
@@ -23,6 +23,7 @@ from radtree.diagnose.effects import EFFECTS, EffectContext, candidates
 from radtree.diagnose.residuals import RULES, DisagreementMap
 from radtree.figures import new_figure, save_png
 from radtree.fileio import write_text
+from radtree.resources import template_environment
 
 if TYPE_CHECKING:
     from radtree.diagnose.loop import LoopResult
@@ -171,8 +172,7 @@ def fig_candidates(att: Any, times: list[str], title: str, path: Path) -> str:
 
 # --------------------------------------------------------------------------- HTML
 def _env() -> Environment:
-    env = Environment(loader=PackageLoader("radtree", "templates"), undefined=StrictUndefined,
-                      autoescape=True, trim_blocks=True, lstrip_blocks=True)
+    env = template_environment(autoescape=True, trim_blocks=True, lstrip_blocks=True)
     env.filters["f3"] = lambda v: "–" if v is None or (isinstance(v, float) and
                                                       not math.isfinite(v)) else f"{v:.3f}"
     env.filters["f0"] = lambda v: "–" if v is None or (isinstance(v, float) and

@@ -73,7 +73,7 @@ def read_table(path: Path, hint: str = "") -> pd.DataFrame:
     """A results table read from ``path`` and checked (columns, clock times); RadtreeError
     naming the file otherwise. ``hint``: what to run when the file is missing or empty."""
     if not path.is_file():
-        raise RadtreeError(f"no results: {path} not found" + (f"; {hint}" if hint else ""))
+        raise RadtreeError(f"no results: {hint + ' ' if hint else ''}({path} not found)")
     try:
         df = pd.read_csv(path, dtype=_DTYPES)  # type: ignore[arg-type]
     except (OSError, ValueError) as exc:

@@ -28,7 +28,7 @@ _EXPORTS = {
     "SweepPlan": "plan", "plan_sweep": "plan", "execute": "scheduler",
     "SweepOutcome": "run", "merge_results": "run", "run_sweep": "run",
     "case_metrics": "sensitivity", "sensitivity_table": "sensitivity",
-    "sweep_report_section": "sensitivity", "tornado_plot": "sensitivity",
+    "sweep_section_data": "sensitivity", "tornado_plot": "sensitivity",
     "write_sensitivity": "sensitivity",
 }
 __all__ = sorted(_EXPORTS)

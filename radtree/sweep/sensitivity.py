@@ -19,14 +19,13 @@ Per scenario × parameter × metric (``sensitivity.csv``):
   ranking statistic for Latin hypercube designs; for full factorials it is given as well.
 
 ``tornado.png`` draws the main-effect ranges (nRMSE when measured, and the daily façade mean),
-largest on top, per scenario. :func:`sweep_report_section` returns an HTML fragment naming the
+largest on top, per scenario. :func:`sweep_section_data` gives the report section's data naming the
 unknown that moves scenario A's nRMSE most.
 """
 
 from __future__ import annotations
 
 import base64
-import html
 import json
 import math
 from pathlib import Path
@@ -263,21 +262,22 @@ def _fmt(v: float, metric: str) -> str:
     return f"{v:,.0f} lx"
 
 
-def sweep_report_section(project_root: str | Path, scenario: str = "A") -> str:
-    """HTML fragment on the sweep of the project at ``project_root`` ("" when none was run).
+def sweep_section_data(project_root: str | Path, scenario: str = "A") -> dict[str, Any] | None:
+    """The report section on the sweep of the project at ``project_root`` (None when none was
+    run), as the data ``templates/sections/sweep.html.j2`` renders.
 
     Names the unknown that moves ``scenario``'s nRMSE most (or its daily façade mean when the
     project has no measurements; the first swept scenario when ``scenario`` was not swept),
-    tabulates every parameter's effect and embeds the tornado plot.
+    tabulates every parameter's effect (nRMSE/nMBE as fractions, illuminance in lux) and embeds
+    the tornado plot (base64 PNG).
     """
     out = _sweep_dir(project_root)
     sens_path = out / "sensitivity.csv"
     if not sens_path.exists():
-        return ""
+        return None
     sens = pd.read_csv(sens_path)
     if sens.empty:
-        return ""
-    esc = html.escape
+        return None
     info: dict[str, Any] = {}
     if (out / "design.json").exists():
         info = json.loads((out / "design.json").read_text(encoding="utf-8"))
@@ -287,59 +287,43 @@ def sweep_report_section(project_root: str | Path, scenario: str = "A") -> str:
     metric = "nrmse" if "nrmse" in set(s["metric"]) else "facade_mean_lux"
     s_m = s[s["metric"] == metric].sort_values("effect_range", ascending=False)
     top = s_m.iloc[0]
-    parts = ['<section class="sweep">', "<h2>Sensitivity sweep: which unknown matters</h2>"]
-    n_cases = info.get("cases")
-    kind = {"full": "full factorial", "lhs": "Latin hypercube"}.get(info.get("design", ""), "")
-    params = info.get("parameters", [])
-    desc = ", ".join(f"<code>{esc(p['name'])}</code> = {esc(str(p['spec']))}" for p in params)
-    if n_cases:
-        parts.append(f"<p>{n_cases} cases ({esc(kind)}"
-                     + (f", seed {info['seed']}" if info.get("seed") is not None else "")
-                     + f", engine {esc(str(info.get('engine', '')))}) over {desc}.</p>")
-    if sc != scenario:
-        parts.append(f"<p>Scenario {esc(scenario)} was not in the sweep; scenario {esc(sc)} "
-                     "is shown instead.</p>")
-    what = "normalised RMSE against the measurements" if metric == "nrmse" else (
-        "daily mean façade illuminance (the project has no measurements, so no nRMSE)")
-    parts.append(
-        f"<p><strong>The unknown that moves scenario {esc(sc)}'s {what} most is "
-        f"<code>{esc(str(top['parameter']))}</code></strong>: from "
-        f"{_fmt(top['effect_low'], metric)} at {esc(str(top['value_at_low']))} to "
-        f"{_fmt(top['effect_high'], metric)} at {esc(str(top['value_at_high']))} "
-        f"({esc(str(top['method']))}, averaged over the other parameters; range "
-        f"{_fmt(top['effect_range'], metric)}).</p>")
     lux = s[s["metric"] == "facade_mean_lux"].set_index("parameter")
     nmbe = s[s["metric"] == "nmbe"].set_index("parameter")
     head = ["parameter", f"{METRIC_LABELS.get(metric, metric)} range", "low → high at",
             "Spearman ρ"]
     if metric == "nrmse":
         head += ["nMBE range", "façade lux range"]
-    parts.append("<table><thead><tr>" + "".join(f"<th>{esc(h)}</th>" for h in head)
-                 + "</tr></thead><tbody>")
+    rows = []
     for _, r in s_m.iterrows():
-        rho = "—" if pd.isna(r["spearman_rho"]) else f"{r['spearman_rho']:+.2f}"
-        cells = [f"<code>{esc(str(r['parameter']))}</code>",
-                 f"{_fmt(r['effect_low'], metric)} – {_fmt(r['effect_high'], metric)}",
-                 f"{esc(str(r['value_at_low']))} → {esc(str(r['value_at_high']))}", rho]
+        cells = [f"{_fmt(r['effect_low'], metric)} – {_fmt(r['effect_high'], metric)}",
+                 f"{r['value_at_low']} → {r['value_at_high']}",
+                 "—" if pd.isna(r["spearman_rho"]) else f"{r['spearman_rho']:+.2f}"]
         if metric == "nrmse":
             p = r["parameter"]
             cells.append(f"{nmbe.loc[p, 'effect_low']:+.3f} – {nmbe.loc[p, 'effect_high']:+.3f}"
                          if p in nmbe.index else "—")
             cells.append(f"{lux.loc[p, 'effect_low']:,.0f} – {lux.loc[p, 'effect_high']:,.0f}"
                          if p in lux.index else "—")
-        parts.append("<tr>" + "".join(f"<td>{c}</td>" for c in cells) + "</tr>")
-    parts.append("</tbody></table>")
+        rows.append({"parameter": str(r["parameter"]), "cells": cells})
     png = out / "tornado.png"
-    if png.exists():
-        data = base64.b64encode(png.read_bytes()).decode("ascii")
-        parts.append(f'<figure><img alt="tornado plot of the sweep" '
-                     f'src="data:image/png;base64,{data}"><figcaption>Main-effect range of '
-                     "each parameter (bar) about the mean over all cases (line); labels are "
-                     "the parameter values at the bar ends.</figcaption></figure>")
     failures = out / "failures.csv"
-    if failures.exists():
-        nf = len(pd.read_csv(failures))
-        if nf:
-            parts.append(f"<p>{nf} case(s) failed; see <code>{esc(str(failures))}</code>.</p>")
-    parts.append("</section>")
-    return "\n".join(parts)
+    return {
+        "cases": info.get("cases"),
+        "design": {"full": "full factorial", "lhs": "Latin hypercube"}.get(
+            info.get("design", ""), ""),
+        "seed": info.get("seed"), "engine": str(info.get("engine", "")),
+        "parameters": [{"name": str(p["name"]), "spec": str(p["spec"])}
+                       for p in info.get("parameters", [])],
+        "asked": scenario, "scenario": sc,
+        "what": ("normalised RMSE against the measurements" if metric == "nrmse" else
+                 "daily mean façade illuminance (the project has no measurements, so no nRMSE)"),
+        "top": {"parameter": str(top["parameter"]),
+                "low": _fmt(top["effect_low"], metric), "at_low": str(top["value_at_low"]),
+                "high": _fmt(top["effect_high"], metric), "at_high": str(top["value_at_high"]),
+                "method": str(top["method"]), "range": _fmt(top["effect_range"], metric)},
+        "header": head, "rows": rows,
+        "tornado": (base64.b64encode(png.read_bytes()).decode("ascii") if png.exists()
+                    else None),
+        "failures": len(pd.read_csv(failures)) if failures.exists() else 0,
+        "failures_file": str(failures),
+    }

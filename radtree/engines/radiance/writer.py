@@ -14,11 +14,11 @@ build/<scenario>/
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
-from jinja2 import Environment, PackageLoader, StrictUndefined
 
 import radtree
 from radtree.config import EngineParams
@@ -27,7 +27,8 @@ from radtree.engines.radiance.sky import ANALYTIC_SKY_CAL, sky_text
 from radtree.fileio import write_text
 from radtree.light.sky import SkyState
 from radtree.light.units import PHOTOPIC_RGB, WHITE_EFFICACY
-from radtree.optics import Hole, Plastic, with_reflectance
+from radtree.optics import Hole, Material, Plastic, with_reflectance
+from radtree.resources import template_environment
 from radtree.scene import Mesh, Scene
 
 
@@ -39,6 +40,14 @@ def mesh_to_radiance(mesh: Mesh) -> str:
         coords = " ".join(f"{v:.5f}" for v in t.ravel())
         out.append(f"{mesh.material} polygon {mesh.name}.{i}\n0\n0\n9 {coords}\n")
     return "\n".join(out)
+
+
+def materials_text(materials: Mapping[str, Material], ground: str | None = None) -> str:
+    """``materials.rad``: every material's Radiance entry (as in ``materials/*.rad``), without
+    holes (not written) and without the ground ``ground`` (written per hour in ``skies/``)."""
+    entries = [m.to_radiance() for name, m in materials.items()
+               if not isinstance(m, Hole) and name != ground]
+    return "# materials (ground: per hour in skies/)\n\n" + "\n".join(entries)
 
 
 def rtrace_options(params: EngineParams, ab: int) -> list[str]:
@@ -86,13 +95,7 @@ def write_build(scene: Scene, states: list[SkyState], params: EngineParams, ab: 
     (folder / "grids").mkdir(exist_ok=True)
     (folder / "skies").mkdir(exist_ok=True)
 
-    mats = []
-    for name, m in scene.materials.items():
-        if isinstance(m, Hole) or name == scene.ground_material:
-            continue
-        mats.append(m.to_radiance())
-    write_text(folder / "materials.rad", "# materials (ground: per hour in skies/)\n\n"
-               + "\n".join(mats))
+    write_text(folder / "materials.rad", materials_text(scene.materials, scene.ground_material))
     scene_files = ["materials.rad"]
     geometry_files = []
     for mesh in scene.solid_meshes():
@@ -130,8 +133,7 @@ def write_build(scene: Scene, states: list[SkyState], params: EngineParams, ab: 
 
 
 def write_makefile(plan: BuildPlan, install: RadianceInstall | None, scenario: str) -> None:
-    env = Environment(loader=PackageLoader("radtree", "templates"), undefined=StrictUndefined,
-                      keep_trailing_newline=True)
+    env = template_environment(keep_trailing_newline=True)
     text = env.get_template("Makefile.j2").render(
         version=radtree.__version__, scenario=scenario, hours=plan.hours, grids=plan.grids,
         hour_grids={h: plan.grids_at(h) for h in plan.hours},

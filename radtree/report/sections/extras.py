@@ -1,0 +1,133 @@
+"""The optional studies' report sections: office block, sensitivity sweep, crown realisations,
+permeability scan, diagnosis and annual daylight — each present only when its outputs exist.
+
+Each ``*_data`` function returns the plain data its template renders (formatted text cells:
+lux as whole numbers, nRMSE/nMBE as fractions with 3 decimals), or None when there is nothing
+to show.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from pathlib import Path
+from typing import Any
+
+import pandas as pd
+
+from radtree.config import Project
+from radtree.report.sections import Section
+
+
+def realisation_frame(project: Project) -> pd.DataFrame | None:
+    """Per scenario with crown realisations, per realisation: façade hourly means, nRMSE and
+    nMBE against the measured hourly means (None without ``results/realisations.csv``)."""
+    path = project.results_dir / "realisations.csv"
+    if not path.exists():
+        return None
+    from radtree.measurements import hourly_grid_means
+    from radtree.stats import nmbe, nrmse
+
+    per = pd.read_csv(path)
+    per = per[per["grid"] == "facade"]
+    if per.empty:
+        return None
+    hourly = per.groupby(["scenario", "realisation", "time"])["lux"].mean().unstack("time")
+    measured = hourly_grid_means(project.measured) if project.measured is not None else None
+    out = hourly.reset_index()
+    if measured is not None and set(hourly.columns) <= set(measured.index):
+        m = measured.reindex(hourly.columns).to_numpy()
+        out["nrmse"] = [nrmse(m, row) for row in hourly.to_numpy()]
+        out["nmbe"] = [nmbe(m, row) for row in hourly.to_numpy()]
+    return out
+
+
+def realisations_data(project: Project) -> dict[str, Any] | None:
+    """Each crown realisation of a scenario alone: façade means (lx) per hour, and nRMSE / nMBE
+    against the measured hourly means when they exist (None without realisations)."""
+    t = realisation_frame(project)
+    if t is None:
+        return None
+    hours = [c for c in t.columns if c not in ("scenario", "realisation", "nrmse", "nmbe")]
+    stats = "nrmse" in t.columns
+    rows = []
+    for _, r in t.iterrows():
+        cells = [f"{r[h]:.0f}" for h in hours]
+        if stats:
+            cells += [f"{r['nrmse']:.3f}", f"{r['nmbe']:+.3f}"]
+        rows.append({"scenario": str(r["scenario"]), "realisation": str(int(r["realisation"])),
+                     "cells": cells})
+    spread = [f"Scenario {name}: single crowns give nRMSE {g['nrmse'].min():.3f}–"
+              f"{g['nrmse'].max():.3f} (mean {g['nrmse'].mean():.3f})."
+              for name, g in t.groupby("scenario")] if stats else []
+    return {"columns": [str(h) for h in hours] + (["nRMSE", "nMBE"] if stats else []),
+            "rows": rows, "spread": spread}
+
+
+def diagnose_data(folder: Path) -> dict[str, Any]:
+    """The diagnosis (``folder`` = ``PROJECT/diagnose``): its steps as *fitted* parameters, each
+    with its leave-one-hour-out cross-validated nRMSE. ``steps`` is None without ``steps.csv``
+    and empty when no effect was added."""
+    steps_csv = folder / "steps.csv"
+    if not steps_csv.exists():
+        return {"steps": None}
+    steps = pd.read_csv(steps_csv)
+    return {"steps": [{
+        "step": str(int(r["step"])), "effect": str(r["effect"]),
+        "strength": str(r.get("strength_text", "")),
+        "explained": f"{100 * float(r['explained_fraction']):.0f}",
+        "rmse": f"{float(r['rmse_before']):.3f} → {float(r['rmse_after']):.3f}",
+        "cv_rmse": f"{float(r['cv_rmse_before']):.3f} → {float(r['cv_rmse_after']):.3f}",
+    } for _, r in steps.iterrows()]}
+
+
+def extra_sections(project: Project, out: Path, echo: Callable[[str], None]
+                   ) -> tuple[list[Section], list[Section]]:
+    """The HTML and the Markdown sections of the studies that exist for this project, in page
+    order. Their figures are written into ``out`` (the report folder)."""
+    html: list[Section] = []
+    md: list[Section] = []
+    if project.office is not None:
+        from radtree.office_summary import (
+            office_section_data,
+            read_results,
+            summarise,
+            write_hourly_charts,
+            write_maps,
+            write_summary,
+        )
+
+        write_summary(project, maps=False)
+        table = read_results(project)
+        write_maps(project, table, out / "office")
+        write_hourly_charts(project, summarise(table), out / "office")
+        html.append(Section("office", office_section_data(project)))
+        echo("  office block: summary table and false-colour maps")
+    from radtree.sweep.sensitivity import sweep_section_data
+
+    sweep = sweep_section_data(project.root)
+    if sweep is not None:
+        html.append(Section("sweep", sweep))
+        echo("  sweep: sensitivity section")
+    crowns = realisations_data(project)
+    if crowns is not None:
+        html.append(Section("realisations", crowns))
+        md.append(Section("realisations", crowns))
+        echo("  crown realisations section")
+    from radtree.permeability_scan import scan_section_data
+
+    scan = scan_section_data(project, out)
+    if scan is not None:
+        html.append(Section("permeability_scan", scan))
+        md.append(Section("permeability_scan", scan))
+        echo("  permeability scan section")
+    diagnosis = diagnose_data(project.root / "diagnose")
+    if (project.root / "diagnose" / "index.html").exists():
+        html.append(Section("diagnose", diagnosis))
+    if diagnosis["steps"] is not None:
+        md.append(Section("diagnose", diagnosis))
+    if (project.results_dir / "annual_summary.csv").exists():
+        from radtree.annual import annual_section_data
+
+        html.append(Section("annual", annual_section_data(project)))
+        echo("  annual: metric maps and month × hour heat maps")
+    return html, md
