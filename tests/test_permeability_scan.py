@@ -8,15 +8,15 @@ import pandas as pd
 import pytest
 from click.testing import CliRunner
 
-from radtree.cli import main
-from radtree.config import load_project
-from radtree.permeability_scan import (
+from radtree.calibrate.scan import (
     MEASURED_BAND,
     PermeabilityScan,
     scan_permeability,
     unobstructed_project,
     write_scan,
 )
+from radtree.cli import main
+from radtree.config import load_project
 from radtree.stats import nmbe, nrmse
 from tests.conftest import copy_project
 

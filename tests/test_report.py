@@ -162,7 +162,7 @@ def built(tmp_path_factory: pytest.TempPathFactory) -> tuple[Project, Path]:
 
 def write_scan_and_diagnosis(p: Project) -> None:
     """A permeability scan (results/) and a diagnosis (diagnose/steps.csv) to report."""
-    from radtree.permeability_scan import PermeabilityScan, write_scan
+    from radtree.calibrate.scan import PermeabilityScan, write_scan
 
     scan = pd.DataFrame({"value": [0.5, 0.52], "permeability_street": [0.06, 0.073],
                          "permeability_street_se": [2e-4, 2e-4],

@@ -1,5 +1,5 @@
 """``radtree permeability PROJECT``: scan a crown field against the crown's global permeability
-and a scenario's fit (see :mod:`radtree.permeability_scan`)."""
+and a scenario's fit (see :mod:`radtree.calibrate.scan`)."""
 
 from __future__ import annotations
 
@@ -49,7 +49,7 @@ def permeability_command(project: Path, scenario: str, field: str, values_text: 
 
       radtree permeability examples/mendoza-street -s A --values 0.48:0.54:7
     """
-    from radtree.permeability_scan import scan_permeability, write_scan
+    from radtree.calibrate.scan import scan_permeability, write_scan
 
     values = _values(values_text)
     proj = load_project(project)

@@ -113,7 +113,7 @@ def extra_sections(project: Project, out: Path, echo: Callable[[str], None]
         html.append(Section("realisations", crowns))
         md.append(Section("realisations", crowns))
         echo("  crown realisations section")
-    from radtree.permeability_scan import scan_section_data
+    from radtree.calibrate.scan import scan_section_data
 
     scan = scan_section_data(project, out)
     if scan is not None:
