@@ -91,7 +91,8 @@ class _Reader:
     def check_unknown(self, known: tuple[str, ...]) -> None:
         unknown = sorted(set(self.data) - set(known))
         if unknown:
-            raise self.error(unknown[0], "unknown field (" + known_text(
+            what = "table" if isinstance(self.data[unknown[0]], dict | list) else "field"
+            raise self.error(unknown[0], f"unknown {what} (" + known_text(
                 unknown[0], known, "known here") + ")")
 
 

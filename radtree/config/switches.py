@@ -178,7 +178,7 @@ def check_key(name: Any, value: Any, use: str = SWITCH, *, source: str | None = 
     try:
         typed = key.spec.check(value, lenient=True, allow_path=use == FIELD)
     except ValueError as exc:
-        also = f" ({key.name}: {key.spec.expected()})" if key.name != name else ""
+        also = f" ({key.name}: {key.spec.expected()})"
         raise ConfigError(f"{exc}{also}", source=source, field=where or (
             f"switches.{name}" if use == SWITCH else str(name))) from None
     return key, typed
