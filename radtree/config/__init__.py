@@ -50,10 +50,10 @@ from radtree.config.switches import (
 
 __all__ = [
     "CROWN_MODELS", "ENGINES", "FIELD", "KEYS", "LOUVER_ARRANGEMENTS", "LOUVER_READINGS",
-    "PATH_FIELDS", "PROJECT_SWITCH_SECTIONS", "REFLECTION_GROUNDS", "REFLECTION_MODES", "REFLECTION_VIEW_FACTORS",
-    "SKY_CHOICES", "SWITCH", "TREE_FORMS", "TREE_TABLES", "Crown", "Dome", "EngineParams", "Homogeneous",
-    "Key", "Light", "Louvers", "Office", "Perforated", "Project", "Scenario", "SchemaError",
-    "Sensors", "Site", "Spec", "Street", "Tree", "check_fields", "check_key", "check_switches",
-    "effective_project", "find_project_file", "known", "load_project", "lookup_key",
-    "parse_project", "parse_time", "set_dotted",
+    "PATH_FIELDS", "PROJECT_SWITCH_SECTIONS", "REFLECTION_GROUNDS", "REFLECTION_MODES",
+    "REFLECTION_VIEW_FACTORS", "SKY_CHOICES", "SWITCH", "TREE_FORMS", "TREE_TABLES", "Crown",
+    "Dome", "EngineParams", "Homogeneous", "Key", "Light", "Louvers", "Office", "Perforated",
+    "Project", "Scenario", "SchemaError", "Sensors", "Site", "Spec", "Street", "Tree",
+    "check_fields", "check_key", "check_switches", "effective_project", "find_project_file",
+    "known", "load_project", "lookup_key", "parse_project", "parse_time", "set_dotted",
 ]

@@ -203,7 +203,8 @@ class Checked:
             try:
                 typed = s.check(value, lenient=True)
             except ValueError as exc:
-                raise SchemaError(str(exc), f"{self.TABLE}.{toml_name(type(self), f.name)}") from None
+                key = f"{self.TABLE}.{toml_name(type(self), f.name)}"
+                raise SchemaError(str(exc), key) from None
             if typed is not value:
                 object.__setattr__(self, f.name, typed)
         self.check()

@@ -1,7 +1,7 @@
 """The ``[sweep]`` table of a project file, and checking swept field names (the registry).
 
-``config.py`` does not know ``[sweep]``; the sweep reads the raw TOML itself and hands the rest
-to :func:`radtree.config.parse_project`. The table (every key optional)::
+``radtree.config`` does not read ``[sweep]``; the sweep reads the raw TOML itself and hands the
+rest to :func:`radtree.config.parse_project`. The table (every key optional)::
 
     [sweep]
     design = "full"           # or "lhs"
