@@ -81,7 +81,10 @@ class Spec:
         """The value typed (int → float for a number; ``lenient``: a whole float is an integer),
         or ValueError with the message."""
         if hasattr(value, "item") and not isinstance(value, str | bytes | list | tuple):
-            value = value.item()  # NumPy scalars
+            try:
+                value = value.item()  # NumPy scalars
+            except (TypeError, ValueError):
+                pass
         if value is None and self.optional:
             return None
         if self.path_ok and allow_path and isinstance(value, str | Path):
