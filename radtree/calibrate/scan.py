@@ -28,7 +28,7 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
-from radtree.config import Project, Scenario
+from radtree.config import Project, Scenario, check_key
 from radtree.engines.registry import seeded_engine
 from radtree.errors import ConfigError, RadtreeError
 from radtree.figures import new_figure, save_png
@@ -115,6 +115,8 @@ def scan_permeability(project: Project, scenario: str = "A",
                       echo: Callable[[str], None] = print) -> PermeabilityScan:
     """Scan ``field`` (a crown switch such as ``louvers.transmittance``) over ``values`` for
     ``scenario`` of ``project``; see the module docstring for the columns."""
+    for v in values:  # a switch of the one registry, each value typed and bounded
+        check_key(field, v, source=str(project.source), where=f"switches.{field}")
     sc0 = next((s for s in project.scenarios if s.name == scenario), None)
     if sc0 is None:
         raise ConfigError(f"no scenario {scenario!r} in {project.source} (scenarios: "

@@ -29,7 +29,7 @@ from collections.abc import Iterable
 from dataclasses import dataclass, replace
 from typing import Any
 
-from radtree.config import Scenario, effective_project
+from radtree.config import Scenario, effective_project, lookup_key
 from radtree.diagnose.effect import (
     LOW_BOUNCES,
     Effect,
@@ -317,6 +317,18 @@ EFFECTS: tuple[Effect, ...] = (
     SpecularTransmission(), CrownGaps(), FewerStages(), MoreStages(), HourlyGroundReflectance(),
 )
 EFFECT_NAMES: tuple[str, ...] = tuple(e.name for e in EFFECTS)
+
+
+def check_effect_keys(catalogue: Iterable[Effect] = EFFECTS) -> None:
+    """Every switch an effect writes is a key of the one registry (ConfigError naming it and
+    listing the known switches otherwise); the values are checked when a scenario is made."""
+    for e in catalogue:
+        key = getattr(e, "key", None)
+        if key is not None:
+            lookup_key(key, where=f"effect {e.name}: switches.{key}")
+
+
+check_effect_keys()
 
 
 def get_effect(name: str) -> Effect:

@@ -22,7 +22,7 @@ import numpy as np
 import pandas as pd
 import tomllib
 
-from radtree.config import Project, Scenario, find_project_file, load_project
+from radtree.config import PATH_FIELDS, Project, Scenario, find_project_file, load_project
 from radtree.diagnose.attribution import (
     DEFAULT_MARGIN,
     Attribution,
@@ -326,10 +326,6 @@ def run_loop(sim: Simulator, ctx: EffectContext, start: Scenario, measured: Meas
 
 
 # --------------------------------------------------------------------------- project files
-PATH_FIELDS = ("project.measured", "project.measured_rows", "street.ground_reflectance",
-               "light.direct_normal", "light.epw", "tree.perforated.photo")
-
-
 def _relocate(value: Any, old: Path, new: Path) -> Any:
     """A relative data path of the project at ``old`` as seen from ``new``: relative when
     ``new`` lies inside the project folder, else absolute."""

@@ -22,23 +22,24 @@ AUTO_ORDER = ("radiance", "numpy")
 ENGINE_CHOICES = ("auto", *ENGINES)
 
 
-def engine_class(name: str) -> type[Engine]:
-    """The registered class of engine ``name``."""
+def engine_class(name: str, source: str | None = None) -> type[Engine]:
+    """The registered class of engine ``name`` (``source``: the file that named it)."""
     if name not in ENGINES:
         raise ConfigError(f"unknown engine {name!r} (expected one of {', '.join(ENGINE_CHOICES)})",
-                          field="engine.name")
+                          source=source, field="engine.name")
     module, _, cls = ENGINES[name].partition(":")
     return getattr(import_module(module), cls)
 
 
-def get_engine(name: str = "auto") -> Engine:
-    """An engine instance; ``auto`` → the first available of :data:`AUTO_ORDER`."""
+def get_engine(name: str = "auto", source: str | None = None) -> Engine:
+    """An engine instance; ``auto`` → the first available of :data:`AUTO_ORDER`; an unknown
+    name → ConfigError naming ``source`` and ``engine.name``."""
     if name == "auto":
         for candidate in AUTO_ORDER:
             if engine_class(candidate).available():
                 return engine_class(candidate)()
         raise RadtreeError("no engine available")
-    cls = engine_class(name)
+    cls = engine_class(name, source)
     if not cls.available():
         raise RadtreeError(f"engine {name!r} asked for, but {cls.missing_hint}")
     return cls()

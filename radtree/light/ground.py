@@ -31,9 +31,6 @@ from radtree.light.tables import ground_reflectance_table
 from radtree.scene import SensorGrid
 from radtree.site.street import sky_view_factor_to_street
 
-GROUND_CHOICES = ("shaded", "open")
-VIEW_FACTOR_CHOICES = ("street", "unbounded")
-
 
 def ground_reflectance_at(project: Project, altitude_deg: float) -> float:
     """The street's reflectance for a sun altitude (table: interpolate, clamp; else constant)."""
@@ -63,15 +60,11 @@ class ReflectionChoice:
 
 
 def reflection_choice(project: Project, scenario: Scenario) -> ReflectionChoice:
+    """The scenario's ``reflection.*`` switches (typed by :mod:`radtree.config.switches` when
+    the scenario was made)."""
     sw = scenario.switches
     ground = str(sw.get("reflection.ground", "shaded"))
     vf = str(sw.get("reflection.view_factor", "street"))
-    if ground not in GROUND_CHOICES:
-        raise ValueError(f"scenario {scenario.name}: reflection.ground must be one of "
-                         f"{GROUND_CHOICES}, got {ground!r}")
-    if vf not in VIEW_FACTOR_CHOICES:
-        raise ValueError(f"scenario {scenario.name}: reflection.view_factor must be one of "
-                         f"{VIEW_FACTOR_CHOICES}, got {vf!r}")
     perm = float(sw.get("reflection.permeability", project.tree.homogeneous.permeability))
     return ReflectionChoice(ground, vf, perm)
 
@@ -106,8 +99,6 @@ def unfiltered_ground_light(project: Project, scenario: Scenario, state: SkyStat
     s = float(scenario.switches.get("reflection.unfiltered", 0.0))
     if s <= 0.0:
         return np.zeros(len(grid))
-    if s > 1.0:
-        raise ValueError(f"scenario {scenario.name}: reflection.unfiltered must be in [0, 1]")
     project = effective_project(project, scenario)
     rho = ground_reflectance_at(project, state.sun.altitude_deg)
     e_open = state.direct_horizontal_lux + state.sky_horizontal_lux

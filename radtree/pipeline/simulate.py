@@ -58,7 +58,9 @@ def resolve_engine(project: Project, engine: str | Engine = "auto") -> Engine:
     ``engine.name``, itself ``auto`` → Radiance when found, else NumPy)."""
     if isinstance(engine, Engine):
         return engine
-    return get_engine(engine if engine != "auto" else project.engine.name)
+    if engine != "auto":
+        return get_engine(engine)
+    return get_engine(project.engine.name, source=str(project.source))
 
 
 def prepare_scenario(project: Project, sc: Scenario, engine: Engine,

@@ -17,13 +17,11 @@ from typing import Any
 
 import pandas as pd
 
+from radtree.config import PATH_FIELDS
 from radtree.errors import RadtreeError
 from radtree.fileio import atomic_path, write_text
 from radtree.sweep.design import Value
 
-# fields of the project file that hold paths (resolved against the project folder)
-PATH_FIELDS = ("project.measured", "project.measured_rows", "street.ground_reflectance",
-               "light.direct_normal", "light.epw", "tree.perforated.photo")
 CASE_COLUMNS = ["case_id", "case_hash"]
 
 

@@ -13,7 +13,7 @@ from radtree.config import set_dotted
 from radtree.errors import ConfigError
 from radtree.sweep.cases import CaseSpec, absolutise_paths, case_hash, case_header
 from radtree.sweep.design import Design, Parameter, make_design, parse_param
-from radtree.sweep.settings import check_fields, load_base, resolve_parameters
+from radtree.sweep.settings import check_names, load_base, resolve_parameters
 from radtree.tomlout import dumps
 
 
@@ -61,8 +61,8 @@ def plan_sweep(project: str | Path, params: Sequence[str | Parameter] | None = N
     clash = sorted(set(fixed_all) & {p.name for p in parameters})
     if clash:
         raise ConfigError(f"{', '.join(clash)} both swept and fixed (sweep.set / --set)")
-    check_fields(base, path, [p.name for p in parameters] + list(fixed_all))
-    parameters = resolve_parameters(parameters, project0)
+    check_names([p.name for p in parameters], list(fixed_all), path)
+    parameters = resolve_parameters(parameters)
     kind = design or settings.design or "full"
     seed_v = seed if seed is not None else (settings.seed if settings.seed is not None else 1)
     d = make_design(parameters, kind, samples if samples is not None else settings.samples,

@@ -1,7 +1,7 @@
-"""The ``[sweep]`` table of a project file, and checking swept field names against the project.
+"""The ``[sweep]`` table of a project file, and checking swept field names (the registry).
 
-``config.py`` does not know ``[sweep]``; the sweep reads the raw TOML itself and hands the rest
-to :func:`radtree.config.parse_project`. The table (every key optional)::
+``radtree.config`` does not read ``[sweep]``; the sweep reads the raw TOML itself and hands the
+rest to :func:`radtree.config.parse_project`. The table (every key optional)::
 
     [sweep]
     design = "full"           # or "lhs"
@@ -27,14 +27,13 @@ Dotted keys may be quoted (as above) or written as nested tables; both mean the 
 from __future__ import annotations
 
 import copy
-import typing
-from dataclasses import dataclass, field, fields, is_dataclass, replace
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
 
 import tomllib
 
-from radtree.config import Project, find_project_file, parse_project, set_dotted
+from radtree.config import KEYS, Project, check_fields, find_project_file, parse_project
 from radtree.engines.registry import ENGINE_CHOICES
 from radtree.errors import ConfigError
 from radtree.sweep.design import DESIGNS, Parameter, parse_spec
@@ -42,8 +41,6 @@ from radtree.sweep.design import DESIGNS, Parameter, parse_spec
 SCHEDULER_KINDS = ("local", "sequential")
 _KEYS = {"design", "samples", "seed", "scenarios", "hours", "engine", "workers", "scheduler",
          "out", "params", "set"}
-# TOML names whose dataclass attribute is spelt differently
-_ATTR_ALIASES = {"as": "as_", "direct_normal": "direct_normal_table"}
 
 
 @dataclass
@@ -153,107 +150,22 @@ def load_base(project: str | Path) -> tuple[Path, dict[str, Any], SweepSettings,
 
 
 # ---------------------------------------------------------------- fields
-def _default_instance(owner: Any, attr: str) -> Any:
-    """A default instance of the dataclass a None-valued optional attribute would hold."""
-    try:
-        hint = typing.get_type_hints(type(owner)).get(attr)
-    except (NameError, TypeError):
-        return None
-    for cls in typing.get_args(hint) or (hint,):
-        if isinstance(cls, type) and is_dataclass(cls):
-            try:
-                return cls()
-            except TypeError:
-                return None
-    return None
+def check_names(parameters: list[str], fixed: list[str], path: Path) -> None:
+    """Swept and fixed names must be fields of the project file (the one registry,
+    :mod:`radtree.config.switches`); the message lists the known fields."""
+    check_fields(parameters, source=str(path), verb="sweep")
+    check_fields(fixed, source=str(path), verb="set")
 
 
-def field_value(project: Project, name: str) -> tuple[bool, Any]:
-    """(found, current value) of a dotted TOML field in a loaded project.
-
-    An absent optional table (e.g. ``office``) is looked up in its default dataclass.
-    """
-    obj: Any = project
-    parts = name.split(".")
-    for i, part in enumerate(parts):
-        if not is_dataclass(obj):
-            return False, None
-        names = {f.name for f in fields(obj)}
-        attr = _ATTR_ALIASES.get(part, part)
-        if attr not in names:
-            return False, None
-        value = getattr(obj, attr)
-        if value is None and i < len(parts) - 1:
-            value = _default_instance(obj, attr)
-        if value is None and i == len(parts) - 1:
-            return True, _NoneOf(_hint_types(obj, attr))
-        obj = value
-    return True, obj
-
-
-class _NoneOf:
-    """A field whose current value is None; ``types`` are what it may hold."""
-
-    def __init__(self, types: tuple[Any, ...]):
-        self.types = types
-
-
-def _hint_types(owner: Any, attr: str) -> tuple[Any, ...]:
-    try:
-        hint = typing.get_type_hints(type(owner)).get(attr)
-    except (NameError, TypeError):
-        return ()
-    return tuple(typing.get_args(hint) or (hint,))
-
-
-def check_fields(base: dict[str, Any], path: Path, names: list[str]) -> None:
-    """Raise ConfigError when a field name is not a field of the project file.
-
-    Each field is set, alone, to a probe value in a copy of the project data and the data is
-    parsed; only an *unknown field* (or "not a table") answer about this name counts — a value
-    the probe gets wrong is the cases' business.
-    """
-    for name in names:
-        data = copy.deepcopy(base)
-        try:
-            set_dotted(data, name, 1)
-        except (ConfigError, AttributeError, TypeError):
-            raise ConfigError(f"cannot sweep {name}: {name.rsplit('.', 1)[0]} is not a table of "
-                              "the project file", source=str(path), field=name) from None
-        try:
-            parse_project(data, path)
-        except ConfigError as exc:
-            f = exc.field or ""
-            if f and (name == f or name.startswith(f + ".")) and "unknown field" in str(exc):
-                raise ConfigError(f"cannot sweep {name}: not a field of the project file "
-                                  f"({str(exc).split('unknown field', 1)[1].strip(' ()')})",
-                                  source=str(path), field=name) from None
-            if f == name and "expected a table" in str(exc):
-                raise ConfigError(f"cannot sweep {name}: it is a table; sweep one of its fields",
-                                  source=str(path), field=name) from None
-            if f and name.startswith(f + ".") and "expected a table" in str(exc):
-                raise ConfigError(f"cannot sweep {name}: {f} is not a table",
-                                  source=str(path), field=name) from None
-
-
-def resolve_parameters(parameters: list[Parameter], project: Project) -> list[Parameter]:
-    """Mark ranges over integer fields (from the field's current type) as integer."""
+def resolve_parameters(parameters: list[Parameter]) -> list[Parameter]:
+    """Mark ranges over integer fields (from the field's registered kind) as integer."""
     out = []
     for p in parameters:
-        found, value = field_value(project, p.name)
-        if isinstance(value, _NoneOf):
-            if int in value.types and float not in value.types:
-                value = 0
-            elif float in value.types:
-                value = 0.0
-            else:
-                value = None
-        if p.kind == "range" and found and value is not None:
-            is_int = isinstance(value, int) and not isinstance(value, bool)
-            if not is_int and not isinstance(value, float):
+        key = KEYS.get(p.name)
+        if p.kind == "range" and key is not None:
+            if key.spec.kind not in ("int", "float"):
                 raise ConfigError(f"{p.name}={p.text}: a numeric range for a field holding "
-                                  f"{type(value).__name__} ({value!r}); give a list of values",
-                                  field=p.name)
-            p = replace(p, integer=is_int)
+                                  f"{key.spec.expected()}; give a list of values", field=p.name)
+            p = replace(p, integer=key.spec.kind == "int")
         out.append(p)
     return out

@@ -7,121 +7,66 @@ Scenario ``switches`` override crown parameters with dotted keys naming a table 
 and one of its fields, e.g. ``"louvers.layers" = 6``, ``"louvers.specular_fraction" = 0``,
 ``"homogeneous.transmittance" = 0.2``, ``"dome.radius_m" = 3.5``, ``"crown.clearance_m" = 0.2``
 (a leading ``"tree."`` is allowed). ``"louvers.reading" = "study" | "gap"`` applies a preset
-(:data:`radtree.trees.louvers.READINGS`). Switches whose first part is not a tree table
-(``dome``, ``crown``, ``homogeneous``, ``perforated``, ``louvers``) belong to other parts of
-radtree and are ignored here; an unknown field of a tree table is an error.
+(:data:`radtree.config.LOUVER_READINGS`). The keys and their types are those of the one
+registry, :mod:`radtree.config.switches`; switches whose first part is not ``tree`` or a tree
+table belong to other parts of radtree and are left to them here.
 """
 
 from __future__ import annotations
 
 import time
-from dataclasses import fields, replace
+from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
 from radtree.config import (
+    LOUVER_READINGS,
     TREE_FORMS,
-    Crown,
-    Dome,
-    Homogeneous,
-    Louvers,
-    Perforated,
+    TREE_TABLES,
     Project,
     Scenario,
+    SchemaError,
     Tree,
+    check_key,
 )
 from radtree.errors import ConfigError
 from radtree.site.frame import FacadeFrame
 from radtree.trees.homogeneous import build_homogeneous
-from radtree.trees.louvers import READINGS, build_louvers
+from radtree.trees.louvers import build_louvers
 from radtree.trees.model import TreeModel
 from radtree.trees.perforated import build_perforated
 
 __all__ = ["TreeModel", "apply_switches", "build_crown", "build_tree", "resolve_form"]
 
-SECTIONS: dict[str, type] = {
-    "dome": Dome, "crown": Crown, "homogeneous": Homogeneous, "perforated": Perforated,
-    "louvers": Louvers,
-}
-
-
-def _coerce(value: Any, current: Any, annotation: Any, where: str, source: str | None,
-            root: Path | None) -> Any:
-    def bad(expected: str) -> ConfigError:
-        return ConfigError(f"got {value!r}, expected {expected}", source=source, field=where)
-
-    text = str(annotation)
-    if isinstance(current, bool) or text == "bool":
-        if not isinstance(value, bool):
-            raise bad("true or false")
-        return value
-    if isinstance(current, int) or text == "int":
-        if isinstance(value, bool) or not isinstance(value, int | float) or int(value) != value:
-            raise bad("an integer")
-        return int(value)
-    if isinstance(current, float) or text in ("float", "float | None"):
-        if value is None and "None" in text:
-            return None
-        if isinstance(value, bool) or not isinstance(value, int | float):
-            raise bad("a number")
-        return float(value)
-    if isinstance(current, str) or text == "str":
-        if not isinstance(value, str):
-            raise bad("text")
-        return value
-    if "Path" in text:
-        if value is None:
-            return None
-        if not isinstance(value, str | Path):
-            raise bad("a file path")
-        p = Path(value)
-        return p if p.is_absolute() or root is None else (root / p).resolve()
-    if "tuple" in text:
-        if value is None:
-            return None
-        if not isinstance(value, list | tuple) or len(value) != 3:
-            raise bad("[centre_x, centre_y, radius]")
-        return tuple(float(v) for v in value)
-    return value
-
-
 def apply_switches(tree: Tree, switches: dict[str, Any], *, source: str | None = None,
                    root: Path | None = None) -> tuple[Tree, list[str]]:
-    """Apply dotted crown-parameter switches; returns the new Tree and what was changed."""
+    """Apply the crown switches (keys of ``[tree]``, typed by :mod:`radtree.config.switches`;
+    relative paths against ``root``); returns the new Tree and what was changed. Keys of the
+    rest of radtree are left to the code they concern."""
     changed: list[str] = []
-    for key, value in (switches or {}).items():
-        parts = str(key).split(".")
-        if parts and parts[0] == "tree":
-            parts = parts[1:]
-        where = f"switches.{key}"
-        if len(parts) == 1 and parts[0] == "form":
-            if value not in TREE_FORMS:
-                raise ConfigError(f"got {value!r}, expected one of {', '.join(TREE_FORMS)}",
-                                  source=source, field=where)
-            tree = replace(tree, form=value)
-            changed.append(f"tree.form = {value!r}")
+    for name, value in (switches or {}).items():
+        first = str(name).split(".")[0]
+        if first != "tree" and first not in TREE_TABLES:
             continue
-        if len(parts) != 2 or parts[0] not in SECTIONS:
+        key, new = check_key(name, value, source=source)
+        if key.name == "tree.louvers.reading":
+            preset: dict[str, Any] = LOUVER_READINGS[new]
+            tree = replace(tree, louvers=replace(tree.louvers, **preset))
+            changed.append(f"louvers.reading = {new!r} ({LOUVER_READINGS[new]})")
             continue
-        section, name = parts
-        current = getattr(tree, section)
-        if section == "louvers" and name == "reading":
-            if value not in READINGS:
-                raise ConfigError(f"got {value!r}, expected one of {', '.join(READINGS)}",
-                                  source=source, field=where)
-            current = replace(current, **READINGS[value])
-            tree = replace(tree, louvers=current)
-            changed.append(f"louvers.reading = {value!r} ({READINGS[value]})")
-            continue
-        known = {f.name: f for f in fields(current)}
-        fname = name if name in known else (name + "_" if name + "_" in known else None)
-        if fname is None:
-            raise ConfigError(f"unknown crown parameter '{name}' of [tree.{section}] (known: "
-                              f"{', '.join(sorted(known))})", source=source, field=where)
-        new = _coerce(value, getattr(current, fname), str(known[fname].type), where, source,
-                      root)
-        tree = replace(tree, **{section: replace(current, **{fname: new})})
-        changed.append(f"{section}.{fname} = {new!r}")
+        if key.spec.kind == "path" and new is not None:
+            p = Path(new)
+            new = p if p.is_absolute() or root is None else (root / p).resolve()
+        try:
+            if len(key.attr) == 2:  # tree.form
+                tree = replace(tree, **{key.attr[1]: new})
+                changed.append(f"tree.{key.attr[1]} = {new!r}")
+                continue
+            _, section, attr = key.attr
+            tree = replace(tree, **{section: replace(getattr(tree, section), **{attr: new})})
+        except SchemaError as exc:
+            raise ConfigError(exc.detail, source=source, field=exc.key) from None
+        changed.append(f"{section}.{attr} = {new!r}")
     return tree, changed
 
 

@@ -20,7 +20,7 @@ Two readings of the study's "slat-layer transmittance 0.5" (SPEC, "first physica
   so ≈ 50 % passes each layer through gaps (direct, no ambient bounce needed).
 
 Switch between them with the scenario switch ``"louvers.reading" = "study" | "gap"`` (presets
-in :data:`READINGS`) or by setting the fields. The notes always say which reading is in use.
+in :data:`radtree.config.LOUVER_READINGS`) or by setting the fields. The notes always say which reading is in use.
 
 Geometry
 --------
@@ -64,14 +64,6 @@ from radtree.trees.louvers_dome import build_dome_louvers
 from radtree.trees.louvers_free import BRANCH_SLATS, build_free_louvers
 from radtree.trees.model import BARK_REFLECTANCE, LEAF, TRUNK, TreeModel
 from radtree.trees.volume import build_volume_louvers, recommended_volume_ab, volume_note
-
-READINGS: dict[str, dict[str, float]] = {
-    # the study's numbers: every layer fully covered, the 0.5 in the slat material
-    "study": {"cover_fraction": 1.0, "transmittance": 0.5, "reflectance": 0.11},
-    # near-opaque real leaves (measured diffuse T 0.05) with half of each layer open
-    "gap": {"cover_fraction": 0.5, "transmittance": 0.05, "reflectance": 0.11,
-            "specular_fraction": 0.0},
-}
 
 
 # ---------------------------------------------------------------- optics

@@ -1,0 +1,254 @@
+"""The project file ``radtree.toml`` read into the dataclasses of :mod:`radtree.config.schema`.
+
+Every invalid field raises :class:`radtree.errors.ConfigError` naming the file, the field, the
+value found and what was expected; an unknown field or table lists every known one (close
+matches first). Values are typed by the fields' :class:`radtree.config.spec.Spec`; relative
+paths are resolved against the project folder.
+"""
+
+from __future__ import annotations
+
+import re
+from dataclasses import fields
+from pathlib import Path
+from typing import Any
+
+import tomllib
+
+from radtree.config.schema import Project, Scenario, Site, Street, parse_time
+from radtree.config.spec import SchemaError, Spec, spec_for, spec_of, toml_name
+from radtree.config.switches import (
+    FIELD,
+    TABLES,
+    check_switches,
+    known_text,
+    lookup_key,
+    table_keys,
+)
+from radtree.errors import ConfigError
+
+TOP_TABLES = ("project", "site", "street", "light", "tree", "sensors", "engine", "office",
+              "geometry", "scenario", "sweep")
+SCENARIO_KEYS = tuple(f.name for f in fields(Scenario))
+GEOMETRY_KEYS = ("file", "material")
+
+
+class _Reader:
+    """Reads one TOML table, remembering the dotted path for error messages."""
+
+    def __init__(self, data: dict, path: str, source: str):
+        if not isinstance(data, dict):
+            raise ConfigError(f"expected a table, got {type(data).__name__}", source=source,
+                              field=path)
+        self.data, self.path, self.source = data, path, source
+        self.used: set[str] = set()
+
+    def _name(self, key: str) -> str:
+        return f"{self.path}.{key}" if self.path else key
+
+    def error(self, key: str, msg: str) -> ConfigError:
+        return ConfigError(msg, source=self.source, field=self._name(key))
+
+    def has(self, key: str) -> bool:
+        return key in self.data
+
+    def sub(self, key: str, required: bool = False) -> _Reader:
+        self.used.add(key)
+        if key not in self.data:
+            if required:
+                raise self.error(key, "missing table")
+            return _Reader({}, self._name(key), self.source)
+        return _Reader(self.data[key], self._name(key), self.source)
+
+    def raw(self, key: str, default: Any = None) -> Any:
+        self.used.add(key)
+        return self.data.get(key, default)
+
+    def value(self, key: str, spec: Spec, default: Any = None, *, required: bool = False) -> Any:
+        """The value of ``key`` checked by ``spec`` (``default`` when absent)."""
+        self.used.add(key)
+        if key not in self.data:
+            if required or default is None and not spec.optional:
+                raise self.error(key, f"missing ({spec.expected()} is required)")
+            return default
+        try:
+            return spec.check(self.data[key])
+        except ValueError as exc:
+            raise self.error(key, str(exc)) from None
+
+    def optional_path(self, key: str, base: Path, *, must_exist: bool = True) -> Path | None:
+        self.used.add(key)
+        value = self.data.get(key)
+        if value is None:
+            return None
+        if not isinstance(value, str) or not value:
+            raise self.error(key, f"expected a file path, got {value!r}")
+        p = (base / value).resolve() if not Path(value).is_absolute() else Path(value)
+        if must_exist and not p.exists():
+            raise self.error(key, f"file not found: {p}")
+        return p
+
+    def check_unknown(self, known: tuple[str, ...]) -> None:
+        unknown = sorted(set(self.data) - set(known))
+        if unknown:
+            what = "table" if isinstance(self.data[unknown[0]], dict | list) else "field"
+            raise self.error(unknown[0], f"unknown {what} (" + known_text(
+                unknown[0], known, "known here") + ")")
+
+
+def _table(r: _Reader, table: str, base: Path, **given: Any) -> Any:
+    """The dataclass of ``table`` from its TOML table: every field with a Spec that the table
+    holds (paths resolved), then ``given``; the table's unknown fields are rejected."""
+    cls = TABLES[table]
+    kwargs: dict[str, Any] = {}
+    for f in fields(cls):
+        spec = spec_of(cls, f.name)
+        key = toml_name(cls, f.name)
+        if spec is None or f.name in given or not r.has(key):
+            continue
+        kwargs[f.name] = (r.optional_path(key, base) if spec.kind == "path"
+                          else r.value(key, spec))
+    kwargs.update(given)
+    r.check_unknown(table_keys(table))
+    try:
+        return cls(**kwargs)
+    except SchemaError as exc:
+        raise ConfigError(exc.detail, source=r.source, field=exc.key) from None
+
+
+# ---------------------------------------------------------------- loading
+def find_project_file(project: str | Path) -> Path:
+    """PROJECT is a folder holding ``radtree.toml`` or the file itself."""
+    p = Path(project)
+    if p.is_dir():
+        p = p / "radtree.toml"
+    if not p.exists():
+        raise ConfigError(f"project file not found: {p}")
+    return p.resolve()
+
+
+def load_project(project: str | Path, overrides: dict[str, Any] | None = None) -> Project:
+    """Load and validate a project. ``overrides`` maps dotted field names (:data:`FIELD` keys
+    of :mod:`radtree.config.switches`) to values."""
+    path = find_project_file(project)
+    try:
+        data = tomllib.loads(path.read_text(encoding="utf-8"))
+    except tomllib.TOMLDecodeError as exc:
+        raise ConfigError(f"not valid TOML: {exc}", source=str(path)) from exc
+    except (OSError, UnicodeDecodeError) as exc:
+        raise ConfigError(f"cannot read: {exc}", source=str(path)) from exc
+    for key, value in (overrides or {}).items():
+        lookup_key(key, FIELD, source=str(path))
+        set_dotted(data, key, value)
+    return parse_project(data, path)
+
+
+def set_dotted(data: dict, key: str, value: Any) -> None:
+    """Set ``a.b.c = value`` inside nested dicts (used by overrides and sweeps)."""
+    parts = key.split(".")
+    d = data
+    for part in parts[:-1]:
+        d = d.setdefault(part, {})
+        if not isinstance(d, dict):
+            raise ConfigError(f"cannot set {key}: {part} is not a table")
+    d[parts[-1]] = value
+
+
+def parse_project(data: dict, path: Path) -> Project:
+    """The :class:`Project` of the TOML ``data`` of the file at ``path``."""
+    src = str(path)
+    base = path.parent
+    top = _Reader(data, "", src)
+
+    proj = top.sub("project")
+    name = proj.value("name", Spec("str"), path.parent.name)
+    measured = proj.optional_path("measured", base)
+    measured_rows = proj.optional_path("measured_rows", base)
+    proj.check_unknown(table_keys("project"))
+
+    s = top.sub("site", required=True)
+    hours_raw = s.raw("hours")
+    if not isinstance(hours_raw, list) or not hours_raw:
+        raise s.error("hours", f"expected a non-empty list of 'HH:MM' times, got {hours_raw!r}")
+    hours = tuple(parse_time(h, f"site.hours[{i}]", src) for i, h in enumerate(hours_raw))
+    if len(set(hours)) != len(hours):
+        raise s.error("hours", "hours repeat")
+    site = _table(s, "site", base, hours=hours, name=s.value("name", Spec("str"), name),
+                  elevation_m=s.value("elevation_m", spec_for(Site, "elevation_m"), 0.0),
+                  date=s.value("date", spec_for(Site, "date"), "2024-12-22"),
+                  **{k: s.value(k, spec_for(Site, k), required=True)
+                     for k in ("latitude", "longitude", "utc_offset_hours")})
+
+    st = top.sub("street")
+    g = st.raw("ground_reflectance")
+    ground: dict[str, Any] = {}
+    if isinstance(g, str):
+        ground = {"ground_reflectance": Street().ground_reflectance,
+                  "ground_reflectance_table": st.optional_path("ground_reflectance", base)}
+    street = _table(st, "street", base, **ground)
+
+    li = top.sub("light")
+    light = _table(li, "light", base)
+    if light.direct_normal_table is None and light.epw is None:
+        raise li.error("direct_normal", "missing: give a DNI table (time,direct_normal_lux) "
+                       "or an 'epw' weather file")
+
+    tr = top.sub("tree")
+    crowns = {t: _table(tr.sub(t), f"tree.{t}", base)
+              for t in ("dome", "crown", "homogeneous", "perforated", "louvers")}
+    tree = _table(tr, "tree", base, **crowns)
+
+    se = top.sub("sensors")
+    dense = se.value("dense_hours", spec_for(TABLES["sensors"], "dense_hours"), ())
+    unknown = [h for h in dense if h not in hours]
+    if unknown:
+        raise se.error("dense_hours", f"{', '.join(unknown)} not among site.hours")
+    sensors = _table(se, "sensors", base, dense_hours=dense)
+    engine = _table(top.sub("engine"), "engine", base)
+    office = _table(top.sub("office"), "office", base) if top.has("office") else None
+
+    # extra user geometry: [[geometry]] file = "x.obj", material = "name"
+    extra = []
+    for i, item in enumerate(top.raw("geometry", []) or []):
+        r = _Reader(item, f"geometry[{i}]", src)
+        gpath = r.optional_path("file", base)
+        if gpath is None:
+            raise r.error("file", "missing (an OBJ/STL/PLY or .rad file)")
+        extra.append((gpath, r.value("material", Spec("str"), required=True)))
+        r.check_unknown(GEOMETRY_KEYS)
+
+    scenarios = _scenarios(top, src)
+    top.raw("sweep")  # read by radtree.sweep
+    top.check_unknown(TOP_TABLES)
+    return Project(name=name, root=path.parent, source=path, site=site, street=street,
+                   light=light, tree=tree, sensors=sensors, engine=engine,
+                   scenarios=scenarios, measured=measured, measured_rows=measured_rows,
+                   office=office, extra_geometry=tuple(extra))
+
+
+def _scenarios(top: _Reader, src: str) -> tuple[Scenario, ...]:
+    raw_sc = top.raw("scenario", None)
+    if raw_sc is None:
+        raw_sc = [{"name": "base", "model": "louvers"}]
+    if not isinstance(raw_sc, list) or not raw_sc:
+        raise ConfigError("expected one or more [[scenario]] tables", source=src, field="scenario")
+    scenarios = []
+    for i, item in enumerate(raw_sc):
+        r = _Reader(item, f"scenario[{i}]", src)
+        kwargs: dict[str, Any] = {}
+        for f in fields(Scenario):
+            spec = spec_of(Scenario, f.name)
+            if spec is not None:
+                kwargs[f.name] = r.value(f.name, spec, f.default if f.name not in (
+                    "name", "model") else None, required=f.name in ("name", "model"))
+        sw = r.raw("switches", {})
+        check_switches(sw, source=src, where=f"scenario[{i}].switches")
+        if not re.match(r"^[A-Za-z0-9_.-]+$", kwargs["name"]):
+            raise r.error("name", f"got {kwargs['name']!r}: use letters, digits, _ . - only "
+                          "(it names a folder)")
+        r.check_unknown(SCENARIO_KEYS)
+        scenarios.append(Scenario(switches=dict(sw), **kwargs))
+    names = [sc.name for sc in scenarios]
+    if len(set(names)) != len(names):
+        raise ConfigError(f"scenario names repeat: {names}", source=src, field="scenario")
+    return tuple(scenarios)

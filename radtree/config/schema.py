@@ -1,0 +1,386 @@
+"""The project's typed dataclasses, validated on creation (:class:`radtree.config.spec.Checked`).
+
+Lengths in metres, angles in degrees (azimuth clockwise from north), illuminance in lux, times
+as local clock ``HH:MM``. Bounds, choices and TOML names are field metadata (:func:`meta`).
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+from collections.abc import Callable
+from dataclasses import dataclass, field, fields, is_dataclass
+from pathlib import Path
+from typing import Any, ClassVar
+
+from radtree.config.spec import TIME_RE, Checked, meta
+from radtree.errors import ConfigError
+
+CROWN_MODELS = ("homogeneous", "perforated", "louvers", "none")
+TREE_FORMS = ("dome", "free")
+LOUVER_ARRANGEMENTS = ("layers", "volume")
+REFLECTION_MODES = ("traced", "calculated")
+SKY_CHOICES = ("none", "perez")
+#: Presets of the louvers slat optics (the switch ``"louvers.reading"``): the study's reading
+#: (every layer fully covered, T 0.5 in the slat) and near-opaque leaves with open gaps.
+LOUVER_READINGS: dict[str, dict[str, float]] = {
+    "study": {"cover_fraction": 1.0, "transmittance": 0.5, "reflectance": 0.11},
+    "gap": {"cover_fraction": 0.5, "transmittance": 0.05, "reflectance": 0.11,
+            "specular_fraction": 0.0},
+}
+
+
+def _positive(default: float) -> Any:
+    return field(default=default, metadata=meta(0.0, lo_open=True))
+
+
+def _fraction(default: float) -> Any:
+    return field(default=default, metadata=meta(0.0, 1.0))
+
+
+# ---------------------------------------------------------------- dataclasses
+@dataclass(frozen=True)
+class Site(Checked):
+    """Place and times: latitude north +, longitude east + (west negative), UTC offset hours."""
+
+    TABLE: ClassVar[str] = "site"
+    name: str
+    latitude: float = field(metadata=meta(-90, 90))
+    longitude: float = field(metadata=meta(-180, 180))
+    elevation_m: float = field(metadata=meta(-500, 9000))
+    utc_offset_hours: float = field(metadata=meta(-14, 14))
+    date: str = field(metadata=meta(kind="date"))
+    hours: tuple[str, ...] = field(metadata=meta(kind="times", switch=False))
+
+
+@dataclass(frozen=True)
+class Street(Checked):
+    """An east–west (by default) street canyon.
+
+    ``facade_azimuth_deg`` is the compass direction the studied façade looks towards (its
+    outward normal): 0 = north. The façade lies at the canyon's side y' = 0 of a local frame
+    rotated by that azimuth; the opposite façade is ``width_m`` away. ``ground_reflectance`` is
+    a constant, or in the file the path of a per-hour table (then ``ground_reflectance_table``).
+    """
+
+    TABLE: ClassVar[str] = "street"
+    width_m: float = _positive(20.0)
+    length_m: float = _positive(80.0)
+    facade_azimuth_deg: float = field(default=0.0, metadata=meta(-360, 360))
+    facade_reflectance: float = _fraction(0.9)
+    building_height_m: float = _positive(15.0)
+    opposite_building_height_m: float = _positive(15.0)
+    opposite_reflectance: float = _fraction(0.35)
+    ground_reflectance: float = field(default=0.15, metadata=meta(0.0, 1.0, path_ok=True))
+    ground_reflectance_table: Path | None = field(default=None, metadata=meta(kind="-"))
+
+
+@dataclass(frozen=True)
+class Light(Checked):
+    """Sun and sky inputs: a DNI table (``time,direct_normal_lux``) or an EPW file.
+
+    ``sky``: ``none`` = sun only (the study's set-up) or ``perez`` = clear-sky Perez sky of
+    ``diffuse_horizontal_lux`` (a stated substitute: the study gives no diffuse values).
+    """
+
+    TABLE: ClassVar[str] = "light"
+    direct_normal_table: Path | None = field(default=None, metadata=meta(
+        toml="direct_normal", switch=False))
+    epw: Path | None = field(default=None, metadata=meta(switch=False))
+    sky: str = field(default="none", metadata=meta(choices=SKY_CHOICES))
+    diffuse_horizontal_lux: float = field(default=12000.0, metadata=meta(0.0, 150000.0))
+
+
+@dataclass(frozen=True)
+class Dome(Checked):
+    """Study form: hemisphere of ``radius_m`` centred on the sensor grid, flat side on the wall."""
+
+    TABLE: ClassVar[str] = "tree.dome"
+    radius_m: float = _positive(4.0)
+    segments: int = 48
+
+
+@dataclass(frozen=True)
+class Crown(Checked):
+    """Free-standing crowns: spheroids on trunks in a row along the façade.
+
+    Trunk ``trunk_distance_m`` from the façade, trees every ``spacing_m`` (``count`` trees,
+    centred on the sensors), crown of horizontal radius ``radius_m`` and vertical semi-axis
+    ``vertical_radius_m``, crown base ``base_height_m`` above the street; the crown is clipped
+    ``clearance_m`` from the façade plane.
+    """
+
+    TABLE: ClassVar[str] = "tree.crown"
+    trunk_distance_m: float = _positive(3.0)
+    spacing_m: float = _positive(8.0)
+    count: int = field(default=3, metadata=meta(1, 50))
+    radius_m: float = _positive(5.0)
+    vertical_radius_m: float = _positive(4.75)
+    base_height_m: float = _positive(3.0)
+    clearance_m: float = field(default=0.0, metadata=meta(0.0))
+    trunk_diameter_m: float = _positive(0.45)
+    segments: int = 32
+
+
+@dataclass(frozen=True)
+class Homogeneous(Checked):
+    """One translucent sheet. ``transmittance`` None → chosen so the crown passes ``permeability``
+    (T in the dome form, crossed once; √permeability for a free crown, crossed twice)."""
+
+    TABLE: ClassVar[str] = "tree.homogeneous"
+    transmittance: float | None = field(default=None, metadata=meta(0.0, 1.0))
+    reflectance: float = _fraction(0.11)
+    permeability: float = _fraction(0.055)
+
+    def check(self) -> None:
+        if self.transmittance is not None and self.transmittance + self.reflectance > 1:
+            raise self.fail("transmittance", "reflectance + transmittance exceeds 1")
+
+
+@dataclass(frozen=True)
+class Perforated(Checked):
+    """Opaque sheet (leaf reflectance) with holes where the photo shows sky.
+
+    ``photo`` a fisheye image (with ``lens`` and ``mask`` = cx,cy,r px), else a seeded random
+    gap pattern of ``openness``.
+    """
+
+    TABLE: ClassVar[str] = "tree.perforated"
+    photo: Path | None = None
+    lens: str = "equidistant"
+    mask: tuple[float, float, float] | None = field(default=None, metadata=meta(kind="mask"))
+    openness: float = _fraction(0.06)
+    reflectance: float = _fraction(0.11)
+    resolution: int = 64
+
+
+@dataclass(frozen=True)
+class Louvers(Checked):
+    """Inclined translucent leaf slats in ``layers`` filtration stages.
+
+    Each slat is a ``slat_size_m`` square inclined ``inclination_deg`` (leaf inclination), slat
+    centres on a triangular grid along branches inclined ``branch_inclination_deg``; each layer
+    covers ``cover_fraction`` of the horizontal plane. Slat optics: reflectance, total
+    transmittance, and the fraction of that transmittance that is specular (undeviated).
+
+    ``arrangement`` (free-standing crowns only): ``"layers"`` — nested lens-shaped layers, every
+    vertical line crosses ``layers`` slats; ``"volume"`` — slat centres uniform at random in the
+    crown, azimuths random, density such that a vertical line through the crown centre crosses
+    ``crossings`` slats on average (0: use ``layers``), times ``cover_fraction``.
+    ``realisations``: how many random crowns (``seed``, ``seed`` + 1, …) ``simulate`` traces
+    and averages; the results' ``lux_stderr`` is then the standard error over them.
+    """
+
+    TABLE: ClassVar[str] = "tree.louvers"
+    layers: int = field(default=4, metadata=meta(1, 20))
+    slat_size_m: float = field(default=0.3, metadata=meta(0.02, 3.0))
+    inclination_deg: float = field(default=30.0, metadata=meta(0.0, 90.0))
+    branch_inclination_deg: float = 40.0
+    cover_fraction: float = _fraction(1.0)
+    reflectance: float = _fraction(0.11)
+    transmittance: float = _fraction(0.5)
+    specular_fraction: float = _fraction(0.9)
+    seed: int = 1
+    arrangement: str = field(default="layers", metadata=meta(choices=LOUVER_ARRANGEMENTS))
+    crossings: float = field(default=0.0, metadata=meta(0.0, 60.0))
+    realisations: int = field(default=1, metadata=meta(1, 64))
+
+    def check(self) -> None:
+        if self.reflectance + self.transmittance > 1:
+            raise self.fail("transmittance", f"reflectance {self.reflectance} + transmittance "
+                            f"{self.transmittance} exceeds 1")
+
+
+@dataclass(frozen=True)
+class Tree(Checked):
+    """The crown: its ``form`` (``dome`` | ``free``) and one table per crown model."""
+
+    TABLE: ClassVar[str] = "tree"
+    form: str = field(default="dome", metadata=meta(choices=TREE_FORMS))
+    dome: Dome = field(default_factory=Dome)
+    crown: Crown = field(default_factory=Crown)
+    homogeneous: Homogeneous = field(default_factory=Homogeneous)
+    perforated: Perforated = field(default_factory=Perforated)
+    louvers: Louvers = field(default_factory=Louvers)
+
+
+@dataclass(frozen=True)
+class Sensors(Checked):
+    """The façade sensor circle: ``count`` points at equal angle steps on a ``radius_m`` circle
+    centred ``height_m`` above the street and ``offset_m`` off the wall, normal out of the wall.
+    Rows by height: top third ``higher``, middle ``intermediate``, bottom ``lower``. The dense
+    façade map grid (``dense_*``) is traced at ``dense_hours`` only (empty = every hour)."""
+
+    TABLE: ClassVar[str] = "sensors"
+    height_m: float = _positive(5.0)
+    count: int = field(default=8, metadata=meta(1, 10000))
+    radius_m: float = _positive(0.25)
+    offset_m: float = _positive(0.01)
+    x_m: float = 0.0
+    dense_grid: bool = True
+    dense_size_m: float = _positive(6.0)
+    dense_spacing_m: float = _positive(0.5)
+    dense_hours: tuple[str, ...] = field(default=(), metadata=meta(kind="times", switch=False))
+
+
+@dataclass(frozen=True)
+class Office(Checked):
+    """A block of offices in the studied façade (the building application, SPEC.md §5).
+
+    ``bays`` × ``storeys`` identical offices (both odd: a central office exists), each
+    ``width_m`` wide, ``height_m`` high (floor to ceiling) and ``depth_m`` deep, with a glazed
+    façade towards the street. Storey ``k`` (0 = ground) has its floor at ``ground_floor_m +
+    k·storey_height_m``. The glazing's measured normal transmittance ``glazing_transmittance``
+    becomes a Radiance ``glass`` transmissivity; ``frame_fraction`` of each façade opening is
+    opaque frame. Results are read in the central office. Work plane at
+    ``workplane_height_m``, grids at ``grid_spacing_m`` spacing, ``wall_offset_m`` from the walls.
+    """
+
+    TABLE: ClassVar[str] = "office"
+    bays: int = field(default=3, metadata=meta(1, 21))
+    storeys: int = field(default=3, metadata=meta(1, 21))
+    width_m: float = _positive(3.0)
+    height_m: float = _positive(2.5)
+    depth_m: float = _positive(6.0)
+    storey_height_m: float = _positive(2.5)
+    ground_floor_m: float = 1.25
+    glazing_transmittance: float = field(default=0.8, metadata=meta(0.0, 0.9183, lo_open=True))
+    frame_fraction: float = _fraction(0.1)
+    window_sill_m: float = 0.0
+    window_head_m: float = 2.5
+    floor_reflectance: float = _fraction(0.2)
+    wall_reflectance: float = _fraction(0.5)
+    ceiling_reflectance: float = _fraction(0.7)
+    workplane_height_m: float = 0.8
+    grid_spacing_m: float = _positive(0.5)
+    wall_offset_m: float = 0.5
+    facade_grid_spacing_m: float = _positive(0.5)
+
+    def check(self) -> None:
+        if self.bays % 2 == 0 or self.storeys % 2 == 0:
+            raise self.fail("bays", "bays and storeys must be odd so that a central office exists")
+        if self.height_m > self.storey_height_m:
+            raise self.fail("height_m", f"office height {self.height_m} m exceeds the storey "
+                            f"height {self.storey_height_m} m")
+
+
+@dataclass(frozen=True)
+class EngineParams(Checked):
+    """Tracing parameters. Radiance: ``ab`` (None = from the crown model), ``ad``, ``as_``
+    (written ``as`` in the file), ``ar``, ``aa``, ``lw``. The defaults (``-aa 0 -as 0``: no
+    irradiance cache, no super-sampling) are pure Monte Carlo: behind slat crowns the cache and
+    ``-as`` bias ``-I`` low by 4–8 % and the cache makes ``-ab 7`` runs take minutes instead of
+    seconds. NumPy engine: ``rays`` per sensor, ``max_bounces``, ``seed``."""
+
+    TABLE: ClassVar[str] = "engine"
+    # an engine name of radtree.engines.registry (checked when the engine is chosen)
+    name: str = "auto"
+    ab: int | None = field(default=None, metadata=meta(0, 20))
+    ad: int = field(default=2048, metadata=meta(1))
+    as_: int = field(default=0, metadata=meta(0, toml="as"))
+    ar: int = field(default=256, metadata=meta(1))
+    aa: float = field(default=0.0, metadata=meta(0.0, 1.0))
+    lw: float = field(default=0.0001, metadata=meta(0.0, 1.0))
+    rays: int = field(default=4096, metadata=meta(1))
+    max_bounces: int = field(default=8, metadata=meta(0))
+    seed: int = 1
+    workers: int = field(default=2, metadata=meta(1))
+
+
+@dataclass(frozen=True)
+class Scenario(Checked):
+    """One simulated case: a crown model, how ground-reflected light is handled, sky on/off.
+
+    ``switches`` maps dotted keys (``"louvers.layers"``, ``"engine.ab"``,
+    ``"reflection.unfiltered"``, …) to values; each key and value is checked on creation
+    against the one registry, :mod:`radtree.config.switches`."""
+
+    TABLE: ClassVar[str] = "scenario"
+    name: str
+    model: str = field(metadata=meta(choices=CROWN_MODELS))
+    reflection: str = field(default="traced", metadata=meta(choices=REFLECTION_MODES))
+    sky: str | None = field(default=None, metadata=meta(choices=SKY_CHOICES))
+    form: str | None = field(default=None, metadata=meta(choices=TREE_FORMS))
+    description: str = ""
+    switches: dict[str, Any] = field(default_factory=dict)
+
+    #: the registry's check of a ``switches`` table; :mod:`radtree.config.switches` installs
+    #: it on import (the registry is built from these dataclasses, so it cannot be imported here)
+    switch_check: ClassVar[Callable[[dict[str, Any]], None] | None] = None
+
+    def check(self) -> None:
+        if Scenario.switch_check is None:   # pragma: no cover - config/__init__ installs it
+            raise RuntimeError("radtree.config.switches was not imported")
+        Scenario.switch_check(self.switches)
+
+
+@dataclass(frozen=True)
+class Project:
+    """A loaded project file: its tables, scenarios and where it lives (``root``)."""
+
+    name: str
+    root: Path
+    source: Path
+    site: Site
+    street: Street
+    light: Light
+    tree: Tree
+    sensors: Sensors
+    engine: EngineParams
+    scenarios: tuple[Scenario, ...]
+    measured: Path | None = None
+    measured_rows: Path | None = None
+    office: Office | None = None
+    extra_geometry: tuple[tuple[Path, str], ...] = ()
+
+    @property
+    def build_dir(self) -> Path:
+        return self.root / "build"
+
+    @property
+    def results_dir(self) -> Path:
+        return self.root / "results"
+
+    @property
+    def report_dir(self) -> Path:
+        return self.root / "report"
+
+    def scenario(self, name: str) -> Scenario:
+        for s in self.scenarios:
+            if s.name == name:
+                return s
+        raise ConfigError(f"no scenario named {name!r} (have: "
+                          f"{', '.join(s.name for s in self.scenarios)})", source=str(self.source))
+
+    def to_dict(self) -> dict[str, Any]:
+        return _plain(self)
+
+    def params_hash(self, scenario: Scenario) -> str:
+        """Short hash of everything that changes a scenario's numbers."""
+        d = self.to_dict()
+        payload = {k: d[k] for k in ("site", "street", "light", "tree", "sensors", "engine",
+                                     "office", "extra_geometry")}
+        payload["engine"].pop("workers", None)
+        payload["scenario"] = _plain(scenario)
+        text = json.dumps(payload, sort_keys=True, default=str)
+        return hashlib.sha256(text.encode()).hexdigest()[:12]
+
+
+def _plain(obj: Any) -> Any:
+    if is_dataclass(obj) and not isinstance(obj, type):
+        return {f.name: _plain(getattr(obj, f.name)) for f in fields(obj)}
+    if isinstance(obj, dict):
+        return {k: _plain(v) for k, v in obj.items()}
+    if isinstance(obj, list | tuple):
+        return [_plain(v) for v in obj]
+    if isinstance(obj, Path):
+        return str(obj)
+    return obj
+
+
+def parse_time(value: Any, where: str = "time", source: str | None = None) -> str:
+    """Validate a local clock time ``HH:MM`` (24 h)."""
+    if not isinstance(value, str) or not TIME_RE.match(value):
+        raise ConfigError(f"got {value!r}, expected a local clock time HH:MM such as '10:30'",
+                          source=source, field=where)
+    return value

@@ -1,0 +1,219 @@
+"""The typing of one value: :class:`Spec` (kind, bounds, choices) and the field metadata.
+
+A dataclass field's bounds, choices and TOML name (when it differs from the attribute:
+``as_`` is written ``as``, ``direct_normal_table`` is written ``direct_normal``) are its
+:func:`meta` metadata; :func:`spec_of` turns a field into the :class:`Spec` that the reader
+(:mod:`radtree.config.reader`), the switch registry (:mod:`radtree.config.switches`) and the
+dataclasses' own ``__post_init__`` (:class:`Checked`) check values with. An invalid value
+raises :class:`SchemaError` (a :class:`radtree.errors.ConfigError`) naming the dotted field.
+"""
+
+from __future__ import annotations
+
+import math
+import re
+from dataclasses import dataclass, fields
+from datetime import date as _date
+from pathlib import Path
+from typing import Any, ClassVar
+
+from radtree.errors import ConfigError
+
+TIME_RE = re.compile(r"^([01]\d|2[0-3]):([0-5]\d)$")
+
+
+class SchemaError(ConfigError):
+    """An invalid value; ``key`` is the dotted field, ``detail`` the message without place."""
+
+    def __init__(self, detail: str, key: str):
+        super().__init__(detail, field=key)
+        self.detail, self.key = detail, key
+
+
+def show(value: Any) -> str:
+    """A value as the user wrote it (NumPy scalars as plain numbers, text quoted)."""
+    if hasattr(value, "item") and not isinstance(value, str | bytes):
+        try:
+            value = value.item()
+        except (TypeError, ValueError):
+            pass
+    return repr(value)
+
+
+def _g(x: float) -> str:
+    return f"{x:g}"
+
+
+@dataclass(frozen=True)
+class Spec:
+    """What one value may be. ``kind``: ``float`` | ``int`` | ``bool`` | ``str`` | ``path`` |
+    ``times`` (a list of ``HH:MM``) | ``date`` (``YYYY-MM-DD``) | ``mask`` ([cx, cy, r] px).
+    ``optional``: None is a value; ``path_ok``: a file path is accepted too (in the file)."""
+
+    kind: str
+    lo: float | None = None
+    hi: float | None = None
+    lo_open: bool = False
+    choices: tuple[str, ...] | None = None
+    optional: bool = False
+    path_ok: bool = False
+
+    def expected(self) -> str:
+        """What is expected, in words (for lists of keys and messages)."""
+        words = {"float": "a number", "int": "an integer", "bool": "true or false",
+                 "str": "text", "path": "a file path", "times": "a list of 'HH:MM' times",
+                 "date": "a date YYYY-MM-DD", "mask": "[centre_x, centre_y, radius] in pixels"}
+        text = words[self.kind]
+        if self.choices:
+            text = "one of " + ", ".join(self.choices)
+        bounds = []
+        if self.lo is not None:
+            bounds.append(f"{'>' if self.lo_open else '≥'} {_g(self.lo)}")
+        if self.hi is not None:
+            bounds.append(f"≤ {_g(self.hi)}")
+        if bounds:
+            text += " " + " and ".join(bounds)
+        if self.path_ok:
+            text += " or a file path"
+        return text
+
+    def check(self, value: Any, *, lenient: bool = False, allow_path: bool = True) -> Any:
+        """The value typed (int → float for a number; ``lenient``: a whole float is an integer),
+        or ValueError with the message."""
+        if hasattr(value, "item") and not isinstance(value, str | bytes | list | tuple):
+            try:
+                value = value.item()  # NumPy scalars
+            except (TypeError, ValueError):
+                pass
+        if value is None and self.optional:
+            return None
+        if self.path_ok and allow_path and isinstance(value, str | Path):
+            return self._path(value)
+        k = self.kind
+        if k == "float":
+            if isinstance(value, bool) or not isinstance(value, int | float):
+                raise ValueError(f"expected a number, got {show(value)}")
+            value = float(value)
+            if math.isnan(value) or math.isinf(value):
+                raise ValueError(f"expected a finite number, got {value}")
+            return self._bounds(value)
+        if k == "int":
+            whole = lenient and isinstance(value, float) and value.is_integer()
+            if isinstance(value, bool) or not (isinstance(value, int) or whole):
+                raise ValueError(f"expected an integer, got {show(value)}")
+            return self._bounds(int(value))
+        if k == "bool":
+            if not isinstance(value, bool):
+                raise ValueError(f"expected true or false, got {show(value)}")
+            return value
+        if k == "str":
+            if not isinstance(value, str):
+                raise ValueError(f"expected text, got {show(value)}")
+            if self.choices is not None and value not in self.choices:
+                raise ValueError(f"got {show(value)}, expected one of {', '.join(self.choices)}")
+            return value
+        if k == "path":
+            return self._path(value)
+        if k == "times":
+            if not isinstance(value, list | tuple):
+                raise ValueError(f"expected a list of 'HH:MM' times, got {show(value)}")
+            for v in value:
+                if not isinstance(v, str) or not TIME_RE.match(v):
+                    raise ValueError(f"got {show(v)}, expected a local clock time HH:MM such "
+                                     "as '10:30'")
+            return tuple(value)
+        if k == "date":
+            try:
+                _date.fromisoformat(value if isinstance(value, str) else "?")
+            except ValueError:
+                raise ValueError(f"got {show(value)}, expected YYYY-MM-DD") from None
+            return value
+        if k == "mask":
+            if (not isinstance(value, list | tuple) or len(value) != 3 or not all(
+                    isinstance(v, int | float) and not isinstance(v, bool) for v in value)):
+                raise ValueError(f"expected [centre_x, centre_y, radius] in pixels, got "
+                                 f"{show(value)}")
+            return (float(value[0]), float(value[1]), float(value[2]))
+        raise ValueError(f"cannot check a value of kind {k!r}")  # pragma: no cover
+
+    def _path(self, value: Any) -> Any:
+        if isinstance(value, Path) or (isinstance(value, str) and value):
+            return value
+        raise ValueError(f"expected a file path, got {show(value)}")
+
+    def _bounds(self, value: float) -> Any:
+        lo, hi = self.lo, self.hi
+        if lo is not None and (value < lo or (self.lo_open and value <= lo)):
+            raise ValueError(f"got {value}, expected {'>' if self.lo_open else '≥'} {_g(lo)}")
+        if hi is not None and value > hi:
+            raise ValueError(f"got {value}, expected ≤ {_g(hi)}")
+        return value
+
+
+def meta(lo: float | None = None, hi: float | None = None, *, lo_open: bool = False,
+         choices: tuple[str, ...] | None = None, toml: str | None = None,
+         kind: str | None = None, switch: bool = True, path_ok: bool = False) -> dict:
+    """Field metadata: bounds, choices, the TOML name, the kind (else from the annotation),
+    whether a scenario may switch it."""
+    return {"lo": lo, "hi": hi, "lo_open": lo_open, "choices": choices, "toml": toml,
+            "kind": kind, "switch": switch, "path_ok": path_ok}
+
+
+_KINDS = {"float": "float", "int": "int", "bool": "bool", "str": "str", "Path": "path"}
+
+
+def spec_of(cls: type, name: str) -> Spec | None:
+    """The :class:`Spec` of field ``name`` of dataclass ``cls`` (None: a nested table or a
+    field the file does not hold)."""
+    f = next(f for f in fields(cls) if f.name == name)
+    m = dict(f.metadata) or meta()
+    text = str(f.type)
+    parts = [p.strip() for p in text.split("|")]
+    optional = "None" in parts
+    base = [p for p in parts if p != "None"][0]
+    kind = m["kind"] or _KINDS.get(base)
+    if kind is None or kind == "-":
+        return None
+    return Spec(kind, m["lo"], m["hi"], m["lo_open"], m["choices"], optional and kind != "path",
+                m["path_ok"])
+
+
+def spec_for(cls: type, name: str) -> Spec:
+    """:func:`spec_of` for a field known to have a Spec."""
+    s = spec_of(cls, name)
+    if s is None:
+        raise TypeError(f"{cls.__name__}.{name} has no Spec")
+    return s
+
+
+def toml_name(cls: type, name: str) -> str:
+    """The name a field of ``cls`` has in the project file (``as_`` → ``as``)."""
+    f = next(f for f in fields(cls) if f.name == name)
+    return dict(f.metadata).get("toml") or name
+
+
+class Checked:
+    """Validates every field with a :class:`Spec` on creation (numbers become floats)."""
+
+    TABLE: ClassVar[str] = ""
+
+    def __post_init__(self) -> None:
+        for f in fields(self):  # type: ignore[arg-type]
+            s = spec_of(type(self), f.name)
+            if s is None or s.kind in ("path", "times", "mask"):
+                continue
+            value = getattr(self, f.name)
+            try:
+                typed = s.check(value, lenient=True)
+            except ValueError as exc:
+                key = f"{self.TABLE}.{toml_name(type(self), f.name)}"
+                raise SchemaError(str(exc), key) from None
+            if typed is not value:
+                object.__setattr__(self, f.name, typed)
+        self.check()
+
+    def check(self) -> None:
+        """Rules across fields (none by default)."""
+
+    def fail(self, name: str, detail: str) -> SchemaError:
+        return SchemaError(detail, f"{self.TABLE}.{name}")
