@@ -74,3 +74,8 @@ def dumps(data: dict[str, Any], header: str = "") -> str:
     lines = [f"# {h}" if h else "#" for h in header.splitlines()]
     _emit(data, [], lines)
     return "\n".join(lines).lstrip("\n") + "\n"
+
+
+def value_text(v: Any) -> str:
+    """One TOML value (scalar, list or inline table) as text."""
+    return _value(v)

@@ -34,6 +34,7 @@ from radtree.errors import ConfigError, RadtreeError
 from radtree.fileio import write_text
 from radtree.sensor_grid import facade_circle
 from radtree.site.frame import FacadeFrame
+from radtree.tomlout import value_text
 from radtree.trees.build import build_crown
 from radtree.trees.geometry import GOLDEN_ANGLE, fibonacci_cosine_directions
 from radtree.trees.homogeneous import shell_transmittance
@@ -272,13 +273,8 @@ _HEADER = re.compile(r"^\s*\[\s*([A-Za-z0-9_.\-]+)\s*\]\s*(#.*)?$")
 
 
 def _toml_value(v: Any) -> str:
-    if isinstance(v, bool):
-        return "true" if v else "false"
-    if isinstance(v, int):
-        return str(v)
-    if isinstance(v, float):
-        return repr(round(v, 6))
-    return '"' + str(v).replace('"', '\\"') + '"'
+    """A value as TOML text, floats to 6 decimals (the written calibration)."""
+    return value_text(round(v, 6) if isinstance(v, float) else v)
 
 
 def calibrated_path(project: Project) -> Path:
