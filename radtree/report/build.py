@@ -65,7 +65,7 @@ class FigureRef:
 
 
 @dataclass
-class Context:
+class PageContext:
     """Everything the page templates and their core sections render (as ``c``)."""
 
     title: str
@@ -196,7 +196,7 @@ def build_report(project: Project, echo: Callable[[str], None] = print) -> Path:
             tables["convergence"], tables["convergence_summary"] = conv, conv_summary
         tables.update(provenance_tables(data, created))
         p = project
-        ctx = Context(
+        ctx = PageContext(
             title=f"radtree report — {p.name}",
             subtitle=(f"{p.site.name}, {p.site.date}; façade looking "
                       f"{p.street.facade_azimuth_deg:g}° (compass); " + (
