@@ -26,7 +26,7 @@ TREE_FORMS = ("dome", "free")
 LOUVER_ARRANGEMENTS = ("layers", "volume")
 REFLECTION_MODES = ("traced", "calculated")
 SKY_CHOICES = ("none", "perez")
-ENGINES = ("auto", "radiance", "numpy")
+ENGINES = ("auto", "radiance", "numpy", "forward")
 
 
 # ---------------------------------------------------------------- field readers
@@ -353,6 +353,20 @@ class EngineParams:
     max_bounces: int = 8
     seed: int = 1
     workers: int = 2
+    # forward engine (radtree.engines.forward.settings): photons per hour, flux threshold
+    # relative to a photon's launched flux, ray splitting (else Russian roulette), sun beam
+    # diameter aimed at the first grid (None = the whole scene), square detector side, batches
+    photons: int = 1_000_000
+    forward_threshold: float = 0.05
+    forward_splitting: bool = False
+    beam_diameter_m: float | None = None
+    patch_m: float = 0.5
+    forward_batches: int = 16
+
+
+#: the :class:`EngineParams` fields only the forward engine reads
+FORWARD_KEYS = ("photons", "forward_threshold", "forward_splitting", "beam_diameter_m",
+                "patch_m", "forward_batches")
 
 
 @dataclass(frozen=True)
@@ -413,6 +427,9 @@ class Project:
         payload = {k: d[k] for k in ("site", "street", "light", "tree", "sensors", "engine",
                                      "office", "extra_geometry")}
         payload["engine"].pop("workers", None)
+        for key in FORWARD_KEYS:  # forward-engine settings at their defaults: hashes unchanged
+            if payload["engine"].get(key) == getattr(EngineParams, key):
+                payload["engine"].pop(key, None)
         payload["scenario"] = _plain(scenario)
         text = json.dumps(payload, sort_keys=True, default=str)
         return hashlib.sha256(text.encode()).hexdigest()[:12]
@@ -667,6 +684,15 @@ def parse_project(data: dict, path: Path) -> Project:
     for k in ("aa", "lw"):
         if en.has(k):
             en.number(k, lo=0.0, hi=1.0)
+    for k in ("photons", "forward_batches"):
+        if en.has(k):
+            en.integer(k, lo=1 if k == "photons" else 2)
+    for k in ("beam_diameter_m", "patch_m"):
+        if en.has(k):
+            en.number(k, lo=0.0, lo_open=True)
+    if en.has("forward_threshold") and not 0.0 < en.number("forward_threshold") < 1.0:
+        raise en.error("forward_threshold", "must be strictly between 0 and 1 (a fraction of "
+                       f"the launched flux), got {en.raw('forward_threshold')!r}")
     if en.has("name"):
         en.string("name", choices=ENGINES)
     engine = _dataclass_from(en, EngineParams, base)
