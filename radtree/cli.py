@@ -185,6 +185,7 @@ def _register_commands() -> None:
     for cmd in (hemi_command, report_command, calibrate_command, sweep_command,
                 diagnose_command, annual_command, permeability_command):
         main.add_command(cmd)
+    main.add_command(__import__("radtree.verify.command", fromlist=["_"]).verify_command)
 
 
 _register_commands()

@@ -49,12 +49,12 @@ def patch_points(grid: SensorGrid, side: float, points: int, rng: np.random.Gene
     return SensorGrid(f"{grid.name}_patches", np.vstack(pts), np.vstack(nrm))
 
 
-def backward_patch_mean(engine: str, scene: Scene, state: SkyState, grid: str, side: float,
-                        *, ab: int, points: int = 64, rays: int = 64, seed: int = 1,
-                        params: EngineParams | None = None) -> PatchMean:
-    """The mean over ``grid``'s squares of side ``side`` by a backward engine (``numpy`` or
-    ``radiance``): ``points`` random points per square, ``rays`` paths per point (NumPy) or
-    the Radiance settings of ``params``."""
+def backward_patch_values(engine: str, scene: Scene, state: SkyState, grid: str,
+                          side: float, *, ab: int, points: int = 64, rays: int = 64,
+                          seed: int = 1, params: EngineParams | None = None) -> np.ndarray:
+    """(sensors, points) illuminances (lux) at ``points`` random points inside each of
+    ``grid``'s squares of side ``side`` by a backward engine (``numpy`` or ``radiance``):
+    ``rays`` paths per point (NumPy) or the Radiance settings of ``params``."""
     from radtree.engines.registry import get_engine
 
     g = scene.grids[grid]
@@ -64,7 +64,17 @@ def backward_patch_mean(engine: str, scene: Scene, state: SkyState, grid: str, s
     base = params or EngineParams()
     p = replace(base, rays=rays, seed=seed, max_bounces=ab, ab=ab)
     res = get_engine(engine).trace_once(sub, state, p, ab)[pg.name]
-    per_point = res.lux.reshape(len(g), points).mean(axis=0)  # mean over squares, per draw
+    return res.lux.reshape(len(g), points)
+
+
+def backward_patch_mean(engine: str, scene: Scene, state: SkyState, grid: str, side: float,
+                        *, ab: int, points: int = 64, rays: int = 64, seed: int = 1,
+                        params: EngineParams | None = None) -> PatchMean:
+    """The mean over ``grid``'s squares by :func:`backward_patch_values`; its standard error
+    from the spread of the per-draw means over the squares (spatial and ray noise)."""
+    values = backward_patch_values(engine, scene, state, grid, side, ab=ab, points=points,
+                                   rays=rays, seed=seed, params=params)
+    per_point = values.mean(axis=0)
     return PatchMean(float(per_point.mean()), float(per_point.std(ddof=1) / np.sqrt(points)))
 
 
