@@ -22,10 +22,11 @@ from radtree.scene import Scene, SensorGrid
 from radtree.sky import SkyState
 
 MENDOZA = Path(__file__).resolve().parents[2] / "examples" / "mendoza-street"
-#: the reduced Mendoza louvers dome: a 10 m piece of an 8 m wide street between 8 m high
-#: façades, the 5-layer louvers dome of radius 3 m (instead of 4 m), sun only, one hour
-REDUCED_DOME = {"street.length_m": 10.0, "street.width_m": 8.0,
-                "street.building_height_m": 8.0, "street.opposite_building_height_m": 8.0,
+#: the reduced Mendoza louvers dome: a 6.5 m piece of a 6 m wide street between 8.5 m high
+#: façades (a small scene keeps the forward engine's launch disc small), the 5-layer louvers
+#: dome of radius 3 m (instead of 4 m) on the sensors, one hour
+REDUCED_DOME = {"street.length_m": 6.5, "street.width_m": 6.0,
+                "street.building_height_m": 8.5, "street.opposite_building_height_m": 8.5,
                 "tree.dome.radius_m": 3.0}
 
 

@@ -43,7 +43,7 @@ def run_verify(out: Path, full: bool = False, backward: list[str] | None = None,
                                       progress=echo)
         checks += energy_checks(photons=200_000)
         checks += agreement_checks(hours=("10:30", "12:30", "14:30"), scenarios=("A", "B"),
-                                   photons=12_000_000, points=64, rays=128, ad=2048,
+                                   photons=40_000_000, points=64, rays=128, ad=2048,
                                    backward=backward,
                                    progress=echo)
     else:

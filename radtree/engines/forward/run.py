@@ -26,13 +26,23 @@ from radtree.sky import SkyState
 
 @dataclass
 class ForwardResult:
-    """Lux per grid, where the flux went, and what it cost."""
+    """Lux per grid, where the flux went, and what it cost. ``batches[grid]``: (batches,
+    sensors) lux of each independent batch (each batch's tally scaled to all photons)."""
 
     grids: dict[str, GridResult]
     ledger: Ledger
     photons: int
     segments: int
     seconds: float
+    batches: dict[str, np.ndarray]
+
+    def grid_mean(self, grid: str) -> tuple[float, float]:
+        """Mean lux over the grid's sensors and its standard error from the batches (patches
+        that overlap share photons: their errors are correlated, so the batches, not the
+        per-sensor errors, give the mean's error)."""
+        per_batch = self.batches[grid].mean(axis=1)
+        return float(self.grids[grid].lux.mean()), float(
+            per_batch.std(ddof=1) / np.sqrt(len(per_batch)))
 
 
 def target_grid(scene: Scene) -> str:
@@ -88,7 +98,6 @@ def trace_forward(scene: Scene, state: SkyState, settings: ForwardSettings,
                            settings.batches, threshold=settings.threshold,
                            splitting=settings.splitting, max_bounces=settings.max_bounces,
                            max_specular=settings.max_specular, chunk=settings.chunk, rng=rng)
-    total_flux = sum(s.flux for s in sources)
     counts = _allot(settings.photons, [s.flux for s in sources], settings.batches)
     for src, n_src in zip(sources, counts):
         per_photon = src.flux / n_src
@@ -96,16 +105,14 @@ def trace_forward(scene: Scene, state: SkyState, settings: ForwardSettings,
             k = min(settings.chunk, n_src - c0)
             batch = (c0 + np.arange(k)) % settings.batches
             tracer.run(Photons.start(src.launch(k, per_photon, rng), batch))
-    out = {}
+    out, per = {}, {}
     b = settings.batches
     for name in names:
-        per_batch = tracer.tally[:, det.slices[name]] * b / det.area
+        per[name] = tracer.tally[:, det.slices[name]] * b / det.area
         mean = tracer.tally[:, det.slices[name]].sum(axis=0) / det.area
-        se = per_batch.std(axis=0, ddof=1) / np.sqrt(b)
-        out[name] = GridResult(mean, se)
-    del total_flux
+        out[name] = GridResult(mean, per[name].std(axis=0, ddof=1) / np.sqrt(b))
     return ForwardResult(out, tracer.ledger, int(sum(counts)), tracer.segments,
-                         time.perf_counter() - t0)
+                         time.perf_counter() - t0, per)
 
 
 def _allot(photons: int, fluxes: list[float], batches: int) -> list[int]:
