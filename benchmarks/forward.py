@@ -44,7 +44,7 @@ def _line(engine: str, what: str, seconds: float, queries: int, units: float, un
     t1 = seconds * (se / (0.01 * mean)) ** 2 if mean > 0 else math.inf
     print(f"  {engine:8s} {what:22s} {seconds:7.1f} s  {queries / seconds / 1e6:5.2f} M rays/s  "
           f"{units / seconds / 1e3:7.1f} k {unit}/s  façade {mean:8.1f} ± {se:6.1f} lx "
-          f"({se / mean:5.1%})  → 1 % s.e. in {t1:8.0f} s")
+          f"({se / mean:5.1%})  → 1 % s.e. in {t1:8.3g} s")
 
 
 def run(label: str, overrides: dict, scenarios: list[str], photons: int, rays: int) -> None:

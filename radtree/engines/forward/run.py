@@ -76,7 +76,10 @@ def sun_source(scene: Scene, state: SkyState, settings: ForwardSettings, sphere
 def trace_forward(scene: Scene, state: SkyState, settings: ForwardSettings,
                   grids: list[str] | None = None, *, backend: str = "auto", workers: int = 2,
                   label: str | None = None) -> ForwardResult:
-    """Forward-trace one hour of ``scene`` on ``grids`` (default every grid)."""
+    """Forward-trace one hour of ``scene`` on ``grids`` (default every grid). Sources: the sun
+    over the whole scene plus the sky and the distant ground glow of the hour (as the backward
+    engines see them), or — with ``settings.beam_diameter_m`` — the sun beam alone (the
+    study's surface source: no sky, no ground glow)."""
     t0 = time.perf_counter()
     names = list(scene.grids) if grids is None else list(grids)
     missing = [g for g in names if g not in scene.grids]
@@ -89,9 +92,10 @@ def trace_forward(scene: Scene, state: SkyState, settings: ForwardSettings,
     sources: list = []
     if state.sun_on:
         sources.append(sun_source(scene, state, settings, sphere))
-    env = EnvironmentSource(_Environment(state), sphere)
-    if env.cdf is not None and env.flux > 0:
-        sources.append(env)
+    if settings.beam_diameter_m is None:  # a beam is the study's only source: no sky, no glow
+        env = EnvironmentSource(_Environment(state), sphere)
+        if env.cdf is not None and env.flux > 0:
+            sources.append(env)
     rng = np.random.default_rng(np.random.SeedSequence(
         [int(settings.seed) & 0xFFFFFFFF, zlib.crc32((label or state.label).encode())]))
     tracer = ForwardTracer(geo, _optics(scene, state, geo.material_names), det,

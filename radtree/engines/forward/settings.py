@@ -6,7 +6,8 @@ Keys of the project's ``[engine]`` table (:class:`radtree.config.EngineParams`):
 and kill children below the threshold, as TracePro does — biased low by the flux it kills;
 false: one event per hit chosen ∝ its coefficient, Russian roulette below the threshold —
 unbiased), ``beam_diameter_m`` (the sun as a collimated beam of that diameter aimed at the
-centre of the first sensor grid; unset = sunlight over the whole scene), ``patch_m`` (side of
+centre of the first sensor grid, and then the only source — no sky, no ground glow, as in the
+study; unset = sunlight, sky and ground glow over the whole scene), ``patch_m`` (side of
 the square detector around each sensor, m) and ``forward_batches`` (independent batches for the
 standard error).
 """
