@@ -26,6 +26,7 @@ from radtree.cli.permeability import permeability_command
 from radtree.cli.report import report_command
 from radtree.cli.simulate import simulate_command
 from radtree.cli.sweep import sweep_command
+from radtree.cli.verify import verify_command
 
 __all__ = ["main"]
 
@@ -55,5 +56,5 @@ def main(ctx: click.Context, debug: bool) -> None:
 
 for _command in (doctor_command, build_command, simulate_command, hemi_command, report_command,
                  calibrate_command, sweep_command, diagnose_command, annual_command,
-                 permeability_command):
+                 permeability_command, verify_command):
     main.add_command(_command)

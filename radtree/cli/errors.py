@@ -39,7 +39,7 @@ from radtree.errors import EngineError, RadtreeError, Terminated
 
 OK = 0
 BUG = 1
-CHECK_FAILED = 1  # diagnose --selftest: a distinguishable hidden effect was misnamed
+CHECK_FAILED = 1  # diagnose --selftest misnamed a hidden effect; verify: a physics check failed
 BAD_INPUT = 2
 ENGINE_FAILURE = 3
 INTERRUPTED = 130

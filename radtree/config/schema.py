@@ -285,6 +285,21 @@ class EngineParams(Checked):
     max_bounces: int = field(default=8, metadata=meta(0))
     seed: int = 1
     workers: int = field(default=2, metadata=meta(1))
+    # forward engine (radtree.engines.forward.settings): photons per hour, flux threshold
+    # relative to a photon's launched flux, ray splitting (else Russian roulette), sun beam
+    # diameter aimed at the first grid (None = the whole scene), square detector side, batches
+    photons: int = field(default=1_000_000, metadata=meta(1))
+    forward_threshold: float = field(default=0.05, metadata=meta(0.0, 1.0, lo_open=True,
+                                                                    hi_open=True))
+    forward_splitting: bool = False
+    beam_diameter_m: float | None = field(default=None, metadata=meta(0.0, lo_open=True))
+    patch_m: float = field(default=0.5, metadata=meta(0.0, lo_open=True))
+    forward_batches: int = field(default=16, metadata=meta(2))
+
+
+#: the :class:`EngineParams` fields only the forward engine reads
+FORWARD_KEYS = ("photons", "forward_threshold", "forward_splitting", "beam_diameter_m",
+                "patch_m", "forward_batches")
 
 
 @dataclass(frozen=True)
@@ -361,6 +376,9 @@ class Project:
         payload = {k: d[k] for k in ("site", "street", "light", "tree", "sensors", "engine",
                                      "office", "extra_geometry")}
         payload["engine"].pop("workers", None)
+        for key in FORWARD_KEYS:  # forward-engine settings at their defaults: hashes unchanged
+            if payload["engine"].get(key) == getattr(EngineParams, key):
+                payload["engine"].pop(key, None)
         payload["scenario"] = _plain(scenario)
         text = json.dumps(payload, sort_keys=True, default=str)
         return hashlib.sha256(text.encode()).hexdigest()[:12]

@@ -57,6 +57,7 @@ class Spec:
     choices: tuple[str, ...] | None = None
     optional: bool = False
     path_ok: bool = False
+    hi_open: bool = False
 
     def expected(self) -> str:
         """What is expected, in words (for lists of keys and messages)."""
@@ -70,7 +71,7 @@ class Spec:
         if self.lo is not None:
             bounds.append(f"{'>' if self.lo_open else '≥'} {_g(self.lo)}")
         if self.hi is not None:
-            bounds.append(f"≤ {_g(self.hi)}")
+            bounds.append(f"{'<' if self.hi_open else '≤'} {_g(self.hi)}")
         if bounds:
             text += " " + " and ".join(bounds)
         if self.path_ok:
@@ -145,17 +146,18 @@ class Spec:
         lo, hi = self.lo, self.hi
         if lo is not None and (value < lo or (self.lo_open and value <= lo)):
             raise ValueError(f"got {value}, expected {'>' if self.lo_open else '≥'} {_g(lo)}")
-        if hi is not None and value > hi:
-            raise ValueError(f"got {value}, expected ≤ {_g(hi)}")
+        if hi is not None and (value > hi or (self.hi_open and value >= hi)):
+            raise ValueError(f"got {value}, expected {'<' if self.hi_open else '≤'} {_g(hi)}")
         return value
 
 
 def meta(lo: float | None = None, hi: float | None = None, *, lo_open: bool = False,
+         hi_open: bool = False,
          choices: tuple[str, ...] | None = None, toml: str | None = None,
          kind: str | None = None, switch: bool = True, path_ok: bool = False) -> dict:
     """Field metadata: bounds, choices, the TOML name, the kind (else from the annotation),
     whether a scenario may switch it."""
-    return {"lo": lo, "hi": hi, "lo_open": lo_open, "choices": choices, "toml": toml,
+    return {"lo": lo, "hi": hi, "lo_open": lo_open, "hi_open": hi_open, "choices": choices, "toml": toml,
             "kind": kind, "switch": switch, "path_ok": path_ok}
 
 
@@ -175,7 +177,7 @@ def spec_of(cls: type, name: str) -> Spec | None:
     if kind is None or kind == "-":
         return None
     return Spec(kind, m["lo"], m["hi"], m["lo_open"], m["choices"], optional and kind != "path",
-                m["path_ok"])
+                m["path_ok"], m.get("hi_open", False))
 
 
 def spec_for(cls: type, name: str) -> Spec:

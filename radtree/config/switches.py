@@ -13,7 +13,7 @@ Two uses (a key may have both):
   ``tree`` fields (the leading ``tree.`` may be dropped: ``"louvers.layers"``), which
   :func:`radtree.trees.build.apply_switches` applies; and the keys code reads:
   ``tree.louvers.reading`` (a preset of :data:`LOUVER_READINGS`) and ``reflection.*``
-  (:mod:`radtree.reflect`). Switch values are typed and bounded here.
+  (:mod:`radtree.light.ground`). Switch values are typed and bounded here.
 
 The keys of the file's tables come from the dataclass fields of :mod:`radtree.config.schema`
 (their TOML names, kinds, bounds and choices), so a new field is known everywhere at once.

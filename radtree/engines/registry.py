@@ -1,4 +1,5 @@
-"""Engines by name: ``radiance`` (rtrace on the build folder), ``numpy`` (built-in Monte Carlo).
+"""Engines by name: ``radiance`` (rtrace on the build folder), ``numpy`` (built-in Monte Carlo),
+``forward`` (forward light tracing to patch detectors).
 
 ``get_engine("auto")`` is Radiance when its binaries are found, else the NumPy engine. A new
 estimator is one class registered here; nothing else in radtree names an engine.
@@ -15,6 +16,7 @@ from radtree.errors import ConfigError, RadtreeError
 ENGINES: dict[str, str] = {
     "radiance": "radtree.engines.radiance.interface:RadianceEngine",
     "numpy": "radtree.engines.numpy.interface:NumpyEngine",
+    "forward": "radtree.engines.forward.interface:ForwardEngine",
 }
 #: ``auto`` tries these in order
 AUTO_ORDER = ("radiance", "numpy")

@@ -1,0 +1,38 @@
+"""``radtree verify``: the physics suite, writing ``verify.csv``; exit status 1 on a failure."""
+
+from __future__ import annotations
+
+import sys
+from pathlib import Path
+
+import click
+
+from radtree.cli.errors import CHECK_FAILED
+from radtree.cli.options import CONTEXT
+
+
+@click.command("verify", context_settings=CONTEXT)
+@click.option("--full", is_flag=True,
+              help="The long version: more photons and leaf layers, scenarios A and B of the "
+                   "reduced dome at 10:30, 12:30 and 14:30.")
+@click.option("--out", type=click.Path(dir_okay=False, path_type=Path),
+              default=Path("verify.csv"), show_default=True, help="Where to write the table.")
+@click.option("--backward", multiple=True,
+              help="Backward engine(s) to compare the forward engine with (default: every "
+                   "available one).")
+def verify_command(full: bool, out: Path, backward: tuple[str, ...]) -> None:
+    """Physics checks: uncollided transmission through random leaf layers against
+    exp(−G·LAI/cos θ), energy conservation, forward vs backward engines on the reduced
+    Mendoza louvers dome. Writes OUT (check, engine, expected, got, tolerance, passed)."""
+    from radtree.verify.suite import run_verify
+
+    outcome = run_verify(out, full=full, backward=list(backward) or None,
+                         echo=lambda m: click.echo(f"  {m}"))
+    for c in outcome.checks:
+        mark = "ok  " if c.passed else "FAIL"
+        click.echo(f"{mark} {c.engine:8s} {c.check}: expected {c.expected:.5g}, got "
+                   f"{c.got:.5g} (± {c.tolerance:.3g})")
+    n, bad = len(outcome.checks), len(outcome.failed)
+    click.echo(f"{n - bad}/{n} checks passed in {outcome.seconds:.0f} s → {outcome.path}")
+    if bad:
+        sys.exit(CHECK_FAILED)

@@ -1,0 +1,127 @@
+"""One hour of forward light tracing: sources, transport, detectors → lux per sensor.
+
+:func:`trace_forward` returns the illuminance of every traced grid (lux = tallied lm / patch
+area, mean of all photons; standard error = s.d. of the ``batches`` batch estimates / √batches)
+with the hour's :class:`~radtree.engines.forward.tracer.Ledger` and counters.
+"""
+
+from __future__ import annotations
+
+import time
+import zlib
+from dataclasses import dataclass
+
+import numpy as np
+
+from radtree.engines.base import GridResult
+from radtree.engines.forward.detectors import PatchDetectors
+from radtree.engines.forward.settings import ForwardSettings
+from radtree.engines.forward.sources import EnvironmentSource, SunSource, bounding_sphere
+from radtree.engines.forward.tracer import ForwardTracer, Ledger, Photons
+from radtree.engines.numpy.engine import _Environment, _geometry, _optics
+from radtree.errors import ConfigError, EngineError
+from radtree.light.sky import SkyState
+from radtree.scene import Scene
+
+
+@dataclass
+class ForwardResult:
+    """Lux per grid, where the flux went, and what it cost. ``batches[grid]``: (batches,
+    sensors) lux of each independent batch (each batch's tally scaled to all photons)."""
+
+    grids: dict[str, GridResult]
+    ledger: Ledger
+    photons: int
+    segments: int
+    seconds: float
+    batches: dict[str, np.ndarray]
+
+    def grid_mean(self, grid: str) -> tuple[float, float]:
+        """Mean lux over the grid's sensors and its standard error from the batches (patches
+        that overlap share photons: their errors are correlated, so the batches, not the
+        per-sensor errors, give the mean's error)."""
+        per_batch = self.batches[grid].mean(axis=1)
+        return float(self.grids[grid].lux.mean()), float(
+            per_batch.std(ddof=1) / np.sqrt(len(per_batch)))
+
+
+def target_grid(scene: Scene) -> str:
+    """The grid a sun beam is aimed at: ``facade`` when the scene has one, else the first."""
+    return "facade" if "facade" in scene.grids else next(iter(scene.grids))
+
+
+def sun_source(scene: Scene, state: SkyState, settings: ForwardSettings, sphere
+               ) -> SunSource:
+    """The hour's sun: over the whole bounding sphere, or the beam aimed at the target grid's
+    centre (every sensor of that grid must lie inside the beam)."""
+    sun = np.asarray(state.sun.vector, float)
+    if settings.beam_diameter_m is None:
+        return SunSource(sun, state.direct_normal_lux, sphere.centre, sphere.radius,
+                         sphere.radius + 1.0)
+    name = target_grid(scene)
+    pts = scene.grids[name].points
+    target = pts.mean(axis=0)
+    radius = settings.beam_diameter_m / 2.0
+    dist = float(np.linalg.norm(target - sphere.centre)) + sphere.radius + 1.0
+    src = SunSource(sun, state.direct_normal_lux, target, radius, dist)
+    need = float(src.distance_to_axis(pts).max())
+    if need > radius:
+        raise ConfigError(
+            f"the {settings.beam_diameter_m:g} m sun beam aimed at the centre of grid '{name}' "
+            f"misses its sensors at {state.time} (the farthest is {need:.3f} m from the beam "
+            f"axis: a diameter ≥ {2 * need:.3f} m is needed)", field="engine.beam_diameter_m")
+    return src
+
+
+def trace_forward(scene: Scene, state: SkyState, settings: ForwardSettings,
+                  grids: list[str] | None = None, *, backend: str = "auto", workers: int = 2,
+                  label: str | None = None) -> ForwardResult:
+    """Forward-trace one hour of ``scene`` on ``grids`` (default every grid). Sources: the sun
+    over the whole scene plus the sky and the distant ground glow of the hour (as the backward
+    engines see them), or — with ``settings.beam_diameter_m`` — the sun beam alone (the
+    study's surface source: no sky, no ground glow)."""
+    t0 = time.perf_counter()
+    names = list(scene.grids) if grids is None else list(grids)
+    missing = [g for g in names if g not in scene.grids]
+    if missing:
+        raise EngineError(f"unknown sensor grid(s): {', '.join(missing)}")
+    geo = _geometry(scene, backend, workers)
+    det = PatchDetectors({n: scene.grids[n] for n in names}, settings.patch_m)
+    pts = np.vstack([geo.vertices, det.corners().reshape(-1, 3)])
+    sphere = bounding_sphere(pts)
+    sources: list = []
+    if state.sun_on:
+        sources.append(sun_source(scene, state, settings, sphere))
+    if settings.beam_diameter_m is None:  # a beam is the study's only source: no sky, no glow
+        env = EnvironmentSource(_Environment(state), sphere)
+        if env.cdf is not None and env.flux > 0:
+            sources.append(env)
+    rng = np.random.default_rng(np.random.SeedSequence(
+        [int(settings.seed) & 0xFFFFFFFF, zlib.crc32((label or state.label).encode())]))
+    tracer = ForwardTracer(geo, _optics(scene, state, geo.material_names), det,
+                           settings.batches, threshold=settings.threshold,
+                           splitting=settings.splitting, max_bounces=settings.max_bounces,
+                           max_specular=settings.max_specular, chunk=settings.chunk, rng=rng)
+    counts = _allot(settings.photons, [s.flux for s in sources], settings.batches)
+    for src, n_src in zip(sources, counts):
+        per_photon = src.flux / n_src
+        for c0 in range(0, n_src, settings.chunk):
+            k = min(settings.chunk, n_src - c0)
+            batch = (c0 + np.arange(k)) % settings.batches
+            tracer.run(Photons.start(src.launch(k, per_photon, rng), batch))
+    out, per = {}, {}
+    b = settings.batches
+    for name in names:
+        per[name] = tracer.tally[:, det.slices[name]] * b / det.area
+        mean = tracer.tally[:, det.slices[name]].sum(axis=0) / det.area
+        out[name] = GridResult(mean, per[name].std(axis=0, ddof=1) / np.sqrt(b))
+    return ForwardResult(out, tracer.ledger, int(sum(counts)), tracer.segments,
+                         time.perf_counter() - t0, per)
+
+
+def _allot(photons: int, fluxes: list[float], batches: int) -> list[int]:
+    """Photons per source ∝ its flux (equal photon fluxes), at least ``batches`` each."""
+    total = sum(fluxes)
+    if total <= 0:
+        return [batches for _ in fluxes]
+    return [max(batches, int(round(photons * f / total))) for f in fluxes]

@@ -1,0 +1,95 @@
+"""The forward engine's settings: one typed, validated dataclass read from ``[engine]``.
+
+Keys of the project's ``[engine]`` table (:class:`radtree.config.EngineParams`): ``photons``
+(per hour), ``forward_threshold`` (flux threshold as a fraction of a photon's launched flux, in
+(0, 1)), ``forward_splitting`` (true: split every hit into reflected and transmitted children
+and kill children below the threshold, as TracePro does — biased low by the flux it kills;
+false: one event per hit chosen ∝ its coefficient, Russian roulette below the threshold —
+unbiased), ``beam_diameter_m`` (the sun as a collimated beam of that diameter aimed at the
+centre of the first sensor grid, and then the only source — no sky, no ground glow, as in the
+study; unset = sunlight, sky and ground glow over the whole scene), ``patch_m`` (side of
+the square detector around each sensor, m) and ``forward_batches`` (independent batches for the
+standard error).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import TYPE_CHECKING
+
+from radtree.errors import ConfigError
+
+if TYPE_CHECKING:
+    from radtree.config import EngineParams
+
+
+def _bad(field: str, message: str) -> ConfigError:
+    return ConfigError(message, field=f"engine.{field}")
+
+
+@dataclass(frozen=True)
+class ForwardSettings:
+    """How the forward engine launches, scatters and tallies photons.
+
+    ``photons``: photons per hour (sun and sky together, allotted ∝ their launched flux, so
+    every photon starts with the same flux). ``threshold``: relative flux threshold.
+    ``splitting``: ray splitting (else Russian roulette). ``beam_diameter_m``: None = the sun
+    over the scene's whole bounding sphere. ``patch_m``: detector side (m); a detector tallies
+    the flux crossing its square from the sensor's front side; lux = lm / m².
+    ``batches``: independent batches (standard error = s.d. of batch means / √batches).
+    ``max_bounces``: diffuse scattering events per photon (``-ab``: a backward path with k
+    diffuse segments is a photon path with k diffuse events). ``max_specular``: specular events
+    per photon. ``chunk``: photons stepped at once (bounded memory). ``seed``: random seed.
+    """
+
+    photons: int = 1_000_000
+    threshold: float = 0.05
+    splitting: bool = False
+    beam_diameter_m: float | None = None
+    patch_m: float = 0.5
+    batches: int = 16
+    max_bounces: int = 8
+    max_specular: int = 32
+    chunk: int = 1 << 17
+    seed: int = 1
+
+    def __post_init__(self) -> None:
+        if isinstance(self.photons, bool) or not isinstance(self.photons, int) or self.photons < 1:
+            raise _bad("photons", f"must be a whole number ≥ 1, got {self.photons!r}")
+        if not isinstance(self.threshold, int | float) or not 0.0 < self.threshold < 1.0:
+            raise _bad("forward_threshold", "must be strictly between 0 and 1 (a fraction of the "
+                       f"launched flux), got {self.threshold!r}")
+        if not isinstance(self.splitting, bool):
+            raise _bad("forward_splitting", f"must be true or false, got {self.splitting!r}")
+        d = self.beam_diameter_m
+        if d is not None and (not isinstance(d, int | float) or not math.isfinite(d) or d <= 0):
+            raise _bad("beam_diameter_m", f"must be > 0 m (or unset for sun over the whole "
+                       f"scene), got {d!r}")
+        if not isinstance(self.patch_m, int | float) or not math.isfinite(self.patch_m) \
+                or self.patch_m <= 0:
+            raise _bad("patch_m", f"must be > 0 m, got {self.patch_m!r}")
+        if isinstance(self.batches, bool) or not isinstance(self.batches, int) \
+                or self.batches < 2:
+            raise _bad("forward_batches", f"must be a whole number ≥ 2, got {self.batches!r}")
+        if self.photons < self.batches:
+            raise _bad("photons", f"{self.photons} photons cannot fill {self.batches} batches")
+        if self.max_bounces < 0 or self.max_specular < 0 or self.chunk < 1:
+            raise _bad("max_bounces", "bounce caps must be ≥ 0 and the chunk ≥ 1")
+
+    @classmethod
+    def from_params(cls, params: EngineParams, ab: int | None = None) -> ForwardSettings:
+        """The settings of a project's ``[engine]`` table; ``ab`` (the scene's ``-ab``) caps the
+        diffuse events (default ``params.max_bounces``)."""
+        return cls(photons=params.photons, threshold=params.forward_threshold,
+                   splitting=params.forward_splitting, beam_diameter_m=params.beam_diameter_m,
+                   patch_m=params.patch_m, batches=params.forward_batches,
+                   max_bounces=int(params.max_bounces if ab is None else ab),
+                   seed=int(params.seed))
+
+    def describe(self) -> str:
+        source = ("sun over the whole scene" if self.beam_diameter_m is None
+                  else f"sun beam {self.beam_diameter_m:g} m")
+        scatter = "ray splitting" if self.splitting else "Russian roulette"
+        return (f"{self.photons} photons, {source}, {scatter}, threshold {self.threshold:g}, "
+                f"patches {self.patch_m:g} m, {self.batches} batches, seed {self.seed}")

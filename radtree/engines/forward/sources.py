@@ -1,0 +1,119 @@
+"""Where the forward engine's photons start: the sun as a collimated source (over the whole
+scene or as a beam aimed at a target), and the sky and distant ground glow.
+
+* **Sun, whole scene**: a launch disc perpendicular to the sun, of the radius of the scene's
+  bounding sphere, outside that sphere: flux E_dn · π R² (lm, E_dn the direct normal
+  illuminance in lux), photon origins uniform on the disc, all travelling along −sun.
+* **Sun beam**: the same disc with the stated diameter, its axis through the target point.
+* **Environment** (sky above the horizon, the distant ground glow below — the luminance the
+  NumPy engine's escaping rays see, :class:`radtree.engines.numpy.engine._Environment`): a
+  direction ω is drawn from a table of the luminance over the whole sphere (equal solid-angle
+  cells, ∝ L·Ω) and a photon starts on the disc of radius R perpendicular to ω outside the
+  bounding sphere, travelling along −ω; flux through the disc from dω is L(ω) dω · π R², so
+  the total is π R² ∫ L dω and a photon's flux is corrected by L(ω) / L(cell).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from radtree.engines.numpy.sampling import orthonormal_basis
+
+_ENV_ZONES = (48, 96)  # cells in z (uniform in cos θ) and in azimuth: equal solid angles
+
+
+@dataclass(frozen=True)
+class Sphere:
+    """Bounding sphere (m) of everything photons can meet, detectors included."""
+
+    centre: np.ndarray
+    radius: float
+
+
+def bounding_sphere(points: np.ndarray) -> Sphere:
+    """Box-centred bounding sphere of ``points`` (k, 3), with a 1 % (≥ 1 cm) margin."""
+    lo, hi = points.min(axis=0), points.max(axis=0)
+    c = (lo + hi) / 2.0
+    r = float(np.linalg.norm(points - c, axis=1).max())
+    return Sphere(c, max(r * 1.01, r + 0.01))
+
+
+@dataclass
+class Launch:
+    """Photons ready to start: origins, unit directions of travel, flux each (lm)."""
+
+    origins: np.ndarray
+    dirs: np.ndarray
+    flux: np.ndarray
+
+
+def _disc_points(centres: np.ndarray, normals: np.ndarray, radius: float,
+                 rng: np.random.Generator) -> np.ndarray:
+    k = len(centres)
+    r = radius * np.sqrt(rng.random(k))
+    phi = 2.0 * math.pi * rng.random(k)
+    t, b = orthonormal_basis(normals)
+    return centres + t * (r * np.cos(phi))[:, None] + b * (r * np.sin(phi))[:, None]
+
+
+class SunSource:
+    """The collimated sun: direction ``sun`` (unit, towards the sun), direct normal
+    illuminance ``dni`` (lux), a disc of ``radius`` (m) whose axis passes through ``axis_point``,
+    placed ``distance`` (m) from it towards the sun."""
+
+    def __init__(self, sun: np.ndarray, dni: float, axis_point: np.ndarray, radius: float,
+                 distance: float):
+        self.sun = np.asarray(sun, float) / np.linalg.norm(sun)
+        self.axis_point = np.asarray(axis_point, float)
+        self.radius = float(radius)
+        self.centre = self.axis_point + self.sun * float(distance)
+        self.flux = float(dni) * math.pi * self.radius ** 2
+
+    def launch(self, k: int, photon_flux: float, rng: np.random.Generator) -> Launch:
+        normals = np.broadcast_to(self.sun, (k, 3))
+        o = _disc_points(np.broadcast_to(self.centre, (k, 3)), normals, self.radius, rng)
+        return Launch(o, np.broadcast_to(-self.sun, (k, 3)).copy(), np.full(k, photon_flux))
+
+    def distance_to_axis(self, points: np.ndarray) -> np.ndarray:
+        """Perpendicular distance (m) of ``points`` from the beam axis."""
+        rel = points - self.axis_point
+        return np.linalg.norm(rel - np.outer(rel @ self.sun, self.sun), axis=1)
+
+
+class EnvironmentSource:
+    """Sky and ground glow of luminance ``luminance(d)`` (cd/m², d unit directions towards
+    the source) around a bounding ``sphere``."""
+
+    def __init__(self, luminance, sphere: Sphere):
+        nz, nphi = _ENV_ZONES
+        self.nz, self.nphi = nz, nphi
+        self.sphere = sphere
+        zc = -1.0 + (np.arange(nz) + 0.5) * 2.0 / nz
+        pc = (np.arange(nphi) + 0.5) * 2.0 * math.pi / nphi
+        Z, P = np.meshgrid(zc, pc, indexing="ij")
+        s = np.sqrt(1.0 - Z * Z)
+        d = np.column_stack([(s * np.cos(P)).ravel(), (s * np.sin(P)).ravel(), Z.ravel()])
+        self.luminance = luminance
+        self.cell_l = np.maximum(np.asarray(luminance(d), float), 0.0)
+        self.omega = 4.0 * math.pi / (nz * nphi)
+        total = float(self.cell_l.sum())
+        self.area = math.pi * sphere.radius ** 2
+        self.flux = self.area * total * self.omega
+        self.cdf = np.cumsum(self.cell_l) / total if total > 0 else None
+
+    def launch(self, k: int, photon_flux: float, rng: np.random.Generator) -> Launch:
+        assert self.cdf is not None
+        cell = np.minimum(np.searchsorted(self.cdf, rng.random(k), side="right"),
+                          len(self.cdf) - 1)
+        iz, ip = cell // self.nphi, cell % self.nphi
+        z = -1.0 + (iz + rng.random(k)) * 2.0 / self.nz
+        phi = (ip + rng.random(k)) * 2.0 * math.pi / self.nphi
+        s = np.sqrt(np.maximum(0.0, 1.0 - z * z))
+        w = np.column_stack([s * np.cos(phi), s * np.sin(phi), z])
+        ratio = np.asarray(self.luminance(w), float) / self.cell_l[cell]
+        centres = self.sphere.centre + w * (self.sphere.radius + 1.0)
+        o = _disc_points(centres, w, self.sphere.radius, rng)
+        return Launch(o, -w, photon_flux * ratio)

@@ -1,0 +1,205 @@
+"""Forward light tracing: photons from the sun and sky through the scene, tallied on patches.
+
+Same scene, materials and ray caster as the NumPy engine (:mod:`radtree.engines.numpy`): all
+surfaces two-sided; ``Plastic`` reflects ρ(1 − spec) Lambertian plus ``spec`` as a mirror (the
+ground material takes the hour's reflectance); ``Trans`` reflects R and transmits T_d
+Lambertian and T_s undeviated; ``Glass`` transmits T(θ) and mirrors R(θ) (Radiance's formulas).
+What a surface does not reflect or transmit is absorbed there.
+
+At every hit a photon of flux w either
+
+* **splits** (``splitting``): one child per event (diffuse reflection, diffuse transmission,
+  specular transmission, mirror reflection) carrying w × the event's coefficient; children
+  below ``threshold`` × the photon's launched flux are killed (TracePro's behaviour: the
+  killed flux is lost, a bias that shrinks with the threshold), or
+* takes **one event** chosen ∝ its coefficient and keeps w × (sum of coefficients); below the
+  threshold it plays Russian roulette (survives with probability w / (threshold · w₀), then
+  carries threshold · w₀): unbiased.
+
+Diffuse events per photon are capped at ``max_bounces`` (``-ab``: the diffuse part of a hit
+beyond the cap is dropped, like a backward path that may not bounce again) and specular events
+at ``max_specular``. Every lumen is accounted for in a :class:`Ledger`: launched = escaped +
+absorbed + capped + killed − promoted (roulette survivors' gain), exactly.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from radtree.engines.forward.detectors import PatchDetectors
+from radtree.engines.forward.sources import Launch
+from radtree.engines.numpy.engine import _Geometry, _Optics, glass_coefficients
+from radtree.engines.numpy.sampling import cosine_hemisphere, mirror
+
+
+@dataclass
+class Ledger:
+    """Where the launched flux went (lm). ``absorbed`` per material (the geometry's material
+    order); ``escaped_up``/``escaped_down``: photons leaving the scene upwards / downwards."""
+
+    materials: list[str]
+    launched: float = 0.0
+    escaped_up: float = 0.0
+    escaped_down: float = 0.0
+    absorbed: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    capped: float = 0.0
+    killed: float = 0.0
+    promoted: float = 0.0
+
+    def __post_init__(self) -> None:
+        if len(self.absorbed) != len(self.materials):
+            self.absorbed = np.zeros(len(self.materials))
+
+    @property
+    def escaped(self) -> float:
+        return self.escaped_up + self.escaped_down
+
+    def absorbed_by(self, material: str) -> float:
+        return float(self.absorbed[self.materials.index(material)]) \
+            if material in self.materials else 0.0
+
+    @property
+    def balance(self) -> float:
+        """launched − (escaped + absorbed + capped + killed − promoted): 0 up to rounding."""
+        return self.launched - (self.escaped + float(self.absorbed.sum()) + self.capped
+                                + self.killed - self.promoted)
+
+
+@dataclass
+class Photons:
+    """A set of photons in flight (struct of arrays)."""
+
+    o: np.ndarray
+    d: np.ndarray
+    w: np.ndarray        # flux (lm)
+    w0: np.ndarray       # launched flux (lm), the threshold's reference
+    ndiff: np.ndarray    # diffuse events so far
+    nspec: np.ndarray    # specular events so far
+    batch: np.ndarray    # batch of the photon (standard errors)
+
+    def __len__(self) -> int:
+        return len(self.w)
+
+    def take(self, m: np.ndarray | slice) -> Photons:
+        return Photons(self.o[m], self.d[m], self.w[m], self.w0[m], self.ndiff[m],
+                       self.nspec[m], self.batch[m])
+
+    @staticmethod
+    def join(parts: list[Photons]) -> Photons:
+        return Photons(*(np.concatenate([getattr(p, f) for p in parts])
+                         for f in ("o", "d", "w", "w0", "ndiff", "nspec", "batch")))
+
+    @staticmethod
+    def start(launch: Launch, batch: np.ndarray) -> Photons:
+        k = len(launch.flux)
+        z = np.zeros(k, np.int64)
+        return Photons(launch.origins, launch.dirs, launch.flux.copy(), launch.flux.copy(),
+                       z, z.copy(), batch)
+
+
+class ForwardTracer:
+    """Transport of photon sets through one scene's geometry with one hour's optics."""
+
+    def __init__(self, geo: _Geometry, optics: _Optics, detectors: PatchDetectors, batches: int,
+                 *, threshold: float, splitting: bool, max_bounces: int, max_specular: int,
+                 chunk: int, rng: np.random.Generator):
+        self.geo, self.opt, self.det = geo, optics, detectors
+        self.threshold, self.splitting = float(threshold), bool(splitting)
+        self.max_bounces, self.max_specular = int(max_bounces), int(max_specular)
+        self.chunk = int(chunk)
+        self.rng = rng
+        self.eps = max(1e-5, 2e-6 * geo.size)
+        self.tally = np.zeros((batches, detectors.count))
+        self.ledger = Ledger(list(geo.material_names))
+        self.segments = 0
+
+    def run(self, photons: Photons) -> None:
+        """Trace ``photons`` (and every child) until none is left."""
+        self.ledger.launched += float(photons.w.sum())
+        stack = [photons]
+        while stack:
+            ph = stack.pop()
+            if len(ph) > self.chunk:
+                stack.append(ph.take(slice(self.chunk, None)))
+                ph = ph.take(slice(0, self.chunk))
+            children = self.step(ph)
+            if len(children):
+                stack.append(children)
+
+    def step(self, ph: Photons) -> Photons:
+        """One segment per photon: tally detectors, absorb, scatter; the children."""
+        geo, opt, led = self.geo, self.opt, self.ledger
+        tri, t = geo.caster.first_hit(ph.o, ph.d)
+        self.segments += len(ph)
+        self.det.tally(ph.o, ph.d, t, ph.w, ph.batch, self.tally)
+        miss = tri < 0
+        if miss.any():
+            up = ph.d[miss, 2] > 0
+            led.escaped_up += float(ph.w[miss][up].sum())
+            led.escaped_down += float(ph.w[miss][~up].sum())
+            keep = ~miss
+            ph, tri, t = ph.take(keep), tri[keep], t[keep]
+            if len(ph) == 0:
+                return ph
+        p = ph.o + t[:, None] * ph.d
+        ng = geo.normals[tri]
+        cosd = np.einsum("ij,ij->i", ph.d, ng)
+        nf = np.where((cosd < 0)[:, None], ng, -ng)  # normal on the incoming side
+        mat = geo.tri_material[tri]
+        coef = np.stack([opt.rd[mat], opt.td[mat], opt.ts[mat], opt.rm[mat]], axis=1)
+        glass = np.isfinite(opt.glass_tn[mat])
+        if glass.any():
+            tg, rg = glass_coefficients(cosd[glass], opt.glass_tn[mat][glass])
+            coef[glass, 2], coef[glass, 3] = tg, rg
+        w = ph.w
+        led.absorbed += np.bincount(mat, w * (1.0 - coef.sum(axis=1)),
+                                    minlength=len(led.materials))
+        no_diff = ph.ndiff >= self.max_bounces
+        no_spec = ph.nspec >= self.max_specular
+        led.capped += float((w[no_diff] * coef[no_diff, :2].sum(axis=1)).sum()
+                            + (w[no_spec] * coef[no_spec, 2:].sum(axis=1)).sum())
+        coef[no_diff, :2] = 0.0
+        coef[no_spec, 2:] = 0.0
+        floor = self.threshold * ph.w0
+        if self.splitting:
+            ev = np.repeat(np.arange(4)[None, :], len(ph), axis=0).ravel()
+            src = np.repeat(np.arange(len(ph)), 4)
+            cw = (w[:, None] * coef).ravel()
+            live = cw > 0
+            ev, src, cw = ev[live], src[live], cw[live]
+            dead = cw < floor[src]
+            led.killed += float(cw[dead].sum())
+            ev, src, cw = ev[~dead], src[~dead], cw[~dead]
+        else:
+            total = coef.sum(axis=1)
+            cw = w * total
+            cum = np.cumsum(coef, axis=1)
+            pick = self.rng.random(len(ph)) * total
+            ev = np.minimum((pick[:, None] >= cum).sum(axis=1), 3)
+            live = cw > 0
+            low = live & (cw < floor)
+            if low.any():
+                win = self.rng.random(int(low.sum())) * floor[low] < cw[low]
+                lw = cw[low]
+                led.killed += float(lw[~win].sum())
+                led.promoted += float((floor[low][win] - lw[win]).sum())
+                cw[low] = np.where(win, floor[low], 0.0)
+                live &= cw > 0
+            src = np.flatnonzero(live)
+            ev, cw = ev[live], cw[live]
+        if len(src) == 0:
+            return ph.take(np.zeros(0, np.int64))
+        d, n = ph.d[src], nf[src]
+        new_d = d.copy()
+        diff_r, diff_t, spec_t, mir = ev == 0, ev == 1, ev == 2, ev == 3
+        diffuse = diff_r | diff_t
+        if diffuse.any():
+            axis = np.where(diff_r[diffuse, None], n[diffuse], -n[diffuse])
+            new_d[diffuse] = cosine_hemisphere(axis, self.rng)
+        if mir.any():
+            new_d[mir] = mirror(d[mir], n[mir])
+        side = np.where(diff_t | spec_t, -1.0, 1.0)
+        return Photons(p[src] + n * (self.eps * side)[:, None], new_d, cw, ph.w0[src],
+                       ph.ndiff[src] + diffuse, ph.nspec[src] + (spec_t | mir), ph.batch[src])

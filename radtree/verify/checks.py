@@ -1,0 +1,218 @@
+"""The physics suite's checks: each returns :class:`Check` rows (what ``verify.csv`` holds).
+
+* :func:`transmission_checks` — uncollided transmission through horizontally homogeneous
+  layers of random discrete black leaves (LAI 1 and 3; spherical, planophile, erectophile;
+  sun zenith 0°, 30°, 60°) against exp(−G(θ)·LAI/cos θ), by the forward engine (horizontal
+  patch detectors under the layer) and the NumPy engine (direct sun at random points there):
+  within 1 % or 3 standard errors (over independent leaf layers).
+* :func:`energy_checks` — leaves with r + t = 1 over a white Lambertian floor send all the flux
+  back up (≤ 0.5 %); over a black floor reflected + transmitted + absorbed = launched, and the
+  floor's detector tiles tally what the floor absorbed.
+* :func:`agreement_checks` — forward vs every backward engine available (NumPy, Radiance) on
+  the reduced Mendoza louvers dome (:data:`radtree.verify.compare.REDUCED_DOME`), façade
+  patch mean within 2 % or 3 combined standard errors.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+from dataclasses import dataclass, replace
+
+import numpy as np
+
+from radtree.engines.forward import ForwardSettings, trace_forward
+from radtree.engines.numpy.scenes import sky_state
+from radtree.optics import Plastic, Trans
+from radtree.scene import Mesh, Scene, SensorGrid, quad
+from radtree.verify.compare import backward_patch_mean, backward_patch_values, reduced_dome_project
+from radtree.verify.leaves import LEAF_DISTRIBUTIONS, leaf_layer, uncollided_transmission
+
+FORWARD = "forward"
+DNI = 100000.0
+UP = np.array([0.0, 0.0, 1.0])
+
+
+@dataclass(frozen=True)
+class Check:
+    """One verified number: ``passed`` when |got − expected| ≤ tolerance."""
+
+    check: str
+    engine: str
+    expected: float
+    got: float
+    tolerance: float
+
+    @property
+    def passed(self) -> bool:
+        return bool(abs(self.got - self.expected) <= self.tolerance)
+
+    def row(self) -> dict:
+        return {"check": self.check, "engine": self.engine, "expected": self.expected,
+                "got": self.got, "tolerance": self.tolerance, "passed": self.passed}
+
+
+def _tolerance(expected: float, se: float, rel: float) -> float:
+    return max(rel * abs(expected), 3.0 * se)
+
+
+def _square(name: str, material: str, half: float, z: float = 0.0) -> Mesh:
+    return quad(name, material, np.array([[-half, -half, z], [half, -half, z],
+                                          [half, half, z], [-half, half, z]], float))
+
+
+# ----------------------------------------------------------------- Beer–Lambert
+
+
+ZENITHS = (0.0, 30.0, 60.0)
+LAIS = (1.0, 3.0)
+
+
+def _layer_scene(lai: float, distribution: str, seed: int, leaf: float) -> Scene:
+    """Black leaves in a 10 m × 10 m × 1 m layer (z 1–2 m), 36 detectors of 1 m (6 m × 6 m,
+    facing up) just below it: no floor, so only uncollided sunlight reaches them. The slant
+    path at 60° crosses the layer within 1.73 m of a detector, inside the layer's edge."""
+    layer = leaf_layer("leaves", "black", lai=lai, distribution=distribution, extent=10.0,
+                       z_bottom=1.0, z_top=2.0, size=leaf, rng=np.random.default_rng(seed))
+    xs = np.arange(-2.5, 3.0, 1.0)
+    X, Y = np.meshgrid(xs, xs)
+    det = SensorGrid("facade", np.column_stack([X.ravel(), Y.ravel(), np.full(X.size, 0.95)]),
+                     np.tile(UP, (X.size, 1)))
+    return Scene([layer], {"black": Plastic("black", 0.0)}, {"facade": det})
+
+
+def transmission_checks(realisations: int = 4, photons: int = 20_000, points: int = 64,
+                        leaf: float = 0.07, engines: tuple[str, ...] = (FORWARD,),
+                        lais: tuple[float, ...] = LAIS,
+                        distributions: tuple[str, ...] = LEAF_DISTRIBUTIONS,
+                        zeniths: tuple[float, ...] = ZENITHS,
+                        progress: Callable[[str], None] | None = None) -> list[Check]:
+    """Uncollided transmission for LAI 1 and 3 × the three leaf-angle distributions × sun
+    zenith 0°, 30°, 60°: mean over the 36 detectors of ``realisations`` independent layers,
+    its standard error from the spread of those (nearly independent) detector values: photon
+    and leaf-placement noise together. The forward engine launches
+    a 9 m sun beam on the detectors, ``photons`` / T photons (T the expected transmission, at
+    most 20×); a backward engine (e.g. ``numpy``) traces the direct sun at ``points`` random
+    points per detector."""
+    out = []
+    for lai in lais:
+        for dist in distributions:
+            got: dict[tuple[str, float], list[float]] = {(e, z): [] for e in engines
+                                                         for z in zeniths}
+            for r in range(realisations):
+                scene = _layer_scene(lai, dist, 1000 + r, leaf)
+                for z in zeniths:
+                    expected = uncollided_transmission(dist, lai, z)
+                    st = sky_state("none", altitude=90.0 - z, azimuth=0.0, dni=DNI,
+                                   ground_glow=False)
+                    direct = DNI * math.cos(math.radians(z))
+                    for e in engines:
+                        if e == FORWARD:
+                            res = trace_forward(scene, st, ForwardSettings(
+                                photons=int(photons / max(expected, 0.05)), batches=4,
+                                max_bounces=0, beam_diameter_m=9.0, patch_m=1.0,
+                                seed=r + 1))
+                            value = res.grids["facade"].lux
+                        else:
+                            value = backward_patch_values(e, scene, st, "facade", 1.0, ab=0,
+                                                          points=points, rays=1,
+                                                          seed=r + 1).mean(axis=1)
+                        got[e, z].extend(np.asarray(value) / direct)
+            for z in zeniths:
+                expected = uncollided_transmission(dist, lai, z)
+                name = f"uncollided transmission LAI {lai:g} {dist} zenith {z:g}°"
+                for e in engines:
+                    v = np.array(got[e, z])
+                    se = float(v.std(ddof=1) / math.sqrt(len(v))) if len(v) > 1 else 0.0
+                    out.append(Check(name, e, expected, float(v.mean()),
+                                     _tolerance(expected, se, 0.01)))
+                if progress:
+                    progress(f"{name}: expected {expected:.4f}, " + ", ".join(
+                        f"{e} {np.mean(got[e, z]):.4f}" for e in engines))
+    return out
+
+
+# ----------------------------------------------------------------- energy
+
+
+def _canopy(material: str, floor: str, floor_half: float) -> list[Mesh]:
+    return [leaf_layer("leaves", material, lai=2.0, distribution="spherical", extent=3.0,
+                       z_bottom=0.5, z_top=1.5, size=0.15, rng=np.random.default_rng(3)),
+            _square("floor", floor, floor_half)]
+
+
+def energy_checks(photons: int = 40_000) -> list[Check]:
+    """Flux conservation of the forward engine (a 2 m sun beam on a 3 m leaf layer)."""
+    out = []
+    st = sky_state("none", altitude=60.0, azimuth=0.0, dni=DNI, ground_glow=False)
+    target = {"facade": SensorGrid("facade", np.array([[0, 0, 0.01]]), UP[None, :])}
+    white = Scene(_canopy("leaf", "floor", 500.0),
+                  {"leaf": Trans("leaf", 0.45, 0.45, 0.10), "floor": Plastic("floor", 1.0)},
+                  target)
+    r = trace_forward(white, st, ForwardSettings(photons=photons, max_bounces=200,
+                                                 max_specular=200, threshold=0.001,
+                                                 beam_diameter_m=2.0))
+    led = r.ledger
+    out.append(Check("energy: r + t = 1 leaves over a white floor, fraction sent back up",
+                     FORWARD, 1.0, led.escaped_up / led.launched, 0.005))
+    xs = np.arange(-11.0, 12.0, 2.0)
+    X, Y = np.meshgrid(xs, xs)
+    tiles = SensorGrid("floor_tiles", np.column_stack([X.ravel(), Y.ravel(),
+                                                       np.full(X.size, 1e-3)]),
+                       np.tile(UP, (X.size, 1)))
+    black = Scene(_canopy("leaf", "floor", 12.0),
+                  {"leaf": Trans("leaf", 0.10, 0.15, 0.30), "floor": Plastic("floor", 0.0)},
+                  {**target, "floor_tiles": tiles})
+    r = trace_forward(black, st, ForwardSettings(photons=photons, max_bounces=50,
+                                                 threshold=0.001, beam_diameter_m=2.0,
+                                                 patch_m=2.0))
+    led = r.ledger
+    floor = led.absorbed_by("floor")
+    rta = led.escaped_up + floor + led.escaped_down + led.absorbed_by("leaf")
+    out.append(Check("energy: black floor, (reflected + transmitted + absorbed) / launched",
+                     FORWARD, 1.0, rta / led.launched, 0.005))
+    tallied = float(r.grids["floor_tiles"].lux.sum()) * 4.0
+    out.append(Check("energy: black floor, detector tiles' flux / flux absorbed by the floor",
+                     FORWARD, 1.0, tallied / floor, 1e-4))
+    return out
+
+
+# ----------------------------------------------------------------- estimator agreement
+
+
+def agreement_checks(hours: tuple[str, ...] = ("12:30",), scenarios: tuple[str, ...] = ("A",),
+                     photons: int = 16_000_000, points: int = 16, rays: int = 192,
+                     ad: int | None = 256, backward: list[str] | None = None,
+                     progress: Callable[[str], None] | None = None) -> list[Check]:
+    """Forward vs backward engines on the reduced Mendoza louvers dome: the 8 sensors' 0.5 m
+    patch mean per scenario and hour (expected = the backward engine's value). ``points``
+    random points per patch, ``rays`` paths per point (NumPy), ``-ad ad`` (Radiance; None =
+    the project's)."""
+    from radtree.engines.registry import available_engines
+    from radtree.light.hours import hour_states
+    from radtree.pipeline.assemble import make_scene
+
+    names = backward if backward is not None else [
+        e.name for e in available_engines() if e.name != FORWARD]
+    out = []
+    for hour in hours:
+        proj = reduced_dome_project(hour)
+        params = proj.engine if ad is None else replace(proj.engine, ad=int(ad))
+        for name in scenarios:
+            sc = proj.scenario(name)
+            built = make_scene(proj, sc, dense_grid=False)
+            st = hour_states(proj, sc, [hour])[0]
+            fw = trace_forward(built.scene, st, ForwardSettings(
+                photons=photons, max_bounces=built.ab, seed=7), ["facade"])
+            got, se = fw.grid_mean("facade")
+            for e in names:
+                bw = backward_patch_mean(e, built.scene, st, "facade", 0.5, ab=built.ab,
+                                         points=points, rays=rays, params=params)
+                comb = math.hypot(se, bw.stderr)
+                label = (f"agreement: reduced Mendoza louvers dome {name} {hour}, façade patch "
+                         f"mean, forward vs {e}")
+                out.append(Check(label, FORWARD, bw.lux, got, _tolerance(bw.lux, comb, 0.02)))
+                if progress:
+                    progress(f"{label}: {e} {bw.lux:.1f} ± {bw.stderr:.1f}, forward "
+                             f"{got:.1f} ± {se:.1f}")
+    return out

@@ -1,0 +1,99 @@
+"""The physics suite: G functions against their closed forms, a reduced run of each check
+family, and ``radtree verify``'s table and exit status."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pandas as pd
+import pytest
+from click.testing import CliRunner
+
+from radtree.verify import Check, energy_checks, transmission_checks
+from radtree.verify.leaves import (
+    LEAF_DISTRIBUTIONS,
+    g_function,
+    leaf_angle_density,
+    leaf_layer,
+    sample_inclinations,
+    uncollided_transmission,
+)
+
+
+@pytest.mark.parametrize("zenith", [0.0, 30.0, 60.0, 85.0])
+def test_spherical_g_is_one_half(zenith):
+    assert g_function("spherical", zenith) == pytest.approx(0.5, abs=1e-4)
+
+
+def test_g_at_the_zenith_is_the_mean_leaf_cosine():
+    # planophile: (2/π)∫(1 + cos 2t) cos t dt = 8/(3π); erectophile 4/(3π)
+    assert g_function("planophile", 0.0) == pytest.approx(8 / (3 * math.pi), abs=1e-4)
+    assert g_function("erectophile", 0.0) == pytest.approx(4 / (3 * math.pi), abs=1e-4)
+
+
+@pytest.mark.parametrize("dist", LEAF_DISTRIBUTIONS)
+def test_g_is_normalised_and_crosses_one_half_near_57_degrees(dist):
+    # ∫ G(θ) sin θ dθ = 1/2 for every distribution; all G curves meet near 57.5°
+    th = np.radians(np.linspace(0.05, 89.95, 900))
+    g = np.array([g_function(dist, math.degrees(t)) for t in th])
+    assert float(np.sum(g * np.sin(th)) * (th[1] - th[0])) == pytest.approx(0.5, abs=2e-3)
+    assert g_function(dist, 57.5) == pytest.approx(0.5, abs=0.01)
+
+
+@pytest.mark.parametrize("dist", LEAF_DISTRIBUTIONS)
+def test_sampled_inclinations_follow_the_density(dist):
+    t = sample_inclinations(dist, 200_000, np.random.default_rng(1))
+    hist, edges = np.histogram(t, bins=9, range=(0, math.pi / 2), density=True)
+    mid = (edges[:-1] + edges[1:]) / 2
+    f = leaf_angle_density(dist, mid)
+    f = f / (np.sum(f) * (edges[1] - edges[0]))
+    assert np.allclose(hist, f, rtol=0.05, atol=0.02)
+
+
+def test_leaf_layer_has_the_stated_leaf_area_index():
+    m = leaf_layer("l", "black", lai=2.0, distribution="planophile", extent=6.0,
+                   z_bottom=1.0, z_top=2.0, size=0.1, rng=np.random.default_rng(2))
+    assert m.area() / 36.0 == pytest.approx(2.0, rel=0.03)
+
+
+def test_transmission_check_reduced():
+    checks = transmission_checks(realisations=2, photons=20_000, engines=("forward", "numpy"),
+                                 lais=(1.0,), distributions=("planophile",), zeniths=(60.0,))
+    assert len(checks) == 2
+    expected = uncollided_transmission("planophile", 1.0, 60.0)
+    for c in checks:
+        print(c)
+        assert c.expected == pytest.approx(expected)
+        assert c.tolerance < 0.1 * expected
+        assert c.passed
+
+
+def test_energy_checks_pass():
+    checks = energy_checks(photons=20_000)
+    for c in checks:
+        print(c)
+    assert [c.passed for c in checks] == [True, True, True]
+
+
+def _fake_suite(monkeypatch, checks):
+    import radtree.verify.suite as suite
+
+    monkeypatch.setattr(suite, "transmission_checks", lambda **_k: checks)
+    monkeypatch.setattr(suite, "energy_checks", lambda **_k: [])
+    monkeypatch.setattr(suite, "agreement_checks", lambda **_k: [])
+
+
+@pytest.mark.parametrize("got, code", [(1.0, 0), (2.0, 1)])
+def test_verify_command_writes_the_table_and_fails_on_a_failure(monkeypatch, tmp_path, got,
+                                                                 code):
+    from radtree.cli import main
+
+    _fake_suite(monkeypatch, [Check("a check", "forward", 1.0, got, 0.1)])
+    out = tmp_path / "verify.csv"
+    res = CliRunner().invoke(main, ["verify", "--out", str(out)])
+    assert res.exit_code == code, res.output
+    t = pd.read_csv(out)
+    assert list(t.columns) == ["check", "engine", "expected", "got", "tolerance", "passed"]
+    assert bool(t["passed"][0]) is (code == 0)
+    assert ("FAIL" in res.output) is (code == 1)
