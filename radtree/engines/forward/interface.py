@@ -9,7 +9,7 @@ from typing import TYPE_CHECKING
 from radtree.engines.base import Engine, GridResult
 from radtree.engines.forward.run import trace_forward
 from radtree.engines.forward.settings import ForwardSettings
-from radtree.engines.numpy.raycast import embree_available
+from radtree.engines.numpy.raycast import backend_version, embree_available
 
 if TYPE_CHECKING:
     from radtree.config import EngineParams
@@ -39,9 +39,7 @@ class ForwardEngine(Engine):
         return True
 
     def version(self) -> str | None:
-        import numpy
-
-        return f"numpy {numpy.__version__}" + (", embree" if embree_available() else "")
+        return backend_version()
 
     def describe(self) -> str:
         ray = "embree" if embree_available() else "numpy-bvh"

@@ -8,7 +8,7 @@ from typing import TYPE_CHECKING
 
 from radtree.engines.base import Engine, GridResult
 from radtree.engines.numpy.engine import describe, trace_hour
-from radtree.engines.numpy.raycast import embree_available
+from radtree.engines.numpy.raycast import backend_version
 
 if TYPE_CHECKING:
     from radtree.config import EngineParams
@@ -38,9 +38,7 @@ class NumpyEngine(Engine):
         return True
 
     def version(self) -> str | None:
-        import numpy
-
-        return f"numpy {numpy.__version__}" + (", embree" if embree_available() else "")
+        return backend_version()
 
     def describe(self) -> str:
         return f"available ({describe()})"
