@@ -15,22 +15,22 @@ from tests.conftest import needs_radiance
 from tests.golden_cases import CASES, GOLDEN, as_text
 
 
-def _compare(name: str, tmp_path: Path) -> None:
+def assert_table_unchanged(name: str, tmp_path: Path) -> None:
+    """The regenerated table's CSV text equals tests/golden/<name>.csv (diff shown if not)."""
     expected = (GOLDEN / f"{name}.csv").read_text()
     got = as_text(CASES[name](tmp_path))
-    if got != expected:
-        diff = "".join(list(difflib.unified_diff(
-            expected.splitlines(True), got.splitlines(True), "golden", "now", n=0))[:40])
-        pytest.fail(f"{name} differs from tests/golden/{name}.csv:\n{diff}")
+    diff = "".join(list(difflib.unified_diff(
+        expected.splitlines(True), got.splitlines(True), "golden", "now", n=0))[:40])
+    assert got == expected, f"{name} differs from tests/golden/{name}.csv:\n{diff}"
 
 
 @pytest.mark.parametrize("name", ["mendoza_numpy", "office_numpy"])
 def test_numpy_tables_unchanged(name, tmp_path):
-    _compare(name, tmp_path)
+    assert_table_unchanged(name, tmp_path)
 
 
 @needs_radiance
 @pytest.mark.radiance
 @pytest.mark.parametrize("name", ["mendoza_radiance", "office_radiance"])
 def test_radiance_tables_unchanged(name, tmp_path):
-    _compare(name, tmp_path)
+    assert_table_unchanged(name, tmp_path)

@@ -20,7 +20,7 @@ import pandas as pd
 from matplotlib.colors import LogNorm
 from matplotlib.figure import Figure
 
-from radtree.annual import metrics
+import radtree.annual.metrics as metrics
 from radtree.config import Project
 from radtree.figures import new_figure, save_png
 

@@ -49,7 +49,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from radtree.annual import metrics
+import radtree.annual.metrics as metrics
 from radtree.annual.branches import BranchParams, build_leaf_off
 from radtree.annual.coefficients import CoefficientRunner, TraceParams
 from radtree.annual.schedule import (

@@ -22,9 +22,9 @@ from pathlib import Path
 
 import pandas as pd
 
+import radtree.report.figures as figures
 from radtree.config import Project
 from radtree.fileio import atomic_dir
-from radtree.report import figures
 from radtree.report.data import ReportData, collect
 from radtree.report.sections import Section, environment
 from radtree.report.sections.extras import extra_sections

@@ -126,7 +126,7 @@ def extra_sections(project: Project, out: Path, echo: Callable[[str], None]
     if diagnosis["steps"] is not None:
         md.append(Section("diagnose", diagnosis))
     if (project.results_dir / "annual_summary.csv").exists():
-        from radtree.annual import annual_section_data
+        from radtree.annual.report import annual_section_data
 
         html.append(Section("annual", annual_section_data(project)))
         echo("  annual: metric maps and month × hour heat maps")
