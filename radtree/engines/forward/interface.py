@@ -6,10 +6,11 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-from radtree.engines.base import Engine, GridResult
+from radtree.engines.base import GridResult
 from radtree.engines.forward.run import trace_forward
 from radtree.engines.forward.settings import ForwardSettings
-from radtree.engines.numpy.raycast import backend_version, embree_available
+from radtree.engines.numpy.inprocess import InProcessEngine
+from radtree.engines.numpy.raycast import embree_available
 
 if TYPE_CHECKING:
     from radtree.config import EngineParams
@@ -27,19 +28,11 @@ class ForwardPlan:
     workers: int
 
 
-class ForwardEngine(Engine):
+class ForwardEngine(InProcessEngine):
     """Photons from the sun (collimated: whole scene or a beam) and the sky, ray splitting or
     Russian roulette, square patch detectors around the sensors (TracePro's method)."""
 
     name = "forward"
-    missing_hint = "the forward engine failed to load"
-
-    @classmethod
-    def available(cls) -> bool:
-        return True
-
-    def version(self) -> str | None:
-        return backend_version()
 
     def describe(self) -> str:
         ray = "embree" if embree_available() else "numpy-bvh"

@@ -6,9 +6,9 @@ from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-from radtree.engines.base import Engine, GridResult
+from radtree.engines.base import GridResult
 from radtree.engines.numpy.engine import describe, trace_hour
-from radtree.engines.numpy.raycast import backend_version
+from radtree.engines.numpy.inprocess import InProcessEngine
 
 if TYPE_CHECKING:
     from radtree.config import EngineParams
@@ -25,20 +25,12 @@ class NumpyPlan:
     params: EngineParams
 
 
-class NumpyEngine(Engine):
+class NumpyEngine(InProcessEngine):
     """Vectorised backward path tracing (Embree first-hit queries when available). Like for
     like with Radiance: ``max_bounces`` = the scene's ``-ab``."""
 
     name = "numpy"
-    missing_hint = "NumPy engine failed to load"
     seeded = True
-
-    @classmethod
-    def available(cls) -> bool:
-        return True
-
-    def version(self) -> str | None:
-        return backend_version()
 
     def describe(self) -> str:
         return f"available ({describe()})"

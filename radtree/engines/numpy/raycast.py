@@ -312,9 +312,3 @@ def make_caster(vertices: np.ndarray, faces: np.ndarray, backend: str = "auto",
         return EmbreeCaster(vertices, faces, workers=workers)
     return BVHCaster(vertices, faces)
 
-
-def backend_version() -> str:
-    """``numpy <version>[, embree]``: what the in-process engines trace with."""
-    import numpy
-
-    return f"numpy {numpy.__version__}" + (", embree" if embree_available() else "")
