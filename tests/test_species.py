@@ -4,12 +4,17 @@ from __future__ import annotations
 
 import math
 from dataclasses import replace
+from pathlib import Path
 
 import pytest
 import tomllib
 
+from radtree.config import load_project
 from radtree.errors import ConfigError
 from radtree.resources import folder, read_text
+from radtree.site.frame import FacadeFrame
+from radtree.trees.build import build_crown
+from radtree.trees.louvers import LouverOptics
 from radtree.trees.species import (
     CrownSize,
     crown_size,
@@ -17,7 +22,9 @@ from radtree.trees.species import (
     load_species,
     louvers_cover_fraction,
     species_library,
+    tree_defaults,
 )
+from tests.conftest import MENDOZA, copy_project
 from tests.test_materials import entries
 
 MENDOZA4 = ["morus_alba", "platanus_x_acerifolia", "fraxinus_excelsior", "melia_azedarach"]
@@ -116,12 +123,16 @@ def test_species_validated_on_creation() -> None:
 def test_louvers_cover_fraction_matches_permeability() -> None:
     morus, melia = load_species("morus_alba"), load_species("melia_azedarach")
     for sp in (morus, melia):
-        f = louvers_cover_fraction(sp, 4)
+        f = louvers_cover_fraction(sp.permeability_leaf_on, sp.leaf_transmittance_direct, 4)
         per_layer = 1 - f + f * sp.leaf_transmittance_direct
         assert per_layer ** 4 == pytest.approx(sp.permeability_leaf_on)
     # mulberry: slats 0.48 direct → nearly full cover (the study reading)
-    assert louvers_cover_fraction(morus, 4) == pytest.approx((1 - 0.055 ** 0.25) / 0.52)
-    assert louvers_cover_fraction(melia, 4) == pytest.approx(1 - 0.0272 ** 0.25)
+    assert tree_defaults(morus)["louvers"]["cover_fraction"] == round((1 - 0.055 ** 0.25) / 0.52, 4)
+    assert tree_defaults(melia)["louvers"]["cover_fraction"] == round(1 - 0.0272 ** 0.25, 4)
+    # the optics the project gives are the ones solved for: T 0.5 × 0.9 direct, 5 layers
+    given = {"louvers": {"layers": 5, "transmittance": 0.5, "specular_fraction": 0.9}}
+    assert tree_defaults(morus, given)["louvers"]["cover_fraction"] == \
+        round((1 - 0.055 ** 0.2) / (1 - 0.45), 4)
 
 
 def test_crown_size_from_inventory_row() -> None:
@@ -132,3 +143,44 @@ def test_crown_size_from_inventory_row() -> None:
     assert (c.vertical_radius_m, c.base_height_m, c.height_m) == (3.75, 5.0, 12.5)
     with pytest.raises(ConfigError, match="T7: crown_base_m 13"):
         crown_size(sp, 12.5, 10.0, 13.0, where="T7")
+
+
+def test_tree_species_fills_what_the_project_leaves_out(tmp_path: Path) -> None:
+    proj = copy_project(tmp_path / "p", {
+        r"^form = \"dome\".*$": 'form = "dome"\nspecies = "Melia azedarach"',
+        r"^\[tree.homogeneous\]\nreflectance = 0.11\n": "[tree.homogeneous]\n",
+        r"^reflectance = 0.11\ntransmittance = 0.5 .*\nspecular_fraction = 0.9 .*$": "",
+    })
+    p = load_project(proj)
+    melia = load_species("melia_azedarach")
+    lv = p.tree.louvers
+    assert p.tree.species == "Melia azedarach"
+    # filled from the species: leaf optics, tilt kept where given (30°), cover solved
+    assert (lv.reflectance, lv.transmittance, lv.specular_fraction) == (0.09, 0.06, 0.0)
+    assert lv.inclination_deg == 30.0 and lv.layers == 5
+    assert lv.cover_fraction == round(1 - 0.0272 ** 0.2, 4)            # 0.5137
+    assert LouverOptics.of(lv).tau_crown_direct == pytest.approx(0.0272, rel=1e-3)
+    assert p.tree.homogeneous.reflectance == 0.09
+    assert p.tree.homogeneous.permeability == 0.055                      # given in the file
+    assert p.tree.perforated.openness == 0.06                            # given in the file
+    # the crown carries the species' leaf and says so
+    model = build_crown(p, "louvers", "dome", FacadeFrame(p.street.facade_azimuth_deg))
+    assert model.materials["leaf"].to_radiance().splitlines()[-1] == "7 0.15 0.15 0.15 0 0 0.4 0"
+    assert model.notes[0].startswith("Species Melia azedarach (chinaberry, "
+                                     "materials/species/melia_azedarach.toml)")
+    assert melia.describe() in model.notes[0]
+
+
+def test_no_species_changes_no_hash() -> None:
+    p = load_project(MENDOZA)
+    assert p.tree.species is None
+    assert p.params_hash(p.scenarios[0]) == "ea9c1c0b26e3"     # as before species existed
+    q = load_project(MENDOZA, {"tree.species": "morus_alba"})
+    assert p.params_hash(p.scenarios[0]) != q.params_hash(q.scenarios[0])
+
+
+def test_unknown_tree_species_names_the_field(tmp_path: Path) -> None:
+    with pytest.raises(ConfigError) as err:
+        load_project(MENDOZA, {"tree.species": "Ginkgo biloba"})
+    assert "field 'tree.species': unknown species 'Ginkgo biloba' (known: acer_platanoides" \
+        in str(err.value)

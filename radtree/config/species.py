@@ -33,6 +33,7 @@ from typing import Any
 import numpy as np
 import tomllib
 
+from radtree.config.schema import Louvers
 from radtree.errors import ConfigError
 from radtree.optics import Trans
 from radtree.resources import folder
@@ -271,37 +272,68 @@ def species_library() -> dict[str, Species]:
     return dict(_library())
 
 
+def find_species(key_or_name: str) -> Species | None:
+    """The species of key, scientific or common name (case-insensitive; see
+    :func:`load_species`), None when the library has none such."""
+    want = _normal(key_or_name)
+    for sp in _library().values():
+        if want in (_normal(sp.key), _normal(sp.name), _normal(sp.common_name)):
+            return sp
+    return None
+
+
+def unknown_species_message(key_or_name: str) -> str:
+    """"unknown species 'X' (known: key (Name); …)"."""
+    lib = _library()
+    listed = "; ".join(f"{k} ({lib[k].name})" for k in sorted(lib))
+    return f"unknown species {key_or_name!r} (known: {listed})"
+
+
 def load_species(key_or_name: str) -> Species:
     """The species of key (``"morus_alba"``), scientific name (``"Platanus × acerifolia"``,
     ``"platanus x acerifolia"``) or common name (``"white mulberry"``), case-insensitive.
     Unknown → :class:`ConfigError` listing the known species."""
-    lib = _library()
-    want = _normal(key_or_name)
-    for sp in lib.values():
-        if want in (_normal(sp.key), _normal(sp.name), _normal(sp.common_name)):
-            return sp
-    listed = "; ".join(f"{k} ({lib[k].name})" for k in sorted(lib))
-    raise ConfigError(f"unknown species {key_or_name!r} (known: {listed})", field="species")
+    sp = find_species(key_or_name)
+    if sp is None:
+        raise ConfigError(unknown_species_message(key_or_name), field="species")
+    return sp
 
 
 # ---------------------------------------------------------------- crown defaults
-def louvers_cover_fraction(sp: Species, layers: int) -> float:
+def louvers_cover_fraction(permeability: float, direct_transmittance: float,
+                           layers: int) -> float:
     """The cover fraction f of each of ``layers`` slat layers whose direct transmission
-    ((1 − f) + f·T_direct)^layers equals the species' leaf-on permeability (clamped 0–1):
-    the louvers model's own optics (:mod:`radtree.trees.louvers`) solved for f."""
-    per_layer = sp.permeability_leaf_on ** (1.0 / layers)
-    return min(1.0, max(0.0, (1.0 - per_layer) / (1.0 - sp.leaf_transmittance_direct)))
+    ((1 − f) + f·T_direct)^layers equals ``permeability`` (clamped 0–1): the louvers model's
+    own optics (:mod:`radtree.trees.louvers`) solved for f."""
+    per_layer = permeability ** (1.0 / layers)
+    if direct_transmittance >= 1.0:
+        return 1.0
+    return min(1.0, max(0.0, (1.0 - per_layer) / (1.0 - direct_transmittance)))
 
 
-def tree_defaults(sp: Species, layers: int) -> dict[str, dict[str, float]]:
-    """The ``[tree.*]`` fields a species fills when the project does not give them:
-    table → field → value (leaf optics, slat inclination = mean leaf tilt, permeability)."""
+def tree_defaults(sp: Species, given: dict[str, dict[str, Any]] | None = None
+                  ) -> dict[str, dict[str, float]]:
+    """The ``[tree.*]`` fields a species fills where the project does not give them:
+    table → field → value (leaf optics, slat inclination = mean leaf tilt, permeability).
+
+    ``given``: the values the project gives (table → field → value); the louvers cover
+    fraction is solved (:func:`louvers_cover_fraction`) for the slat optics and layer count in
+    use — given or filled — so that the crown passes the species' leaf-on permeability."""
     t = sp.leaf_transmittance_global
+    louvers: dict[str, float] = {
+        "reflectance": sp.leaf_reflectance, "transmittance": t,
+        "specular_fraction": sp.leaf_transmittance_direct / t if t > 0 else 0.0,
+        "inclination_deg": sp.mean_leaf_tilt_deg}
+    used = {**louvers, **(given or {}).get("louvers", {})}
+    try:
+        layers = int(used.get("layers", Louvers.layers))
+        direct = float(used["transmittance"]) * float(used["specular_fraction"])
+    except (TypeError, ValueError):   # a bad given value: the reader reports it
+        layers, direct = Louvers.layers, sp.leaf_transmittance_direct
+    louvers["cover_fraction"] = round(louvers_cover_fraction(
+        sp.permeability_leaf_on, direct, max(layers, 1)), 4)
     return {
-        "louvers": {"reflectance": sp.leaf_reflectance, "transmittance": t,
-                    "specular_fraction": sp.leaf_transmittance_direct / t if t > 0 else 0.0,
-                    "inclination_deg": sp.mean_leaf_tilt_deg,
-                    "cover_fraction": round(louvers_cover_fraction(sp, layers), 4)},
+        "louvers": louvers,
         "homogeneous": {"reflectance": sp.leaf_reflectance,
                         "permeability": sp.permeability_leaf_on},
         "perforated": {"reflectance": sp.leaf_reflectance,
