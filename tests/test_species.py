@@ -6,9 +6,11 @@ import math
 from dataclasses import replace
 from pathlib import Path
 
+import numpy as np
 import pytest
 import tomllib
 
+from radtree.annual.phenology import Phenology, blend
 from radtree.config import load_project
 from radtree.errors import ConfigError
 from radtree.resources import folder, read_text
@@ -184,3 +186,23 @@ def test_unknown_tree_species_names_the_field(tmp_path: Path) -> None:
         load_project(MENDOZA, {"tree.species": "Ginkgo biloba"})
     assert "field 'tree.species': unknown species 'Ginkgo biloba' (known: acer_platanoides" \
         in str(err.value)
+
+
+def test_phenology_hourly_fraction_and_beer_weights() -> None:
+    morus = Phenology.of("morus_alba", -32.89)     # Mendoza: out 258 → full 288 (south)
+    month, day, hour = np.array([9, 9, 12, 7]), np.array([30, 30, 22, 1]), \
+        np.array([12.5, 0.5, 12.5, 12.5])
+    f = morus.leaf_fraction(month, day, hour)
+    # 30 Sep = day 273; 12:30 → t = 273 + 0.5/24; 00:30 → 273 − 11.5/24
+    np.testing.assert_allclose(f, [(15 + 0.5 / 24) / 30, (15 - 11.5 / 24) / 30, 1.0, 0.0])
+    leaf_area = 5.8 - 1.39                          # lai_leaf_on − lai_leaf_off
+    assert morus.leaf_area == pytest.approx(leaf_area)
+    w = morus.weight(np.array([0.0, 0.5, 1.0]))
+    expect = (1 - math.exp(-0.5 * 0.5 * leaf_area)) / (1 - math.exp(-0.5 * leaf_area))
+    np.testing.assert_allclose(w, [0.0, expect, 1.0])
+    assert expect == pytest.approx(0.7507, abs=1e-4)
+    on, off = np.array([[100.0, 100.0, 100.0]], np.float32), np.array([[300.0] * 3], np.float32)
+    np.testing.assert_allclose(blend(on, off, w), [[300.0, 300 - 200 * expect, 100.0]],
+                               rtol=1e-6)
+    assert "leaves out from day 258, full leaf day 288, leaf fall days 105–152" in \
+        morus.describe()
