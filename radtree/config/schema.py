@@ -378,12 +378,12 @@ class Project:
         d = self.to_dict()
         payload = {k: d[k] for k in ("site", "street", "light", "tree", "sensors", "engine",
                                      "office", "extra_geometry")}
+        if payload["tree"].get("species") is None:  # no species: hashes unchanged
+            payload["tree"].pop("species", None)
         payload["engine"].pop("workers", None)
         for key in FORWARD_KEYS:  # forward-engine settings at their defaults: hashes unchanged
             if payload["engine"].get(key) == getattr(EngineParams, key):
                 payload["engine"].pop(key, None)
-        if payload["tree"].get("species") is None:  # no species: hashes unchanged
-            payload["tree"].pop("species", None)
         payload["scenario"] = _plain(scenario)
         text = json.dumps(payload, sort_keys=True, default=str)
         return hashlib.sha256(text.encode()).hexdigest()[:12]
