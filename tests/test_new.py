@@ -138,3 +138,17 @@ def test_new_refuses_to_overwrite_and_bad_requests(tmp_path: Path) -> None:
     with pytest.raises(ConfigError, match="district template needs --trees"):
         new_project(tmp_path / "b", template="district")
     assert not (tmp_path / "b").exists()
+
+
+def test_site_from_inputs_and_epw(tmp_path: Path) -> None:
+    tp, _ = _inventory(tmp_path)
+    site, why = site_facts(EPW, read_inputs(tp, None, None))
+    assert (site["latitude"], site["longitude"], site["utc_offset_hours"],
+            site["elevation_m"]) == (-32.8895, -68.8445, -3.0, 750.0)
+    assert why.startswith("latitude/longitude the centroid of the inputs; time zone")
+    far = tmp_path / "far.geojson"
+    far.write_text(json.dumps({"type": "FeatureCollection", "features": [
+        {"type": "Feature", "geometry": {"type": "Point", "coordinates": [2.35, 48.85]},
+         "properties": {"species": "tilia_cordata"}}]}))
+    with pytest.raises(ConfigError, match="more than 0.5° from the inputs' centre"):
+        site_facts(EPW, read_inputs(far, None, None))

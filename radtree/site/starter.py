@@ -148,24 +148,40 @@ def read_inputs(trees: Path | None, buildings: Path | None, honeybee: Path | Non
     return info
 
 
+def _centroid(inputs: Inputs) -> tuple[float, float] | None:
+    if not inputs.lonlat:
+        return None
+    lon = sum(p[0] for p in inputs.lonlat) / len(inputs.lonlat)
+    lat = sum(p[1] for p in inputs.lonlat) / len(inputs.lonlat)
+    return (lon, lat) if -180 <= lon <= 180 and -90 <= lat <= 90 else None
+
+
 def site_facts(epw: Path | None, inputs: Inputs) -> tuple[dict[str, Any], str]:
-    """The ``[site]`` place and where it came from (EPW, the inputs' coordinates, default)."""
+    """The ``[site]`` place and where it came from: latitude/longitude from the inputs'
+    longitude/latitude centroid (the site origin of their local frame) or else the EPW; time
+    zone and elevation from the EPW, else estimated; else the Mendoza reference site."""
+    centre = _centroid(inputs)
     if epw is not None:
         w = read_epw(epw)
-        city = w.path.stem.replace("_", " ")
-        return ({"name": city, "latitude": round(w.latitude, 4),
-                 "longitude": round(w.longitude, 4), "elevation_m": float(w.elevation_m),
-                 "utc_offset_hours": float(w.utc_offset_hours)},
-                f"from the EPW {epw.name} (pvlib)")
-    if inputs.lonlat:
-        lon = sum(p[0] for p in inputs.lonlat) / len(inputs.lonlat)
-        lat = sum(p[1] for p in inputs.lonlat) / len(inputs.lonlat)
-        if -180 <= lon <= 180 and -90 <= lat <= 90:
-            return ({"name": "site of the inputs", "latitude": round(lat, 5),
-                     "longitude": round(lon, 5), "elevation_m": 0.0,
-                     "utc_offset_hours": float(round(lon / 15.0))},
-                    "the centroid of the inputs' longitude/latitude; time zone ESTIMATED as "
-                    "round(longitude / 15) h and elevation 0 m: check both")
+        site = {"name": w.path.stem.replace("_", " "), "latitude": round(w.latitude, 4),
+                "longitude": round(w.longitude, 4), "elevation_m": float(w.elevation_m),
+                "utc_offset_hours": float(w.utc_offset_hours)}
+        why = f"from the EPW {epw.name} (pvlib)"
+        if centre is not None:
+            if abs(centre[0] - w.longitude) > 0.5 or abs(centre[1] - w.latitude) > 0.5:
+                raise ConfigError(f"the EPW {epw} is for latitude {w.latitude}, longitude "
+                                  f"{w.longitude}, more than 0.5° from the inputs' centre "
+                                  f"({centre[1]:.4f}, {centre[0]:.4f})")
+            site.update(latitude=round(centre[1], 5), longitude=round(centre[0], 5))
+            why = (f"latitude/longitude the centroid of the inputs; time zone and elevation "
+                   f"from the EPW {epw.name} (pvlib)")
+        return site, why
+    if centre is not None:
+        return ({"name": "site of the inputs", "latitude": round(centre[1], 5),
+                 "longitude": round(centre[0], 5), "elevation_m": 0.0,
+                 "utc_offset_hours": float(round(centre[0] / 15.0))},
+                "the centroid of the inputs' longitude/latitude; time zone ESTIMATED as "
+                "round(longitude / 15) h and elevation 0 m: check both")
     return dict(MENDOZA), "the Mendoza reference site (no EPW, no geographic inputs): edit it"
 
 
