@@ -27,6 +27,7 @@ from radtree.trees.species import (
     load_species,
     louvers_cover_fraction,
     species_library,
+    species_tree,
     tree_defaults,
 )
 from tests.conftest import MENDOZA, copy_project
@@ -218,3 +219,19 @@ def test_phenology_hourly_fraction_and_beer_weights() -> None:
                                rtol=1e-6)
     assert "leaves out from day 258, full leaf day 288, leaf fall days 105–152" in \
         morus.describe()
+
+
+def test_species_tree_from_a_species_and_a_size() -> None:
+    p = load_project(MENDOZA)
+    sp = load_species("platanus_x_acerifolia")
+    size = crown_size(sp, 14.0, 12.0, 4.0)                    # radius 6, semi-axis 5
+    t = species_tree(p.tree, sp, size, keep=["louvers.layers", "louvers.inclination_deg"])
+    assert (t.crown.radius_m, t.crown.vertical_radius_m, t.crown.base_height_m) == (6, 5, 4)
+    assert t.crown.trunk_distance_m == p.tree.crown.trunk_distance_m
+    lv = t.louvers
+    assert (lv.reflectance, lv.transmittance, lv.specular_fraction) == (0.09, 0.06, 0.0)
+    assert (lv.layers, lv.inclination_deg) == (5, 30.0)        # kept as the project has them
+    assert LouverOptics.of(lv).tau_crown_direct == pytest.approx(0.218, rel=1e-3)
+    assert t.homogeneous.permeability == 0.218 and t.perforated.openness == 0.218
+    untouched = species_tree(p.tree, sp)
+    assert untouched.crown == p.tree.crown and untouched.louvers.inclination_deg == 26.76
