@@ -234,4 +234,4 @@ def test_species_tree_from_a_species_and_a_size() -> None:
     assert LouverOptics.of(lv).tau_crown_direct == pytest.approx(0.218, rel=1e-3)
     assert t.homogeneous.permeability == 0.218 and t.perforated.openness == 0.218
     untouched = species_tree(p.tree, sp)
-    assert untouched.crown == p.tree.crown and untouched.louvers.inclination_deg == 26.76
+    assert untouched.crown == p.tree.crown and untouched.louvers.inclination_deg == 44.2
