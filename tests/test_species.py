@@ -139,6 +139,9 @@ def test_louvers_cover_fraction_matches_permeability() -> None:
     given = {"louvers": {"layers": 5, "transmittance": 0.5, "specular_fraction": 0.9}}
     assert tree_defaults(morus, given)["louvers"]["cover_fraction"] == \
         round((1 - 0.055 ** 0.2) / (1 - 0.45), 4)
+    # the volume arrangement's density is its crossings: the cover is left alone
+    assert "cover_fraction" not in tree_defaults(morus, {"louvers": {"arrangement": "volume"}}
+                                                 )["louvers"]
 
 
 def test_crown_size_from_inventory_row() -> None:

@@ -318,13 +318,16 @@ def tree_defaults(sp: Species, given: dict[str, dict[str, Any]] | None = None
 
     ``given``: the values the project gives (table → field → value); the louvers cover
     fraction is solved (:func:`louvers_cover_fraction`) for the slat optics and layer count in
-    use — given or filled — so that the crown passes the species' leaf-on permeability."""
+    use — given or filled — so that the crown passes the species' leaf-on permeability; not
+    for the ``volume`` arrangement, whose density is ``crossings`` (calibrated separately)."""
     t = sp.leaf_transmittance_global
     louvers: dict[str, float] = {
         "reflectance": sp.leaf_reflectance, "transmittance": t,
         "specular_fraction": sp.leaf_transmittance_direct / t if t > 0 else 0.0,
         "inclination_deg": sp.mean_leaf_tilt_deg}
     used = {**louvers, **(given or {}).get("louvers", {})}
+    if used.get("arrangement", Louvers.arrangement) == "volume":   # density from crossings,
+        return _other_tables(sp, louvers)                          # not from layers
     try:
         layers = int(used.get("layers", Louvers.layers))
         direct = float(used["transmittance"]) * float(used["specular_fraction"])
@@ -332,6 +335,10 @@ def tree_defaults(sp: Species, given: dict[str, dict[str, Any]] | None = None
         layers, direct = Louvers.layers, sp.leaf_transmittance_direct
     louvers["cover_fraction"] = round(louvers_cover_fraction(
         sp.permeability_leaf_on, direct, max(layers, 1)), 4)
+    return _other_tables(sp, louvers)
+
+
+def _other_tables(sp: Species, louvers: dict[str, float]) -> dict[str, dict[str, float]]:
     return {
         "louvers": louvers,
         "homogeneous": {"reflectance": sp.leaf_reflectance,
