@@ -139,9 +139,11 @@ def test_louvers_cover_fraction_matches_permeability() -> None:
     given = {"louvers": {"layers": 5, "transmittance": 0.5, "specular_fraction": 0.9}}
     assert tree_defaults(morus, given)["louvers"]["cover_fraction"] == \
         round((1 - 0.055 ** 0.2) / (1 - 0.45), 4)
-    # the volume arrangement's density is its crossings: the cover is left alone
-    assert "cover_fraction" not in tree_defaults(morus, {"louvers": {"arrangement": "volume"}}
-                                                 )["louvers"]
+    # a volume crown of given crossings keeps its density; without crossings it uses layers
+    volume = {"arrangement": "volume", "crossings": 14.6}
+    assert "cover_fraction" not in tree_defaults(morus, {"louvers": volume})["louvers"]
+    assert tree_defaults(morus, {"louvers": {"arrangement": "volume"}})["louvers"][
+        "cover_fraction"] == round((1 - 0.055 ** 0.25) / 0.52, 4)
 
 
 def test_crown_size_from_inventory_row() -> None:

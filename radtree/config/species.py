@@ -318,16 +318,22 @@ def tree_defaults(sp: Species, given: dict[str, dict[str, Any]] | None = None
 
     ``given``: the values the project gives (table → field → value); the louvers cover
     fraction is solved (:func:`louvers_cover_fraction`) for the slat optics and layer count in
-    use — given or filled — so that the crown passes the species' leaf-on permeability; not
-    for the ``volume`` arrangement, whose density is ``crossings`` (calibrated separately)."""
+    use — given or filled — so that the crown passes the species' leaf-on permeability (for
+    the ``volume`` arrangement too, whose crossings then default to ``layers``; not when it
+    gives ``crossings``: that density is the project's, e.g. calibrated)."""
     t = sp.leaf_transmittance_global
     louvers: dict[str, float] = {
         "reflectance": sp.leaf_reflectance, "transmittance": t,
         "specular_fraction": sp.leaf_transmittance_direct / t if t > 0 else 0.0,
         "inclination_deg": sp.mean_leaf_tilt_deg}
     used = {**louvers, **(given or {}).get("louvers", {})}
-    if used.get("arrangement", Louvers.arrangement) == "volume":   # density from crossings,
-        return _other_tables(sp, louvers)                          # not from layers
+    try:
+        explicit_density = (used.get("arrangement", Louvers.arrangement) == "volume"
+                            and float(used.get("crossings", Louvers.crossings)) > 0)
+    except (TypeError, ValueError):
+        explicit_density = False
+    if explicit_density:      # a volume crown of given crossings: its density is set
+        return _other_tables(sp, louvers)
     try:
         layers = int(used.get("layers", Louvers.layers))
         direct = float(used["transmittance"]) * float(used["specular_fraction"])
