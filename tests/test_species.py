@@ -238,5 +238,7 @@ def test_species_tree_from_a_species_and_a_size() -> None:
     assert (lv.layers, lv.inclination_deg) == (5, 30.0)        # kept as the project has them
     assert LouverOptics.of(lv).tau_crown_direct == pytest.approx(0.218, rel=1e-3)
     assert t.homogeneous.permeability == 0.218 and t.perforated.openness == 0.218
+    dense = replace(p.tree, louvers=replace(p.tree.louvers, arrangement="volume", crossings=9.0))
+    assert species_tree(dense, sp).louvers.cover_fraction == 1.0          # its own density
     untouched = species_tree(p.tree, sp)
     assert untouched.crown == p.tree.crown and untouched.louvers.inclination_deg == 44.2
