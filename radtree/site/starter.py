@@ -351,6 +351,9 @@ def new_project(folder: Path, trees: Path | None = None, buildings: Path | None 
     template = template or ("district" if buildings is not None else "street")
     if template not in TEMPLATES:
         raise ConfigError(f"unknown template {template!r} (known: {', '.join(TEMPLATES)})")
+    if template == "office" and honeybee is not None:
+        raise ConfigError("the office template and --honeybee both build the rooms: use the "
+                          "Honeybee model with --template street (or district)")
     if template == "district" and trees is None and buildings is None:
         raise ConfigError("the district template needs --trees and/or --buildings")
     for p in (trees, buildings, honeybee, epw):
