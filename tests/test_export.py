@@ -8,7 +8,6 @@ per hour and crown so that the year takes a few seconds.
 from __future__ import annotations
 
 import shutil
-from pathlib import Path
 
 import numpy as np
 import pytest

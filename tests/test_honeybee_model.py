@@ -15,6 +15,8 @@ octrees and single sensors differ by 5 % at ``-ab 1 -ad 8192``.
 from __future__ import annotations
 
 import json
+import re
+import shutil
 import subprocess
 from pathlib import Path
 
@@ -149,38 +151,128 @@ def rtrace_lux(build: Path, hb_files: list[Path], opts: list[str], pts: str) -> 
     return rgb_to_lux(np.loadtxt(out.decode().splitlines()).reshape(-1, 3))
 
 
+CROWN = """
+[tree]
+form = "free"
+[tree.crown]
+count = 1
+radius_m = 2.5
+vertical_radius_m = 2.0
+base_height_m = 2.0
+trunk_distance_m = 2.5
+[tree.louvers]
+arrangement = "volume"
+crossings = 4
+[[scenario]]
+name = "crown"
+model = "louvers"
+description = "one radtree crown in front of the window"
+"""
+
+
+@pytest.fixture(scope="module")
+def traced(tmp_path_factory):
+    """The one-room model traced by radtree (Radiance): scenario ``open`` (the model alone) and
+    ``crown`` (a radtree crown added in front of the window); built, simulated, reported."""
+    from radtree.pipeline.build import build_project
+    from radtree.pipeline.simulate import simulate_project
+    from radtree.report import build_report
+
+    folder = write_project(tmp_path_factory.mktemp("hb") / "p", dni=0.0,
+                           toml=TOML.replace("[sensors]", "[sensors]\nheight_m = 1.5") + CROWN)
+    project = load_project(folder)
+    build_project(project, echo=lambda s: None, progress=False, pictures=False)
+    simulate_project(project, engine="radiance", echo=lambda s: None, progress=False)
+    index = build_report(project, echo=lambda s: None)
+    return project, pd.read_csv(project.results_dir / "illuminance.csv"), index
+
+
 @needs_radiance
-def test_cross_tool_radtree_vs_honeybee_radiance(tmp_path):
+def test_cross_tool_radtree_vs_honeybee_radiance(traced, tmp_path):
     """radtree's trace of the model and rtrace on honeybee-radiance's translation agree < 1 %."""
     from honeybee.model import Model
     from honeybee_radiance.writer import model_to_rad
 
     from radtree.engines.radiance.writer import rtrace_options
-    from radtree.pipeline.build import build_project
-    from radtree.pipeline.simulate import simulate_project
 
-    folder = write_project(tmp_path / "p", dni=0.0)
-    project = load_project(folder)
-    build_project(project, echo=lambda s: None, progress=False, pictures=False)
-    simulate_project(project, engine="radiance", echo=lambda s: None, progress=False)
-    table = pd.read_csv(project.results_dir / "illuminance.csv")
-    ours = table[table["grid"] == "office"].sort_values("sensor")["lux_traced"].to_numpy()
-
-    model = Model.from_hbjson(str(folder / "model.hbjson"))
+    project, table, _ = traced
+    sel = table[(table["grid"] == "office") & (table["scenario"] == "open")]
+    ours = sel.sort_values("sensor")["lux_traced"].to_numpy()
+    model = Model.from_hbjson(str(project.honeybee.model))
     geometry, modifiers = model_to_rad(model)
-    hb_dir = tmp_path / "hb"
-    hb_dir.mkdir()
-    (hb_dir / "modifiers.rad").write_text(modifiers)
-    (hb_dir / "model.rad").write_text(geometry)
+    (tmp_path / "modifiers.rad").write_text(modifiers)
+    (tmp_path / "model.rad").write_text(geometry)
     build = project.build_dir / "open"
     opts = rtrace_options(project.engine, 2)
-    grid = model.properties.radiance.sensor_grids
-    assert not grid   # the model has none: radtree generated the room's grid (1 m cells)
-    theirs = rtrace_lux(build, [hb_dir / "modifiers.rad", hb_dir / "model.rad"], opts,
+    assert opts[:6] == ["-h", "-I", "-u-", "-ab", "2", "-ad"] and opts[6] == "1024"
+    assert not model.properties.radiance.sensor_grids   # radtree generated the room's grid
+    theirs = rtrace_lux(build, [tmp_path / "modifiers.rad", tmp_path / "model.rad"], opts,
                         (build / "grids" / "office.pts").read_text())
     assert len(ours) == len(theirs) == 15
     assert ours.min() > 10 and ours.max() > 1000   # daylight reaches every sensor
     rel = np.abs(ours / theirs - 1)
     assert rel.max() < 0.01, f"max |radtree / honeybee-radiance − 1| = {rel.max():.4f}"
-    print(f"cross-tool: 15 sensors, mean {ours.mean():.1f} vs {theirs.mean():.1f} lx, "
-          f"max deviation {100 * rel.max():.3f} %")
+    print(f"cross-tool: 15 sensors, mean {ours.mean():.2f} vs {theirs.mean():.2f} lx, "
+          f"max deviation {100 * rel.max():.4f} %")
+
+
+@needs_radiance
+def test_report_shows_both_grids_and_honeybee_results(traced):
+    """With a radtree crown added, the report shows the model's grid and the façade grid for
+    both scenarios, and writes each grid's results in honeybee-radiance's layout."""
+    project, table, index = traced
+    html = index.read_text()
+    section = html[html.index('<section id="honeybee">'):]
+    section = section[:section.index("</section>")]
+    for sc in ("open", "crown"):
+        for grid in ("office", "facade"):
+            mean = table[(table["scenario"] == sc) & (table["grid"] == grid)]["lux"].mean()
+            assert f"<td>{sc}</td><td>{grid}</td><td>13:30</td>" in section
+            assert f'<td class="num">{mean:.0f}</td>' in section
+    office = table[table["grid"] == "office"].groupby("scenario")["lux"].mean()
+    assert office["crown"] < 0.95 * office["open"]     # the crown shades the room
+    folder = index.parent / "honeybee"
+    for sc in ("open", "crown"):
+        res = np.loadtxt(folder / sc / "1330" / "office.res")
+        want = table[(table["scenario"] == sc) & (table["grid"] == "office")].sort_values(
+            "sensor")["lux"].to_numpy()
+        assert np.allclose(res, want, atol=0.006)
+        info = json.loads((folder / sc / "1330" / "grids_info.json").read_text())
+        assert info == [{"count": 15, "name": "office", "identifier": "office", "group": "",
+                         "full_id": "office"}]
+    from honeybee.model import Model
+
+    back = Model.from_hbjson(str(folder / "model.hbjson"))
+    assert [g.identifier for g in back.properties.radiance.sensor_grids] == ["office"]
+
+
+CHROMIUM = shutil.which("chromium") or shutil.which("chromium-browser")
+
+
+@needs_radiance
+@pytest.mark.skipif(CHROMIUM is None, reason="chromium not installed (.ci/run installs it)")
+def test_3d_view_draws_in_headless_chromium(traced, tmp_path):
+    """The report's 3-D view opens from the report folder with no network and draws the scene:
+    a headless Chromium screenshot (virtual time, no sleeps) is mostly not background."""
+    from PIL import Image
+
+    _, _, index = traced
+    html = index.read_text()
+    assert '<iframe src="view3d.html"' in html
+    view = index.parent / "view3d.html"
+    text = view.read_text()
+    assert not re.search(r"<script[^>]*\ssrc=", text)   # plotly inline: nothing to fetch
+    assert len(text) > 1_000_000 and "Plotly.newPlot" in text
+    shot = tmp_path / "view.png"
+    subprocess.run([CHROMIUM, "--headless", "--no-sandbox", "--disable-gpu", "--hide-scrollbars",
+                    "--no-first-run", "--disable-extensions", "--window-size=800,600",
+                    "--virtual-time-budget=5000", f"--screenshot={shot}", view.as_uri()],
+                   check=True, capture_output=True, timeout=120)
+    img = np.asarray(Image.open(shot).convert("RGB"), float)
+    assert img.shape[:2] == (600, 800)
+    plot = img[90:560, 20:680]                     # the 3-D scene, below the buttons
+    background = np.all(plot > 250, axis=2)
+    green = (plot[..., 1] > plot[..., 0] + 25) & (plot[..., 1] > plot[..., 2] + 25)
+    assert (~background).mean() > 0.3              # the scene fills the view
+    assert green.mean() > 0.01                     # the crown (green leaves) is drawn
+    assert plot.std() > 20                         # not a flat canvas

@@ -79,9 +79,9 @@ def make_scene(project: Project, scenario: Scenario, dense_grid: bool | None = N
         hbp = honeybee_parts(project.honeybee, project.street.length_m / 2.0)
         meshes = hbp.meshes   # the model and its ground plane replace the street canyon
         materials.update(hbp.materials)
-        clash = sorted(set(hbp.grids) & set(grids))
-        if clash:
-            raise RadtreeError(f"Honeybee sensor grid names {clash} are radtree's own grids: "
+        same = sorted(set(hbp.grids) & set(grids))
+        if same:
+            raise RadtreeError(f"Honeybee sensor grid names {same} are radtree's own grids: "
                                "rename them in the model")
         grids.update(hbp.grids)
         notes = list(hbp.notes)

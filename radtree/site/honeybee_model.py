@@ -248,8 +248,7 @@ def honeybee_parts(hb: HoneybeeSite, margin_m: float = 40.0,
 def _coloured(model: Any, name: str) -> bool:
     for mod in model.properties.radiance.modifiers:
         if mod.identifier == name:
-            vals = [getattr(mod, f"{c}_{k}", None) for k in ("reflectance", "transmissivity")
-                    for c in "rgb"]
-            vals = [v for v in vals if v is not None]
+            vals: list[float] = [float(getattr(mod, f"{c}_{k}")) for k in (
+                "reflectance", "transmissivity") for c in "rgb" if hasattr(mod, f"{c}_{k}")]
             return len(vals) >= 3 and (max(vals[:3]) - min(vals[:3]) > 1e-9)
     return False
