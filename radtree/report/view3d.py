@@ -90,7 +90,9 @@ def view_figure(scenes: dict[str, Scene], table: pd.DataFrame, hour: str) -> tup
     colorbar = {"title": {"text": "lux"}, "tickvals": [np.log10(v) for v in ticks],
                 "ticktext": [f"{v:g}" for v in ticks]}
     cmax = 10.0 ** hi
-    traces, owner, facts = [], [], {"subsampled": [], "triangles": 0, "sensors": 0}
+    traces: list[Any] = []
+    owner: list[str | None] = []
+    facts: dict[str, Any] = {"subsampled": [], "triangles": 0, "sensors": 0}
     first = names[0]
     others = np.vstack([m.vertices for s in scenes.values() for m in s.solid_meshes()
                         if m.material != s.ground_material and m.n_triangles]
