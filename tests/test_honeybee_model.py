@@ -276,3 +276,35 @@ def test_3d_view_draws_in_headless_chromium(traced, tmp_path):
     assert (~background).mean() > 0.3              # the scene fills the view
     assert green.mean() > 0.01                     # the crown (green leaves) is drawn
     assert plot.std() > 20                         # not a flat canvas
+
+
+def test_annual_results_in_honeybee_layout(tmp_path):
+    """radtree annual's hourly arrays → honeybee-radiance's annual folders (.ill per grid)."""
+    from radtree.config.honeybee import HoneybeeSite
+    from radtree.export.honeybee import write_annual_results
+    from radtree.site.honeybee_model import model_grids
+
+    model = office_model()
+    grids, _ = model_grids(model, HoneybeeSite(tmp_path / "m.hbjson", 0.8, 1.0))
+    n = len(grids["office"])
+    days = np.repeat(np.arange(365), 24)
+    month = np.searchsorted(np.cumsum([31, 28, 31, 30, 31, 30, 31, 31, 30, 31, 30, 31]),
+                            days, side="right") + 1
+    day = days - np.concatenate([[0], np.cumsum([31, 28, 31, 30, 31, 30, 31, 31, 30, 31, 30])]
+                                )[month - 1] + 1
+    hour = np.tile(np.arange(24) + 0.5, 365)
+    up = (hour > 6) & (hour < 19)
+    lux = np.where(up, 100.0 + np.arange(n)[:, None] + hour[None, :], 0.0)
+    path = tmp_path / "hourly.npz"
+    np.savez(path, month=month, day=day, hour=hour, total__with__office=lux,
+             direct__with__office=lux / 2, total__with__facade=lux[:2])
+    folders = write_annual_results(path, model, tmp_path / "annual")
+    assert [f.name for f in folders] == ["with"]
+    hours = np.loadtxt(folders[0] / "sun-up-hours.txt")
+    assert len(hours) == 365 * 13 and hours[0] == 6.5 and hours[-1] == 364 * 24 + 18.5
+    ill = np.loadtxt(folders[0] / "__static_apertures__/default/total/office.ill")
+    assert ill.shape == (n, 365 * 13)
+    assert ill[3, 0] == pytest.approx(103 + 6.5)
+    direct = np.loadtxt(folders[0] / "__static_apertures__/default/direct/office.ill")
+    assert np.allclose(direct, ill / 2, atol=0.05)
+    assert json.loads((folders[0] / "grids_info.json").read_text())[0]["count"] == n == 15

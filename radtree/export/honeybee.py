@@ -14,7 +14,8 @@ results in honeybee-radiance's point-in-time layout.
   ``crown_transmittance.idf`` with the matching ``Schedule:File`` objects (1 row to skip).
 * Results: ``<out>/<scenario>/<HHMM>/<grid>.res`` (one lux value per sensor, in the grid's
   order) with ``grids_info.json``, and the model with its grids as ``model.hbjson`` — the
-  folder Ladybug Tools' point-in-time result loaders read.
+  folder Ladybug Tools' point-in-time result loaders read; and after ``radtree annual`` the
+  annual layout (``sun-up-hours.txt``, ``__static_apertures__/default/total/<grid>.ill``).
 """
 
 from __future__ import annotations
@@ -147,5 +148,39 @@ def write_results(table: pd.DataFrame, model: Any, out: Path) -> list[Path]:
             write_text(folder / f"{gid}.res", "\n".join(f"{v:.2f}" for v in lux) + "\n")
             info.append(g.info_dict())
         write_text(folder / "grids_info.json", json.dumps(info, indent=2))
+        folders.append(folder)
+    return folders
+
+
+def write_annual_results(hourly: Path, model: Any, out: Path) -> list[Path]:
+    """Annual results (``results/annual/hourly.npz`` of ``radtree annual``) of the model's grids
+    in honeybee-radiance's annual layout, one folder per variant (``with``, ``without``,
+    ``leaf_on``, ``leaf_off``): ``grids_info.json``, ``sun-up-hours.txt`` (hours of the year at
+    the hours' middles, e.g. 12.5) and ``__static_apertures__/default/{total,direct}/<grid>.ill``
+    (one row per sensor, one column per sun-up hour, lux)."""
+    from radtree.annual.schedule import day_of_year
+
+    data = np.load(hourly)
+    grids = {g.identifier: g for g in model.properties.radiance.sensor_grids}
+    hoy = (day_of_year(data["month"], data["day"]) - 1) * 24 + data["hour"]
+    variants = sorted({k.split("__")[1] for k in data.files if k.startswith("total__")})
+    folders = []
+    for variant in variants:
+        names = [g for g in grids if f"total__{variant}__{g}" in data.files]
+        if not names:
+            continue
+        up = np.zeros(len(hoy), bool)
+        for g in names:
+            up |= data[f"total__{variant}__{g}"].max(axis=0) > 0
+        folder = out / variant
+        write_text(folder / "sun-up-hours.txt", "\n".join(f"{h:g}" for h in hoy[up]) + "\n")
+        write_text(folder / "grids_info.json",
+                   json.dumps([grids[g].info_dict() for g in names], indent=2))
+        for g in names:
+            for kind in ("total", "direct"):
+                values = data[f"{kind}__{variant}__{g}"][:, up]
+                text = "\n".join(" ".join(f"{v:.1f}" for v in row) for row in values)
+                write_text(folder / "__static_apertures__" / "default" / kind / f"{g}.ill",
+                           text + "\n")
         folders.append(folder)
     return folders

@@ -3,7 +3,9 @@ honeybee-radiance's layout (``report/honeybee/``) with a per-grid table.
 
 ``view3d_data`` writes ``report/view3d.html`` (:mod:`radtree.report.view3d`); ``honeybee_data``
 writes ``report/honeybee/<scenario>/<HHMM>/<grid>.res`` + ``grids_info.json`` and
-``report/honeybee/model.hbjson`` (:func:`radtree.export.honeybee.write_results`) and returns
+``report/honeybee/model.hbjson`` (:func:`radtree.export.honeybee.write_results`), after
+``radtree annual`` also ``report/honeybee/annual/<variant>/`` (``.ill`` files,
+:func:`~radtree.export.honeybee.write_annual_results`), and returns
 the mean / min / max lux per scenario, grid and hour (whole numbers).
 """
 
@@ -43,11 +45,14 @@ def honeybee_data(project: Project, table: pd.DataFrame, out: Path,
                   echo: Callable[[str], None]) -> dict[str, Any] | None:
     if project.honeybee is None:
         return None
-    from radtree.export.honeybee import write_results
+    from radtree.export.honeybee import write_annual_results, write_results
     from radtree.site.honeybee_model import honeybee_parts
 
     parts = honeybee_parts(project.honeybee)
     folders = write_results(table, parts.model, out / "honeybee")
+    hourly = project.results_dir / "annual" / "hourly.npz"
+    if hourly.exists():
+        folders += write_annual_results(hourly, parts.model, out / "honeybee" / "annual")
     echo(f"  Honeybee results: {len(folders)} folders in honeybee-radiance's layout → "
          f"{out / 'honeybee'}")
     grids = [g.identifier for g in parts.model.properties.radiance.sensor_grids]
