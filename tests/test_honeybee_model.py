@@ -117,8 +117,7 @@ def bad(tmp_path: Path, name: str, text: str) -> str:
 def test_bad_models_one_clear_message(tmp_path):
     good = office_model().to_dict()
     msg = bad(tmp_path, "json", "{not json")
-    assert "model.hbjson: not a Honeybee model (not readable JSON" in msg
-    assert "field 'site.honeybee'" in msg
+    assert "model.hbjson, field 'site.honeybee': not a Honeybee model (not readable JSON" in msg
     msg = bad(tmp_path, "type", json.dumps({"type": "Room", "identifier": "x"}))
     assert "not a Honeybee model (its 'type' is 'Room', expected 'Model')" in msg
     newer = dict(good, version="99.0.0")
@@ -134,6 +133,18 @@ def test_bad_models_one_clear_message(tmp_path):
                               if f["identifier"] != floor.identifier]
     msg = bad(tmp_path, "nofloor", json.dumps(d))
     assert "room 'office' (office) has no floor face" in msg
+    for m in (msg, bad(tmp_path, "metal", json.dumps(with_metal(good)))):
+        assert m.count("model.hbjson") == 1 and m.count("\n") == 0   # one line, file once
+    assert "modifier 'shiny' is a Radiance metal; radtree reads plastic, glass and trans" in m
+
+
+def with_metal(model_dict: dict) -> dict:
+    from honeybee.model import Model
+    from honeybee_radiance.modifier.material import Metal
+
+    model = Model.from_dict(model_dict)
+    model.rooms[0].faces[1].properties.radiance.modifier = Metal("shiny", 0.8, 0.8, 0.8)
+    return model.to_dict()
 
 
 def rtrace_lux(build: Path, hb_files: list[Path], opts: list[str], pts: str) -> np.ndarray:

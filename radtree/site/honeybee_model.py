@@ -58,7 +58,7 @@ class HoneybeeParts:
 
 
 def _fail(path: Path, message: str) -> ConfigError:
-    return ConfigError(f"{path.name}: {message}", source=str(path), field=FIELD)
+    return ConfigError(message, source=str(path), field=FIELD)
 
 
 def _version_tuple(text: str) -> tuple[int, ...]:
@@ -124,17 +124,18 @@ def modifier_material(mod: Any, path: Path) -> Material:
     from honeybee_radiance.modifier.material import Trans as HBTrans
 
     name = mod.identifier
-    if isinstance(mod, HBTrans):   # a subclass of Plastic: test first
+    # exact types: honeybee-radiance's Trans and Metal are subclasses of its Plastic
+    if type(mod) is HBTrans:
         if mod.specularity > 0:
             raise _fail(path, f"modifier {name!r}: trans with specular reflection "
                         f"{mod.specularity} is not supported (set it to 0)")
         c = photopic(mod.r_reflectance, mod.g_reflectance, mod.b_reflectance)
         t = c * mod.transmitted_diff
         return Trans(name, c - t, t * (1 - mod.transmitted_spec), t * mod.transmitted_spec)
-    if isinstance(mod, HBPlastic):
+    if type(mod) is HBPlastic:
         return Plastic(name, photopic(mod.r_reflectance, mod.g_reflectance, mod.b_reflectance),
                        mod.specularity, mod.roughness)
-    if isinstance(mod, HBGlass):
+    if type(mod) is HBGlass:
         index = getattr(mod, "refraction_index", None)
         if index is not None and abs(index - RADIANCE_GLASS_INDEX) > 1e-6:
             raise _fail(path, f"modifier {name!r}: glass with refraction index {index} is not "
