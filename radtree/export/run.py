@@ -58,6 +58,9 @@ def export_project(project: Project, fmt: str, out: Path, scenario: str | None =
     from radtree.export.transmittance import crown_models, default_leaf_schedule, year_schedules
     from radtree.pipeline.build import progress_bar
 
+    if sc.model == "none":
+        raise ConfigError(f"scenario {sc.name!r} has no crown (model 'none'): choose one with "
+                          "a crown model", source=str(project.source), field="--scenario")
     leaf = default_leaf_schedule(project, leaf_on, leaf_off)
     echo(f"{sc.name}: hourly crown transmittance along the sun for {8760} hours, "
          f"{rays} rays per hour and crown; leaf " + (
