@@ -57,5 +57,6 @@ def main(ctx: click.Context, debug: bool) -> None:
 
 for _command in (doctor_command, build_command, simulate_command, hemi_command, report_command,
                  calibrate_command, sweep_command, diagnose_command, annual_command,
-                 permeability_command, verify_command, export_command):
+                 permeability_command, verify_command):
     main.add_command(_command)
+main.add_command(export_command)   # radtree export (cli/export.py)
