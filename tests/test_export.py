@@ -67,12 +67,42 @@ def project(tmp_path_factory):
 
 
 @pytest.fixture(scope="module")
-def year(project):
-    from radtree.export.transmittance import crown_models, year_schedules
+def exported(project, tmp_path_factory):
+    """``radtree export PROJECT --format honeybee`` (16 rays per hour): the HBJSON loaded back
+    with honeybee-core, and the schedules as written (with their crowns and leaf states)."""
+    from click.testing import CliRunner
+    from honeybee.model import Model
 
-    sc = project.scenarios[0]
-    models = crown_models(project, sc, facade_frame(project))
-    return models, year_schedules(project, sc, facade_frame(project), RAYS, models=models)
+    from radtree.cli import main
+    from radtree.export.transmittance import (
+        CrownSchedule,
+        crown_envelopes,
+        default_leaf_schedule,
+        year_hours,
+    )
+
+    out = tmp_path_factory.mktemp("hbjson")
+    r = CliRunner().invoke(main, ["export", str(project.root), "--format", "honeybee", "--out",
+                                  str(out), "--rays", str(RAYS)])
+    assert r.exit_code == 0, r.output
+    path = out / "radtree_crowns.hbjson"
+    assert f"wrote {path}" in r.output and "1 crown shades" in r.output
+    model = Model.from_hbjson(str(path))
+    hours = year_hours(project)
+    leaf = default_leaf_schedule(project, None, None)
+    in_leaf = np.asarray(leaf.in_leaf(np.array([h.month for h in hours]),
+                                      np.array([h.day for h in hours])), bool)
+    crowns = crown_envelopes(project, project.scenarios[0], facade_frame(project))
+    schedules = [CrownSchedule(c, np.array(s.properties.energy.transmittance_schedule.values),
+                               in_leaf) for c, s in zip(crowns, model.shade_meshes)]
+    return model, schedules
+
+
+@pytest.fixture(scope="module")
+def year(project, exported):
+    from radtree.export.transmittance import crown_models
+
+    return crown_models(project, project.scenarios[0], facade_frame(project)), exported[1]
 
 
 def test_schedule_year_and_seasons(project, year):
@@ -95,8 +125,9 @@ def test_schedule_year_and_seasons(project, year):
 
 @needs_radiance
 def test_schedule_agrees_with_radiance_direct_sun(project, year, tmp_path):
-    """Three hours of the schedule against radtree's Radiance engine tracing the sun (-ab 0)
-    at the same points under the crown: E / (DNI · sin altitude), averaged → within 1 %."""
+    """Three hours of the exported schedule (as written in the HBJSON) against radtree's
+    Radiance engine tracing the sun (-ab 0) at the same points under the crown:
+    E / (DNI · sin altitude), averaged → within 1 %."""
     from radtree.engines.radiance.interface import RadianceEngine
     from radtree.export.transmittance import bundle, year_hours
     from radtree.scene import Scene, SensorGrid
@@ -121,41 +152,32 @@ def test_schedule_agrees_with_radiance_direct_sun(project, year, tmp_path):
         radiance_tau = float(np.mean(lux / (1e5 * np.sin(np.radians(sun.altitude_deg)))))
         found.append((cs.values[k], radiance_tau))
         assert cs.values[k] == pytest.approx(radiance_tau, rel=0.01), (h, found)
-    print("schedule vs Radiance direct sun:", [f"{a:.4f}/{b:.4f}" for a, b in found])
+    print("schedule vs Radiance direct sun:", [f"{a:.5f}/{b:.5f} ({100 * (a / b - 1):+.4f} %)"
+                                               for a, b in found])
     assert len({round(a, 3) for a, _ in found}) == 3   # three different sun positions
 
 
-def test_honeybee_round_trip_idf_and_csv(project, year, tmp_path):
-    from honeybee.model import Model
-
-    from radtree.export.honeybee import (
-        crown_shades,
-        shade_model,
-        write_hbjson,
-        write_idf,
-        write_schedule_csv,
-    )
+def test_honeybee_round_trip_idf_and_csv(project, exported, year, tmp_path):
+    from radtree.export.honeybee import crown_shades, shade_model, write_idf, write_schedule_csv
     from radtree.export.run import leaf_material
 
-    (meshes, _, materials, _), schedules = year
-    leaf = leaf_material(meshes, materials)
-    assert leaf.name == "leaf"
-    model = shade_model(project.name, crown_shades(schedules, leaf))
-    path = write_hbjson(model, tmp_path)
-    back = Model.from_hbjson(str(path))
+    back, schedules = exported
     assert back.check_all(raise_exception=False) == ""
-    assert len(back.shade_meshes) == 1
+    assert len(back.shade_meshes) == 1 and not back.rooms
     shade = back.shade_meshes[0]
+    assert shade.identifier == "radtree_crown_1"
     sched = shade.properties.energy.transmittance_schedule
-    assert len(sched.values) == 8760
-    assert np.allclose(sched.values, schedules[0].values)
+    assert len(sched.values) == 8760 and sched.schedule_type_limit.identifier == "Fractional"
+    assert len(shade.faces) == len(schedules[0].crown.faces)
+    (meshes, _, materials, _), _ = year
+    leaf = leaf_material(meshes, materials)
     mod = shade.properties.radiance.modifier
-    assert mod.identifier == "leaf"
+    assert mod.identifier == leaf.name == "leaf"
     c, trans, tspec = leaf.coefficients
     assert (mod.r_reflectance, mod.transmitted_diff, mod.transmitted_spec) == pytest.approx(
         (c, trans, tspec))
-    assert len(shade.faces) == len(schedules[0].crown.faces)
 
+    model = shade_model(project.name, crown_shades(schedules, leaf))
     idf = write_idf(model, tmp_path).read_text()
     assert idf.count("Shading:Building:Detailed,") == len(shade.faces)
     assert "radtree_crown_1_transmittance" in idf
