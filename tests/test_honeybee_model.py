@@ -320,3 +320,32 @@ def test_annual_results_in_honeybee_layout(tmp_path):
     direct = np.loadtxt(folders[0] / "__static_apertures__/default/direct/office.ill")
     assert np.allclose(direct, ill / 2, atol=0.05)
     assert json.loads((folders[0] / "grids_info.json").read_text())[0]["count"] == n == 15
+
+
+def test_example_model_is_the_scripts_and_loads():
+    """examples/honeybee-office: the committed model.hbjson is what make_model.py makes, and
+    the project reads it (two offices, their grids, the context shade, interior wall once)."""
+    import importlib.util
+
+    from radtree.pipeline.assemble import make_scene
+
+    from .conftest import ROOT
+
+    folder = ROOT / "examples" / "honeybee-office"
+    spec = importlib.util.spec_from_file_location("make_model", folder / "make_model.py")
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    made = module.make_model()
+    project = load_project(folder)
+    scene = make_scene(project, project.scenario("model")).scene
+    committed = json.loads((folder / "model.hbjson").read_text())
+    assert [r["identifier"] for r in committed["rooms"]] == [r.identifier for r in made.rooms]
+    assert {g: len(scene.grids[g]) for g in ("Office_1", "Office_2")} == {
+        "Office_1": 96, "Office_2": 96}   # (4 − 0) × (6 − 0) m at 0.5 m cells
+    assert scene.mesh("hb_generic_exterior_window_vis_0.64").area() == pytest.approx(
+        2 * 0.4 * 4 * 3)
+    assert scene.mesh("hb_generic_exterior_shade_0.35").area() == pytest.approx(40 * 12)
+    # walls: façade minus windows, back, outer sides, and the shared wall once (of the
+    # interior pair), not twice
+    walls = 2 * (4 * 3 * 0.6 + 4 * 3) + 2 * 6 * 3 + 6 * 3
+    assert scene.mesh("hb_generic_wall_0.50").area() == pytest.approx(walls)

@@ -6,7 +6,7 @@ of each office's façade wall, an opposite building 20 m across the street as a 
 the shared wall between them an interior pair (Surface boundary condition), and one work-plane
 sensor grid per office (0.8 m above the floor, 0.5 m cells). Units: metres;
 x east, y north, z up. Honeybee's default modifiers (walls 0.5, floor 0.2, ceiling 0.8,
-glazing 0.64 visible transmittance, context 0.2).
+glazing 0.64 visible transmittance, exterior shade 0.35).
 
     python examples/honeybee-office/make_model.py      # → examples/honeybee-office/model.hbjson
 """
