@@ -181,6 +181,8 @@ def own_tracer(crown: Crown, meshes: list[Mesh], materials: dict[str, Material]
     schedule leaves its neighbours out: they are shades of their own; the part of a trunk
     below the crown is below the rays' start plane and never crossed)."""
     env = crown.trimesh()
+    if not env.is_watertight:   # the sensor dome (open on the wall): one crown, all of it
+        return DirectTracer(meshes, materials)
     own = []
     for m in meshes:
         if not m.n_triangles:
