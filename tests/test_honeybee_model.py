@@ -136,6 +136,13 @@ def test_bad_models_one_clear_message(tmp_path):
     for m in (msg, bad(tmp_path, "metal", json.dumps(with_metal(good)))):
         assert m.count("model.hbjson") == 1 and m.count("\n") == 0   # one line, file once
     assert "modifier 'shiny' is a Radiance metal; radtree reads plastic, glass and trans" in m
+    from click.testing import CliRunner
+
+    from radtree.cli import main
+
+    r = CliRunner().invoke(main, ["build", str(tmp_path / "feet")])
+    assert r.exit_code == 2       # bad input, no traceback
+    assert "units are 'Feet'; radtree works in metres" in r.output and "Traceback" not in r.output
 
 
 def with_metal(model_dict: dict) -> dict:
