@@ -12,7 +12,7 @@ EXAMPLE := examples/mendoza-street
 $(STAMP): pyproject.toml
 	$(PYTHON) -m venv $(VENV)
 	$(BIN)/pip install --quiet --upgrade pip
-	$(BIN)/pip install --quiet -e ".[dev,sweep]"
+	$(BIN)/pip install --quiet -e ".[dev,sweep,honeybee]"
 	touch $(STAMP)
 
 install: $(STAMP)

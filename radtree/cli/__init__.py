@@ -20,6 +20,7 @@ from radtree.cli.calibrate import calibrate_command
 from radtree.cli.diagnose import diagnose_command
 from radtree.cli.doctor import doctor_command
 from radtree.cli.errors import RadtreeGroup
+from radtree.cli.export import export_command
 from radtree.cli.hemi import hemi_command
 from radtree.cli.new import new_command
 from radtree.cli.options import CONTEXT
@@ -60,3 +61,4 @@ for _command in (doctor_command, build_command, simulate_command, hemi_command, 
                  calibrate_command, sweep_command, diagnose_command, annual_command,
                  permeability_command, verify_command):
     main.add_command(_command)
+main.add_command(export_command)   # radtree export (cli/export.py)

@@ -15,6 +15,7 @@ from typing import Any
 
 import tomllib
 
+from radtree.config.honeybee import read_honeybee
 from radtree.config.schema import Project, Scenario, Site, Street, parse_time
 from radtree.config.spec import SchemaError, Spec, spec_for, spec_of, toml_name
 from radtree.config.species import find_species, tree_defaults, unknown_species_message
@@ -168,6 +169,8 @@ def parse_project(data: dict, path: Path) -> Project:
     proj.check_unknown(table_keys("project"))
 
     s = top.sub("site", required=True)
+    s.data = dict(s.data)  # [site] honeybee = "model.hbjson" (radtree.config.honeybee)
+    honeybee = read_honeybee(s.data, base, src)
     hours_raw = s.raw("hours")
     if not isinstance(hours_raw, list) or not hours_raw:
         raise s.error("hours", f"expected a non-empty list of 'HH:MM' times, got {hours_raw!r}")
@@ -227,7 +230,7 @@ def parse_project(data: dict, path: Path) -> Project:
     return Project(name=name, root=path.parent, source=path, site=site, street=street,
                    light=light, tree=tree, sensors=sensors, engine=engine,
                    scenarios=scenarios, measured=measured, measured_rows=measured_rows,
-                   office=office, extra_geometry=tuple(extra))
+                   office=office, extra_geometry=tuple(extra), honeybee=honeybee)
 
 
 def species_fill(tr: _Reader) -> dict[str, dict[str, float]]:

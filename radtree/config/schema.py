@@ -13,6 +13,7 @@ from dataclasses import dataclass, field, fields, is_dataclass
 from pathlib import Path
 from typing import Any, ClassVar
 
+from radtree.config.honeybee import HoneybeeSite
 from radtree.config.spec import TIME_RE, Checked, meta
 from radtree.errors import ConfigError
 
@@ -350,6 +351,7 @@ class Project:
     measured_rows: Path | None = None
     office: Office | None = None
     extra_geometry: tuple[tuple[Path, str], ...] = ()
+    honeybee: HoneybeeSite | None = None   # [site] honeybee (radtree.config.honeybee)
 
     @property
     def build_dir(self) -> Path:
@@ -384,6 +386,8 @@ class Project:
         for key in FORWARD_KEYS:  # forward-engine settings at their defaults: hashes unchanged
             if payload["engine"].get(key) == getattr(EngineParams, key):
                 payload["engine"].pop(key, None)
+        if self.honeybee is not None:   # absent otherwise: other projects' hashes unchanged
+            payload["honeybee"] = {**_plain(self.honeybee), "sha256": self.honeybee.digest()}
         payload["scenario"] = _plain(scenario)
         text = json.dumps(payload, sort_keys=True, default=str)
         return hashlib.sha256(text.encode()).hexdigest()[:12]

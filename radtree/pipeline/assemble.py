@@ -71,6 +71,20 @@ def make_scene(project: Project, scenario: Scenario, dense_grid: bool | None = N
         materials.update(o_materials)
         grids = o_grids
         notes += o_notes
+    if project.honeybee is not None:
+        from radtree.site.honeybee_model import honeybee_parts
+
+        if project.office is not None:
+            raise RadtreeError("[office] and [site] honeybee both build the rooms: keep one")
+        hbp = honeybee_parts(project.honeybee, project.street.length_m / 2.0)
+        meshes = hbp.meshes   # the model and its ground plane replace the street canyon
+        materials.update(hbp.materials)
+        same = sorted(set(hbp.grids) & set(grids))
+        if same:
+            raise RadtreeError(f"Honeybee sensor grid names {same} are radtree's own grids: "
+                               "rename them in the model")
+        grids.update(hbp.grids)
+        notes = list(hbp.notes)
     t0 = time.perf_counter()
     info: dict[str, float] = {}
     tree = None

@@ -130,4 +130,13 @@ def extra_sections(project: Project, out: Path, echo: Callable[[str], None]
 
         html.append(Section("annual", annual_section_data(project)))
         echo("  annual: metric maps and month × hour heat maps")
+    from radtree.pipeline.results import read_results
+    from radtree.report.sections.models3d import honeybee_data, view3d_data
+
+    table = read_results(project)
+    for name, make in (("honeybee", honeybee_data), ("view3d", view3d_data)):
+        data = make(project, table, out, echo)
+        if data is not None:
+            html.append(Section(name, data))
+            md.append(Section(name, data))
     return html, md

@@ -1,0 +1,245 @@
+"""Each crown's hourly transmittance along the sun direction for a year (energy shading schedules).
+
+**Definition.** For a sun direction s (unit vector towards the sun) the crown's transmittance
+is the mean, over a bundle of parallel rays travelling towards the sun through the crown, of
+the product of the *specular* (undeviated) transmittances of every crown surface the ray
+crosses (:class:`radtree.trees.raycast.DirectTracer`: ``trans`` T_s, holes 1, trunk and
+branches 0). That is the beam an energy model's shading surface lets through. The bundle
+(:func:`bundle`) starts on the horizontal plane 1 cm below the crown's lowest point: the points
+of a square lattice whose ray towards the sun meets the crown envelope, i.e. the crown's
+shadow on that plane sampled uniformly (equal area across the beam), about ``rays`` points.
+
+**Year.** 8760 hours of a non-leap year (the site's year, or the year before when that is a
+leap year), hour k covering local standard time [k, k + 1) h; the sun position is taken at
+the middle of the hour (pvlib SPA, as :func:`radtree.light.sun.sun_position`). Hours with the
+sun below 2° (no meaningful beam: the shadow plane grows without bound) take the crown's
+transmittance towards the zenith of the same leaf state.
+
+**Leaf on / off.** :class:`radtree.annual.schedule.LeafSchedule` dates: leafed crown inside
+the season, the bare branches of :func:`radtree.annual.branches.build_leaf_off` outside it
+(``leaf_off=False`` keeps the leafed crown all year).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from datetime import date, datetime, timedelta, timezone
+
+import numpy as np
+import trimesh
+
+from radtree.config import Project, Scenario
+from radtree.errors import RadtreeError
+from radtree.optics import Material
+from radtree.scene import Mesh
+from radtree.site.frame import FacadeFrame
+from radtree.trees.raycast import DirectTracer
+
+HOURS = 8760
+MIN_ALTITUDE_DEG = 2.0
+"""Below this sun altitude an hour takes the zenith transmittance (see the module)."""
+PLANE_GAP_M = 0.01
+
+
+@dataclass
+class Crown:
+    """One crown's envelope (world metres) as a closed triangle mesh, and its name."""
+
+    name: str
+    vertices: np.ndarray
+    faces: np.ndarray
+
+    def trimesh(self) -> trimesh.Trimesh:
+        return trimesh.Trimesh(self.vertices, self.faces, process=False)
+
+
+@dataclass
+class CrownSchedule:
+    """A crown and its 8760 hourly transmittances (fractions 0–1)."""
+
+    crown: Crown
+    values: np.ndarray
+    leaf_on: np.ndarray = field(default_factory=lambda: np.zeros(0, bool))
+
+
+def crown_envelopes(project: Project, scenario: Scenario, frame: FacadeFrame) -> list[Crown]:
+    """The envelopes of the scenario's crowns: one per free-standing crown, or the sensor dome."""
+    from radtree.trees.build import apply_switches, resolve_form
+    from radtree.trees.envelope import crown_row_spec, dome_spec
+
+    tree, _ = apply_switches(project.tree, scenario.switches, source=str(project.source),
+                             root=project.root)
+    if resolve_form(project, scenario) == "dome":
+        spec = dome_spec(tree, project.sensors, project.street, str(project.source))
+        v, f = spec.shell(24)
+        return [Crown("crown_dome", frame.to_world(v), f)]
+    row = crown_row_spec(tree, project.sensors, project.street, str(project.source))
+    out = []
+    for i in range(row.count):
+        v, f, _ = row.envelope(i, 3)
+        out.append(Crown(f"crown_{i + 1}", frame.to_world(v), f))
+    return out
+
+
+def year_of(project: Project) -> int:
+    """The site's year, or the year before when that is a leap year (8760 hours)."""
+    y = int(project.site.date[:4])
+    return y - 1 if (y % 4 == 0 and (y % 100 != 0 or y % 400 == 0)) else y
+
+
+def year_hours(project: Project) -> list[datetime]:
+    """Middles of the year's 8760 hours, local standard time (site.utc_offset_hours)."""
+    tz = timezone(timedelta(hours=project.site.utc_offset_hours))
+    start = datetime(year_of(project), 1, 1, 0, 30, tzinfo=tz)
+    return [start + timedelta(hours=k) for k in range(HOURS)]
+
+
+def sun_vectors(project: Project, hours: list[datetime]) -> tuple[np.ndarray, np.ndarray]:
+    """(N, 3) unit vectors towards the sun (x east, y north, z up) and altitudes (degrees)."""
+    import pandas as pd
+    import pvlib
+
+    s = project.site
+    sp = pvlib.solarposition.spa_python(pd.DatetimeIndex(hours), s.latitude, s.longitude,
+                                        altitude=s.elevation_m)
+    alt = np.radians(sp["apparent_elevation"].to_numpy())
+    az = np.radians(sp["azimuth"].to_numpy())
+    vec = np.column_stack([np.cos(alt) * np.sin(az), np.cos(alt) * np.cos(az), np.sin(alt)])
+    return vec, np.degrees(alt)
+
+
+def shadow_areas(crown: Crown, suns: np.ndarray) -> np.ndarray:
+    """Area (m²) of the convex crown's shadow on a horizontal plane for each sun (k, 3):
+    its projected area across the beam, ½ Σ_faces A·|n·s| (Cauchy), divided by s_z."""
+    tri = crown.vertices[crown.faces]
+    cross = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])   # 2·A·n
+    return 0.25 * np.abs(suns @ cross.T).sum(axis=1) / suns[:, 2]
+
+
+def lattice(crown: Crown, sun: np.ndarray, rays: int, area: float | None = None) -> np.ndarray:
+    """Candidate origins: a square lattice over the crown's shadow on the plane 1 cm below the
+    crown, its step chosen from the shadow's area so that about ``rays`` points fall inside."""
+    s = np.asarray(sun, float) / np.linalg.norm(sun)
+    if s[2] <= 0:
+        raise ValueError("the sun must be above the horizon")
+    z0 = float(crown.vertices[:, 2].min()) - PLANE_GAP_M
+    shadow = crown.vertices[:, :2] - s[:2] * ((crown.vertices[:, 2] - z0) / s[2])[:, None]
+    lo, hi = shadow.min(axis=0), shadow.max(axis=0)
+    if area is None:
+        area = float(shadow_areas(crown, s[None, :])[0])
+    step = float(np.sqrt(area / max(rays, 1)))
+    X, Y = np.meshgrid(np.arange(lo[0] + step / 2, hi[0], step),
+                       np.arange(lo[1] + step / 2, hi[1], step))
+    return np.column_stack([X.ravel(), Y.ravel(), np.full(X.size, z0)])
+
+
+def bundle(crown: Crown, sun: np.ndarray, rays: int) -> np.ndarray:
+    """Ray origins (k, 3): the :func:`lattice` points whose ray towards ``sun`` meets the
+    envelope — the crown's shadow sampled uniformly (equal area across the beam)."""
+    o = lattice(crown, sun, rays)
+    s = np.asarray(sun, float) / np.linalg.norm(sun)
+    return o[crown.trimesh().ray.intersects_any(o, np.tile(s, (len(o), 1)))]
+
+
+def transmittances(tracer: DirectTracer, crown: Crown, suns: np.ndarray, rays: int
+                   ) -> np.ndarray:
+    """The crown's transmittance along each of ``suns`` (k, 3) (see the module): the mean over
+    each direction's :func:`bundle`, all directions traced in one batch."""
+    suns = np.atleast_2d(np.asarray(suns, float))
+    suns = suns / np.linalg.norm(suns, axis=1)[:, None]
+    areas = shadow_areas(crown, suns)
+    grids = [lattice(crown, s, rays, a) for s, a in zip(suns, areas)]
+    who = np.concatenate([np.full(len(g), k) for k, g in enumerate(grids)])
+    o, d = np.vstack(grids), suns[who]
+    hit = crown.trimesh().ray.intersects_any(o, d)
+    who, o, d = who[hit], o[hit], d[hit]
+    n = np.bincount(who, minlength=len(suns))
+    if (n == 0).any():
+        raise RadtreeError(f"{crown.name}: no ray of the bundle meets the crown")
+    tau = tracer.transmission(o, d)
+    return np.bincount(who, tau, minlength=len(suns)) / n
+
+
+def crown_models(project: Project, scenario: Scenario, frame: FacadeFrame
+                 ) -> tuple[list[Mesh], list[Mesh], dict[str, Material], list[str]]:
+    """Meshes of the leafed crown model and of its bare (leaf-off) branches, their materials."""
+    from radtree.annual.branches import build_leaf_off
+    from radtree.trees.build import build_tree
+
+    if scenario.model == "none":
+        raise RadtreeError(f"scenario {scenario.name!r} has no crown (model 'none'): choose "
+                           "one with a crown model")
+    leafed = build_tree(project, scenario, frame)
+    bare = build_leaf_off(project, scenario, frame)
+    return (list(leafed.meshes), list(bare.meshes), {**leafed.materials, **bare.materials},
+            leafed.notes[:1] + bare.notes[:1])
+
+
+def own_tracer(crown: Crown, meshes: list[Mesh], materials: dict[str, Material]
+               ) -> DirectTracer:
+    """A tracer of the triangles with a corner in ``crown``'s envelope only (a crown's
+    schedule leaves its neighbours out: they are shades of their own; the part of a trunk
+    below the crown is below the rays' start plane and never crossed)."""
+    env = crown.trimesh()
+    if not env.is_watertight:   # the sensor dome (open on the wall): one crown, all of it
+        return DirectTracer(meshes, materials)
+    own = []
+    for m in meshes:
+        if not m.n_triangles:
+            continue
+        inside = env.contains(m.vertices)
+        keep = inside[m.faces].any(axis=1)
+        if keep.any():
+            own.append(Mesh(m.name, m.material, m.triangles[keep].reshape(-1, 3),
+                            np.arange(3 * int(keep.sum())).reshape(-1, 3)))
+    return DirectTracer(own, materials)
+
+
+def year_schedules(project: Project, scenario: Scenario, frame: FacadeFrame, rays: int = 128,
+                   leaf_on: str | None = None, leaf_off: str | None = None,
+                   seasons: bool = True, progress=None, models=None) -> list[CrownSchedule]:
+    """8760 hourly transmittances per crown (leafed in the leaf season, bare outside it).
+    ``models``: the :func:`crown_models` of the scenario when already built."""
+    crowns = crown_envelopes(project, scenario, frame)
+    on_meshes, off_meshes, materials, _ = models or crown_models(project, scenario, frame)
+    hours = year_hours(project)
+    sun, alt = sun_vectors(project, hours)
+    leaf = default_leaf_schedule(project, leaf_on, leaf_off)
+    if seasons:
+        in_leaf = np.asarray(leaf.in_leaf(np.array([h.month for h in hours]),
+                                          np.array([h.day for h in hours])), bool)
+    else:
+        in_leaf = np.ones(HOURS, bool)
+    up = alt >= MIN_ALTITUDE_DEG
+    zenith = np.array([0.0, 0.0, 1.0])
+    out = []
+    for crown in crowns:
+        values = np.zeros(HOURS)
+        for state, meshes in ((True, on_meshes), (False, off_meshes)):
+            tracer = own_tracer(crown, meshes, materials)
+            sel = in_leaf == state
+            if not sel.any():
+                continue
+            values[sel & ~up] = transmittances(tracer, crown, zenith, rays)[0]
+            idx = np.flatnonzero(sel & up)
+            for chunk in (progress(idx, crown.name, state) if progress else [idx]):
+                values[chunk] = transmittances(tracer, crown, sun[chunk], rays)
+        out.append(CrownSchedule(crown, np.clip(values, 0.0, 1.0), in_leaf))
+    return out
+
+
+def default_leaf_schedule(project: Project, leaf_on: str | None, leaf_off: str | None):
+    """The leaf season: given dates, else the Mendoza mulberry dates of
+    :mod:`radtree.annual.schedule` (southern hemisphere), shifted by half a year north of the
+    equator (an assumption, stated in the export's notes)."""
+    from radtree.annual.schedule import DEFAULT_LEAF_OFF, DEFAULT_LEAF_ON, LeafSchedule
+
+    on, off = DEFAULT_LEAF_ON, DEFAULT_LEAF_OFF
+    if project.site.latitude >= 0:
+        on, off = (_shift_half_year(on), _shift_half_year(off))
+    return LeafSchedule(leaf_on or on, leaf_off or off)
+
+
+def _shift_half_year(mmdd: str) -> str:
+    d = date(2023, int(mmdd[:2]), int(mmdd[3:])) + timedelta(days=182)
+    return f"{d.month:02d}-{d.day:02d}"

@@ -1,0 +1,211 @@
+"""radtree export: crowns as Honeybee shades with an hourly transmittance schedule, IDF, the
+Schedule:File CSV, glTF / OBJ — and the schedule against radtree's own direct-sun trace.
+
+One free-standing louvers crown (2 layers, cover 0.6: a crown the sun gets through), 16 rays
+per hour and crown so that the year takes a few seconds.
+"""
+
+from __future__ import annotations
+
+import shutil
+
+import numpy as np
+import pytest
+
+from radtree.config import EngineParams, load_project
+from radtree.light.sky import SkyState
+from radtree.light.sun import local_datetime, sun_position
+from radtree.pipeline.assemble import facade_frame
+
+from .conftest import needs_radiance
+
+pytest.importorskip("honeybee.model")   # a guard only: CI installs radtree[honeybee]
+
+TOML = """
+[site]
+name = "Mendoza"
+latitude = -32.89
+longitude = -68.83
+elevation_m = 750
+utc_offset_hours = -3
+date = "2023-12-22"
+hours = ["13:30"]
+[light]
+direct_normal = "dni.csv"
+[tree]
+form = "free"
+[tree.crown]
+count = 1
+radius_m = 3.0
+vertical_radius_m = 2.5
+base_height_m = 3.0
+trunk_distance_m = 4.0
+[tree.louvers]
+layers = 2
+cover_fraction = 0.6
+slat_size_m = 0.5
+transmittance = 0.5
+specular_fraction = 0.5
+[sensors]
+dense_grid = false
+[engine]
+ab = 0
+lw = 0.000001
+[[scenario]]
+name = "crown"
+model = "louvers"
+"""
+RAYS = 16
+
+
+@pytest.fixture(scope="module")
+def project(tmp_path_factory):
+    folder = tmp_path_factory.mktemp("export")
+    (folder / "radtree.toml").write_text(TOML)
+    (folder / "dni.csv").write_text("time,direct_normal_lux\n13:30,80000\n")
+    return load_project(folder)
+
+
+@pytest.fixture(scope="module")
+def exported(project, tmp_path_factory):
+    """``radtree export PROJECT --format honeybee`` (16 rays per hour): the HBJSON loaded back
+    with honeybee-core, and the schedules as written (with their crowns and leaf states)."""
+    from click.testing import CliRunner
+    from honeybee.model import Model
+
+    from radtree.cli import main
+    from radtree.export.transmittance import (
+        CrownSchedule,
+        crown_envelopes,
+        default_leaf_schedule,
+        year_hours,
+    )
+
+    out = tmp_path_factory.mktemp("hbjson")
+    r = CliRunner().invoke(main, ["export", str(project.root), "--format", "honeybee", "--out",
+                                  str(out), "--rays", str(RAYS)])
+    assert r.exit_code == 0, r.output
+    path = out / "radtree_crowns.hbjson"
+    assert f"wrote {path}" in r.output and "1 crown shades" in r.output
+    model = Model.from_hbjson(str(path))
+    hours = year_hours(project)
+    leaf = default_leaf_schedule(project, None, None)
+    in_leaf = np.asarray(leaf.in_leaf(np.array([h.month for h in hours]),
+                                      np.array([h.day for h in hours])), bool)
+    crowns = crown_envelopes(project, project.scenarios[0], facade_frame(project))
+    schedules = [CrownSchedule(c, np.array(s.properties.energy.transmittance_schedule.values),
+                               in_leaf) for c, s in zip(crowns, model.shade_meshes)]
+    return model, schedules
+
+
+@pytest.fixture(scope="module")
+def year(project, exported):
+    from radtree.export.transmittance import crown_models
+
+    return crown_models(project, project.scenarios[0], facade_frame(project)), exported[1]
+
+
+def test_schedule_year_and_seasons(project, year):
+    from radtree.export.transmittance import year_hours
+
+    _, schedules = year
+    assert len(schedules) == 1
+    cs = schedules[0]
+    assert cs.values.shape == (8760,)
+    assert np.all((cs.values >= 0) & (cs.values <= 1))
+    hours = year_hours(project)
+    assert hours[0].isoformat() == "2023-01-01T00:30:00-03:00"
+    # Mendoza defaults: leaf-on 15 Oct (inclusive) to 1 June (exclusive)
+    assert cs.leaf_on.sum() == 24 * (365 - (30 + 31 + 31 + 30 + 14))   # June … 14 Oct bare
+    assert cs.leaf_on[0] and not cs.leaf_on[24 * 200]
+    # the bare crown passes more of the sun than the leafed one
+    noon = np.array([h.hour == 12 for h in hours])
+    assert cs.values[noon & ~cs.leaf_on].mean() > cs.values[noon & cs.leaf_on].mean() + 0.1
+
+
+@needs_radiance
+def test_schedule_agrees_with_radiance_direct_sun(project, year, tmp_path):
+    """Three hours of the exported schedule (as written in the HBJSON) against radtree's
+    Radiance engine tracing the sun (-ab 0) at the same points under the crown:
+    E / (DNI · sin altitude), averaged → within 1 %."""
+    from radtree.engines.radiance.interface import RadianceEngine
+    from radtree.export.transmittance import bundle, year_hours
+    from radtree.scene import Scene, SensorGrid
+
+    (meshes, _, materials, _), schedules = year
+    cs = schedules[0]
+    hours = year_hours(project)
+    found = []
+    for k in (24 * 14 + 11, 24 * 59 + 16, 24 * 334 + 9):   # 15 Jan 11:30, 1 Mar 16:30, 1 Dec 9:30
+        h = hours[k]
+        assert cs.leaf_on[k]
+        sun = sun_position(local_datetime(h.date().isoformat(), h.strftime("%H:%M"), -3.0),
+                           project.site.latitude, project.site.longitude, 750)
+        origins = bundle(cs.crown, sun.vector, RAYS)
+        grid = SensorGrid("under", origins, np.tile([0, 0, 1.0], (len(origins), 1)))
+        scene = Scene(list(meshes), dict(materials), {"under": grid})
+        st = SkyState(time=h.strftime("%H:%M"), datetime=h, sun=sun, direct_normal_lux=1e5,
+                      sky_model="none", ground_glow=False)
+        eng = RadianceEngine()
+        plan = eng.prepare(scene, [st], EngineParams(ab=0, lw=1e-6), 0, tmp_path / str(k))
+        lux = eng.trace(plan, st.label)["under"].lux
+        radiance_tau = float(np.mean(lux / (1e5 * np.sin(np.radians(sun.altitude_deg)))))
+        found.append((cs.values[k], radiance_tau))
+        assert cs.values[k] == pytest.approx(radiance_tau, rel=0.01), (h, found)
+    print("schedule vs Radiance direct sun:", [f"{a:.5f}/{b:.5f} ({100 * (a / b - 1):+.4f} %)"
+                                               for a, b in found])
+    assert len({round(a, 3) for a, _ in found}) == 3   # three different sun positions
+
+
+def test_honeybee_round_trip_idf_and_csv(project, exported, year, tmp_path):
+    from radtree.export.honeybee import crown_shades, shade_model, write_idf, write_schedule_csv
+    from radtree.export.run import leaf_material
+
+    back, schedules = exported
+    assert back.check_all(raise_exception=False) == ""
+    assert len(back.shade_meshes) == 1 and not back.rooms
+    shade = back.shade_meshes[0]
+    assert shade.identifier == "radtree_crown_1"
+    sched = shade.properties.energy.transmittance_schedule
+    assert len(sched.values) == 8760 and sched.schedule_type_limit.identifier == "Fractional"
+    assert len(shade.faces) == len(schedules[0].crown.faces)
+    (meshes, _, materials, _), _ = year
+    leaf = leaf_material(meshes, materials)
+    mod = shade.properties.radiance.modifier
+    assert mod.identifier == leaf.name == "leaf"
+    c, trans, tspec = leaf.coefficients
+    assert (mod.r_reflectance, mod.transmitted_diff, mod.transmitted_spec) == pytest.approx(
+        (c, trans, tspec))
+
+    model = shade_model(project.name, crown_shades(schedules, leaf))
+    idf = write_idf(model, tmp_path).read_text()
+    assert idf.count("Shading:Building:Detailed,") == len(shade.faces)
+    assert "radtree_crown_1_transmittance" in idf
+
+    csv, sidf = write_schedule_csv(schedules, tmp_path)
+    lines = csv.read_text().splitlines()
+    assert lines[0] == "crown_1" and len(lines) == 1 + 8760
+    assert float(lines[1 + 4000]) == pytest.approx(schedules[0].values[4000], abs=1e-6)
+    text = sidf.read_text()
+    assert "Schedule:File," in text and "crown_transmittance.csv" in text and "8760" in text
+
+
+def test_cli_gltf_and_obj(project, tmp_path):
+    import trimesh
+    from click.testing import CliRunner
+
+    from radtree.cli import main
+
+    folder = tmp_path / "p"
+    shutil.copytree(project.root, folder, ignore=shutil.ignore_patterns("build", "results"))
+    for fmt, name in (("gltf", "crown_scene.glb"), ("obj", "crown_scene.obj")):
+        r = CliRunner().invoke(main, ["export", str(folder), "--format", fmt, "--out",
+                                      str(tmp_path / "out")])
+        assert r.exit_code == 0, r.output
+        path = tmp_path / "out" / name
+        assert f"wrote {path}" in r.output
+    glb = trimesh.load(tmp_path / "out" / "crown_scene.glb")
+    assert {"facade", "ground", "opposite_facade", "tree_leaves", "tree_trunks"} <= set(
+        glb.geometry)
+    obj = (tmp_path / "out" / "crown_scene.obj").read_text()
+    assert obj.count("\nf ") == sum(len(g.faces) for g in glb.geometry.values())
