@@ -1,0 +1,130 @@
+"""One writer per output folder: an advisory lock file ``FOLDER/.radtree.lock``.
+
+A command that writes a project's ``results/``, ``build/``, ``report/`` or ``diagnose/``
+folder holds that folder's lock while it runs. The lock is an ``fcntl.flock`` on the file, so
+the kernel releases it when the holder dies (``kill -9``, a crash, a lost machine): a lock left
+by a dead process is never in the way. The file carries the holder's pid, host and command
+line, so a second run is refused with one message naming them (or, with ``wait=True``, waits
+for them to finish). Within one process the lock is re-entrant (``simulate`` → ``build``).
+
+    with folder_lock(project.results_dir, "radtree simulate examples/mendoza-street"):
+        ...
+"""
+
+from __future__ import annotations
+
+import contextlib
+import fcntl
+import json
+import os
+import socket
+import threading
+from collections.abc import Callable, Iterator
+from datetime import datetime, timezone
+from pathlib import Path
+
+from radtree.errors import RadtreeError
+
+LOCK_NAME = ".radtree.lock"
+
+_held: dict[str, list[int]] = {}   # resolved lock path → [fd, depth] held by this process
+_guard = threading.Lock()
+
+
+class LockHeld(RadtreeError):
+    """Another process holds the folder's lock; ``holder`` is what its lock file says."""
+
+    def __init__(self, folder: Path, holder: dict):
+        self.folder, self.holder = folder, holder
+        super().__init__(f"{folder} is in use by {describe(holder)}; wait for it to finish "
+                         f"(or rerun with --wait), or stop that process")
+
+
+def describe(holder: dict) -> str:
+    """``pid 123 (radtree simulate proj) on host, since 2026-12-01T20:00:00+00:00``."""
+    if not holder.get("pid"):
+        return "another radtree process"
+    text = f"pid {holder['pid']}"
+    if holder.get("command"):
+        text += f" ({holder['command']})"
+    if holder.get("host") and holder["host"] != socket.gethostname():
+        text += f" on {holder['host']}"
+    if holder.get("since"):
+        text += f", since {holder['since']}"
+    return text
+
+
+def read_holder(path: Path) -> dict:
+    """What the lock file at ``path`` says (``{}`` when absent, empty or unreadable)."""
+    try:
+        data = json.loads(path.read_text(encoding="utf-8"))
+    except (OSError, ValueError):
+        return {}
+    return data if isinstance(data, dict) else {}
+
+
+def pid_alive(pid: int) -> bool:
+    """True when a process ``pid`` exists on this machine."""
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except PermissionError:
+        return True
+    return True
+
+
+@contextlib.contextmanager
+def folder_lock(folder: str | os.PathLike, command: str, wait: bool = False,
+                echo: Callable[[str], None] | None = None) -> Iterator[Path]:
+    """Hold ``FOLDER/.radtree.lock`` (the folder is created) while inside.
+
+    Another process holding it → :class:`LockHeld` naming its pid and command, or with
+    ``wait`` a message to ``echo`` and a blocking wait. A lock file left by a process that
+    is gone is taken over (said to ``echo``)."""
+    path = Path(folder) / LOCK_NAME
+    path.parent.mkdir(parents=True, exist_ok=True)
+    key = str(path.resolve())
+    with _guard:
+        if key in _held:
+            _held[key][1] += 1
+            reentered = True
+        else:
+            reentered = False
+    if reentered:
+        try:
+            yield path
+        finally:
+            with _guard:
+                _held[key][1] -= 1
+        return
+    fd = os.open(path, os.O_RDWR | os.O_CREAT, 0o644)
+    try:
+        try:
+            fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except BlockingIOError:
+            holder = read_holder(path)
+            if not wait:
+                raise LockHeld(Path(folder), holder) from None
+            if echo:
+                echo(f"waiting for {describe(holder)} to release {folder}")
+            fcntl.flock(fd, fcntl.LOCK_EX)
+        previous = read_holder(path)
+        if echo and previous.get("pid") and not pid_alive(int(previous["pid"])):
+            echo(f"note: {folder} was locked by pid {previous['pid']} "
+                 f"({previous.get('command', '?')}), which is no longer running; lock taken over")
+        record = json.dumps({"pid": os.getpid(), "host": socket.gethostname(),
+                             "command": command,
+                             "since": datetime.now(timezone.utc).isoformat(timespec="seconds")})
+        os.ftruncate(fd, 0)
+        os.pwrite(fd, record.encode(), 0)
+        with _guard:
+            _held[key] = [fd, 1]
+        try:
+            yield path
+        finally:
+            with _guard:
+                del _held[key]
+            os.ftruncate(fd, 0)   # released: an empty file names no holder
+    finally:
+        os.close(fd)
