@@ -24,7 +24,7 @@ from radtree.cli import main
 from radtree.config import load_project
 from radtree.pipeline.results import read_results
 
-from .conftest import copy_project
+from .conftest import copy_project, needs_radiance
 
 HELD = str(Path(__file__).with_name("held_run.py"))
 TINY = {r'model = "\w+"': 'model = "none"', r"^rays = \d+": "rays = 64",
@@ -39,6 +39,14 @@ def tiny(tmp_path: Path) -> Path:
 
 def cli(*args: str):
     return CliRunner().invoke(main, list(args))
+
+
+def error_lines(res) -> list[str]:  # type: ignore[no-untyped-def]
+    """The lines of a command's stderr from its one ``error:`` line on (after progress bars)."""
+    lines = res.stderr.splitlines()
+    starts = [i for i, line in enumerate(lines) if line.startswith("error: ")]
+    assert len(starts) == 1, res.stderr
+    return lines[starts[0]:]
 
 
 def held(k: int | None, *args: str, wait_for: str = "engine:") -> subprocess.Popen:
@@ -99,3 +107,95 @@ def test_second_writer_is_refused_or_waits_and_readers_see_one_table(tiny: Path)
 def _holder(pid: int, tiny: Path) -> str:
     lock = json.loads((tiny / "results" / ".radtree.lock").read_text())
     return f"pid {pid} (radtree simulate {tiny}), since {lock['since']}"
+
+
+# ---------------------------------------------------------------- 2. killed / failing engine
+KILLER = """#!{python} -I
+# rtrace for hour {hour} is SIGKILLed after {rows} rows of output, and so is this wrapper
+import os, signal, subprocess, sys
+real = {real!r}
+if "octrees/{hour}.oct" not in sys.argv:
+    os.execv(real, [real, *sys.argv[1:]])
+child = subprocess.Popen([real, *sys.argv[1:]], stdout=subprocess.PIPE)
+for n, line in enumerate(child.stdout, 1):
+    sys.stdout.buffer.write(line)
+    if n == {rows}:
+        break
+sys.stdout.flush()
+child.kill()
+child.wait()
+os.kill(os.getpid(), signal.SIGKILL)
+"""
+
+
+def _killing_radiance(tmp_path: Path, hour: str, rows: int) -> Path:
+    """A Radiance bin/ folder whose rtrace is killed mid-hour: the real programs linked in,
+    rtrace replaced by a wrapper around the real one (KILLER)."""
+    from radtree.engines.radiance.binaries import find_radiance
+
+    real = find_radiance()
+    assert real is not None
+    bin_dir = tmp_path / "radiance" / "bin"
+    bin_dir.mkdir(parents=True)
+    if real.lib_dir is not None:
+        (tmp_path / "radiance" / "lib").symlink_to(real.lib_dir)
+    for prog in real.bin_dir.iterdir():
+        (bin_dir / prog.name).symlink_to(prog)
+    (bin_dir / "rtrace").unlink()
+    (bin_dir / "rtrace").write_text(KILLER.format(python=sys.executable, hour=hour, rows=rows,
+                                                  real=real.program("rtrace")))
+    (bin_dir / "rtrace").chmod(0o755)
+    return bin_dir
+
+
+def _parts(project: Path) -> list[str]:
+    return sorted(p.name.split("_")[1] for p in (project / "results" / "parts").glob("*.csv"))
+
+
+@needs_radiance
+def test_killed_or_failing_engine_names_scenario_and_hour_and_resumes(tmp_path, monkeypatch):
+    from radtree.engines.radiance import binaries
+    from radtree.engines.registry import engine_class
+
+    proj = copy_project(tmp_path / "proj", TINY, hours=["10:30", "13:30"])
+    sim = ["simulate", str(proj), "-s", "B", "--workers", "1"]
+    # rtrace really killed (SIGKILL) after 3 of the 13:30 façade rows
+    monkeypatch.setenv("RADTREE_RADIANCE", str(_killing_radiance(tmp_path, "1330", 3)))
+    binaries.find_radiance.cache_clear()
+    res = cli(*sim, "--engine", "radiance")
+    assert res.exit_code == 3, res.output
+    lines = error_lines(res)
+    assert lines[0] == ("error: scenario B, hour 13:30: the radiance engine failed: rtrace was "
+                        "killed by signal 9 (SIGKILL)")
+    assert lines[1].startswith("  command: rtrace -h -I -u-") and lines[1].endswith("octrees/1330.oct")
+    assert lines[-1] == ("  finished hours are kept in results/parts/; run the same command "
+                         "again to resume")
+    assert _parts(proj) == ["1030"]                        # the finished hour is kept
+    assert not list((proj / "results").rglob(".*tmp")) and not list(
+        (proj / "build" / "B" / "results").glob("1330_*"))  # no half-written output
+    monkeypatch.delenv("RADTREE_RADIANCE")
+    binaries.find_radiance.cache_clear()
+    res = cli(*sim, "--engine", "radiance")
+    assert res.exit_code == 0, res.output
+    assert "1 hours traced, 1 reused" in res.stdout
+
+    # the in-process NumPy engine raising at its second hour (a fault injected around trace)
+    cls = engine_class("numpy")
+    original = cls.trace
+    calls = []
+
+    def failing(self, plan, label, grids=None):  # type: ignore[no-untyped-def]
+        calls.append(label)
+        if len(calls) == 2:
+            raise MemoryError("cannot allocate 12.0 GiB for the ray bundle")
+        return original(self, plan, label, grids)
+
+    monkeypatch.setattr(cls, "trace", failing)
+    res = cli(*sim, "--engine", "numpy")
+    assert res.exit_code == 3
+    assert error_lines(res)[0] == (
+        "error: scenario B, hour 13:30: the numpy engine failed: MemoryError: cannot allocate "
+        "12.0 GiB for the ray bundle")
+    monkeypatch.setattr(cls, "trace", original)
+    res = cli(*sim, "--engine", "numpy")
+    assert res.exit_code == 0 and "1 hours traced, 1 reused" in res.stdout

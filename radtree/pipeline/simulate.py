@@ -21,6 +21,7 @@ import pandas as pd
 from radtree.config import Project, Scenario, effective_project
 from radtree.engines.base import Engine
 from radtree.engines.registry import get_engine
+from radtree.errors import EngineError, RadtreeError
 from radtree.fileio import atomic_path, write_text
 from radtree.light.hours import hour_states
 from radtree.light.sky import SkyState
@@ -29,6 +30,8 @@ from radtree.pipeline.build import ensure_built, hour_grids, progress_bar
 from radtree.pipeline.manifest import manifest
 from radtree.pipeline.realisations import merge_realisations, parent_name, selected
 from radtree.pipeline.results import hour_rows, in_column_order, merge_write, results_path
+
+RESUME = "finished hours are kept in results/parts/; run the same command again to resume"
 
 
 @dataclass
@@ -121,7 +124,7 @@ def simulate_project(project: Project, engine: str | Engine = "auto",
         prep = prepared[sc.name]
         t = time.perf_counter()
         use = hour_grids(project, st.time, list(prep.built.scene.grids), grids, sc)
-        res = eng.trace(prep.plan, st.label, use)
+        res = trace_hour(eng, prep.plan, sc, st, use)
         df = hour_rows(project, sc, st, prep.built.scene, res, eng.name, prep.phash)
         with atomic_path(part) as tmp:
             df.to_csv(tmp, index=False)
@@ -160,6 +163,19 @@ def simulate_project(project: Project, engine: str | Engine = "auto",
         manifest(project, extra={"engine": eng.name, "scenarios": [s.name for s in chosen]}),
         indent=2, default=str))
     return SimulationOutcome(pd.read_csv(out), out, tdf, len(todo), reused, eng.name)
+
+
+def trace_hour(eng: Engine, plan: Any, sc: Scenario, st: SkyState, grids: list[str]
+               ) -> dict[str, Any]:
+    """``eng.trace`` of one hour; any failure of the engine (a Radiance program failing or
+    killed, the in-process engine raising) → one :class:`EngineError` naming scenario and hour.
+    Interrupts pass through."""
+    try:
+        return eng.trace(plan, st.label, grids)
+    except Exception as exc:  # noqa: BLE001 - every engine failure gets its scenario and hour
+        what = str(exc) if isinstance(exc, RadtreeError) else f"{type(exc).__name__}: {exc}"
+        raise EngineError(f"scenario {sc.name}, hour {st.time}: the {eng.name} engine failed: "
+                          f"{what}\n  {RESUME}") from exc
 
 
 def _timing_table(timing: dict[str, dict[str, float]], engine: str) -> pd.DataFrame:
