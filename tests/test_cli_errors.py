@@ -90,7 +90,8 @@ def test_failing_radiance_command_is_3(proj, monkeypatch):
         monkeypatch.setattr(module, "rtrace_options", lambda *a, **k: [*broken(*a, **k), "-zz"])
     r = run("simulate", str(proj), "-s", "B", "--engine", "radiance", "--workers", "1")
     assert r.exit_code == ENGINE_FAILURE, r.output
-    assert "error: rtrace failed" in r.output
+    assert "error: scenario B, hour " in r.output   # named (issue 23)
+    assert "the radiance engine failed: rtrace failed (exit 1)" in r.output
     assert "command: rtrace" in r.output and "-zz" in r.output
     assert "stderr:" in r.output
     assert "Traceback" not in r.output

@@ -199,3 +199,64 @@ def test_killed_or_failing_engine_names_scenario_and_hour_and_resumes(tmp_path, 
     monkeypatch.setattr(cls, "trace", original)
     res = cli(*sim, "--engine", "numpy")
     assert res.exit_code == 0 and "1 hours traced, 1 reused" in res.stdout
+
+
+# ---------------------------------------------------------------- 3. corrupt or stale state
+def test_corrupt_parts_are_detected_and_recomputed(tiny: Path):
+    sim = ["simulate", str(tiny), "--engine", "numpy", "-s", "A", "-s", "B"]
+    assert cli(*sim).exit_code == 0
+    before = read_results(load_project(tiny))
+    parts = tiny / "results" / "parts"
+    a, b = sorted(parts.glob("*.csv"))
+    size = a.stat().st_size
+    a.write_bytes(a.read_bytes()[: size // 2])                      # truncated
+    text = b.read_text()
+    b.write_text(text.replace(",facade,0,", ",facade,9,", 1))       # hand-edited, same size
+    res = cli(*sim)
+    assert res.exit_code == 0, res.output
+    assert res.stdout.splitlines()[1:3] == [
+        f"  results/parts/{a.name} is truncated ({size // 2} of {size} bytes): recomputing it",
+        f"  results/parts/{b.name} was changed after it was written (sha256 differs from its "
+        "manifest): recomputing it"]
+    assert "2 hours traced, 0 reused" in res.stdout
+    pd.testing.assert_frame_equal(read_results(load_project(tiny)), before)  # same numbers
+    (parts / f"{b.name}.json").unlink()                             # an interrupted write
+    res = cli(*sim)
+    assert (f"  results/parts/{b.name} has no valid manifest (an interrupted write or an older "
+            "radtree): recomputing it") in res.stdout
+    assert "1 hours traced, 1 reused" in res.stdout
+
+
+@needs_radiance
+def test_stale_build_folder_is_detected_and_rebuilt(tiny: Path):
+    sim = ["simulate", str(tiny), "--engine", "radiance", "-s", "B"]
+    assert "  build/B is missing: building it" in cli(*sim).stdout
+    before = read_results(load_project(tiny))
+    folder = tiny / "build" / "B"
+    manifest = folder / "manifest.json"
+    stamp = json.loads(manifest.read_text())
+
+    def rerun(**change) -> list[str]:  # type: ignore[no-untyped-def]
+        mf = json.loads(manifest.read_text())
+        mf.update(change.get("top", {}))
+        mf["build"].update(change.get("build", {}))
+        manifest.write_text(json.dumps(mf))
+        res = cli(*sim)
+        assert res.exit_code == 0, res.output
+        return [line for line in res.stdout.splitlines() if line.startswith("  build/B")]
+
+    assert rerun(build={"params_hash": "0123456789ab"}) == [
+        "  build/B was written for other parameters: building it"]
+    assert rerun(top={"radtree_version": "0.0.1"}) == [
+        f"  build/B was written by radtree 0.0.1 (this is {stamp['radtree_version']}): "
+        "building it"]
+    (folder / "geometry" / "ground.rad").unlink()
+    assert rerun() == ["  build/B lacks geometry/ground.rad: building it"]
+    (folder / "skies" / "1030.sky").write_text("# emptied by hand\n")
+    assert rerun() == ["  build/B has skies/1030.sky changed since it was built: building it"]
+    assert rerun() == []                                             # now current
+    for octree in (folder / "octrees").glob("*.oct"):                # a deleted octree is
+        octree.unlink()                                              # remade by oconv
+    assert "1 hours traced, 0 reused" in cli(*sim, "--fresh").stdout
+    assert (folder / "octrees" / "1030.oct").stat().st_size > 0
+    pd.testing.assert_frame_equal(read_results(load_project(tiny)), before)

@@ -28,6 +28,7 @@ from radtree.light.sky import SkyState
 from radtree.pipeline.assemble import BuiltScene, make_scene
 from radtree.pipeline.build import ensure_built, hour_grids, progress_bar
 from radtree.pipeline.manifest import manifest
+from radtree.pipeline.parts import check_part, write_part
 from radtree.pipeline.realisations import merge_realisations, parent_name, selected
 from radtree.pipeline.results import hour_rows, in_column_order, merge_write, results_path
 
@@ -113,10 +114,14 @@ def simulate_project(project: Project, engine: str | Engine = "auto",
     reused = 0
     for sc, st in tasks:
         part = parts_dir / f"{sc.name}_{st.label}_{eng.name}_{prepared[sc.name].phash}.csv"
-        if resume and part.exists():
-            frames.append(pd.read_csv(part))
+        rows, why = check_part(part, sc.name, st.time, prepared[sc.name].phash) if resume and \
+            part.exists() else (None, "")
+        if rows is not None:
+            frames.append(rows)
             reused += 1
         else:
+            if why:
+                echo(f"  results/parts/{part.name} {why}: recomputing it")
             todo.append((sc, st, part))
 
     def work(item: tuple[Scenario, SkyState, Path]) -> pd.DataFrame:
@@ -126,8 +131,7 @@ def simulate_project(project: Project, engine: str | Engine = "auto",
         use = hour_grids(project, st.time, list(prep.built.scene.grids), grids, sc)
         res = trace_hour(eng, prep.plan, sc, st, use)
         df = hour_rows(project, sc, st, prep.built.scene, res, eng.name, prep.phash)
-        with atomic_path(part) as tmp:
-            df.to_csv(tmp, index=False)
+        write_part(part, df)
         with lock:
             timing[sc.name]["tracing_s"] += time.perf_counter() - t
         return df
