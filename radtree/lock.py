@@ -24,6 +24,7 @@ from datetime import datetime, timezone
 from pathlib import Path
 
 from radtree.errors import RadtreeError
+from radtree.fileio import make_folder
 
 LOCK_NAME = ".radtree.lock"
 
@@ -83,7 +84,7 @@ def folder_lock(folder: str | os.PathLike, command: str, wait: bool = False,
     ``wait`` a message to ``echo`` and a blocking wait. A lock file left by a process that
     is gone is taken over (said to ``echo``)."""
     path = Path(folder) / LOCK_NAME
-    path.parent.mkdir(parents=True, exist_ok=True)
+    make_folder(path.parent)
     key = str(path.resolve())
     with _guard:
         if key in _held:

@@ -24,7 +24,7 @@ from radtree.cli import main
 from radtree.config import load_project
 from radtree.pipeline.results import read_results
 
-from .conftest import copy_project, needs_radiance
+from .conftest import copy_project, needs_radiance, radiance_available
 
 HELD = str(Path(__file__).with_name("held_run.py"))
 TINY = {r'model = "\w+"': 'model = "none"', r"^rays = \d+": "rays = 64",
@@ -260,3 +260,66 @@ def test_stale_build_folder_is_detected_and_rebuilt(tiny: Path):
     assert "1 hours traced, 0 reused" in cli(*sim, "--fresh").stdout
     assert (folder / "octrees" / "1030.oct").stat().st_size > 0
     pd.testing.assert_frame_equal(read_results(load_project(tiny)), before)
+
+
+# ---------------------------------------------------------------- 4. full disk, folders, names
+def test_failed_write_names_the_file_and_leaves_nothing_half_written(tmp_path: Path):
+    from radtree.fileio import atomic_path, write_text
+
+    target = write_text(tmp_path / "table.csv", "old,complete\n")
+    with pytest.raises(OSError) as err, atomic_path(target) as tmp:
+        tmp.unlink()
+        tmp.symlink_to("/dev/full")              # the kernel's always-full device: ENOSPC
+        tmp.write_text("new," * 10_000)
+    assert err.value.filename == str(target)
+    assert err.value.strerror == ("cannot write: No space left on device (nothing written; a "
+                                  "previous table.csv, if any, is unchanged)")
+    assert target.read_text() == "old,complete\n"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["table.csv"]
+
+
+def test_full_disk_file_in_the_way_and_unusual_paths(tmp_path: Path):
+    import resource
+
+    proj = copy_project(tmp_path / "calle ñandú 1" / "proyecto", TINY, hours=["10:30"])
+    sim = ["simulate", str(proj), "--engine", "numpy", "-s", "A"]
+    # a file-size limit below one part: the write fails like a full disk (EFBIG, not a kill)
+    limits = resource.getrlimit(resource.RLIMIT_FSIZE)
+    xfsz = signal.signal(signal.SIGXFSZ, signal.SIG_IGN)
+    resource.setrlimit(resource.RLIMIT_FSIZE, (1000, limits[1]))
+    try:
+        res = cli(*sim)
+    finally:
+        resource.setrlimit(resource.RLIMIT_FSIZE, limits)
+        signal.signal(signal.SIGXFSZ, xfsz)
+    assert res.exit_code == 2, res.output
+    part = next(iter(load_project(proj).scenarios)).name
+    lines = error_lines(res)
+    assert len(lines) == 1 and lines[0].startswith(f"error: {proj / 'results' / 'parts' / part}_")
+    assert lines[0].endswith(".csv: cannot write: File too large (nothing written; a previous "
+                             f"{lines[0].split('/')[-1].split(':')[0]}, if any, is unchanged)")
+    assert list((proj / "results" / "parts").iterdir()) == []  # no part, no temporary
+    # a file where an output folder belongs (also how a read-only folder looks to root)
+    shutil.rmtree(proj / "results")
+    (proj / "results").write_text("not a folder")
+    res = cli(*sim)
+    assert res.exit_code == 2
+    assert error_lines(res) == [f"error: {proj / 'results'}: cannot create this folder: a file "
+                                "of that name is in the way (move or delete it)"]
+    (proj / "results").unlink()
+    if os.geteuid() != 0:                        # a read-only folder (root may write anyway)
+        (proj / "results").mkdir()
+        (proj / "results").chmod(0o555)
+        try:
+            res = cli(*sim)
+            assert res.exit_code == 2 and "Permission denied" in error_lines(res)[0]
+        finally:
+            (proj / "results").chmod(0o755)
+    # spaces and non-ASCII letters in the path: both engines, build folder and lock
+    res = cli(*sim)
+    assert res.exit_code == 0 and "1 hours traced, 0 reused" in res.stdout
+    if radiance_available():
+        res = cli("simulate", str(proj), "--engine", "radiance", "-s", "B")
+        assert res.exit_code == 0, res.output
+    assert len(read_results(load_project(proj))) == 2 * len(
+        read_results(load_project(proj)).query("scenario == 'A'")) or not radiance_available()
