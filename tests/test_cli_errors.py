@@ -189,3 +189,7 @@ def test_sigterm_keeps_finished_hours_even_if_the_parent_ignores_it(open_street)
     assert len(list(parts.glob("*.csv"))) == 1
     assert not list(parts.glob(".*tmp"))
     assert not (open_street / "results" / "illuminance.csv").exists()
+    # resumable: the lock went with the process, the finished part is reused (issue 23)
+    done = run("simulate", str(open_street), "--workers", "1", "-s", "A", "--hour", "10:30")
+    assert done.exit_code == OK, done.output
+    assert "0 hours traced, 1 reused" in done.output
