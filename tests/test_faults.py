@@ -323,3 +323,41 @@ def test_full_disk_file_in_the_way_and_unusual_paths(tmp_path: Path):
         assert res.exit_code == 0, res.output
     assert len(read_results(load_project(proj))) == 2 * len(
         read_results(load_project(proj)).query("scenario == 'A'")) or not radiance_available()
+
+
+# ---------------------------------------------------------------- 6. resource limits
+def test_too_big_a_project_is_refused_up_front_with_the_estimate(tiny: Path, tmp_path: Path):
+    from radtree.pipeline.limits import available_memory, check_memory
+
+    toml = tiny / "radtree.toml"
+    toml.write_text(toml.read_text() + "\n[limits]\nmax_triangles = 5\n")
+    for command in ("build", "simulate"):
+        res = cli(command, str(tiny), "-s", "B", *(["--engine", "numpy"] * (command != "build")))
+        assert res.exit_code == 2
+        assert error_lines(res) == [
+            f"error: {toml}, field 'limits.max_triangles': scenario B would build 6 triangles, "
+            "more than the limit of 5: use larger slats (tree.louvers.slat_size_m), fewer "
+            "layers (tree.louvers.layers) or a lower tree.perforated.resolution, or raise "
+            "max_triangles in [limits]"]
+    assert not (tiny / "results" / "parts").exists()
+    toml.write_text(toml.read_text().replace("max_triangles = 5", "max_memory_fraction = 1e-6"))
+    res = cli("simulate", str(tiny), "-s", "B", "--engine", "numpy", "--workers", "3")
+    assert res.exit_code == 2
+    line, = error_lines(res)
+    head, tail = line.split(" GiB available")
+    assert head.startswith(
+        f"error: {toml}, field 'limits.max_memory_fraction': this run would need about 0.10 GiB "
+        "(1 scene(s), 6 triangles, 3 worker(s)), more than 0.0001 % of the ")
+    assert float(head.rsplit(" ", 1)[1]) > 0
+    assert tail == (": use fewer --workers or scenarios at once (-s), a coarser crown model, "
+                    "or raise max_memory_fraction in [limits]")
+    assert not (tiny / "results" / "parts").exists()
+    # the estimate: 200 B per triangle held + per worker 100 MiB + 300 B per traced triangle
+    project = load_project(copy_project(tmp_path / "p2", TINY))
+    with pytest.raises(Exception, match=r"need about 1\.87 GiB \(2 scene\(s\), 3,000,000 "
+                       r"triangles, 2 worker\(s\)\), more than 80 % of the 1\.00 GiB"):
+        check_memory(project, [1_000_000, 2_000_000], 2, available=2**30)
+    check_memory(project, [1_000_000, 2_000_000], 2, available=3 * 2**30)  # fits: no error
+    meminfo = tmp_path / "meminfo"
+    meminfo.write_text("MemTotal:  24731184 kB\nMemFree:  1 kB\nMemAvailable:   22373456 kB\n")
+    assert available_memory(meminfo) == 22373456 * 1024

@@ -13,6 +13,7 @@ from dataclasses import dataclass, field, fields, is_dataclass
 from pathlib import Path
 from typing import Any, ClassVar
 
+from radtree.config.limits import Limits
 from radtree.config.spec import TIME_RE, Checked, meta
 from radtree.errors import ConfigError
 
@@ -347,6 +348,7 @@ class Project:
     measured_rows: Path | None = None
     office: Office | None = None
     extra_geometry: tuple[tuple[Path, str], ...] = ()
+    limits: Limits = field(default_factory=Limits)
 
     @property
     def build_dir(self) -> Path:

@@ -27,6 +27,7 @@ from radtree.light.hours import hour_states
 from radtree.light.sky import SkyState
 from radtree.pipeline.assemble import BuiltScene, make_scene
 from radtree.pipeline.build import ensure_built, hour_grids, progress_bar
+from radtree.pipeline.limits import check_memory
 from radtree.pipeline.manifest import manifest
 from radtree.pipeline.parts import check_part, write_part
 from radtree.pipeline.realisations import merge_realisations, parent_name, selected
@@ -101,6 +102,7 @@ def simulate_project(project: Project, engine: str | Engine = "auto",
         timing[sc.name] = {"preparation_s": prep.seconds,
                            "geometry_s": prep.built.geometry_seconds, "tracing_s": 0.0}
         tasks.extend((sc, st) for st in prep.states)
+    check_memory(project, [p.built.triangles for p in prepared.values()], max(1, workers))
     if dry_run:
         for sc, st in tasks:
             for line in eng.commands(prepared[sc.name].plan, st.label):
