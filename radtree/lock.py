@@ -27,6 +27,9 @@ from radtree.errors import RadtreeError
 from radtree.fileio import make_folder
 
 LOCK_NAME = ".radtree.lock"
+#: held briefly by a writer while it replaces a folder's finished files (exclusive) and by a
+#: reader while it reads them (shared), so a reader sees one writer's files, not a mix
+PUBLISH_NAME = ".radtree.publish.lock"
 
 _held: dict[str, list[int]] = {}   # resolved lock path → [fd, depth] held by this process
 _guard = threading.Lock()
@@ -77,13 +80,15 @@ def pid_alive(pid: int) -> bool:
 
 @contextlib.contextmanager
 def folder_lock(folder: str | os.PathLike, command: str, wait: bool = False,
-                echo: Callable[[str], None] | None = None) -> Iterator[Path]:
-    """Hold ``FOLDER/.radtree.lock`` (the folder is created) while inside.
+                echo: Callable[[str], None] | None = None, name: str = LOCK_NAME,
+                shared: bool = False) -> Iterator[Path]:
+    """Hold ``FOLDER/<name>`` (default ``.radtree.lock``; the folder is created) while inside.
 
     Another process holding it → :class:`LockHeld` naming its pid and command, or with
     ``wait`` a message to ``echo`` and a blocking wait. A lock file left by a process that
-    is gone is taken over (said to ``echo``)."""
-    path = Path(folder) / LOCK_NAME
+    is gone is taken over (said to ``echo``). ``shared``: several readers may hold it at once
+    (they do not sign the file)."""
+    path = Path(folder) / name
     make_folder(path.parent)
     key = str(path.resolve())
     with _guard:
@@ -99,17 +104,33 @@ def folder_lock(folder: str | os.PathLike, command: str, wait: bool = False,
             with _guard:
                 _held[key][1] -= 1
         return
-    fd = os.open(path, os.O_RDWR | os.O_CREAT, 0o644)
+    try:
+        fd = os.open(path, os.O_RDWR | os.O_CREAT, 0o644)
+    except PermissionError:
+        if not shared:
+            raise
+        yield path            # a reader of a read-only folder: no writer can be there
+        return
+    mode = fcntl.LOCK_SH if shared else fcntl.LOCK_EX
     try:
         try:
-            fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+            fcntl.flock(fd, mode | fcntl.LOCK_NB)
         except BlockingIOError:
             holder = read_holder(path)
             if not wait:
                 raise LockHeld(Path(folder), holder) from None
             if echo:
                 echo(f"waiting for {describe(holder)} to release {folder}")
-            fcntl.flock(fd, fcntl.LOCK_EX)
+            fcntl.flock(fd, mode)
+        if shared:
+            with _guard:
+                _held[key] = [fd, 1]
+            try:
+                yield path
+            finally:
+                with _guard:
+                    del _held[key]
+            return
         previous = read_holder(path)
         if echo and previous.get("pid") and not pid_alive(int(previous["pid"])):
             echo(f"note: {folder} was locked by pid {previous['pid']} "

@@ -93,6 +93,24 @@ def test_second_writer_is_refused_or_waits_and_readers_see_one_table(tiny: Path)
     finally:
         if first.poll() is None:
             first.kill()
+    # publishing: while a writer replaces table, timing and manifest, readers wait (shared)
+    from radtree.lock import PUBLISH_NAME, LockHeld, folder_lock
+
+    hold = ("import sys; from radtree.lock import folder_lock, PUBLISH_NAME\n"
+            f"with folder_lock({str(tiny / 'results')!r}, 'radtree simulate', "
+            "name=PUBLISH_NAME, shared=len(sys.argv) > 1):\n print('held', flush=True); "
+            "sys.stdin.read()")
+    for shared, refused in ((False, True), (True, False)):
+        writer = subprocess.Popen([sys.executable, "-c", hold, *["shared"] * shared],
+                                  stdin=subprocess.PIPE, stdout=subprocess.PIPE, text=True)
+        assert writer.stdout is not None and writer.stdout.readline() == "held\n"
+        try:
+            with folder_lock(tiny / "results", "radtree report", name=PUBLISH_NAME,
+                             shared=True):
+                assert not refused
+        except LockHeld as exc:
+            assert refused and f"in use by pid {writer.pid} (radtree simulate)" in str(exc)
+        writer.communicate("")
     # a lock left by a process that is gone is taken over, and said so
     dead = subprocess.Popen([sys.executable, "-c", "pass"])
     dead.wait()

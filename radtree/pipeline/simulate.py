@@ -25,6 +25,7 @@ from radtree.errors import EngineError, RadtreeError
 from radtree.fileio import atomic_path, write_text
 from radtree.light.hours import hour_states
 from radtree.light.sky import SkyState
+from radtree.lock import PUBLISH_NAME, folder_lock
 from radtree.pipeline.assemble import BuiltScene, make_scene
 from radtree.pipeline.build import ensure_built, hour_grids, progress_bar
 from radtree.pipeline.limits import check_memory
@@ -162,12 +163,13 @@ def simulate_project(project: Project, engine: str | Engine = "auto",
         merge_write(project.results_dir / "realisations.csv", per_realisation, parents)
     table = in_column_order(table, [s.name for s in project.scenarios])
     out = results_path(project)
-    merge_write(out, table, parents)
     tdf = _timing_table(timing, eng.name)
-    _merge_timing(project.results_dir / "timing.csv", tdf)
-    write_text(project.results_dir / "manifest.json", json.dumps(
-        manifest(project, extra={"engine": eng.name, "scenarios": [s.name for s in chosen]}),
-        indent=2, default=str))
+    with folder_lock(project.results_dir, "radtree simulate", wait=True, name=PUBLISH_NAME):
+        merge_write(out, table, parents)   # table, timing and manifest: one reader sees all
+        _merge_timing(project.results_dir / "timing.csv", tdf)
+        write_text(project.results_dir / "manifest.json", json.dumps(
+            manifest(project, extra={"engine": eng.name, "scenarios": [s.name for s in chosen]}),
+            indent=2, default=str))
     return SimulationOutcome(pd.read_csv(out), out, tdf, len(todo), reused, eng.name)
 
 
