@@ -410,3 +410,26 @@ def test_same_inputs_and_seed_give_the_same_table_whatever_workers_and_order(tmp
         table = pd.read_csv(pd.io.common.BytesIO(first))
         assert list(dict.fromkeys(table["scenario"])) == ["A", "B", "D"]  # project order
         assert len(table) == 3 * (8 + 9)                        # 8 façade + 9 map sensors
+
+
+# ---------------------------------------------------------------- values as written (finding 3)
+@pytest.mark.parametrize("name, old, new, message", [
+    ("direct_normal_illuminance.csv", "10:30,109170", "10:30,nan",
+     "direct normal illuminance table {path}: data row 1: direct_normal_lux = 'nan' is not a "
+     "non-negative number"),
+    ("direct_normal_illuminance.csv", "10:30,109170", "10:30,inf",
+     "direct normal illuminance table {path}: data row 1: direct_normal_lux = 'inf' is not a "
+     "non-negative number"),
+    ("concrete_reflectance.csv", "50,0.151", "50,NaN",
+     "ground reflectance table {path}: data row 1: reflectance = 'NaN' is not a non-negative "
+     "number"),
+    ("concrete_reflectance.csv", "50,0.151", "nan,0.151",
+     "ground reflectance table {path}: data row 1: angle_deg = 'nan' is not a sun altitude "
+     "0–90°"),
+])
+def test_bad_table_values_are_shown_as_written(tiny: Path, name, old, new, message):
+    path = tiny / "data" / name
+    path.write_text(path.read_text().replace(old, new, 1))
+    res = cli("simulate", str(tiny), "--engine", "numpy", "-s", "A", "--dry-run")
+    assert res.exit_code == 2
+    assert error_lines(res) == ["error: " + message.format(path=path)]
