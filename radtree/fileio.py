@@ -16,12 +16,11 @@ def make_folder(folder: str | os.PathLike) -> Path:
     path = Path(folder)
     try:
         path.mkdir(parents=True, exist_ok=True)
-    except FileExistsError:
-        raise NotADirectoryError(errno.ENOTDIR, "cannot create this folder: a file of that "
-                                 "name is in the way (move or delete it)", str(path)) from None
-    except NotADirectoryError as exc:
-        raise NotADirectoryError(errno.ENOTDIR, "cannot create this folder: "
-                                 f"{exc.filename} is a file, not a folder", str(path)) from None
+    except (FileExistsError, NotADirectoryError):
+        block = next((p for p in (path, *path.parents) if p.exists() and not p.is_dir()), path)
+        what = "a file of that name is in the way" if block == path else f"{block} is a file"
+        raise NotADirectoryError(errno.ENOTDIR, f"cannot create this folder: {what} (move or "
+                                 "delete it)", str(path)) from None
     return path
 
 

@@ -1,4 +1,4 @@
-"""One writer per output folder: an advisory lock file ``FOLDER/.radtree.lock``.
+"""One writer per output folder: an advisory lock file beside it, ``.FOLDER.radtree.lock``.
 
 A command that writes a project's ``results/``, ``build/``, ``report/`` or ``diagnose/``
 folder holds that folder's lock while it runs. The lock is an ``fcntl.flock`` on the file, so
@@ -24,12 +24,11 @@ from datetime import datetime, timezone
 from pathlib import Path
 
 from radtree.errors import RadtreeError
-from radtree.fileio import make_folder
 
-LOCK_NAME = ".radtree.lock"
+LOCK_NAME = ".radtree.lock"    # the suffix: PROJECT/results → PROJECT/.results.radtree.lock
 #: held briefly by a writer while it replaces a folder's finished files (exclusive) and by a
 #: reader while it reads them (shared), so a reader sees one writer's files, not a mix
-PUBLISH_NAME = ".radtree.publish.lock"
+PUBLISH_NAME = ".radtree-publish.lock"
 
 _held: dict[str, list[int]] = {}   # resolved lock path → [fd, depth] held by this process
 _guard = threading.Lock()
@@ -78,18 +77,25 @@ def pid_alive(pid: int) -> bool:
     return True
 
 
+def lock_path(folder: str | os.PathLike, name: str = LOCK_NAME) -> Path:
+    """``PARENT/.FOLDER.radtree.lock`` for ``PARENT/FOLDER`` (beside the folder, so taking the
+    lock creates nothing; a failed command leaves no empty output folder)."""
+    folder = Path(folder)
+    return folder.parent / f".{folder.name}{name}"
+
+
 @contextlib.contextmanager
 def folder_lock(folder: str | os.PathLike, command: str, wait: bool = False,
                 echo: Callable[[str], None] | None = None, name: str = LOCK_NAME,
                 shared: bool = False) -> Iterator[Path]:
-    """Hold ``FOLDER/<name>`` (default ``.radtree.lock``; the folder is created) while inside.
+    """Hold the lock file ``.FOLDER<name>`` beside ``folder`` (:func:`lock_path`; neither
+    the folder nor its parent is created) while inside.
 
     Another process holding it → :class:`LockHeld` naming its pid and command, or with
     ``wait`` a message to ``echo`` and a blocking wait. A lock file left by a process that
     is gone is taken over (said to ``echo``). ``shared``: several readers may hold it at once
     (they do not sign the file)."""
-    path = Path(folder) / name
-    make_folder(path.parent)
+    path = lock_path(folder, name)
     key = str(path.resolve())
     with _guard:
         if key in _held:

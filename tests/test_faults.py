@@ -94,7 +94,7 @@ def test_second_writer_is_refused_or_waits_and_readers_see_one_table(tiny: Path)
         if first.poll() is None:
             first.kill()
     # publishing: while a writer replaces table, timing and manifest, readers wait (shared)
-    from radtree.lock import PUBLISH_NAME, LockHeld, folder_lock
+    from radtree.lock import PUBLISH_NAME, LockHeld, folder_lock, lock_path
 
     hold = ("import sys; from radtree.lock import folder_lock, PUBLISH_NAME\n"
             f"with folder_lock({str(tiny / 'results')!r}, 'radtree simulate', "
@@ -114,7 +114,7 @@ def test_second_writer_is_refused_or_waits_and_readers_see_one_table(tiny: Path)
     # a lock left by a process that is gone is taken over, and said so
     dead = subprocess.Popen([sys.executable, "-c", "pass"])
     dead.wait()
-    (tiny / "results" / ".radtree.lock").write_text(json.dumps(
+    lock_path(tiny / "results").write_text(json.dumps(
         {"pid": dead.pid, "command": "radtree simulate elsewhere"}))
     res = cli(*sim)
     assert res.exit_code == 0, res.output
@@ -123,7 +123,9 @@ def test_second_writer_is_refused_or_waits_and_readers_see_one_table(tiny: Path)
 
 
 def _holder(pid: int, tiny: Path) -> str:
-    lock = json.loads((tiny / "results" / ".radtree.lock").read_text())
+    from radtree.lock import lock_path
+
+    lock = json.loads(lock_path(tiny / "results").read_text())
     return f"pid {pid} (radtree simulate {tiny}), since {lock['since']}"
 
 
@@ -328,8 +330,8 @@ def test_full_disk_file_in_the_way_and_unusual_paths(tmp_path: Path):
     (proj / "results").write_text("not a folder")
     res = cli(*sim)
     assert res.exit_code == 2
-    assert error_lines(res) == [f"error: {proj / 'results'}: cannot create this folder: a file "
-                                "of that name is in the way (move or delete it)"]
+    assert error_lines(res) == [f"error: {proj / 'results' / 'parts'}: cannot create this "
+                                f"folder: {proj / 'results'} is a file (move or delete it)"]
     (proj / "results").unlink()
     if os.geteuid() != 0:                        # a read-only folder (root may write anyway)
         (proj / "results").mkdir()

@@ -22,7 +22,7 @@ from radtree.config import Project, Scenario, effective_project
 from radtree.engines.base import Engine
 from radtree.engines.registry import get_engine
 from radtree.errors import EngineError, RadtreeError
-from radtree.fileio import atomic_path, write_text
+from radtree.fileio import atomic_path, make_folder, write_text
 from radtree.light.hours import hour_states
 from radtree.light.sky import SkyState
 from radtree.lock import PUBLISH_NAME, folder_lock
@@ -110,7 +110,7 @@ def simulate_project(project: Project, engine: str | Engine = "auto",
                 echo(f"{sc.name}: {line}" if not eng.uses_build_folder else line)
         return None
 
-    parts_dir.mkdir(parents=True, exist_ok=True)
+    make_folder(parts_dir)
     lock = threading.Lock()
     frames: list[pd.DataFrame] = []
     todo = []
