@@ -164,7 +164,8 @@ def simulate_project(project: Project, engine: str | Engine = "auto",
     table = in_column_order(table, [s.name for s in project.scenarios])
     out = results_path(project)
     tdf = _timing_table(timing, eng.name)
-    with folder_lock(project.results_dir, "radtree simulate", wait=True, name=PUBLISH_NAME):
+    with folder_lock(project.results_dir, "radtree simulate", wait=True, name=PUBLISH_NAME,
+                     echo=echo):
         merge_write(out, table, parents)   # table, timing and manifest: one reader sees all
         _merge_timing(project.results_dir / "timing.csv", tdf)
         write_text(project.results_dir / "manifest.json", json.dumps(
