@@ -1,4 +1,4 @@
-"""One writer per output folder: an advisory lock file beside it, ``.FOLDER.radtree.lock``.
+"""One writer per output folder: an advisory lock file beside it, ``.radtree.FOLDER.lock``.
 
 A command that writes a project's ``results/``, ``build/``, ``report/`` or ``diagnose/``
 folder holds that folder's lock while it runs. The lock is an ``fcntl.flock`` on the file, so
@@ -25,10 +25,10 @@ from pathlib import Path
 
 from radtree.errors import RadtreeError
 
-LOCK_NAME = ".radtree.lock"    # the suffix: PROJECT/results → PROJECT/.results.radtree.lock
+LOCK_NAME = ".lock"    # the suffix: PROJECT/results → PROJECT/.radtree.results.lock
 #: held briefly by a writer while it replaces a folder's finished files (exclusive) and by a
 #: reader while it reads them (shared), so a reader sees one writer's files, not a mix
-PUBLISH_NAME = ".radtree-publish.lock"
+PUBLISH_NAME = ".publish.lock"
 
 _held: dict[str, list[int]] = {}   # resolved lock path → [fd, depth] held by this process
 _guard = threading.Lock()
@@ -78,17 +78,17 @@ def pid_alive(pid: int) -> bool:
 
 
 def lock_path(folder: str | os.PathLike, name: str = LOCK_NAME) -> Path:
-    """``PARENT/.FOLDER.radtree.lock`` for ``PARENT/FOLDER`` (beside the folder, so taking the
+    """``PARENT/.radtree.FOLDER.lock`` for ``PARENT/FOLDER`` (beside the folder, so taking the
     lock creates nothing; a failed command leaves no empty output folder)."""
     folder = Path(folder)
-    return folder.parent / f".{folder.name}{name}"
+    return folder.parent / f".radtree.{folder.name}{name}"
 
 
 @contextlib.contextmanager
 def folder_lock(folder: str | os.PathLike, command: str, wait: bool = False,
                 echo: Callable[[str], None] | None = None, name: str = LOCK_NAME,
                 shared: bool = False) -> Iterator[Path]:
-    """Hold the lock file ``.FOLDER<name>`` beside ``folder`` (:func:`lock_path`; neither
+    """Hold the lock file ``.radtree.FOLDER<name>`` beside ``folder`` (:func:`lock_path`; neither
     the folder nor its parent is created) while inside.
 
     Another process holding it → :class:`LockHeld` naming its pid and command, or with
