@@ -84,6 +84,16 @@ def lock_path(folder: str | os.PathLike, name: str = LOCK_NAME) -> Path:
     return folder.parent / f".radtree.{folder.name}{name}"
 
 
+def _left_by_dead_process(holder: dict) -> bool:
+    """True when a lock file names a process of this machine that is no longer running."""
+    try:
+        pid = int(holder.get("pid") or 0)
+    except (TypeError, ValueError):
+        return False
+    same_host = holder.get("host") in (None, socket.gethostname())
+    return pid > 0 and same_host and not pid_alive(pid)
+
+
 @contextlib.contextmanager
 def folder_lock(folder: str | os.PathLike, command: str, wait: bool = False,
                 echo: Callable[[str], None] | None = None, name: str = LOCK_NAME,
@@ -138,7 +148,7 @@ def folder_lock(folder: str | os.PathLike, command: str, wait: bool = False,
                     del _held[key]
             return
         previous = read_holder(path)
-        if echo and previous.get("pid") and not pid_alive(int(previous["pid"])):
+        if echo and _left_by_dead_process(previous):
             echo(f"note: {folder} was locked by pid {previous['pid']} "
                  f"({previous.get('command', '?')}), which is no longer running; lock taken over")
         record = json.dumps({"pid": os.getpid(), "host": socket.gethostname(),
