@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import contextlib
+import errno
 import os
 import shutil
 import tempfile
@@ -10,19 +11,50 @@ from collections.abc import Iterator
 from pathlib import Path
 
 
+def make_folder(folder: str | os.PathLike) -> Path:
+    """``mkdir -p folder``; an OSError naming the folder (and a file in its way) otherwise."""
+    path = Path(folder)
+    try:
+        path.mkdir(parents=True, exist_ok=True)
+    except (FileExistsError, NotADirectoryError):
+        block = next((p for p in (path, *path.parents) if p.exists() and not p.is_dir()), path)
+        what = "a file of that name is in the way" if block == path else f"{block} is a file"
+        raise NotADirectoryError(errno.ENOTDIR, f"cannot create this folder: {what} (move or "
+                                 "delete it)", str(path)) from None
+    return path
+
+
+def _unwritten(exc: OSError, target: Path) -> OSError:
+    """``exc`` as raised for ``target`` (not its temporary name), saying nothing was replaced."""
+    why = exc.strerror or str(exc)
+    return type(exc)(exc.errno, f"cannot write: {why} (nothing written; a previous "
+                     f"{target.name}, if any, is unchanged)", str(target))
+
+
 @contextlib.contextmanager
 def atomic_path(path: str | os.PathLike) -> Iterator[Path]:
-    """Yield a temporary path beside ``path``; on success rename it to ``path``, else delete it."""
+    """Yield a temporary path beside ``path``; on success rename it to ``path``, else delete it.
+
+    A failing write (disk full, read-only folder) raises an OSError naming ``path``, leaves no
+    temporary behind and ``path`` as it was."""
     target = Path(path)
-    target.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(prefix=f".{target.name}.", suffix=".tmp", dir=target.parent)
+    make_folder(target.parent)
+    try:
+        fd, tmp = tempfile.mkstemp(prefix=f".{target.name}.", suffix=".tmp", dir=target.parent)
+    except OSError as exc:
+        raise _unwritten(exc, target) from exc
     os.close(fd)
     tmp_path = Path(tmp)
     try:
-        yield tmp_path
-        os.replace(tmp_path, target)
+        try:
+            yield tmp_path
+            os.replace(tmp_path, target)
+        except OSError as exc:
+            if exc.filename is not None and Path(exc.filename) not in (tmp_path, target):
+                raise              # about another file (e.g. an input read while writing)
+            raise _unwritten(exc, target) from exc
     finally:
-        if tmp_path.exists():
+        if tmp_path.is_symlink() or tmp_path.exists():
             tmp_path.unlink()
 
 
@@ -37,7 +69,7 @@ def write_text(path: str | os.PathLike, text: str) -> Path:
 def atomic_dir(path: str | os.PathLike) -> Iterator[Path]:
     """Yield a temporary folder beside ``path``; on success it replaces ``path`` whole."""
     target = Path(path)
-    target.parent.mkdir(parents=True, exist_ok=True)
+    make_folder(target.parent)
     tmp = Path(tempfile.mkdtemp(prefix=f".{target.name}.", dir=target.parent))
     try:
         yield tmp

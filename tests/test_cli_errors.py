@@ -90,7 +90,8 @@ def test_failing_radiance_command_is_3(proj, monkeypatch):
         monkeypatch.setattr(module, "rtrace_options", lambda *a, **k: [*broken(*a, **k), "-zz"])
     r = run("simulate", str(proj), "-s", "B", "--engine", "radiance", "--workers", "1")
     assert r.exit_code == ENGINE_FAILURE, r.output
-    assert "error: rtrace failed" in r.output
+    assert "error: scenario B, hour " in r.output   # named (issue 23)
+    assert "the radiance engine failed: rtrace failed (exit 1)" in r.output
     assert "command: rtrace" in r.output and "-zz" in r.output
     assert "stderr:" in r.output
     assert "Traceback" not in r.output
@@ -188,3 +189,7 @@ def test_sigterm_keeps_finished_hours_even_if_the_parent_ignores_it(open_street)
     assert len(list(parts.glob("*.csv"))) == 1
     assert not list(parts.glob(".*tmp"))
     assert not (open_street / "results" / "illuminance.csv").exists()
+    # resumable: the lock went with the process, the finished part is reused (issue 23)
+    done = run("simulate", str(open_street), "--workers", "1", "-s", "A", "--hour", "10:30")
+    assert done.exit_code == OK, done.output
+    assert "0 hours traced, 1 reused" in done.output

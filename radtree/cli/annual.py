@@ -12,10 +12,11 @@ from radtree.annual.schedule import (
     LeafSchedule,
     parse_occupancy,
 )
-from radtree.cli.options import CONTEXT
+from radtree.cli.options import CONTEXT, writes
 
 
 @click.command("annual", context_settings=CONTEXT)
+@writes("results")
 @click.argument("project", type=click.Path(exists=True, path_type=Path))
 @click.option("--leaf-on", default=DEFAULT_LEAF_ON, show_default=True, metavar="MM-DD",
               help="First day the crown is in leaf (Morus alba in Mendoza: an assumption).")

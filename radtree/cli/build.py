@@ -6,10 +6,11 @@ import time
 
 import click
 
-from radtree.cli.options import CONTEXT, scenarios_option
+from radtree.cli.options import CONTEXT, scenarios_option, writes
 
 
 @click.command("build", context_settings=CONTEXT)
+@writes("build")
 @click.argument("project", type=click.Path())
 @scenarios_option
 @click.option("--no-pictures", is_flag=True, help="Skip the PNG picture of each crown model.")

@@ -14,11 +14,12 @@ from __future__ import annotations
 import click
 
 from radtree.cli.errors import CHECK_FAILED
-from radtree.cli.options import CONTEXT
+from radtree.cli.options import CONTEXT, writes
 from radtree.engines.registry import ENGINES
 
 
 @click.command("diagnose", context_settings=CONTEXT)
+@writes("diagnose", out_param="out")
 @click.argument("project", required=False, type=click.Path(exists=True))
 @click.option("--measured", type=click.Path(dir_okay=False),
               help="Measured CSV (time,measured_lux | time,row,lux | time,sensor,lux). "

@@ -4,10 +4,11 @@ from __future__ import annotations
 
 import click
 
-from radtree.cli.options import CONTEXT
+from radtree.cli.options import CONTEXT, writes
 
 
 @click.command("report", context_settings=CONTEXT)
+@writes("report")
 @click.argument("project", type=click.Path())
 @click.option("--open", "open_", is_flag=True, help="Open index.html in the default browser.")
 def report_command(project: str, open_: bool) -> None:

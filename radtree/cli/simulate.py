@@ -6,11 +6,12 @@ import time
 
 import click
 
-from radtree.cli.options import CONTEXT, scenarios_option
+from radtree.cli.options import CONTEXT, scenarios_option, writes
 from radtree.engines.registry import ENGINE_CHOICES
 
 
 @click.command("simulate", context_settings=CONTEXT)
+@writes("results", "build")
 @click.argument("project", type=click.Path())
 @scenarios_option
 @click.option("--engine", type=click.Choice(ENGINE_CHOICES), default="auto",

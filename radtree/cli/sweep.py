@@ -6,11 +6,12 @@ import time
 
 import click
 
-from radtree.cli.options import CONTEXT
+from radtree.cli.options import CONTEXT, writes
 from radtree.engines.registry import ENGINE_CHOICES
 
 
 @click.command("sweep", context_settings=CONTEXT)
+@writes("sweep", out_param="out")
 @click.argument("project", type=click.Path())
 @click.option("-p", "--param", "params", multiple=True, metavar="FIELD=VALUES",
               help="A swept field: FIELD=low:high:n (n values from low to high) or "

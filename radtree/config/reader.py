@@ -30,7 +30,7 @@ from radtree.config.switches import (
 from radtree.errors import ConfigError
 
 TOP_TABLES = ("project", "site", "street", "light", "tree", "sensors", "engine", "office",
-              "geometry", "scenario", "sweep")
+              "geometry", "scenario", "sweep", "limits")
 SCENARIO_KEYS = tuple(f.name for f in fields(Scenario))
 GEOMETRY_KEYS = ("file", "material")
 
@@ -213,6 +213,7 @@ def parse_project(data: dict, path: Path) -> Project:
     sensors = _table(se, "sensors", base, dense_hours=dense)
     engine = _table(top.sub("engine"), "engine", base)
     office = _table(top.sub("office"), "office", base) if top.has("office") else None
+    limits = _table(top.sub("limits"), "limits", base)
 
     # extra user geometry: [[geometry]] file = "x.obj", material = "name"
     extra = []
@@ -230,7 +231,8 @@ def parse_project(data: dict, path: Path) -> Project:
     return Project(name=name, root=path.parent, source=path, site=site, street=street,
                    light=light, tree=tree, sensors=sensors, engine=engine,
                    scenarios=scenarios, measured=measured, measured_rows=measured_rows,
-                   office=office, extra_geometry=tuple(extra), honeybee=honeybee)
+                   office=office, extra_geometry=tuple(extra), honeybee=honeybee,
+                   limits=limits)
 
 
 def species_fill(tr: _Reader) -> dict[str, dict[str, float]]:

@@ -6,6 +6,7 @@ as local clock ``HH:MM``. Bounds, choices and TOML names are field metadata (:fu
 
 from __future__ import annotations
 
+import functools
 import hashlib
 import json
 from collections.abc import Callable
@@ -14,6 +15,7 @@ from pathlib import Path
 from typing import Any, ClassVar
 
 from radtree.config.honeybee import HoneybeeSite
+from radtree.config.limits import Limits
 from radtree.config.spec import TIME_RE, Checked, meta
 from radtree.errors import ConfigError
 
@@ -352,6 +354,7 @@ class Project:
     office: Office | None = None
     extra_geometry: tuple[tuple[Path, str], ...] = ()
     honeybee: HoneybeeSite | None = None   # [site] honeybee (radtree.config.honeybee)
+    limits: Limits = field(default_factory=Limits)
 
     @property
     def build_dir(self) -> Path:
@@ -376,8 +379,10 @@ class Project:
         return _plain(self)
 
     def params_hash(self, scenario: Scenario) -> str:
-        """Short hash of everything that changes a scenario's numbers."""
-        d = self.to_dict()
+        """Short hash of everything that changes a scenario's numbers. Input files count by
+        their path relative to the project folder and their content (:func:`_file_key`), so
+        a moved project keeps its hashes and an edited input file changes them."""
+        d = _plain(self, lambda p: _file_key(p, self.root))
         payload = {k: d[k] for k in ("site", "street", "light", "tree", "sensors", "engine",
                                      "office", "extra_geometry")}
         if payload["tree"].get("species") is None:  # no species: hashes unchanged
@@ -387,22 +392,46 @@ class Project:
             if payload["engine"].get(key) == getattr(EngineParams, key):
                 payload["engine"].pop(key, None)
         if self.honeybee is not None:   # absent otherwise: other projects' hashes unchanged
-            payload["honeybee"] = {**_plain(self.honeybee), "sha256": self.honeybee.digest()}
+            payload["honeybee"] = {**d["honeybee"], "sha256": self.honeybee.digest()}
         payload["scenario"] = _plain(scenario)
         text = json.dumps(payload, sort_keys=True, default=str)
         return hashlib.sha256(text.encode()).hexdigest()[:12]
 
 
-def _plain(obj: Any) -> Any:
+def _plain(obj: Any, path: Callable[[Path], Any] = str) -> Any:
     if is_dataclass(obj) and not isinstance(obj, type):
-        return {f.name: _plain(getattr(obj, f.name)) for f in fields(obj)}
+        return {f.name: _plain(getattr(obj, f.name), path) for f in fields(obj)}
     if isinstance(obj, dict):
-        return {k: _plain(v) for k, v in obj.items()}
+        return {k: _plain(v, path) for k, v in obj.items()}
     if isinstance(obj, list | tuple):
-        return [_plain(v) for v in obj]
+        return [_plain(v, path) for v in obj]
     if isinstance(obj, Path):
-        return str(obj)
+        return path(obj)
     return obj
+
+
+def _file_key(path: Path, root: Path) -> str:
+    """``relative/path sha256:…`` of an input file (the path as given when it is missing)."""
+    try:
+        name = str(path.resolve().relative_to(root.resolve()))
+    except ValueError:
+        name = str(path)
+    try:
+        st = path.stat()
+    except OSError:
+        return name
+    if not path.is_file():
+        return name
+    return f"{name} sha256:{_content_hash(str(path), st.st_mtime_ns, st.st_size)}"
+
+
+@functools.lru_cache(maxsize=256)
+def _content_hash(path: str, mtime_ns: int, size: int) -> str:
+    h = hashlib.sha256()
+    with open(path, "rb") as f:
+        for chunk in iter(lambda: f.read(1 << 20), b""):
+            h.update(chunk)
+    return h.hexdigest()
 
 
 def parse_time(value: Any, where: str = "time", source: str | None = None) -> str:

@@ -26,6 +26,7 @@ from collections.abc import Iterable
 from dataclasses import dataclass, fields, replace
 from typing import Any
 
+from radtree.config.limits import Limits
 from radtree.config.schema import (
     LOUVER_READINGS,
     Crown,
@@ -54,6 +55,7 @@ TABLES: dict[str, type] = {
     "site": Site, "street": Street, "light": Light, "tree": Tree, "tree.dome": Dome,
     "tree.crown": Crown, "tree.homogeneous": Homogeneous, "tree.perforated": Perforated,
     "tree.louvers": Louvers, "sensors": Sensors, "engine": EngineParams, "office": Office,
+    "limits": Limits,
 }
 #: Tables whose fields a scenario switch replaces through :func:`effective_project`.
 PROJECT_SWITCH_SECTIONS = ("site", "street", "light", "sensors", "engine")

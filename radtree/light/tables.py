@@ -37,13 +37,20 @@ def read_table(path: Path, columns: tuple[str, ...], what: str) -> pd.DataFrame:
                           f"(found: {', '.join(map(str, df.columns))})")
     for c in columns[1:]:
         vals = pd.to_numeric(df[c], errors="coerce")
-        bad = vals.isna() | (vals < 0)
+        bad = vals.isna() | ~np.isfinite(vals) | (vals < 0)
         if bad.any():
             i = int(np.flatnonzero(bad.to_numpy())[0])
-            raise ConfigError(f"{what} {path}: data row {i + 1}: {c} = {df[c].iloc[i]!r} "
-                              "is not a non-negative number")
+            raise ConfigError(f"{what} {path}: data row {i + 1}: {c} = "
+                              f"{_as_written(path, c, i)} is not a non-negative number")
         df[c] = vals
     return df
+
+
+def _as_written(path: Path, column: str, row: int) -> str:
+    """The text of data row ``row`` (0-based) in ``column`` as the file has it (quoted)."""
+    raw = pd.read_csv(path, comment="#", skipinitialspace=True, dtype=str,
+                      keep_default_na=False)
+    return repr(str(raw[column].iloc[row]))
 
 
 def direct_normal_table(path: Path) -> dict[str, float]:
@@ -61,4 +68,16 @@ def direct_normal_table(path: Path) -> dict[str, float]:
 
 def ground_reflectance_table(path: Path) -> pd.DataFrame:
     """The ground reflectance table (columns ``angle_deg``, ``reflectance``), as written."""
-    return read_table(path, ("angle_deg", "reflectance"), "ground reflectance table")
+    df = read_table(path, ("angle_deg", "reflectance"), "ground reflectance table")
+    angles = pd.to_numeric(df["angle_deg"], errors="coerce")
+    bad = ~np.isfinite(angles) | (angles < 0) | (angles > 90)
+    if bad.any():
+        i = int(np.flatnonzero(bad.to_numpy())[0])
+        raise ConfigError(f"ground reflectance table {path}: data row {i + 1}: angle_deg = "
+                          f"{_as_written(path, 'angle_deg', i)} is not a sun altitude 0–90°")
+    if (df["reflectance"] > 1).any():
+        i = int(np.flatnonzero((df["reflectance"] > 1).to_numpy())[0])
+        raise ConfigError(f"ground reflectance table {path}: data row {i + 1}: reflectance = "
+                          f"{_as_written(path, 'reflectance', i)} is above 1")
+    df["angle_deg"] = angles
+    return df

@@ -9,6 +9,7 @@ from typing import Any
 
 from radtree.config import Project, Scenario, effective_project
 from radtree.errors import RadtreeError
+from radtree.pipeline.limits import check_triangles
 from radtree.scene import Scene
 from radtree.sensor_grid import facade_circle, facade_dense_grid
 from radtree.site.frame import FacadeFrame
@@ -106,4 +107,5 @@ def make_scene(project: Project, scenario: Scenario, dense_grid: bool | None = N
         meshes = meshes + load_user_meshes(project.extra_geometry, materials)
     ab = scene_ab(project, None if tree is None else tree.recommended_ab)
     scene = Scene(meshes, materials, grids, notes)
+    check_triangles(project, scenario, scene.n_triangles)
     return BuiltScene(scenario, scene, ab, notes, scene.n_triangles, geometry_seconds, info, tree)

@@ -15,12 +15,13 @@ from collections.abc import Callable, Iterable
 from pathlib import Path
 from typing import Any
 
+import radtree
 from radtree.config import Project, Scenario, effective_project
 from radtree.engines.registry import folder_engine
 from radtree.fileio import atomic_dir, write_text
 from radtree.light.hours import hour_states
 from radtree.pipeline.assemble import make_scene
-from radtree.pipeline.manifest import manifest
+from radtree.pipeline.manifest import file_sha256, manifest
 from radtree.pipeline.realisations import (
     REALISATION_MARK,
     is_later_realisation,
@@ -74,7 +75,8 @@ def build_project(project: Project, scenarios: list[str] | None = None,
                             "writing": time.perf_counter() - t1},
             }
             write_text(tmp / "manifest.json", json.dumps(
-                manifest(project, extra={"build": facts[sc.name]}), indent=2, default=str))
+                manifest(project, extra={"build": facts[sc.name], "files": folder_files(tmp)}),
+                indent=2, default=str))
         echo(f"  {sc.name}: {sc.model} ({facts[sc.name]['form']}), {built.triangles} triangles, "
              f"-ab {built.ab}, geometry {built.geometry_seconds:.2f} s → {build_root / sc.name}")
     _remove_stale_builds(project, chosen)
@@ -83,19 +85,53 @@ def build_project(project: Project, scenarios: list[str] | None = None,
     return facts
 
 
-def build_is_current(project: Project, sc: Scenario) -> bool:
-    """True when ``build/<scenario>/manifest.json`` was written for the scenario's parameters."""
+#: written by the engine while tracing (not part of the built scene)
+_OUTPUTS = ("manifest.json", "model.png", "octrees", "results")
+
+
+def folder_files(folder: Path) -> dict[str, list]:
+    """``relative path → [bytes, sha256]`` of every scene file of a build folder."""
+    return {str(f.relative_to(folder)): [f.stat().st_size, file_sha256(f)]
+            for f in sorted(folder.rglob("*"))
+            if f.is_file() and f.relative_to(folder).parts[0] not in _OUTPUTS}
+
+
+def build_staleness(project: Project, sc: Scenario) -> str:
+    """Why ``build/<scenario>/`` cannot be used ("" when it can): missing, written by another
+    radtree version or for other parameters, or a scene file missing or changed since."""
+    folder = project.build_dir / sc.name
     try:
-        mf = json.loads((project.build_dir / sc.name / "manifest.json").read_text())
-        return bool(mf["build"]["params_hash"] == project.params_hash(sc))
+        mf = json.loads((folder / "manifest.json").read_text())
+        version, phash, files = mf["radtree_version"], mf["build"]["params_hash"], mf["files"]
+    except FileNotFoundError:
+        return "is missing"
     except (OSError, ValueError, KeyError, TypeError):
-        return False
+        return "has no valid manifest.json (written by an older radtree?)"
+    if version != radtree.__version__:
+        return f"was written by radtree {version} (this is {radtree.__version__})"
+    if phash != project.params_hash(sc):
+        return "was written for other parameters"
+    now = folder_files(folder)
+    gone = sorted(set(files) - set(now))
+    if gone:
+        return f"lacks {', '.join(gone)}"
+    changed = sorted(k for k in files if list(now[k]) != list(files[k]))
+    if changed:
+        return f"has {', '.join(changed)} changed since it was built"
+    return ""
+
+
+def build_is_current(project: Project, sc: Scenario) -> bool:
+    """True when ``build/<scenario>/`` is as this radtree built it for the scenario's
+    parameters (see :func:`build_staleness`)."""
+    return not build_staleness(project, sc)
 
 
 def ensure_built(project: Project, sc: Scenario, echo: Callable[[str], None]) -> Path:
-    """The scenario's build folder, (re)built first when missing or stale."""
-    if not build_is_current(project, sc):
-        echo(f"  build/{sc.name} is missing or out of date: building it")
+    """The scenario's build folder, (re)built first when missing or stale (said why)."""
+    why = build_staleness(project, sc)
+    if why:
+        echo(f"  build/{sc.name} {why}: building it")
         build_project(project, [sc.name], echo=echo, progress=False)
     return project.build_dir / sc.name
 

@@ -21,14 +21,20 @@ import pandas as pd
 from radtree.config import Project, Scenario, effective_project
 from radtree.engines.base import Engine
 from radtree.engines.registry import get_engine
-from radtree.fileio import atomic_path, write_text
+from radtree.errors import EngineError, RadtreeError
+from radtree.fileio import atomic_path, make_folder, write_text
 from radtree.light.hours import hour_states
 from radtree.light.sky import SkyState
+from radtree.lock import PUBLISH_NAME, folder_lock
 from radtree.pipeline.assemble import BuiltScene, make_scene
 from radtree.pipeline.build import ensure_built, hour_grids, progress_bar
+from radtree.pipeline.limits import check_memory
 from radtree.pipeline.manifest import manifest
+from radtree.pipeline.parts import check_part, write_part
 from radtree.pipeline.realisations import merge_realisations, parent_name, selected
 from radtree.pipeline.results import hour_rows, in_column_order, merge_write, results_path
+
+RESUME = "finished hours are kept in results/parts/; run the same command again to resume"
 
 
 @dataclass
@@ -97,23 +103,28 @@ def simulate_project(project: Project, engine: str | Engine = "auto",
         timing[sc.name] = {"preparation_s": prep.seconds,
                            "geometry_s": prep.built.geometry_seconds, "tracing_s": 0.0}
         tasks.extend((sc, st) for st in prep.states)
+    check_memory(project, [p.built.triangles for p in prepared.values()], max(1, workers))
     if dry_run:
         for sc, st in tasks:
             for line in eng.commands(prepared[sc.name].plan, st.label):
                 echo(f"{sc.name}: {line}" if not eng.uses_build_folder else line)
         return None
 
-    parts_dir.mkdir(parents=True, exist_ok=True)
+    make_folder(parts_dir)
     lock = threading.Lock()
     frames: list[pd.DataFrame] = []
     todo = []
     reused = 0
     for sc, st in tasks:
         part = parts_dir / f"{sc.name}_{st.label}_{eng.name}_{prepared[sc.name].phash}.csv"
-        if resume and part.exists():
-            frames.append(pd.read_csv(part))
+        rows, why = check_part(part, sc.name, st.time, prepared[sc.name].phash) if resume and \
+            part.exists() else (None, "")
+        if rows is not None:
+            frames.append(rows)
             reused += 1
         else:
+            if why:
+                echo(f"  results/parts/{part.name} {why}: recomputing it")
             todo.append((sc, st, part))
 
     def work(item: tuple[Scenario, SkyState, Path]) -> pd.DataFrame:
@@ -121,10 +132,9 @@ def simulate_project(project: Project, engine: str | Engine = "auto",
         prep = prepared[sc.name]
         t = time.perf_counter()
         use = hour_grids(project, st.time, list(prep.built.scene.grids), grids, sc)
-        res = eng.trace(prep.plan, st.label, use)
+        res = trace_hour(eng, prep.plan, sc, st, use)
         df = hour_rows(project, sc, st, prep.built.scene, res, eng.name, prep.phash)
-        with atomic_path(part) as tmp:
-            df.to_csv(tmp, index=False)
+        write_part(part, df)
         with lock:
             timing[sc.name]["tracing_s"] += time.perf_counter() - t
         return df
@@ -153,13 +163,28 @@ def simulate_project(project: Project, engine: str | Engine = "auto",
         merge_write(project.results_dir / "realisations.csv", per_realisation, parents)
     table = in_column_order(table, [s.name for s in project.scenarios])
     out = results_path(project)
-    merge_write(out, table, parents)
     tdf = _timing_table(timing, eng.name)
-    _merge_timing(project.results_dir / "timing.csv", tdf)
-    write_text(project.results_dir / "manifest.json", json.dumps(
-        manifest(project, extra={"engine": eng.name, "scenarios": [s.name for s in chosen]}),
-        indent=2, default=str))
+    with folder_lock(project.results_dir, "radtree simulate", wait=True, name=PUBLISH_NAME,
+                     echo=echo):
+        merge_write(out, table, parents)   # table, timing and manifest: one reader sees all
+        _merge_timing(project.results_dir / "timing.csv", tdf)
+        write_text(project.results_dir / "manifest.json", json.dumps(
+            manifest(project, extra={"engine": eng.name, "scenarios": [s.name for s in chosen]}),
+            indent=2, default=str))
     return SimulationOutcome(pd.read_csv(out), out, tdf, len(todo), reused, eng.name)
+
+
+def trace_hour(eng: Engine, plan: Any, sc: Scenario, st: SkyState, grids: list[str]
+               ) -> dict[str, Any]:
+    """``eng.trace`` of one hour; any failure of the engine (a Radiance program failing or
+    killed, the in-process engine raising) → one :class:`EngineError` naming scenario and hour.
+    Interrupts pass through."""
+    try:
+        return eng.trace(plan, st.label, grids)
+    except Exception as exc:  # noqa: BLE001 - every engine failure gets its scenario and hour
+        what = str(exc) if isinstance(exc, RadtreeError) else f"{type(exc).__name__}: {exc}"
+        raise EngineError(f"scenario {sc.name}, hour {st.time}: the {eng.name} engine failed: "
+                          f"{what}\n  {RESUME}") from exc
 
 
 def _timing_table(timing: dict[str, dict[str, float]], engine: str) -> pd.DataFrame:

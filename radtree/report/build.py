@@ -25,6 +25,7 @@ import pandas as pd
 import radtree.report.figures as figures
 from radtree.config import Project
 from radtree.fileio import atomic_dir
+from radtree.lock import PUBLISH_NAME, folder_lock
 from radtree.report.data import ReportData, collect
 from radtree.report.sections import Section, environment
 from radtree.report.sections.extras import extra_sections
@@ -174,7 +175,9 @@ def build_report(project: Project, echo: Callable[[str], None] = print) -> Path:
     :func:`radtree.stats.compare` when a measured hour has no simulated counterpart.
     """
     echo(f"report for {project.name}")
-    data = collect(project, echo=echo)
+    with folder_lock(project.results_dir, "radtree report", wait=True, name=PUBLISH_NAME,
+                     shared=True):                 # one simulate's table, timing and manifest
+        data = collect(project, echo=echo)
     created = datetime.now(timezone.utc).isoformat(timespec="seconds")
     target = project.report_dir
     with atomic_dir(target) as tmp:

@@ -78,9 +78,12 @@ def execute(specs: list[CaseSpec], scheduler: str = "local", workers: int | None
             try:
                 res = fut.result()
             except Exception as exc:  # noqa: BLE001 - a lost worker fails this case only
+                what = (f"every Dask worker that ran it died (killed, or out of memory?): "
+                        f"{exc}; its finished hours are kept in {spec.folder}/results/parts "
+                        "and a rerun resumes" if type(exc).__name__ == "KilledWorker"
+                        else f"the dask task failed: {type(exc).__name__}: {exc}")
                 res = CaseResult(spec.case_id, spec.case_hash, dict(spec.params), "failed",
-                                 error=f"the dask task failed: {type(exc).__name__}: {exc}",
-                                 error_type=type(exc).__name__)
+                                 error=what, error_type=type(exc).__name__)
             take(res)
     finally:
         for fut in futures:

@@ -10,6 +10,7 @@ from __future__ import annotations
 import functools
 import os
 import shutil
+import signal
 import subprocess
 from dataclasses import dataclass
 from pathlib import Path
@@ -75,11 +76,26 @@ def _from_path() -> RadianceInstall | None:
     return RadianceInstall(bin_dir, None, "PATH")
 
 
+def _from_env(value: str) -> RadianceInstall:
+    """``RADTREE_RADIANCE=DIR``: the Radiance programs in DIR (its ``../lib`` the library)."""
+    bin_dir = Path(value).expanduser()
+    missing = [p for p in REQUIRED if not (bin_dir / p).exists()]
+    if missing:
+        raise EngineError(f"RADTREE_RADIANCE={value}: no {', '.join(missing)} in that folder "
+                          "(set it to the bin/ folder of a Radiance installation, or unset it)")
+    lib = next((c for c in (bin_dir.parent / "lib", bin_dir.parent / "lib" / "ray")
+                if (c / "rayinit.cal").exists()), None)
+    return RadianceInstall(bin_dir, lib, "RADTREE_RADIANCE")
+
+
 @functools.lru_cache(maxsize=1)
 def find_radiance() -> RadianceInstall | None:
-    """The Radiance to use (pyradiance wheel first), or None. ``RADTREE_NO_RADIANCE=1`` hides it."""
+    """The Radiance to use, or None: ``RADTREE_RADIANCE=DIR`` (a bin/ folder) when set, else
+    the pyradiance wheel's, else one on PATH. ``RADTREE_NO_RADIANCE=1`` hides it."""
     if os.environ.get("RADTREE_NO_RADIANCE") == "1":
         return None
+    if os.environ.get("RADTREE_RADIANCE"):
+        return _from_env(os.environ["RADTREE_RADIANCE"])
     return _from_pyradiance() or _from_path()
 
 
@@ -111,9 +127,20 @@ def run(cmd: list[str], *, stdin: bytes | None = None, cwd: str | Path | None = 
     except OSError as exc:
         raise EngineError(f"could not start {cmd[0]}: {exc}", command=cmd) from exc
     if proc.returncode != 0:
-        raise EngineError(f"{cmd[0]} failed (exit {proc.returncode})", command=cmd,
+        raise EngineError(f"{cmd[0]} {_how(proc.returncode)}", command=cmd,
                           stderr=proc.stderr.decode(errors="replace"))
     return output
+
+
+def _how(returncode: int) -> str:
+    """``failed (exit 1)`` or, for a negative code, ``was killed by signal 9 (SIGKILL)``."""
+    if returncode < 0:
+        try:
+            name = f" ({signal.Signals(-returncode).name})"
+        except ValueError:
+            name = ""
+        return f"was killed by signal {-returncode}{name}"
+    return f"failed (exit {returncode})"
 
 
 def version() -> str | None:
