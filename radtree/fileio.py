@@ -10,6 +10,11 @@ import tempfile
 from collections.abc import Iterator
 from pathlib import Path
 
+_UMASK = os.umask(0)
+os.umask(_UMASK)
+FILE_MODE = 0o666 & ~_UMASK      # what open() would give: temporaries start at 0600
+FOLDER_MODE = 0o777 & ~_UMASK
+
 
 def make_folder(folder: str | os.PathLike) -> Path:
     """``mkdir -p folder``; an OSError naming the folder (and a file in its way) otherwise."""
@@ -48,6 +53,8 @@ def atomic_path(path: str | os.PathLike) -> Iterator[Path]:
     try:
         try:
             yield tmp_path
+            if tmp_path.is_file() and not tmp_path.is_symlink():
+                os.chmod(tmp_path, FILE_MODE)
             os.replace(tmp_path, target)
         except OSError as exc:
             if exc.filename is not None and Path(exc.filename) not in (tmp_path, target):
@@ -73,6 +80,7 @@ def atomic_dir(path: str | os.PathLike) -> Iterator[Path]:
     tmp = Path(tempfile.mkdtemp(prefix=f".{target.name}.", dir=target.parent))
     try:
         yield tmp
+        os.chmod(tmp, FOLDER_MODE)
         if target.exists():
             old = target.with_name(f".{target.name}.old")
             if old.exists():

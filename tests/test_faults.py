@@ -289,6 +289,26 @@ def test_stale_build_folder_is_detected_and_rebuilt(tiny: Path):
 
 
 # ---------------------------------------------------------------- 4. full disk, folders, names
+def test_atomic_writes_get_the_mode_open_would_give(tmp_path: Path):
+    """Temporaries start at 0600; the renamed file and folder must not stay private."""
+    import os
+
+    import radtree.fileio as fileio
+    from radtree.fileio import atomic_dir, write_text
+
+    old = os.umask(fileio._UMASK)
+    try:
+        plain = tmp_path / "plain.txt"
+        plain.write_text("x")
+        atomic = write_text(tmp_path / "atomic.txt", "x")
+        with atomic_dir(tmp_path / "folder") as tmp:
+            (tmp / "f").write_text("x")
+    finally:
+        os.umask(old)
+    assert atomic.stat().st_mode & 0o777 == plain.stat().st_mode & 0o777
+    assert (tmp_path / "folder").stat().st_mode & 0o777 == fileio.FOLDER_MODE
+
+
 def test_failed_write_names_the_file_and_leaves_nothing_half_written(tmp_path: Path):
     from radtree.fileio import atomic_path, write_text
 
