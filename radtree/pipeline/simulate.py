@@ -154,6 +154,7 @@ def simulate_project(project: Project, engine: str | Engine = "auto",
     table = in_column_order(table, [s.name for s in project.scenarios])
     out = results_path(project)
     merge_write(out, table, parents)
+    _write_direct_sun(project, chosen, prepared)
     tdf = _timing_table(timing, eng.name)
     _merge_timing(project.results_dir / "timing.csv", tdf)
     write_text(project.results_dir / "manifest.json", json.dumps(
@@ -179,3 +180,18 @@ def _merge_timing(out: Path, tdf: pd.DataFrame) -> None:
         tdf = pd.concat([old, tdf], ignore_index=True)
     with atomic_path(out) as tmp:
         tdf.to_csv(tmp, index=False)
+
+
+def _write_direct_sun(project: Project, chosen: list[Scenario],
+                      prepared: dict[str, _Prepared]) -> None:
+    """``results/direct_sun.csv``: whether the sun beam reaches each sensor at each hour, per
+    crown realisation, for the perforated scenarios (:mod:`radtree.pipeline.sunreach`)."""
+    from radtree.pipeline.sunreach import direct_sun_rows
+
+    rows = [direct_sun_rows(sc.name, prepared[sc.name].built.scene, prepared[sc.name].states)
+            for sc in chosen if sc.model == "perforated"
+            and "facade" in prepared[sc.name].built.scene.grids]
+    if rows:
+        table = pd.concat(rows, ignore_index=True)
+        merge_write(project.results_dir / "direct_sun.csv", table,
+                    list(dict.fromkeys(table["scenario"].astype(str))))

@@ -156,12 +156,11 @@ def photo_gap_pattern(perf: Perforated, source: str | None = None) -> GapPattern
 
 
 def gap_pattern_for(perf: Perforated, source: str | None = None) -> GapPattern:
-    """The photo's predicate if a photo is set, else the seeded random pattern of openness.
-    (``Perforated`` has no seed field yet; a ``seed`` attribute is used when present.)"""
+    """The photo's predicate if a photo is set, else the seeded random pattern of openness
+    (``perforated.seed``)."""
     if perf.photo is not None:
         return photo_gap_pattern(perf, source)
-    seed = int(getattr(perf, "seed", DEFAULT_SEED))
-    return random_gap_pattern(perf.openness, seed)
+    return random_gap_pattern(perf.openness, perf.seed)
 
 
 # Barycentric centres of the 16 sub-triangles of a triangle split 4 × 4 (sampling points).

@@ -130,4 +130,9 @@ def extra_sections(project: Project, out: Path, echo: Callable[[str], None]
 
         html.append(Section("annual", annual_section_data(project)))
         echo("  annual: metric maps and month × hour heat maps")
+    from radtree.report.sections.photo import photo_sections
+
+    p_html, p_md = photo_sections(project, out)
+    html += p_html
+    md += p_md
     return html, md
