@@ -61,6 +61,8 @@ from radtree.site.frame import FacadeFrame
 from radtree.trees.envelope import crown_row_spec, dome_notes, dome_spec, row_notes
 from radtree.trees.geometry import polygons_to_mesh, quads_to_mesh
 from radtree.trees.louvers_dome import build_dome_louvers
+from radtree.trees.photo import photo_source
+from radtree.trees.photo_cut import dome_from_photo
 from radtree.trees.louvers_free import BRANCH_SLATS, build_free_louvers
 from radtree.trees.model import BARK_REFLECTANCE, LEAF, TRUNK, TreeModel
 from radtree.trees.volume import build_volume_louvers, recommended_volume_ab, volume_note
@@ -194,12 +196,27 @@ def build_louvers(tree: Tree, sensors: Sensors, street: Street, frame: FacadeFra
                           "its concentric slat shells; use arrangement = 'layers' or form "
                           "'free'", source=source, field="tree.louvers.arrangement")
     volume = form != "dome" and lv.arrangement == "volume"
+    photo: dict | None = None
     if form == "dome":
         spec = dome_spec(tree, sensors, street, source)
         quads, ginfo = build_dome_louvers(spec, lv, sensors, source)
-        verts, faces = quads_to_mesh(quads)
+        src = photo_source(tree) if tree.photo is not None else None
+        if src is None:
+            verts, faces = quads_to_mesh(quads)
+        else:
+            pieces, photo_info, photo = dome_from_photo(quads, spec.centre, src, source)
+            verts, faces = polygons_to_mesh(pieces)
+            ginfo.update(photo_info)
         slats = len(quads)
         notes.extend(dome_notes(spec))
+        if src is not None:
+            notes.append(
+                f"Cut by the façade photo {src.path.name} ({src.lens} lens; {tree.photo}): in "
+                f"every shell the slats are removed where the photo shows sky along the line "
+                f"from the dome centre ({int(photo_info['photo_slats_removed'])} slats removed, "
+                f"{int(photo_info['photo_slats_cut'])} cut, "
+                f"{int(photo_info['photo_slats_whole'])} whole; photo openness "
+                f"{photo_info['photo_openness']:.4f}).")
         notes.append(
             f"Louvers: {lv.layers} concentric shells of slats at radii "
             f"{ginfo['layer_radius_min_m']:.2f}–{ginfo['layer_radius_max_m']:.2f} m; each "
@@ -286,4 +303,4 @@ def build_louvers(tree: Tree, sensors: Sensors, street: Street, frame: FacadeFra
             info.pop(key)
     info.update(ginfo)
     return TreeModel(meshes=meshes, materials=materials, notes=notes, recommended_ab=ab,
-                     info=info, form=form, model="louvers")
+                     info=info, form=form, model="louvers", photo=photo)
