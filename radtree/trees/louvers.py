@@ -61,10 +61,10 @@ from radtree.site.frame import FacadeFrame
 from radtree.trees.envelope import crown_row_spec, dome_notes, dome_spec, row_notes
 from radtree.trees.geometry import polygons_to_mesh, quads_to_mesh
 from radtree.trees.louvers_dome import build_dome_louvers
-from radtree.trees.photo import photo_source
-from radtree.trees.photo_cut import dome_from_photo
 from radtree.trees.louvers_free import BRANCH_SLATS, build_free_louvers
 from radtree.trees.model import BARK_REFLECTANCE, LEAF, TRUNK, TreeModel
+from radtree.trees.photo import photo_source, require_direction, with_source
+from radtree.trees.photo_cut import dome_from_photo
 from radtree.trees.volume import build_volume_louvers, recommended_volume_ab, volume_note
 
 
@@ -228,6 +228,29 @@ def build_louvers(tree: Tree, sensors: Sensors, street: Street, frame: FacadeFra
             f"{lv.branch_inclination_deg:g}° branches.")
     else:
         spec_r = crown_row_spec(tree, sensors, street, source)
+        src = photo_source(tree) if tree.photo is not None else None
+        if src is not None:
+            try:
+                require_direction(src, "upward", "the free louvers crowns")
+            except ConfigError as exc:
+                raise with_source(exc, source) from None
+            from radtree.trees.photo_fit import camera_point, fitted_louvers
+
+            lv, fit, photo = fitted_louvers(lv, src, spec_r, camera_point(tree, sensors),
+                                            frame, source)
+            volume = True
+            tilt = (f"leaf inclinations from Campbell's ellipsoidal distribution, x = "
+                    f"{fit.x:.3g} (mean tilt {fit.mean_tilt_deg:.1f}°)" if fit.x is not None
+                    else f"slats fixed at {lv.inclination_deg:g}°")
+            notes.append(
+                f"Fitted to the upward photo {src.path.name} ({src.lens} lens; camera "
+                f"{tree.photo_x_m:g} m along the façade from the sensors, "
+                f"{tree.photo_distance_m:g} m out, {tree.photo_height_m:g} m high; zenith "
+                f"0–{src.zenith_deg:g}°): leaf area density {fit.lad:.3f} m²/m³, {tilt}; "
+                f"vertical crossings {lv.crossings:.2f}; gap-fraction RMS {fit.rms:.4f} "
+                f"(cells), {fit.ring_rms:.4f} (rings); the photo's LAI_eff "
+                f"{fit.lai_photo:.3f}, clumping {fit.clumping_photo:.3f} (not modelled: the "
+                "slats are placed at random, the density is an effective one).")
         if volume:
             polys, ginfo = build_volume_louvers(spec_r, lv, source)
         else:

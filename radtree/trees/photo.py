@@ -180,7 +180,7 @@ def provenance(src: PhotoSource, results: list[HemiResult], fitted: dict[str, An
     detected), direction and hemi's figures, plus the fitted values."""
     photos = []
     for r in results:
-        path = Path(r.image.path) if getattr(r.image, "path", None) else src.path
+        path = Path(r.image.path) if r.image.path is not None else src.path
         g = r.geometry
         photos.append({
             "file": str(path), "sha256": file_sha256(path) if path.is_file() else None,
