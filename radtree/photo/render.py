@@ -96,9 +96,15 @@ def pixel_directions(project: Project, geometry: FisheyeGeometry
 
 
 def render_scenario(project: Project, sc: Scenario, size: int = DEFAULT_SIZE,
-                    workers: int = 2) -> Rendering:
-    """Render the scenario's crown from its photo point through its photo's lens."""
-    tree, src = scenario_photo(project, sc)
+                    workers: int = 2, src: PhotoSource | None = None) -> Rendering:
+    """Render the scenario's crown from its photo point through its photo's lens (``src``:
+    a photo's lens, direction and point for a crown made without one — e.g. to make a
+    synthetic photo of a known crown)."""
+    if src is None:
+        tree, src = scenario_photo(project, sc)
+    else:
+        tree, _ = apply_switches(project.tree, dict(sc.switches), source=str(project.source),
+                                 root=project.root)
     if size < 64 or size > 8000:
         raise ConfigError(f"got {size} px, expected 64–8000", field="--size")
     t0 = time.perf_counter()

@@ -30,7 +30,7 @@ from radtree.config import Tree
 from radtree.config.photo import photo_of
 from radtree.errors import ConfigError, RadtreeError
 from radtree.fileio import file_sha256
-from radtree.hemi import HemiConfig, HemiResult, analyse_image, get_lens
+from radtree.hemi import HemiConfig, HemiResult, get_lens
 from radtree.hemi.lens import Projection, parse_polynomial
 from radtree.hemi.mask import CircularMask, detect_circular_mask
 from radtree.hemi.metrics import RingGrid
@@ -87,12 +87,10 @@ def lens_of(name: str, field: str = "tree.lens") -> Projection:
     return lens
 
 
-def _check_mask(image_path: Path, mask: CircularMask, field: str) -> None:
+def _check_mask(image: Any, mask: CircularMask, field: str) -> None:
     """The given mask against the image circle the photo shows (when one is detected)."""
-    from radtree.hemi.image import load_image
-
     try:
-        found = detect_circular_mask(load_image(image_path).brightness())
+        found = detect_circular_mask(image.brightness())
     except RadtreeError:
         return   # no detectable circle (dark canopy at the rim): trust the mask given
     off = math.hypot(found.cx - mask.cx, found.cy - mask.cy)
@@ -100,7 +98,7 @@ def _check_mask(image_path: Path, mask: CircularMask, field: str) -> None:
             MASK_TOLERANCE * found.radius):
         raise photo_error(
             f"mask [{mask.cx:g}, {mask.cy:g}, {mask.radius:g}] px does not match the image "
-            f"circle of {image_path.name} (centre {found.cx:.0f}, {found.cy:.0f}, radius "
+            f"circle of {image.name} (centre {found.cx:.0f}, {found.cy:.0f}, radius "
             f"{found.radius:.0f} px): give that circle, or leave mask out to detect it",
             field.rsplit(".", 1)[0] + ".mask")
 
@@ -108,15 +106,24 @@ def _check_mask(image_path: Path, mask: CircularMask, field: str) -> None:
 @lru_cache(maxsize=16)
 def _analysed(path: str, mtime: float, lens: str, mask: tuple[float, float, float] | None,
               axis: str, zenith_deg: float, field: str) -> HemiResult:
+    from radtree.hemi.analyse import analyse_loaded
+    from radtree.hemi.image import load_image
+
     p = Path(path)
     projection = lens_of(lens, field.rsplit(".", 1)[0] + ".lens")
     circle = CircularMask(*mask) if mask is not None else None
-    if circle is not None:
-        _check_mask(p, circle, field)
-    config = HemiConfig(lens=projection, mask=circle, axis=axis, outlines=False,
-                        grid=RingGrid(9, 8, 0.0, float(zenith_deg)))
     try:
-        return analyse_image(p, config)
+        image = load_image(p)
+        if circle is not None:
+            _check_mask(image, circle, field)
+        config = HemiConfig(lens=projection, mask=circle, axis=axis, outlines=False,
+                            channel="luma" if image.is_gray else "blue",
+                            grid=RingGrid(9, 8, 0.0, float(zenith_deg)))
+        return analyse_loaded(image, config)
+    except ConfigError as exc:
+        if getattr(exc, "detail", None):
+            raise
+        raise photo_error(f"{exc} (the crown's photo)", field) from None
     except RadtreeError as exc:
         raise photo_error(f"{exc} (the crown's photo)", field) from None
     except OSError as exc:
@@ -149,9 +156,10 @@ def analyse_photo(path: Path, src: PhotoSource, axis: str | None = None) -> Hemi
 def require_direction(src: PhotoSource, wanted: str, what: str) -> None:
     """One clear message when the photo's stated direction is not the one ``what`` needs."""
     if src.direction != wanted:
+        article = "an" if wanted == "upward" else "a"
         raise photo_error(
-            f"{what} needs a {wanted} photo but tree.photo_direction = {src.direction!r} "
-            f"({src.path.name}): "
+            f"{what}: {article} {wanted} photo is needed but tree.photo_direction = "
+            f"{src.direction!r} ({src.path.name}): "
             + ("the dome crowns are cut from a photo taken at the sensors looking out (lens "
                "axis = façade normal); set photo_direction = 'facade' or use form = 'free'"
                if wanted == "facade" else

@@ -10,10 +10,12 @@ leaf-inclination distribution with random azimuths. Seen from the camera point c
 (Beer–Lambert; G from the slats' own distribution, :func:`radtree.trees.leaf_angles.
 mean_projection`). The photo's gap fraction per zenith ring (:mod:`radtree.hemi`, 9 rings over
 0–``photo_zenith_deg``, T_i the mean of its ring × segment cells T_ij) is matched by least
-squares on the contact-number scale, Σ_i (ln P̄_i(u, x) − ln T_i)² (floored at hemi's gap
-floor) — the scale hemi's LAI is computed on, so the fitted crown reproduces the photo's LAI
+squares on the contact-number scale, Σ_i w_i (ln P̄_i(u, x) − ln T_i)² (floored at hemi's
+gap floor; w_i the ring's share of the analysed solid angle, so the small rings near the lens
+axis, crossed by few leaves, do not dominate) — the scale hemi's LAI is computed on, so the fitted crown reproduces the photo's LAI
 and its ring gap fractions; P̄_ij is the solid-angle mean of P over a cell
-(:data:`CELL_SAMPLES` directions per cell, L by marching the ray in :data:`STEP_M` steps).
+(:data:`CELL_SAMPLES` directions per cell, L from the ray's intersections with the clipped
+spheroids, :func:`crown_paths`).
 The fit scans log u × log x (61 × 15 points) and refines the best point with L-BFGS-B;
 hemi's own ellipsoidal x / mean tilt and LAI of the photo are reported beside it. With ``louvers.inclination_distribution = "fixed"``
 only u is fitted (the inclination stays ``inclination_deg``, e.g. the study's 30°).
@@ -46,7 +48,6 @@ from radtree.trees.leaf_angles import mean_projection, mean_tilt
 from radtree.trees.photo import PhotoSource, analyse_photo, provenance, with_source
 
 CELL_SAMPLES = (6, 10)    # zenith × azimuth directions per ring × segment cell
-STEP_M = 0.05             # ray marching step through the crowns
 X_BOUNDS = (0.1, 10.0)
 U_BOUNDS = (1e-3, 20.0)
 
@@ -98,6 +99,7 @@ class CellPaths:
     blocked: np.ndarray
     weight: np.ndarray
     shape: tuple[int, int]
+    ring_weight: np.ndarray   # each ring's share of the analysed solid angle
 
 
 def cell_paths(result: HemiResult, camera: np.ndarray, spec: CrownRowSpec,
@@ -119,27 +121,12 @@ def cell_paths(result: HemiResult, camera: np.ndarray, spec: CrownRowSpec,
     Z, A = np.array(zs), np.array(az)
     world = up_to_world(Z.ravel(), A.ravel())
     d = world @ frame.matrix           # world → local (u, n, z) directions
-    top = float(spec.centres[:, 2].max() + spec.b)
-    reach = float(np.max(np.abs(spec.centres[:, :2] - camera[:2]))
-                  + 2 * spec.a) / max(1e-3, 1.0)
-    t_max = min(200.0, math.hypot(reach, top - camera[2]) * 2.0)
-    steps = np.arange(STEP_M / 2, t_max, STEP_M)
-    length = np.zeros(len(d))
-    blocked = np.zeros(len(d), bool)
-    for k in range(0, len(d), 512):
-        dk = d[k:k + 512]
-        pts = camera[None, None, :] + steps[None, :, None] * dk[:, None, :]
-        flat = pts.reshape(-1, 3)
-        inside = spec.inside(flat).reshape(pts.shape[:2])
-        length[k:k + 512] = inside.sum(axis=1) * STEP_M
-        trunk = np.zeros(len(flat), bool)
-        for c in spec.centres:
-            trunk |= ((np.hypot(flat[:, 0] - c[0], flat[:, 1] - c[1]) < spec.trunk_radius)
-                      & (flat[:, 2] < spec.trunk_top) & (flat[:, 2] >= 0.0))
-        blocked[k:k + 512] = trunk.reshape(pts.shape[:2]).any(axis=1)
+    length, blocked = crown_paths(spec, camera, d)
     shape = (grid.rings, grid.segments)
+    ring_w = -np.diff(np.cos(np.radians(ze)))
     return CellPaths(length.reshape(Z.shape), np.abs(d[:, 2]).reshape(Z.shape),
-                     blocked.reshape(Z.shape), np.sin(np.radians(Z)), shape)
+                     blocked.reshape(Z.shape), np.sin(np.radians(Z)), shape,
+                     ring_w / ring_w.sum())
 
 
 def slat_projection(paths: CellPaths, x: float | None, fixed_deg: float) -> np.ndarray:
@@ -149,6 +136,60 @@ def slat_projection(paths: CellPaths, x: float | None, fixed_deg: float) -> np.n
 
         return np.asarray(projection_g(paths.mu, fixed_deg))
     return np.asarray(mean_projection(paths.mu.ravel(), x)).reshape(paths.mu.shape)
+
+
+def _slab(o: np.ndarray, d: np.ndarray, lo: float, hi: float
+          ) -> tuple[np.ndarray, np.ndarray]:
+    """Ray parameters [t0, t1] inside lo ≤ o + t·d ≤ hi (one coordinate)."""
+    with np.errstate(divide="ignore", invalid="ignore"):
+        a, b = (lo - o) / d, (hi - o) / d
+    t0, t1 = np.minimum(a, b), np.maximum(a, b)
+    flat = d == 0.0
+    inside = (o >= lo) & (o <= hi)
+    t0 = np.where(flat, np.where(inside, -np.inf, np.inf), t0)
+    t1 = np.where(flat, np.where(inside, np.inf, -np.inf), t1)
+    return t0, t1
+
+
+def crown_paths(spec: CrownRowSpec, camera: np.ndarray, d: np.ndarray
+                ) -> tuple[np.ndarray, np.ndarray]:
+    """Path length (m) of rays from ``camera`` along unit ``d`` (local) through the clipped
+    crowns (each spheroid ∩ n ≥ n_clip ∩ its strip of u: disjoint, so lengths add), and
+    whether each ray meets a trunk (vertical cylinder from the street to ``trunk_top``)."""
+    o = np.asarray(camera, float)
+    length = np.zeros(len(d))
+    blocked = np.zeros(len(d), bool)
+    for c, (lo, hi) in zip(spec.centres, spec.strips):
+        q = (o - c) / np.array([spec.a, spec.a, spec.b])
+        v = d / np.array([spec.a, spec.a, spec.b])
+        A = np.einsum("ij,ij->i", v, v)
+        B = 2.0 * v @ q
+        C = float(q @ q) - 1.0
+        disc = B * B - 4.0 * A * C
+        ok = disc > 0
+        r = np.sqrt(np.where(ok, disc, 0.0))
+        t0 = np.where(ok, (-B - r) / (2 * A), np.inf)
+        t1 = np.where(ok, (-B + r) / (2 * A), -np.inf)
+        for axis, lo_v, hi_v in ((1, spec.n_clip, np.inf), (0, lo, hi)):
+            s0, s1 = _slab(np.full(len(d), o[axis]), d[:, axis], lo_v, hi_v)
+            t0, t1 = np.maximum(t0, s0), np.minimum(t1, s1)
+        t0 = np.maximum(t0, 0.0)
+        length += np.clip(t1 - t0, 0.0, None)
+        # trunk: |(o + t d) − c| < r in plan, 0 ≤ z ≤ top
+        qx, qy = o[0] - c[0], o[1] - c[1]
+        a2 = d[:, 0] ** 2 + d[:, 1] ** 2
+        b2 = 2.0 * (d[:, 0] * qx + d[:, 1] * qy)
+        c2 = qx * qx + qy * qy - spec.trunk_radius ** 2
+        disc2 = b2 * b2 - 4.0 * a2 * c2
+        hit = (disc2 > 0) & (a2 > 1e-12)
+        r2 = np.sqrt(np.where(hit, disc2, 0.0))
+        with np.errstate(divide="ignore", invalid="ignore"):
+            u0 = np.where(hit, (-b2 - r2) / (2 * a2), np.inf)
+            u1 = np.where(hit, (-b2 + r2) / (2 * a2), -np.inf)
+        z0, z1 = _slab(np.full(len(d), o[2]), d[:, 2], 0.0, spec.trunk_top)
+        lo_t, hi_t = np.maximum(np.maximum(u0, z0), 0.0), np.minimum(u1, z1)
+        blocked |= hi_t > lo_t
+    return length, blocked
 
 
 def predicted_gaps(paths: CellPaths, lad: float, x: float | None, fixed_deg: float,
@@ -171,13 +212,14 @@ def _fit(targets: list[np.ndarray], paths: list[CellPaths], fixed_deg: float | N
     log u × log x, then L-BFGS-B from the best point."""
     rings = [_ring_log(t) for t in targets]
     ok = [np.isfinite(r) for r in rings]
+    weights = [p.ring_weight for p in paths]
     fixed = fixed_deg or 0.0
 
     def sse_g(lad: float, gs: list[np.ndarray]) -> float:
         total = 0.0
-        for t, pth, m, g in zip(rings, paths, ok, gs):
+        for t, pth, m, g, w in zip(rings, paths, ok, gs, weights):
             r = _ring_log(predicted_gaps(pth, lad, None, fixed, g))[m] - t[m]
-            total += float(r @ r)
+            total += float(w[m] @ (r * r))
         return total
 
     def gs_of(x: float | None) -> list[np.ndarray]:
@@ -224,7 +266,9 @@ def fit_crown(src: PhotoSource, camera: np.ndarray, spec: CrownRowSpec, lv: Louv
     if key in _CACHE:
         return _CACHE[key]
     results = [analyse_photo(p, src) for p in images]
-    paths = [cell_paths(r, camera, spec, frame) for r in results]
+    shared = cell_paths(results[0], camera, spec, frame)   # same grid and camera for all
+    paths = [shared if r.table.grid == results[0].table.grid else
+             cell_paths(r, camera, spec, frame) for r in results]
     targets = [r.table.gap for r in results]
     fixed = None if lv.inclination_distribution == "ellipsoidal" else lv.inclination_deg
     if not any(np.any(p.length > 0) for p in paths):

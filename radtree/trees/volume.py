@@ -58,6 +58,7 @@ from radtree.config import Louvers
 from radtree.errors import ConfigError
 from radtree.trees.crown_clip import cut_to_share, touches_share, trunk_clash
 from radtree.trees.envelope import CrownRowSpec
+from radtree.trees.leaf_angles import draw_inclinations, mean_projection, mean_tilt, projection_g
 
 MAX_VOLUME_SLATS = 200_000
 DRAW_BLOCK = 1024  # slats drawn per block (nested realisations, see _draw_nested)
@@ -78,8 +79,6 @@ def mean_cos(lv: Louvers) -> float:
     """Mean |cos| of the slat normals with the vertical: cos α, or over the ellipsoidal
     distribution (:mod:`radtree.trees.leaf_angles`)."""
     if lv.inclination_distribution == "ellipsoidal":
-        from radtree.trees.leaf_angles import mean_projection
-
         return float(mean_projection(np.array([1.0]), lv.ellipsoid_x)[0])
     return math.cos(math.radians(lv.inclination_deg))
 
@@ -87,8 +86,6 @@ def mean_cos(lv: Louvers) -> float:
 def slat_g(mu: float, lv: Louvers) -> float:
     """The slats' mean projection G for |Ω_z| = mu."""
     if lv.inclination_distribution == "ellipsoidal":
-        from radtree.trees.leaf_angles import mean_projection
-
         return float(mean_projection(np.array([mu]), lv.ellipsoid_x)[0])
     return float(projection_g(mu, lv.inclination_deg))
 
@@ -97,20 +94,6 @@ def volume_density(lv: Louvers, b: float) -> float:
     """Slats per m³: ρ = crossings · cover / (s² cos α · 2b) (cos α: :func:`mean_cos`)."""
     s = lv.slat_size_m
     return crossings_of(lv) * lv.cover_fraction / (s * s * mean_cos(lv) * 2.0 * b)
-
-
-def projection_g(mu: float | np.ndarray, inclination_deg: float) -> np.ndarray:
-    """G = mean over a uniform azimuth of |m·Ω| for slat normals inclined α from vertical and
-    a direction Ω with |Ω_z| = mu (closed form): with p = μ cos α, q = √(1 − μ²) sin α,
-    G = p when q ≤ p, else (2/π)(q √(1 − p²/q²) + p·asin(p/q))."""
-    a = math.radians(inclination_deg)
-    mu = np.abs(np.asarray(mu, float))
-    p = mu * math.cos(a)
-    q = np.sqrt(np.clip(1.0 - mu * mu, 0.0, 1.0)) * math.sin(a)
-    with np.errstate(divide="ignore", invalid="ignore"):
-        r = np.where(q > p, p / np.where(q > 0, q, 1.0), 1.0)
-        g = (2.0 / math.pi) * (q * np.sqrt(np.clip(1.0 - r * r, 0.0, 1.0)) + p * np.arcsin(r))
-    return np.where(q > p, g, p)
 
 
 def volume_slat_bound(spec: CrownRowSpec, lv: Louvers) -> int:
@@ -197,8 +180,6 @@ def build_volume_louvers(spec: CrownRowSpec, lv: Louvers, source: str | None = N
         centres = c + x * np.array([a, a, b])
         tilt: float | np.ndarray = alpha
         if lv.inclination_distribution == "ellipsoidal":
-            from radtree.trees.leaf_angles import draw_inclinations
-
             tilt = draw_inclinations(np.random.default_rng([lv.seed, ti, 7]), per,
                                      lv.ellipsoid_x)
         corners = _slat_corners(centres, phi, s, tilt)
@@ -250,8 +231,6 @@ def volume_note(lv: Louvers, info: dict[str, float], slats: int, t_specular: flo
 
 def _tilt_text(lv: Louvers) -> str:
     if lv.inclination_distribution == "ellipsoidal":
-        from radtree.trees.leaf_angles import mean_tilt
-
         return (f"as drawn from Campbell's ellipsoidal distribution x = {lv.ellipsoid_x:.3g} "
                 f"(mean {mean_tilt(lv.ellipsoid_x):.1f}°)")
     return f"{lv.inclination_deg:g}°"
