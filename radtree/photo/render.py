@@ -22,7 +22,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from radtree.config import Project, Scenario
-from radtree.engines.numpy.raycast import make_caster
+from radtree.engines.numpy.raycast import any_hit, make_caster
 from radtree.errors import ConfigError
 from radtree.hemi import HemiConfig, HemiResult, analyse_array
 from radtree.hemi.classify import ThresholdSpec
@@ -90,9 +90,11 @@ def pixel_directions(project: Project, geometry: FisheyeGeometry
         d = up_to_world(z, a)
     else:
         t, p = np.radians(z), np.radians(a)
-        local = np.column_stack([np.sin(t) * np.sin(p), np.cos(t), np.sin(t) * np.cos(p)])
-        d = facade_frame(project).directions_to_world(local)
-    return field, d / np.linalg.norm(d, axis=1)[:, None]
+        st = np.sin(t)
+        f = facade_frame(project)   # u·(sinθ sinψ) + n·cosθ + z·(sinθ cosψ), no BLAS
+        d = ((st * np.sin(p))[:, None] * f.along[None, :] + np.cos(t)[:, None] * f.normal[None, :])
+        d[:, 2] += st * np.cos(p)
+    return field, d
 
 
 def render_scenario(project: Project, sc: Scenario, size: int = DEFAULT_SIZE,
@@ -124,8 +126,7 @@ def render_scenario(project: Project, sc: Scenario, size: int = DEFAULT_SIZE,
     sky = np.ones(len(d), bool)
     if verts:
         caster = make_caster(np.vstack(verts), np.vstack(faces), workers=workers)
-        hit, _ = caster.first_hit(np.repeat(camera[None, :], len(d), axis=0), d)
-        sky = hit < 0
+        sky = ~any_hit(caster, np.broadcast_to(camera, d.shape), d)
     image = np.zeros((geometry.height, geometry.width), np.uint8)
     box = image[field.rows, field.cols]
     box[field.valid] = np.where(sky, 255, 0).astype(np.uint8)
