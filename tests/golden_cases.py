@@ -13,12 +13,13 @@ per sensor; Radiance: 13:30 only, ``-ad 64``, no dense map; the office block at 
 
 from __future__ import annotations
 
-import re
 import shutil
 import tempfile
 from pathlib import Path
 
 import pandas as pd
+
+from tests.conftest import drop_photo_scenarios
 
 ROOT = Path(__file__).resolve().parents[1]
 GOLDEN = ROOT / "tests" / "golden"
@@ -55,16 +56,9 @@ def _copy(example: str, dst: Path) -> Path:
     text = text.replace('"louvers.realisations" = 8', '"louvers.realisations" = 2')
     # the photo-derived scenarios (A-photo, C-photo, F-photo) are checked by
     # tests/test_photo_crowns.py, not here: the golden tables hold A–F
-    text = _drop_photo_scenarios(text)
+    text = drop_photo_scenarios(text)
     (dst / "radtree.toml").write_text(text)
     return dst
-
-
-def _drop_photo_scenarios(text: str) -> str:
-    """The project text without its ``[[scenario]]`` blocks named ``*-photo``."""
-    head, *blocks = text.split("\n[[scenario]]")
-    kept = [b for b in blocks if not re.search(r'^name = "[^"]*-photo"', b, re.M)]
-    return "\n[[scenario]]".join([head, *kept])
 
 
 def _tidy(table: pd.DataFrame) -> pd.DataFrame:

@@ -23,7 +23,7 @@ FAST = {"sensors.dense_grid": False, "sensors.dense_hours": [], "engine.rays": 6
 
 @pytest.fixture(scope="module")
 def mendoza(tmp_path_factory):
-    root = copy_project(tmp_path_factory.mktemp("photo") / "m")
+    root = copy_project(tmp_path_factory.mktemp("photo") / "m", photo=True)
     return load_project(root, overrides={**FAST, "site.hours": ["10:30", "13:30"]})
 
 
