@@ -91,6 +91,25 @@ def test_louvers_dome_from_the_facade_photo_matches_it(mendoza, tmp_path):
     assert (tmp_path / "report" / "photo_check_A-photo_model.png").is_file()
 
 
+def test_hemi_render_and_check_commands(mendoza):
+    from click.testing import CliRunner
+
+    from radtree.cli import main
+
+    root = str(mendoza.root)
+    r = CliRunner().invoke(main, ["hemi", "check", root, "-s", "C-photo", "--size", "300"])
+    assert r.exit_code == 0, r.output
+    assert "C-photo: gap-fraction RMS 0.0" in r.output and "photo_check.csv" in r.output
+    rows = pd.read_csv(mendoza.results_dir / "photo_check.csv")
+    assert set(rows["scenario"]) >= {"C-photo"} and len(rows[rows["scenario"] == "C-photo"]) == 72
+    r = CliRunner().invoke(main, ["hemi", "render", root, "-s", "C-photo", "--size", "200"])
+    assert r.exit_code == 0, r.output
+    assert (mendoza.results_dir / "photo_render" / "C-photo.png").is_file()
+    assert (mendoza.results_dir / "photo_render" / "C-photo" / "rings.csv").is_file()
+    r = CliRunner().invoke(main, ["hemi", "check", root, "-s", "A"])
+    assert r.exit_code == 2 and "has no photo" in r.output
+
+
 def test_section_only_with_the_check_file(mendoza, tmp_path):
     from radtree.report.sections import Section, render_section
     from radtree.report.sections.photo import photo_check_data
