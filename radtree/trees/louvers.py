@@ -250,7 +250,8 @@ def build_louvers(tree: Tree, sensors: Sensors, street: Street, frame: FacadeFra
                 f"vertical crossings {lv.crossings:.2f}; gap-fraction RMS {fit.rms:.4f} "
                 f"(cells), {fit.ring_rms:.4f} (rings); the photo's LAI_eff "
                 f"{fit.lai_photo:.3f}, clumping {fit.clumping_photo:.3f} (not modelled: the "
-                "slats are placed at random, the density is an effective one).")
+                "slats are placed at random, the density is an effective one)."
+                + _spread_text(fit.spread()))
         if volume:
             polys, ginfo = build_volume_louvers(spec_r, lv, source)
         else:
@@ -327,3 +328,14 @@ def build_louvers(tree: Tree, sensors: Sensors, street: Street, frame: FacadeFra
     info.update(ginfo)
     return TreeModel(meshes=meshes, materials=materials, notes=notes, recommended_ab=ab,
                      info=info, form=form, model="louvers", photo=photo)
+
+
+def _spread_text(spread: dict[str, float]) -> str:
+    """The per-photo spread of a fit to several photos, for the notes."""
+    if spread.get("photos", 1.0) <= 1.0:
+        return ""
+    text = f" One fit to {int(spread['photos'])} photos; per photo s.d. of the density "
+    text += f"{spread.get('lad_sd', float('nan')):.3f} m²/m³"
+    if "x_sd" in spread:
+        text += f", of x {spread['x_sd']:.3f}"
+    return text + "."
