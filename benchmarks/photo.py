@@ -9,7 +9,8 @@ the 90° circle, Embree when installed; render s) and analysed by radtree.hemi (
 and the ring × segment / per-ring gap-fraction RMS against the photo is printed. Then the
 fit alone (photo analysis excluded: cached) is timed for F-photo, one photo and the three
 photos of a folder (the same stand-in photo three times). Target: render + analysis ≤ 5 s
-for 2000 × 2000 on 2 cores.
+for 2000 × 2000 on 2 cores. "CPU s (all)" is the process CPU time of build + render +
+analysis, all threads: on a loaded machine the wall times overstate an idle run.
 
 Run: ``.venv/bin/python benchmarks/photo.py [--size 2000] [--keep]``.
 """
@@ -58,17 +59,19 @@ def run(work: Path, size: int) -> None:
     p = load_project(work / "m", overrides={"sensors.dense_grid": False,
                                             "sensors.dense_hours": []})
     print(f"{'scenario':9} {'build s':>8} {'render s':>9} {'analysis s':>11} "
-          f"{'render+analysis s':>18} {'RMS cells':>10} {'RMS rings':>10}")
+          f"{'render+analysis s':>18} {'CPU s (all)':>12} {'RMS cells':>10} {'RMS rings':>10}")
     for name in ("A-photo", "C-photo", "F-photo"):
         sc = p.scenario(name)
+        c0 = time.process_time()
         r = render_scenario(p, sc, size)
         t0 = time.perf_counter()
         model = r.analyse()
         t_an = time.perf_counter() - t0
+        cpu = time.process_time() - c0
         photos = [analyse_photo(x, r.source) for x in r.source.images]
         rms, ring = rms_of(check_rows(name, photos, model))
         print(f"{name:9} {r.seconds['build']:8.2f} {r.seconds['cast']:9.2f} {t_an:11.2f} "
-              f"{r.seconds['cast'] + t_an:18.2f} {rms:10.4f} {ring:10.4f}")
+              f"{r.seconds['cast'] + t_an:18.2f} {cpu:12.2f} {rms:10.4f} {ring:10.4f}")
     sc = p.scenario("F-photo")
     tree, _ = apply_switches(p.tree, dict(sc.switches), root=p.root)
     src = photo_source(tree)
