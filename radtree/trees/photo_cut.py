@@ -35,6 +35,7 @@ from radtree.trees.photo import (
 
 CELL = 0.01            # gnomonic cell side (X = tan a): 0.57° at a face centre
 EXTENT = 1.10          # the grid covers |X|, |Y| ≤ this (a face spans ±1)
+MIN_PIECE = 1e-9       # pieces smaller than this (gnomonic units², ≈ 2e-9 sr) are dropped
 
 
 def _face_rasters(is_sky, cell: float = CELL) -> list[tuple[np.ndarray, np.ndarray]]:
@@ -116,7 +117,7 @@ def cut_slats(quads: np.ndarray, centre: np.ndarray, is_sky, cell: float = CELL
         slat_polys = shapely.polygons(np.stack([X, Y], axis=2))
         got = shapely.intersection(boxes, slat_polys[np.array(slat_of)])
         own = np.array(owner)
-        keep = ~shapely.is_empty(got) & (shapely.area(got) > 1e-12)
+        keep = ~shapely.is_empty(got) & (shapely.area(got) > MIN_PIECE)
         kept_by = set(own[keep].tolist())
         removed += len(set(owner) - kept_by)
         cut += len(kept_by)
@@ -128,7 +129,7 @@ def cut_slats(quads: np.ndarray, centre: np.ndarray, is_sky, cell: float = CELL
         for g, q in zip(got[keep], own[keep]):
             m, h = planes[int(q)]
             for part in getattr(g, "geoms", [g]):
-                if part.geom_type != "Polygon" or part.area <= 1e-12:
+                if part.geom_type != "Polygon" or part.area <= MIN_PIECE:
                     continue
                 xy = np.asarray(part.exterior.coords)[:-1]
                 dirs = A[None, :] + xy[:, :1] * P[None, :] + xy[:, 1:2] * Q[None, :]
