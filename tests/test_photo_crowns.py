@@ -15,7 +15,7 @@ import pytest
 
 from radtree.config import Scenario, load_project
 from radtree.errors import ConfigError
-from tests.conftest import MENDOZA, copy_project
+from tests.conftest import MENDOZA, copy_project, needs_radiance
 
 PHOTO = MENDOZA / "data" / "fisheye_chestnut_standin.jpg"
 FAST = {"sensors.dense_grid": False, "sensors.dense_hours": [], "engine.rays": 64}
@@ -108,6 +108,22 @@ def test_hemi_render_and_check_commands(mendoza):
     assert (mendoza.results_dir / "photo_render" / "C-photo" / "rings.csv").is_file()
     r = CliRunner().invoke(main, ["hemi", "check", root, "-s", "A"])
     assert r.exit_code == 2 and "has no photo" in r.output
+
+
+@needs_radiance
+@pytest.mark.radiance
+def test_radiance_fisheye_picture(mendoza):
+    from click.testing import CliRunner
+
+    from radtree.cli import main
+
+    r = CliRunner().invoke(main, ["hemi", "render", str(mendoza.root), "-s", "C-photo",
+                                  "--size", "100", "--radiance", "13:30", "--radiance-size",
+                                  "24", "--radiance-ab", "0"])
+    assert r.exit_code == 0, r.output
+    out = mendoza.results_dir / "photo_render"
+    assert (out / "C-photo_1330.hdr").read_bytes().startswith(b"#?RADIANCE")
+    assert (out / "C-photo_1330.bmp").read_bytes()[:2] == b"BM"
 
 
 def test_section_only_with_the_check_file(mendoza, tmp_path):

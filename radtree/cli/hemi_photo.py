@@ -44,8 +44,16 @@ def _photo_scenarios(project, names: tuple[str, ...]) -> list:
               help="Image side in pixels (the 90° circle fills the frame).")
 @click.option("--out", "out_dir", type=click.Path(file_okay=False, path_type=Path),
               default=None, help="Output folder (default PROJECT/results/photo_render).")
+@click.option("--radiance", "radiance_hour", metavar="HH:MM", default=None,
+              help="Also a Radiance rpict -vta fisheye (180°, equidistant) with that hour's "
+                   "sun and sky: <scenario>_<HHMM>.hdr and .bmp.")
+@click.option("--radiance-size", type=int, default=512, show_default=True,
+              help="Side of the Radiance picture, pixels.")
+@click.option("--radiance-ab", type=int, default=None,
+              help="Ambient bounces of the picture (default: the crown model's -ab).")
 def render_command(project: str, scenarios: tuple[str, ...], size: int,
-                   out_dir: Path | None) -> None:
+                   out_dir: Path | None, radiance_hour: str | None, radiance_size: int,
+                   radiance_ab: int | None) -> None:
     """Render each scenario's crown as a binary sky/canopy fisheye (255 sky, 0 canopy) from
     its photo point through its photo's lens, by ray casting; write <scenario>.png and the
     radtree hemi analysis of it (summary.csv, rings.csv) into --out."""
@@ -67,6 +75,13 @@ def render_command(project: str, scenarios: tuple[str, ...], size: int,
                    f"{r.source.direction} photo point {r.camera.round(2).tolist()} m); "
                    f"cast {r.seconds['cast']:.2f} s; openness {m.openness:.4f}  "
                    f"lai_eff {m.lai_eff:.3f}")
+        if radiance_hour:
+            from radtree.photo.render import radiance_picture
+
+            hdr, bmp = radiance_picture(p, sc, radiance_hour, radiance_size,
+                                        out / f"{sc.name}_{radiance_hour.replace(':', '')}",
+                                        echo=click.echo, ab=radiance_ab)
+            click.echo(f"{sc.name}: Radiance fisheye {hdr} and {bmp}")
 
 
 @click.command("check", context_settings=CONTEXT)

@@ -133,3 +133,35 @@ def render_scenario(project: Project, sc: Scenario, size: int = DEFAULT_SIZE,
     t2 = time.perf_counter()
     return Rendering(image, geometry, camera, src,
                      {"build": t1 - t0, "cast": t2 - t1, "triangles": float(off)})
+
+
+def radiance_picture(project: Project, sc: Scenario, hour: str, size: int, out: Any,
+                     echo: Any = print, ab: int | None = None) -> tuple[Any, Any]:
+    """A Radiance ``rpict -vta`` fisheye of the scenario at ``hour`` (HH:MM) from its photo
+    point along its photo's axis, lit by the hour's sun and sky (``ab``: ambient bounces,
+    default the crown's): (HDR path, BMP path)."""
+    from radtree.config import effective_project
+    from radtree.engines.radiance.interface import RadianceEngine
+    from radtree.engines.radiance.picture import fisheye_picture
+    from radtree.light.hours import hour_states
+    from radtree.pipeline.build import ensure_built
+
+    tree, src = scenario_photo(project, sc)
+    states = [s for s in hour_states(project, sc) if s.time == hour]
+    if not states:
+        raise ConfigError(f"unknown hour {hour!r} (site.hours: {', '.join(project.site.hours)})",
+                          source=str(project.source), field="--hour")
+    built = make_scene(project, sc)
+    folder = ensure_built(project, sc, echo)
+    params = effective_project(project, sc).engine
+    plan = RadianceEngine().prepare(built.scene, states, params, built.ab, folder)
+    frame = facade_frame(project)
+    if src.direction == "upward":
+        axis, up = np.array([0.0, 0.0, 1.0]), np.array([0.0, 1.0, 0.0])   # image north up
+    else:
+        axis, up = frame.normal, np.array([0.0, 0.0, 1.0])
+    point = photo_point(project, tree, src)
+    if src.direction != "upward":
+        point = point + project.sensors.offset_m * axis   # off the wall the camera sits on
+    return fisheye_picture(plan, states[0].label, point, axis, up, size,
+                           built.ab if ab is None else ab, params.ad, out)
