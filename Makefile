@@ -24,6 +24,7 @@ demo: $(STAMP)
 	$(BIN)/radtree simulate $(EXAMPLE) --convergence -s A -s C -s E -s F
 	$(BIN)/radtree permeability $(EXAMPLE) -s A --rays 1024
 	$(BIN)/radtree diagnose $(EXAMPLE) -s A
+	$(BIN)/radtree hemi check $(EXAMPLE)
 	$(BIN)/radtree report $(EXAMPLE)
 	@echo ""
 	@echo "Results: $(EXAMPLE)/results/illuminance.csv"

@@ -13,13 +13,24 @@ MENDOZA = ROOT / "examples" / "mendoza-street"
 SHARED = ROOT.parent / "shared"
 
 
+def drop_photo_scenarios(text: str) -> str:
+    """The project text without its ``[[scenario]]`` blocks named ``*-photo``."""
+    head, *blocks = text.split("\n[[scenario]]")
+    kept = [b for b in blocks if not re.search(r'^name = "[^"]*-photo"', b, re.M)]
+    return "\n[[scenario]]".join([head, *kept])
+
+
 def copy_project(dst: Path, replace: dict[str, str] | None = None,
-                 hours: list[str] | None = None) -> Path:
-    """Copy the Mendoza example to ``dst``; regex replacements on its radtree.toml."""
+                 hours: list[str] | None = None, photo: bool = False) -> Path:
+    """Copy the Mendoza example to ``dst``; regex replacements on its radtree.toml. The
+    photo-derived scenarios (A-photo, C-photo, F-photo: tests/test_photo_crowns.py) are left
+    out unless ``photo``."""
     shutil.copytree(MENDOZA, dst, ignore=shutil.ignore_patterns("build", "results", "report",
                                                                 "diagnose", "sweep"))
     toml = dst / "radtree.toml"
     text = toml.read_text()
+    if not photo:
+        text = drop_photo_scenarios(text)
     for pat, rep in (replace or {}).items():
         text, n = re.subn(pat, rep, text, flags=re.M)
         assert n, f"pattern {pat!r} not found in radtree.toml"

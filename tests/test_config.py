@@ -15,9 +15,11 @@ def test_mendoza_project_loads():
     assert p.site.latitude == -32.89 and p.site.longitude == -68.83
     assert p.site.hours == ("10:30", "11:30", "12:30", "13:30", "14:30", "15:30", "16:30")
     assert p.street.facade_azimuth_deg == 0.0
-    assert [s.name for s in p.scenarios] == ["A", "B", "C", "D", "E", "A-sky", "F"]
+    assert [s.name for s in p.scenarios] == ["A", "B", "C", "D", "E", "A-sky", "F", "A-photo",
+                                             "C-photo", "F-photo"]
     assert [s.reflection for s in p.scenarios] == ["calculated", "traced", "traced",
-                                                   "calculated", "traced", "calculated", "traced"]
+                                                   "calculated", "traced", "calculated", "traced",
+                                                   "calculated", "traced", "traced"]
     assert p.tree.louvers.layers == 5 and p.tree.louvers.specular_fraction == 0.9
     assert p.engine.as_ == 0 and p.engine.aa == 0 and p.engine.ab is None
 

@@ -7,6 +7,7 @@ from pathlib import Path
 import click
 
 from radtree.cli.errors import BAD_INPUT
+from radtree.cli.hemi_photo import HemiGroup, check_command, render_command
 from radtree.cli.options import CONTEXT
 from radtree.errors import ConfigError
 from radtree.hemi.analyse import HemiConfig
@@ -151,4 +152,10 @@ def _config(
     )
 
 
-hemi_command = click.command("hemi", help=HELP, context_settings=CONTEXT)(_hemi)
+hemi_analyse = click.command("analyse", help=HELP, context_settings=CONTEXT)(_hemi)
+hemi_command = HemiGroup("hemi", help=HELP + """
+
+Sub-commands (radtree hemi COMMAND --help):
+  render PROJECT -s SCENARIO   synthetic fisheye of the scenario's crown from its photo point
+  check PROJECT -s SCENARIO    the crown against its photo -> results/photo_check.csv
+""", context_settings=CONTEXT, commands=[hemi_analyse, render_command, check_command])

@@ -16,12 +16,14 @@ from typing import Any, ClassVar
 
 from radtree.config.honeybee import HoneybeeSite
 from radtree.config.limits import Limits
+from radtree.config.photo import INCLINATION_DISTRIBUTIONS, drop_photo_defaults, photo_fields
 from radtree.config.spec import TIME_RE, Checked, meta
 from radtree.errors import ConfigError
 
 CROWN_MODELS = ("homogeneous", "perforated", "louvers", "none")
 TREE_FORMS = ("dome", "free")
 LOUVER_ARRANGEMENTS = ("layers", "volume")
+_PHOTO = photo_fields()
 REFLECTION_MODES = ("traced", "calculated")
 SKY_CHOICES = ("none", "perez")
 #: Presets of the louvers slat optics (the switch ``"louvers.reading"``): the study's reading
@@ -145,7 +147,9 @@ class Perforated(Checked):
     """Opaque sheet (leaf reflectance) with holes where the photo shows sky.
 
     ``photo`` a fisheye image (with ``lens`` and ``mask`` = cx,cy,r px), else a seeded random
-    gap pattern of ``openness``.
+    gap pattern of ``openness`` (``seed``). ``realisations``: how many random gap patterns
+    (``seed``, ``seed`` + 1, …) ``simulate`` traces and averages, as for the louvers; without a
+    photo only (a photo is one fixed pattern). The shared ``[tree] photo`` wins over ``photo``.
     """
 
     TABLE: ClassVar[str] = "tree.perforated"
@@ -155,6 +159,8 @@ class Perforated(Checked):
     openness: float = _fraction(0.06)
     reflectance: float = _fraction(0.11)
     resolution: int = 64
+    seed: int = 1
+    realisations: int = field(default=1, metadata=meta(1, 64))
 
 
 @dataclass(frozen=True)
@@ -187,6 +193,11 @@ class Louvers(Checked):
     arrangement: str = field(default="layers", metadata=meta(choices=LOUVER_ARRANGEMENTS))
     crossings: float = field(default=0.0, metadata=meta(0.0, 60.0))
     realisations: int = field(default=1, metadata=meta(1, 64))
+    # volume slats: one inclination, or drawn from Campbell's ellipsoidal distribution of
+    # parameter ellipsoid_x (radtree.config.photo; fitted to an upward photo)
+    inclination_distribution: str = field(default="fixed", metadata=meta(
+        choices=INCLINATION_DISTRIBUTIONS))
+    ellipsoid_x: float = field(default=1.0, metadata=meta(0.05, 20.0))
 
     def check(self) -> None:
         if self.reflectance + self.transmittance > 1:
@@ -196,7 +207,8 @@ class Louvers(Checked):
 
 @dataclass(frozen=True)
 class Tree(Checked):
-    """The crown: its ``form`` (``dome`` | ``free``) and one table per crown model."""
+    """The crown: its ``form`` (``dome`` | ``free``), one table per crown model and the crown's
+    photograph (``photo``, ``lens``, ``mask``, ``photo_direction``, …: :mod:`radtree.config.photo`)."""
 
     TABLE: ClassVar[str] = "tree"
     form: str = field(default="dome", metadata=meta(choices=TREE_FORMS))
@@ -208,6 +220,15 @@ class Tree(Checked):
     #: a species of the library (materials/species/, key or name): fills the leaf optics, slat
     #: inclination and permeability that the [tree.*] tables leave out (radtree.config.species)
     species: str | None = field(default=None, metadata=meta(switch=False))
+    # the crown's photograph, shared by the crown models (radtree.config.photo)
+    photo: Path | None = _PHOTO["photo"]
+    lens: str = _PHOTO["lens"]
+    mask: tuple[float, float, float] | None = _PHOTO["mask"]
+    photo_direction: str = _PHOTO["photo_direction"]
+    photo_x_m: float = _PHOTO["photo_x_m"]
+    photo_distance_m: float = _PHOTO["photo_distance_m"]
+    photo_height_m: float = _PHOTO["photo_height_m"]
+    photo_zenith_deg: float = _PHOTO["photo_zenith_deg"]
 
 
 @dataclass(frozen=True)
@@ -393,6 +414,7 @@ class Project:
                 payload["engine"].pop(key, None)
         if self.honeybee is not None:   # absent otherwise: other projects' hashes unchanged
             payload["honeybee"] = {**d["honeybee"], "sha256": self.honeybee.digest()}
+        drop_photo_defaults(payload["tree"])  # photo fields at their defaults: hashes unchanged
         payload["scenario"] = _plain(scenario)
         text = json.dumps(payload, sort_keys=True, default=str)
         return hashlib.sha256(text.encode()).hexdigest()[:12]

@@ -71,6 +71,7 @@ def build_project(project: Project, scenarios: list[str] | None = None,
                 "form": sc.form or project.tree.form, "ab": built.ab,
                 "triangles": built.triangles, "notes": built.notes, "info": built.info,
                 "params_hash": project.params_hash(sc),
+                "photo": getattr(built.tree, "photo", None),
                 "seconds": {"preparation": prep, "geometry": built.geometry_seconds,
                             "writing": time.perf_counter() - t1},
             }

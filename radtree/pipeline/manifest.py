@@ -2,21 +2,15 @@
 
 from __future__ import annotations
 
-import hashlib
 import platform
 from datetime import datetime, timezone
 from pathlib import Path
 from typing import Any
 
 import radtree
+from radtree.fileio import file_sha256
 
-
-def file_sha256(path: Path) -> str:
-    h = hashlib.sha256()
-    with open(path, "rb") as f:
-        for chunk in iter(lambda: f.read(1 << 20), b""):
-            h.update(chunk)
-    return h.hexdigest()
+__all__ = ["file_sha256", "input_files", "manifest"]
 
 
 def input_files(project) -> dict[str, str]:
@@ -26,7 +20,7 @@ def input_files(project) -> dict[str, str]:
                    ("direct_normal", project.light.direct_normal_table),
                    ("epw", project.light.epw),
                    ("ground_reflectance", project.street.ground_reflectance_table),
-                   ("photo", project.tree.perforated.photo)):
+                   ("photo", project.tree.perforated.photo), ("tree_photo", project.tree.photo)):
         if p is not None:
             paths[key] = p
     return {k: f"{Path(v).name} sha256:{file_sha256(Path(v))}" for k, v in paths.items()

@@ -1,5 +1,6 @@
-"""Crown realisations: a louvers crown with ``louvers.realisations`` N > 1 is traced as N random
-crowns ``<name>@1`` … ``<name>@N`` (seeds ``louvers.seed`` … + N − 1) and averaged back into
+"""Crown realisations: a louvers crown with ``louvers.realisations`` N > 1 (a perforated crown
+with ``perforated.realisations`` N > 1: random gap patterns) is traced as N random crowns
+``<name>@1`` … ``<name>@N`` (seeds ``<table>.seed`` … + N − 1) and averaged back into
 ``<name>``; ``lux_stderr`` becomes the standard error over the crowns."""
 
 from __future__ import annotations
@@ -15,21 +16,33 @@ from radtree.errors import ConfigError
 REALISATION_MARK = "@"   # "F@3": the third random crown of scenario F
 
 
+#: crown models with random realisations and the table holding their ``seed``/``realisations``
+RANDOM_CROWNS = {"louvers": "louvers", "perforated": "perforated"}
+
+
 def realisations_of(project: Project, sc: Scenario) -> list[Scenario]:
     """The scenario as traced: itself or, for a louvers crown with ``louvers.realisations``
-    N > 1, N copies named ``<name>@k`` whose ``louvers.seed`` is seed + k − 1 (k = 1…N);
-    ``simulate`` averages them back into ``<name>``."""
-    if sc.model != "louvers":
+    (a perforated crown with ``perforated.realisations``) N > 1, N copies named ``<name>@k``
+    whose ``<table>.seed`` is seed + k − 1 (k = 1…N); ``simulate`` averages them back into
+    ``<name>``. A perforated crown made from a photo has one fixed pattern: N > 1 is an error."""
+    table = RANDOM_CROWNS.get(sc.model)
+    if table is None:
         return [sc]
     from radtree.trees.build import apply_switches
 
     tree, _ = apply_switches(project.tree, dict(sc.switches), source=str(project.source))
-    n = tree.louvers.realisations
+    params = getattr(tree, table)
+    n = params.realisations
     if n <= 1:
         return [sc]
+    if table == "perforated" and (tree.perforated.photo is not None or tree.photo is not None):
+        raise ConfigError(f"scenario {sc.name}: perforated.realisations = {n} draws random gap "
+                          "patterns, but the crown's gaps come from a photo (one fixed pattern): "
+                          "set perforated.realisations = 1 or remove the photo",
+                          source=str(project.source), field="tree.perforated.realisations")
     return [replace(sc, name=f"{sc.name}{REALISATION_MARK}{k}",
-                    switches={**sc.switches, "louvers.seed": tree.louvers.seed + k - 1,
-                              "louvers.realisations": 1})
+                    switches={**sc.switches, f"{table}.seed": params.seed + k - 1,
+                              f"{table}.realisations": 1})
             for k in range(1, n + 1)]
 
 

@@ -167,6 +167,7 @@ def simulate_project(project: Project, engine: str | Engine = "auto",
     with folder_lock(project.results_dir, "radtree simulate", wait=True, name=PUBLISH_NAME,
                      echo=echo):
         merge_write(out, table, parents)   # table, timing and manifest: one reader sees all
+        _write_direct_sun(project, chosen, prepared)
         _merge_timing(project.results_dir / "timing.csv", tdf)
         write_text(project.results_dir / "manifest.json", json.dumps(
             manifest(project, extra={"engine": eng.name, "scenarios": [s.name for s in chosen]}),
@@ -204,3 +205,18 @@ def _merge_timing(out: Path, tdf: pd.DataFrame) -> None:
         tdf = pd.concat([old, tdf], ignore_index=True)
     with atomic_path(out) as tmp:
         tdf.to_csv(tmp, index=False)
+
+
+def _write_direct_sun(project: Project, chosen: list[Scenario],
+                      prepared: dict[str, _Prepared]) -> None:
+    """``results/direct_sun.csv``: whether the sun beam reaches each sensor at each hour, per
+    crown realisation, for the perforated scenarios (:mod:`radtree.pipeline.sunreach`)."""
+    from radtree.pipeline.sunreach import direct_sun_rows
+
+    rows = [direct_sun_rows(sc.name, prepared[sc.name].built.scene, prepared[sc.name].states)
+            for sc in chosen if sc.model == "perforated"
+            and "facade" in prepared[sc.name].built.scene.grids]
+    if rows:
+        table = pd.concat(rows, ignore_index=True)
+        merge_write(project.results_dir / "direct_sun.csv", table,
+                    list(dict.fromkeys(table["scenario"].astype(str))))

@@ -63,6 +63,8 @@ from radtree.trees.geometry import polygons_to_mesh, quads_to_mesh
 from radtree.trees.louvers_dome import build_dome_louvers
 from radtree.trees.louvers_free import BRANCH_SLATS, build_free_louvers
 from radtree.trees.model import BARK_REFLECTANCE, LEAF, TRUNK, TreeModel
+from radtree.trees.photo import photo_source, require_direction, with_source
+from radtree.trees.photo_cut import dome_from_photo
 from radtree.trees.volume import build_volume_louvers, recommended_volume_ab, volume_note
 
 
@@ -194,12 +196,27 @@ def build_louvers(tree: Tree, sensors: Sensors, street: Street, frame: FacadeFra
                           "its concentric slat shells; use arrangement = 'layers' or form "
                           "'free'", source=source, field="tree.louvers.arrangement")
     volume = form != "dome" and lv.arrangement == "volume"
+    photo: dict | None = None
     if form == "dome":
         spec = dome_spec(tree, sensors, street, source)
         quads, ginfo = build_dome_louvers(spec, lv, sensors, source)
-        verts, faces = quads_to_mesh(quads)
+        src = photo_source(tree) if tree.photo is not None else None
+        if src is None:
+            verts, faces = quads_to_mesh(quads)
+        else:
+            pieces, photo_info, photo = dome_from_photo(quads, spec.centre, src, source)
+            verts, faces = polygons_to_mesh(pieces)
+            ginfo.update(photo_info)
         slats = len(quads)
         notes.extend(dome_notes(spec))
+        if src is not None:
+            notes.append(
+                f"Cut by the façade photo {src.path.name} ({src.lens} lens; {tree.photo}): in "
+                f"every shell the slats are removed where the photo shows sky along the line "
+                f"from the dome centre ({int(photo_info['photo_slats_removed'])} slats removed, "
+                f"{int(photo_info['photo_slats_cut'])} cut, "
+                f"{int(photo_info['photo_slats_whole'])} whole; photo openness "
+                f"{photo_info['photo_openness']:.4f}).")
         notes.append(
             f"Louvers: {lv.layers} concentric shells of slats at radii "
             f"{ginfo['layer_radius_min_m']:.2f}–{ginfo['layer_radius_max_m']:.2f} m; each "
@@ -211,6 +228,30 @@ def build_louvers(tree: Tree, sensors: Sensors, street: Street, frame: FacadeFra
             f"{lv.branch_inclination_deg:g}° branches.")
     else:
         spec_r = crown_row_spec(tree, sensors, street, source)
+        src = photo_source(tree) if tree.photo is not None else None
+        if src is not None:
+            try:
+                require_direction(src, "upward", "the free louvers crowns")
+            except ConfigError as exc:
+                raise with_source(exc, source) from None
+            from radtree.trees.photo_fit import camera_point, fitted_louvers
+
+            lv, fit, photo = fitted_louvers(lv, src, spec_r, camera_point(tree, sensors),
+                                            frame, source)
+            volume = True
+            tilt = (f"leaf inclinations from Campbell's ellipsoidal distribution, x = "
+                    f"{fit.x:.3g} (mean tilt {fit.mean_tilt_deg:.1f}°)" if fit.x is not None
+                    else f"slats fixed at {lv.inclination_deg:g}°")
+            notes.append(
+                f"Fitted to the upward photo {src.path.name} ({src.lens} lens; camera "
+                f"{tree.photo_x_m:g} m along the façade from the sensors, "
+                f"{tree.photo_distance_m:g} m out, {tree.photo_height_m:g} m high; zenith "
+                f"0–{src.zenith_deg:g}°): leaf area density {fit.lad:.3f} m²/m³, {tilt}; "
+                f"vertical crossings {lv.crossings:.2f}; gap-fraction RMS {fit.rms:.4f} "
+                f"(cells), {fit.ring_rms:.4f} (rings); the photo's LAI_eff "
+                f"{fit.lai_photo:.3f}, clumping {fit.clumping_photo:.3f} (not modelled: the "
+                "slats are placed at random, the density is an effective one)."
+                + _spread_text(fit.spread()))
         if volume:
             polys, ginfo = build_volume_louvers(spec_r, lv, source)
         else:
@@ -286,4 +327,15 @@ def build_louvers(tree: Tree, sensors: Sensors, street: Street, frame: FacadeFra
             info.pop(key)
     info.update(ginfo)
     return TreeModel(meshes=meshes, materials=materials, notes=notes, recommended_ab=ab,
-                     info=info, form=form, model="louvers")
+                     info=info, form=form, model="louvers", photo=photo)
+
+
+def _spread_text(spread: dict[str, float]) -> str:
+    """The per-photo spread of a fit to several photos, for the notes."""
+    if spread.get("photos", 1.0) <= 1.0:
+        return ""
+    text = f" One fit to {int(spread['photos'])} photos; per photo s.d. of the density "
+    text += f"{spread.get('lad_sd', float('nan')):.3f} m²/m³"
+    if "x_sd" in spread:
+        text += f", of x {spread['x_sd']:.3f}"
+    return text + "."

@@ -36,6 +36,7 @@ class TreeModel:
     form: str = "dome"
     model: str = "none"
     frame: FacadeFrame | None = None  # the façade frame the crown was built in
+    photo: dict | None = None  # provenance of a photo-derived crown (radtree.trees.photo)
 
     def __post_init__(self) -> None:
         for m in self.meshes:

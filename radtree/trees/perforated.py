@@ -34,17 +34,27 @@ import math
 from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
 from radtree.config import Perforated, Sensors, Street, Tree
-from radtree.errors import ConfigError, RadtreeError
+from radtree.errors import ConfigError
 from radtree.optics import Plastic
 from radtree.scene import Mesh
 from radtree.site.frame import FacadeFrame
 from radtree.trees.envelope import crown_row_spec, dome_notes, dome_spec, row_notes
 from radtree.trees.geometry import fibonacci_hemisphere, triangle_solid_angles, unit
 from radtree.trees.model import BARK_REFLECTANCE, SHELL, TRUNK, TreeModel
+from radtree.trees.photo import (
+    PhotoSource,
+    analyse_photo,
+    facade_sky,
+    photo_source,
+    provenance,
+    require_direction,
+    with_source,
+)
 
 SkyPredicate = Callable[[np.ndarray], np.ndarray]
 OPENNESS_SAMPLES = 200_000
@@ -61,6 +71,7 @@ class GapPattern:
     is_sky: SkyPredicate
     openness: float
     source: str
+    photo: Any = None   # the hemi analysis (HemiResult) of a photo pattern
 
 
 def measure_openness(is_sky: SkyPredicate, samples: int = OPENNESS_SAMPLES) -> float:
@@ -118,50 +129,40 @@ def random_gap_pattern(openness: float, seed: int = DEFAULT_SEED, gaps: int | No
                       f"{radii.min():.1f}–{radii.max():.1f}° radius, openness {measured:.4f}")
 
 
-def photo_gap_pattern(perf: Perforated, source: str | None = None) -> GapPattern:
-    """The sky predicate of ``perforated.photo`` (a horizontal-axis fisheye photo taken from the
-    façade looking out), through :mod:`radtree.hemi`.
+def photo_gap_pattern(perf: Perforated, source: str | None = None,
+                      src: PhotoSource | None = None) -> GapPattern:
+    """The sky predicate of the crown's façade photo (``[tree] photo`` as ``src``, else
+    ``perforated.photo``): a horizontal-axis fisheye photo taken from the façade looking out,
+    through :mod:`radtree.hemi` (:mod:`radtree.trees.photo`).
 
     Directions map to the photo's angles as (angle from the lens axis n, angle around it
-    clockwise from up as seen looking out, 90° = +u). Photo analysis failures surface as the
-    hemi module's errors; there is no silent fallback to a random pattern.
+    clockwise from up as seen looking out, 90° = +u). Photo analysis failures surface as one
+    ConfigError naming the field; there is no silent fallback to a random pattern.
     """
-    if perf.photo is None:
-        raise ConfigError("no photo given", source=source, field="tree.perforated.photo")
+    if src is None:
+        if perf.photo is None:
+            raise ConfigError("no photo given", source=source, field="tree.perforated.photo")
+        src = PhotoSource(Path(perf.photo), perf.lens, perf.mask, "facade",
+                          "tree.perforated.photo")
     try:
-        from radtree.hemi import HemiConfig, analyse_image, get_lens
-        from radtree.hemi.mask import CircularMask
-    except ImportError as exc:  # pragma: no cover - depends on the hemi module being present
-        raise RadtreeError(
-            f"{source + ': ' if source else ''}field 'tree.perforated.photo': building the "
-            "perforated crown from a photo is not yet supported (radtree.hemi is not "
-            "available); remove 'photo' to use the seeded random gap pattern of 'openness'"
-        ) from exc
-    mask = CircularMask(*perf.mask) if perf.mask is not None else None
-    config = HemiConfig(lens=get_lens(perf.lens), mask=mask, axis="horizontal")
-    result = analyse_image(Path(perf.photo), config)
-    predicate = result.sky_predicate(outside=False)
-
-    def is_sky(d: np.ndarray) -> np.ndarray:
-        d = np.asarray(d, float)
-        theta = np.degrees(np.arccos(np.clip(d[:, 1], -1.0, 1.0)))
-        psi = np.mod(np.degrees(np.arctan2(d[:, 0], d[:, 2])), 360.0)
-        return np.asarray(predicate(theta, psi), bool)
-
+        require_direction(src, "facade", "the perforated crown")
+        result = analyse_photo(src.path, src)
+    except ConfigError as exc:
+        raise with_source(exc, source) from None
+    is_sky = facade_sky(result)
     openness = measure_openness(is_sky)
     return GapPattern(is_sky, openness,
-                      f"photo {Path(perf.photo).name} ({perf.lens} lens, horizontal axis = façade "
+                      f"photo {src.path.name} ({src.lens} lens, horizontal axis = façade "
                       f"normal): openness {openness:.4f} of the hemisphere "
-                      f"(hemi's own figure {result.metrics.openness:.4f})")
+                      f"(hemi's own figure {result.metrics.openness:.4f})", result)
 
 
 def gap_pattern_for(perf: Perforated, source: str | None = None) -> GapPattern:
-    """The photo's predicate if a photo is set, else the seeded random pattern of openness.
-    (``Perforated`` has no seed field yet; a ``seed`` attribute is used when present.)"""
+    """The photo's predicate if a photo is set, else the seeded random pattern of openness
+    (``perforated.seed``)."""
     if perf.photo is not None:
         return photo_gap_pattern(perf, source)
-    seed = int(getattr(perf, "seed", DEFAULT_SEED))
-    return random_gap_pattern(perf.openness, seed)
+    return random_gap_pattern(perf.openness, perf.seed)
 
 
 # Barycentric centres of the 16 sub-triangles of a triangle split 4 × 4 (sampling points).
@@ -221,11 +222,13 @@ def build_perforated(tree: Tree, sensors: Sensors, street: Street, frame: Facade
         raise ConfigError(f"got {perf.resolution}, expected 4–{MAX_RESOLUTION} rings "
                           "(triangles ≈ 5.1·resolution²)", source=source,
                           field="tree.perforated.resolution")
+    src = photo_source(tree)
     if pattern is None:
-        if perf.photo is None and not 0.0 <= perf.openness <= 1.0:
+        if src is None and not 0.0 <= perf.openness <= 1.0:
             raise ConfigError(f"got {perf.openness}, expected 0–1", source=source,
                               field="tree.perforated.openness")
-        pattern = gap_pattern_for(perf, source)
+        pattern = (photo_gap_pattern(perf, source, src) if src is not None
+                   else gap_pattern_for(perf, source))
     materials: dict = {SHELL: Plastic(SHELL, perf.reflectance)}
     meshes: list[Mesh] = []
     notes: list[str] = []
@@ -283,5 +286,7 @@ def build_perforated(tree: Tree, sensors: Sensors, street: Street, frame: Facade
     notes.append(f"Radiance: holes pass direct sun as shadow rays; -ab {PERFORATED_AB} covers "
                  "ground, wall and sheet inter-reflections (-ab 3 reads about 4 % low: "
                  "`radtree simulate --convergence`).")
+    photo = (provenance(src, [pattern.photo], {"hole_fraction": hole_fraction})
+             if src is not None and pattern.photo is not None else None)
     return TreeModel(meshes=meshes, materials=materials, notes=notes, recommended_ab=PERFORATED_AB,
-                     info=info, form=form, model="perforated")
+                     info=info, form=form, model="perforated", photo=photo)

@@ -58,6 +58,7 @@ from radtree.config import Louvers
 from radtree.errors import ConfigError
 from radtree.trees.crown_clip import cut_to_share, touches_share, trunk_clash
 from radtree.trees.envelope import CrownRowSpec
+from radtree.trees.leaf_angles import draw_inclinations, mean_projection, mean_tilt, projection_g
 
 MAX_VOLUME_SLATS = 200_000
 DRAW_BLOCK = 1024  # slats drawn per block (nested realisations, see _draw_nested)
@@ -74,25 +75,25 @@ def crossings_of(lv: Louvers) -> float:
     return float(lv.crossings) if lv.crossings > 0 else float(lv.layers)
 
 
+def mean_cos(lv: Louvers) -> float:
+    """Mean |cos| of the slat normals with the vertical: cos α, or over the ellipsoidal
+    distribution (:mod:`radtree.trees.leaf_angles`)."""
+    if lv.inclination_distribution == "ellipsoidal":
+        return float(mean_projection(np.array([1.0]), lv.ellipsoid_x)[0])
+    return math.cos(math.radians(lv.inclination_deg))
+
+
+def slat_g(mu: float, lv: Louvers) -> float:
+    """The slats' mean projection G for |Ω_z| = mu."""
+    if lv.inclination_distribution == "ellipsoidal":
+        return float(mean_projection(np.array([mu]), lv.ellipsoid_x)[0])
+    return float(projection_g(mu, lv.inclination_deg))
+
+
 def volume_density(lv: Louvers, b: float) -> float:
-    """Slats per m³: ρ = crossings · cover / (s² cos α · 2b)."""
+    """Slats per m³: ρ = crossings · cover / (s² cos α · 2b) (cos α: :func:`mean_cos`)."""
     s = lv.slat_size_m
-    cos_a = math.cos(math.radians(lv.inclination_deg))
-    return crossings_of(lv) * lv.cover_fraction / (s * s * cos_a * 2.0 * b)
-
-
-def projection_g(mu: float | np.ndarray, inclination_deg: float) -> np.ndarray:
-    """G = mean over a uniform azimuth of |m·Ω| for slat normals inclined α from vertical and
-    a direction Ω with |Ω_z| = mu (closed form): with p = μ cos α, q = √(1 − μ²) sin α,
-    G = p when q ≤ p, else (2/π)(q √(1 − p²/q²) + p·asin(p/q))."""
-    a = math.radians(inclination_deg)
-    mu = np.abs(np.asarray(mu, float))
-    p = mu * math.cos(a)
-    q = np.sqrt(np.clip(1.0 - mu * mu, 0.0, 1.0)) * math.sin(a)
-    with np.errstate(divide="ignore", invalid="ignore"):
-        r = np.where(q > p, p / np.where(q > 0, q, 1.0), 1.0)
-        g = (2.0 / math.pi) * (q * np.sqrt(np.clip(1.0 - r * r, 0.0, 1.0)) + p * np.arcsin(r))
-    return np.where(q > p, g, p)
+    return crossings_of(lv) * lv.cover_fraction / (s * s * mean_cos(lv) * 2.0 * b)
 
 
 def volume_slat_bound(spec: CrownRowSpec, lv: Louvers) -> int:
@@ -137,13 +138,15 @@ def _draw_nested(rng: np.random.Generator, n: int) -> tuple[np.ndarray, np.ndarr
     return np.concatenate(xs)[:n], np.concatenate(phis)[:n]
 
 
-def _slat_corners(centres: np.ndarray, phi: np.ndarray, s: float, alpha: float) -> np.ndarray:
-    """(k, 4, 3) corners of s × s squares, normal inclined ``alpha`` (rad) at azimuth ``phi``,
-    one edge horizontal."""
-    ca, sa = math.cos(alpha), math.sin(alpha)
+def _slat_corners(centres: np.ndarray, phi: np.ndarray, s: float,
+                  alpha: float | np.ndarray) -> np.ndarray:
+    """(k, 4, 3) corners of s × s squares, normal inclined ``alpha`` (rad; one or one per
+    slat) at azimuth ``phi``, one edge horizontal."""
+    ca = np.broadcast_to(np.cos(alpha), phi.shape)
+    sa = np.broadcast_to(np.sin(alpha), phi.shape)
     cp, sp = np.cos(phi), np.sin(phi)
     e1 = np.stack([-sp, cp, np.zeros_like(phi)], axis=1)            # horizontal edge
-    e2 = np.stack([-ca * cp, -ca * sp, np.full_like(phi, sa)], axis=1)  # up the slope
+    e2 = np.stack([-ca * cp, -ca * sp, sa], axis=1)  # up the slope
     h1 = np.array([-0.5, 0.5, 0.5, -0.5]) * s
     h2 = np.array([-0.5, -0.5, 0.5, 0.5]) * s
     return (centres[:, None, :] + h1[None, :, None] * e1[:, None, :]
@@ -155,7 +158,7 @@ def build_volume_louvers(spec: CrownRowSpec, lv: Louvers, source: str | None = N
     """Slat polygons (local coordinates) of the volume arrangement and geometry info."""
     s = lv.slat_size_m
     alpha = math.radians(lv.inclination_deg)
-    if math.cos(alpha) < 1e-6:
+    if mean_cos(lv) < 1e-6:
         raise ConfigError("vertical slats (inclination 90°) give no vertical crossings: the "
                           "volume density is undefined", source=source,
                           field="tree.louvers.inclination_deg")
@@ -175,7 +178,11 @@ def build_volume_louvers(spec: CrownRowSpec, lv: Louvers, source: str | None = N
         lo, hi = spec.strips[ti]
         x, phi = _draw_nested(rng, per)
         centres = c + x * np.array([a, a, b])
-        corners = _slat_corners(centres, phi, s, alpha)
+        tilt: float | np.ndarray = alpha
+        if lv.inclination_distribution == "ellipsoidal":
+            tilt = draw_inclinations(np.random.default_rng([lv.seed, ti, 7]), per,
+                                     lv.ellipsoid_x)
+        corners = _slat_corners(centres, phi, s, tilt)
         rho_plan = np.hypot(centres[:, 0] - c[0], centres[:, 1] - c[1])
         clash = trunk_clash(rho_plan, corners[:, :, 2].min(axis=1), spec, s)
         ok = touches_share(corners, spec, lo, hi) & ~clash
@@ -186,8 +193,7 @@ def build_volume_louvers(spec: CrownRowSpec, lv: Louvers, source: str | None = N
         polys.extend(kept)
         cut += n_cut
     volume, volume_se = clipped_volume(spec)
-    g_v = float(projection_g(1.0, lv.inclination_deg))
-    g_h = float(projection_g(0.0, lv.inclination_deg))
+    g_v, g_h = slat_g(1.0, lv), slat_g(0.0, lv)
     info = {
         "slat_bound": float(bound), "slats_drawn": float(per * spec.count),
         "slats_cut": float(cut), "slats_dropped": float(dropped_trunk),
@@ -210,7 +216,7 @@ def volume_note(lv: Louvers, info: dict[str, float], slats: int, t_specular: flo
     lam_v, lam_h = info["lambda_vertical"], info["lambda_horizontal"]
     return (
         f"Louvers, volume arrangement: {slats} slats of {lv.slat_size_m:g} m × "
-        f"{lv.slat_size_m:g} m inclined {lv.inclination_deg:g}° at random azimuths, centres "
+        f"{lv.slat_size_m:g} m inclined {_tilt_text(lv)} at random azimuths, centres "
         f"uniform at random in the crowns, density {info['density_per_m3']:.2f} slats/m³ "
         f"(crossings {info['crossings']:g} × cover {lv.cover_fraction:g} on a vertical line "
         f"through a crown centre); clipped crown volume {info['crown_volume_m3']:.0f} m³ "
@@ -221,3 +227,10 @@ def volume_note(lv: Louvers, info: dict[str, float], slats: int, t_specular: flo
         f"centre (2a). Direct (specular, T_s {t_specular:.3f}) transmission exp(−λ(1 − T_s)): "
         f"vertical {math.exp(-lam_v * (1 - t_specular)):.3g}, horizontal "
         f"{math.exp(-lam_h * (1 - t_specular)):.3g}.")
+
+
+def _tilt_text(lv: Louvers) -> str:
+    if lv.inclination_distribution == "ellipsoidal":
+        return (f"as drawn from Campbell's ellipsoidal distribution x = {lv.ellipsoid_x:.3g} "
+                f"(mean {mean_tilt(lv.ellipsoid_x):.1f}°)")
+    return f"{lv.inclination_deg:g}°"

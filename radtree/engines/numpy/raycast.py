@@ -295,6 +295,24 @@ class NullCaster:
         return np.full(n, -1, np.int64), np.full(n, np.inf)
 
 
+def any_hit(caster: RayCaster, origins: np.ndarray, directions: np.ndarray) -> np.ndarray:
+    """Whether each ray hits anything (no distances: Embree's occlusion query, split over
+    the caster's threads; other casters: ``first_hit``)."""
+    if not isinstance(caster, EmbreeCaster):
+        return caster.first_hit(origins, directions)[0] >= 0
+    n = len(origins)
+    caster.rays_cast += n
+
+    def query(s: slice) -> np.ndarray:
+        return np.asarray(caster._intersector.intersects_any(origins[s], directions[s]), bool)
+
+    step = min(caster.chunk, max(1, -(-n // caster.workers)))
+    parts = [slice(i, min(i + step, n)) for i in range(0, n, step)]
+    if caster._pool is None or len(parts) == 1:
+        return np.concatenate([query(s) for s in parts]) if parts else np.zeros(0, bool)
+    return np.concatenate(list(caster._pool.map(query, parts)))
+
+
 def make_caster(vertices: np.ndarray, faces: np.ndarray, backend: str = "auto",
                 workers: int = 2) -> RayCaster:
     """A first-hit ray caster for a triangle soup: Embree when available (``auto``)."""

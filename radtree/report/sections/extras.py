@@ -139,4 +139,10 @@ def extra_sections(project: Project, out: Path, echo: Callable[[str], None]
         if data is not None:
             html.append(Section(name, data))
             md.append(Section(name, data))
+
+    from radtree.report.sections.photo import photo_sections
+
+    p_html, p_md = photo_sections(project, out)
+    html += p_html
+    md += p_md
     return html, md

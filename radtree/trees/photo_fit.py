@@ -1,0 +1,315 @@
+"""Free crowns fitted to upward photos taken under them (``photo_direction = "upward"``).
+
+The free louvers crowns of the volume arrangement are a turbid medium: slat centres uniform
+in the clipped crown spheroids, leaf (slat) area density u = ρ·s² (m²/m³), normals from a
+leaf-inclination distribution with random azimuths. Seen from the camera point c, a direction
+Ω crossing the crowns over a path L(Ω) is sky with probability
+
+    P(Ω) = exp(−u · G(|Ω_z|) · L(Ω))        (0 where Ω meets a trunk)
+
+(Beer–Lambert; G from the slats' own distribution, :func:`radtree.trees.leaf_angles.
+mean_projection`). The photo's gap fraction per zenith ring (:mod:`radtree.hemi`, 9 rings over
+0–``photo_zenith_deg``, T_i the mean of its ring × segment cells T_ij) is matched by least
+squares on the contact-number scale, Σ_i w_i (ln P̄_i(u, x) − ln T_i)² (floored at hemi's
+gap floor; w_i the ring's share of the analysed solid angle, so the small rings near the lens
+axis, crossed by few leaves, do not dominate) — the scale hemi's LAI is computed on, so the fitted crown reproduces the photo's LAI
+and its ring gap fractions; P̄_ij is the solid-angle mean of P over a cell
+(:data:`CELL_SAMPLES` directions per cell, L from the ray's intersections with the clipped
+spheroids, :func:`crown_paths`).
+The fit scans log u × log x (61 × 15 points) and refines the best point with L-BFGS-B;
+hemi's own ellipsoidal x / mean tilt and LAI of the photo are reported beside it. With ``louvers.inclination_distribution = "fixed"``
+only u is fitted (the inclination stays ``inclination_deg``, e.g. the study's 30°).
+
+Clumping: the model's slats are placed at random (no clumping); hemi's clumping index
+``clumping_lx`` of the photo is reported beside the fit, the fitted u is an *effective*
+density (it reproduces the photo's gaps, not the true leaf area of a clumped crown).
+
+Several photos (``photo`` names a folder, all taken at the same camera point): one joint fit
+over all their cells, plus one fit per photo whose spread (s.d.) is reported.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, replace
+from typing import Any
+
+import numpy as np
+from scipy.optimize import minimize
+
+from radtree.config import Louvers, Sensors
+from radtree.errors import ConfigError
+from radtree.hemi import HemiResult
+from radtree.hemi.directions import up_to_world
+from radtree.hemi.metrics import DEFAULT_GAP_FLOOR
+from radtree.site.frame import FacadeFrame
+from radtree.trees.envelope import CrownRowSpec
+from radtree.trees.leaf_angles import mean_projection, mean_tilt
+from radtree.trees.photo import PhotoSource, analyse_photo, provenance, with_source
+
+CELL_SAMPLES = (6, 10)    # zenith × azimuth directions per ring × segment cell
+X_BOUNDS = (0.1, 10.0)
+U_BOUNDS = (1e-3, 20.0)
+
+
+@dataclass(frozen=True)
+class CrownFit:
+    """The fitted crown: leaf area density ``lad`` (m²/m³), ellipsoidal ``x`` (None: fixed
+    inclination), the vertical ``crossings`` through a crown centre, fit residuals and the
+    per-photo spread."""
+
+    lad: float
+    x: float | None
+    crossings: float
+    rms: float
+    ring_rms: float
+    lai_photo: float
+    clumping_photo: float
+    per_photo: tuple[tuple[float, float | None], ...]
+
+    @property
+    def mean_tilt_deg(self) -> float | None:
+        return None if self.x is None else mean_tilt(self.x)
+
+    def spread(self) -> dict[str, float]:
+        lads = [p[0] for p in self.per_photo]
+        xs = [p[1] for p in self.per_photo if p[1] is not None]
+        out = {"photos": float(len(lads))}
+        if len(lads) > 1:
+            out["lad_sd"] = float(np.std(lads, ddof=1))
+            if len(xs) > 1:
+                out["x_sd"] = float(np.std(xs, ddof=1))
+        return out
+
+    def as_dict(self) -> dict[str, Any]:
+        return {"leaf_area_density_m2_m3": self.lad, "ellipsoid_x": self.x,
+                "mean_tilt_deg": self.mean_tilt_deg, "crossings": self.crossings,
+                "gap_rms_cells": self.rms, "gap_rms_rings": self.ring_rms,
+                "lai_eff_photo": self.lai_photo, "clumping_lx_photo": self.clumping_photo,
+                **self.spread()}
+
+
+@dataclass
+class CellPaths:
+    """Per ring × segment cell: the sample directions' path lengths through the crowns,
+    |Ω_z|, trunk blocking and solid-angle weights (all (cells, samples))."""
+
+    length: np.ndarray
+    mu: np.ndarray
+    blocked: np.ndarray
+    weight: np.ndarray
+    shape: tuple[int, int]
+    ring_weight: np.ndarray   # each ring's share of the analysed solid angle
+
+
+def cell_paths(result: HemiResult, camera: np.ndarray, spec: CrownRowSpec,
+               frame: FacadeFrame) -> CellPaths:
+    """March the sample rays of every cell of ``result``'s grid from ``camera`` (local)."""
+    grid = result.table.grid
+    ze, ae = grid.ring_edges, grid.segment_edges
+    nz, na = CELL_SAMPLES
+    fz = (np.arange(nz) + 0.5) / nz
+    fa = (np.arange(na) + 0.5) / na
+    zs, az = [], []
+    for i in range(grid.rings):
+        for j in range(grid.segments):
+            z = ze[i] + fz * (ze[i + 1] - ze[i])
+            a = ae[j] + fa * (ae[j + 1] - ae[j])
+            Z, A = np.meshgrid(z, a, indexing="ij")
+            zs.append(Z.ravel())
+            az.append(A.ravel())
+    Z, A = np.array(zs), np.array(az)
+    world = up_to_world(Z.ravel(), A.ravel())
+    d = world @ frame.matrix           # world → local (u, n, z) directions
+    length, blocked = crown_paths(spec, camera, d)
+    shape = (grid.rings, grid.segments)
+    ring_w = -np.diff(np.cos(np.radians(ze)))
+    return CellPaths(length.reshape(Z.shape), np.abs(d[:, 2]).reshape(Z.shape),
+                     blocked.reshape(Z.shape), np.sin(np.radians(Z)), shape,
+                     ring_w / ring_w.sum())
+
+
+def slat_projection(paths: CellPaths, x: float | None, fixed_deg: float) -> np.ndarray:
+    """G of every sample direction for distribution x (None: the fixed angle)."""
+    if x is None:
+        from radtree.trees.volume import projection_g
+
+        return np.asarray(projection_g(paths.mu, fixed_deg))
+    return np.asarray(mean_projection(paths.mu.ravel(), x)).reshape(paths.mu.shape)
+
+
+def _slab(o: np.ndarray, d: np.ndarray, lo: float, hi: float
+          ) -> tuple[np.ndarray, np.ndarray]:
+    """Ray parameters [t0, t1] inside lo ≤ o + t·d ≤ hi (one coordinate)."""
+    with np.errstate(divide="ignore", invalid="ignore"):
+        a, b = (lo - o) / d, (hi - o) / d
+    t0, t1 = np.minimum(a, b), np.maximum(a, b)
+    flat = d == 0.0
+    inside = (o >= lo) & (o <= hi)
+    t0 = np.where(flat, np.where(inside, -np.inf, np.inf), t0)
+    t1 = np.where(flat, np.where(inside, np.inf, -np.inf), t1)
+    return t0, t1
+
+
+def crown_paths(spec: CrownRowSpec, camera: np.ndarray, d: np.ndarray
+                ) -> tuple[np.ndarray, np.ndarray]:
+    """Path length (m) of rays from ``camera`` along unit ``d`` (local) through the clipped
+    crowns (each spheroid ∩ n ≥ n_clip ∩ its strip of u: disjoint, so lengths add), and
+    whether each ray meets a trunk (vertical cylinder from the street to ``trunk_top``)."""
+    o = np.asarray(camera, float)
+    length = np.zeros(len(d))
+    blocked = np.zeros(len(d), bool)
+    for c, (lo, hi) in zip(spec.centres, spec.strips):
+        q = (o - c) / np.array([spec.a, spec.a, spec.b])
+        v = d / np.array([spec.a, spec.a, spec.b])
+        A = np.einsum("ij,ij->i", v, v)
+        B = 2.0 * v @ q
+        C = float(q @ q) - 1.0
+        disc = B * B - 4.0 * A * C
+        ok = disc > 0
+        r = np.sqrt(np.where(ok, disc, 0.0))
+        t0 = np.where(ok, (-B - r) / (2 * A), np.inf)
+        t1 = np.where(ok, (-B + r) / (2 * A), -np.inf)
+        for axis, lo_v, hi_v in ((1, spec.n_clip, np.inf), (0, lo, hi)):
+            s0, s1 = _slab(np.full(len(d), o[axis]), d[:, axis], lo_v, hi_v)
+            t0, t1 = np.maximum(t0, s0), np.minimum(t1, s1)
+        t0 = np.maximum(t0, 0.0)
+        length += np.clip(t1 - t0, 0.0, None)
+        # trunk: |(o + t d) − c| < r in plan, 0 ≤ z ≤ top
+        qx, qy = o[0] - c[0], o[1] - c[1]
+        a2 = d[:, 0] ** 2 + d[:, 1] ** 2
+        b2 = 2.0 * (d[:, 0] * qx + d[:, 1] * qy)
+        c2 = qx * qx + qy * qy - spec.trunk_radius ** 2
+        disc2 = b2 * b2 - 4.0 * a2 * c2
+        hit = (disc2 > 0) & (a2 > 1e-12)
+        r2 = np.sqrt(np.where(hit, disc2, 0.0))
+        with np.errstate(divide="ignore", invalid="ignore"):
+            u0 = np.where(hit, (-b2 - r2) / (2 * a2), np.inf)
+            u1 = np.where(hit, (-b2 + r2) / (2 * a2), -np.inf)
+        z0, z1 = _slab(np.full(len(d), o[2]), d[:, 2], 0.0, spec.trunk_top)
+        lo_t, hi_t = np.maximum(np.maximum(u0, z0), 0.0), np.minimum(u1, z1)
+        blocked |= hi_t > lo_t
+    return length, blocked
+
+
+def predicted_gaps(paths: CellPaths, lad: float, x: float | None, fixed_deg: float,
+                   g: np.ndarray | None = None) -> np.ndarray:
+    """P̄_ij (rings × segments) for density ``lad`` and distribution x (None: fixed angle)."""
+    g = slat_projection(paths, x, fixed_deg) if g is None else g
+    p = np.where(paths.blocked, 0.0, np.exp(-lad * g * paths.length))
+    return ((p * paths.weight).sum(axis=1) / paths.weight.sum(axis=1)).reshape(paths.shape)
+
+
+def _ring_log(gaps: np.ndarray) -> np.ndarray:
+    """ln of the ring means of a rings × segments gap table (floored at hemi's gap floor)."""
+    with np.errstate(invalid="ignore"):
+        return np.log(np.maximum(np.nanmean(gaps, axis=1), DEFAULT_GAP_FLOOR))
+
+
+def _fit(targets: list[np.ndarray], paths: list[CellPaths], fixed_deg: float | None
+         ) -> tuple[float, float | None, float]:
+    """Least squares over all cells of all photos → (lad, x or None, RMS): a scan over
+    log u × log x, then L-BFGS-B from the best point."""
+    rings = [_ring_log(t) for t in targets]
+    ok = [np.isfinite(r) for r in rings]
+    weights = [p.ring_weight for p in paths]
+    fixed = fixed_deg or 0.0
+
+    def sse_g(lad: float, gs: list[np.ndarray]) -> float:
+        total = 0.0
+        for t, pth, m, g, w in zip(rings, paths, ok, gs, weights):
+            r = _ring_log(predicted_gaps(pth, lad, None, fixed, g))[m] - t[m]
+            total += float(w[m] @ (r * r))
+        return total
+
+    def gs_of(x: float | None) -> list[np.ndarray]:
+        return [slat_projection(p, x, fixed) for p in paths]
+
+    us = np.exp(np.linspace(math.log(U_BOUNDS[0]), math.log(U_BOUNDS[1]), 61))
+    xs: list[float | None] = ([None] if fixed_deg is not None else
+                              list(np.exp(np.linspace(math.log(X_BOUNDS[0]),
+                                                      math.log(X_BOUNDS[1]), 15))))
+    best: tuple[float, float, float | None] = (math.inf, 1.0, None)
+    for x in xs:
+        gs = gs_of(x)
+        for u in us:
+            e = sse_g(float(u), gs)
+            if e < best[0]:
+                best = (e, float(u), x)
+
+    def sse(v: np.ndarray) -> float:
+        x = None if fixed_deg is not None else float(np.exp(v[1]))
+        return sse_g(float(np.exp(v[0])), gs_of(x))
+
+    v0 = [math.log(best[1])] + ([] if best[2] is None else [math.log(best[2])])
+    bounds = [(math.log(U_BOUNDS[0]), math.log(U_BOUNDS[1]))] + (
+        [] if fixed_deg is not None else [(math.log(X_BOUNDS[0]), math.log(X_BOUNDS[1]))])
+    res = minimize(sse, np.array(v0), method="L-BFGS-B", bounds=bounds)
+    v = res.x if res.fun <= best[0] else np.array(v0)
+    lad = float(np.exp(v[0]))
+    x = None if fixed_deg is not None else float(np.exp(v[1]))
+    cells = [predicted_gaps(p, lad, x, fixed) - t for p, t in zip(paths, targets)]
+    return lad, x, float(np.sqrt(np.nanmean(np.concatenate([c.ravel() for c in cells]) ** 2)))
+
+
+_CACHE: dict[Any, tuple[CrownFit, list[HemiResult]]] = {}
+
+
+def fit_crown(src: PhotoSource, camera: np.ndarray, spec: CrownRowSpec, lv: Louvers,
+              frame: FacadeFrame) -> tuple[CrownFit, list[HemiResult]]:
+    """Fit u (and x) to the upward photo(s) of ``src`` from ``camera`` (local, m)."""
+    images = src.images
+    key = (tuple((str(p), p.stat().st_mtime) for p in images), src.lens, src.mask,
+           src.zenith_deg, tuple(camera.round(6)), spec.a, spec.b, spec.n_clip,
+           tuple(spec.centres.ravel().round(6)), lv.inclination_distribution,
+           lv.inclination_deg, frame.azimuth_deg)
+    if key in _CACHE:
+        return _CACHE[key]
+    results = [analyse_photo(p, src) for p in images]
+    shared = cell_paths(results[0], camera, spec, frame)   # same grid and camera for all
+    paths = [shared if r.table.grid == results[0].table.grid else
+             cell_paths(r, camera, spec, frame) for r in results]
+    targets = [r.table.gap for r in results]
+    fixed = None if lv.inclination_distribution == "ellipsoidal" else lv.inclination_deg
+    if not any(np.any(p.length > 0) for p in paths):
+        raise ConfigError(f"no line of sight from the camera point {camera.round(2).tolist()} m "
+                          "crosses a crown within the analysed zenith range: check "
+                          "tree.photo_x_m, photo_distance_m, photo_height_m and the crown "
+                          "table", field="tree.photo_height_m")
+    lad, x, rms = _fit(targets, paths, fixed)
+    per = tuple(_fit([t], [p], fixed)[:2] for t, p in zip(targets, paths)
+                ) if len(results) > 1 else ((lad, x),)
+    model = [predicted_gaps(p, lad, x, fixed or 0.0) for p in paths]
+    ring_d = [np.nanmean(mg, axis=1) - np.nanmean(t, axis=1) for mg, t in zip(model, targets)]
+    ring_rms = float(np.sqrt(np.nanmean(np.concatenate(ring_d) ** 2)))
+    fitted_lv = replace(lv, inclination_distribution="ellipsoidal" if x is not None
+                        else "fixed", ellipsoid_x=x if x is not None else lv.ellipsoid_x)
+    from radtree.trees.volume import mean_cos
+
+    crossings = lad * mean_cos(fitted_lv) * 2.0 * spec.b / lv.cover_fraction
+    fit = CrownFit(lad, x, crossings, rms, ring_rms,
+                   float(np.nanmean([r.metrics.lai_eff for r in results])),
+                   float(np.nanmean([r.metrics.clumping_lx for r in results])), per)
+    _CACHE[key] = (fit, results)
+    return fit, results
+
+
+def fitted_louvers(lv: Louvers, src: PhotoSource, spec: CrownRowSpec, camera: np.ndarray,
+                   frame: FacadeFrame, source: str | None = None
+                   ) -> tuple[Louvers, CrownFit, dict[str, Any]]:
+    """The louvers table with the fitted density (``crossings``) and distribution, the fit
+    and its provenance."""
+    try:
+        fit, results = fit_crown(src, camera, spec, lv, frame)
+    except ConfigError as exc:
+        raise with_source(exc, source) from None
+    new = replace(lv, arrangement="volume", crossings=float(np.clip(fit.crossings, 0.01, 60.0)),
+                  inclination_distribution="ellipsoidal" if fit.x is not None else "fixed",
+                  ellipsoid_x=fit.x if fit.x is not None else lv.ellipsoid_x)
+    return new, fit, provenance(src, results, {**fit.as_dict(),
+                                               "camera_local_m": camera.tolist()})
+
+
+def camera_point(tree: Any, sensors: Sensors) -> np.ndarray:
+    """The upward photo's camera point in the façade frame (u, n, z), m."""
+    return np.array([sensors.x_m + tree.photo_x_m, tree.photo_distance_m, tree.photo_height_m])
