@@ -308,6 +308,7 @@ def document(template: str, site: dict[str, Any], site_source: str, data: dict[s
     doc.add("tree", tree)
     doc.add("sensors", table(TABLES["sensors"], {}))
     doc.add("engine", table(TABLES["engine"], {}))
+    doc.add("limits", table(TABLES["limits"], {}))
     if template == "office":
         doc.add("office", table(TABLES["office"], {}))
     scenarios = tomlkit.aot()
