@@ -20,6 +20,7 @@ from radtree.config.spec import SchemaError, Spec, spec_for, spec_of, toml_name
 from radtree.config.switches import (
     FIELD,
     TABLES,
+    TREE_TABLES,
     check_switches,
     known_text,
     lookup_key,
@@ -195,7 +196,7 @@ def parse_project(data: dict, path: Path) -> Project:
 
     tr = top.sub("tree")
     crowns = {t: _table(tr.sub(t), f"tree.{t}", base)
-              for t in ("dome", "crown", "homogeneous", "perforated", "louvers")}
+              for t in TREE_TABLES}
     tree = _table(tr, "tree", base, **crowns)
 
     se = top.sub("sensors")

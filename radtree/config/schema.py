@@ -13,6 +13,7 @@ from dataclasses import dataclass, field, fields, is_dataclass
 from pathlib import Path
 from typing import Any, ClassVar
 
+from radtree.config.bsdf import REPRESENTATIONS, CrownBsdf
 from radtree.config.spec import TIME_RE, Checked, meta
 from radtree.errors import ConfigError
 
@@ -202,6 +203,8 @@ class Tree(Checked):
     homogeneous: Homogeneous = field(default_factory=Homogeneous)
     perforated: Perforated = field(default_factory=Perforated)
     louvers: Louvers = field(default_factory=Louvers)
+    representation: str = field(default="explicit", metadata=meta(choices=REPRESENTATIONS))
+    bsdf: CrownBsdf = field(default_factory=CrownBsdf)
 
 
 @dataclass(frozen=True)
@@ -379,6 +382,9 @@ class Project:
         for key in FORWARD_KEYS:  # forward-engine settings at their defaults: hashes unchanged
             if payload["engine"].get(key) == getattr(EngineParams, key):
                 payload["engine"].pop(key, None)
+        for key, default in (("representation", "explicit"), ("bsdf", _plain(CrownBsdf()))):
+            if payload["tree"].get(key) == default:   # BSDF settings unused: hashes unchanged
+                payload["tree"].pop(key, None)
         payload["scenario"] = _plain(scenario)
         text = json.dumps(payload, sort_keys=True, default=str)
         return hashlib.sha256(text.encode()).hexdigest()[:12]

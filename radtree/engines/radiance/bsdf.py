@@ -48,10 +48,10 @@ class FluxSettings:
     ``tiles`` × ``tiles`` periodic copies of the cell; ``tensor_tree`` = 0 (Klems only) or
     the log2 resolution of an additional anisotropic tensor tree (genBSDF ``-t4 N``)."""
 
-    samples: int = 1000
+    samples: int = 500
     ab: int = 6
-    ad: int = 64
-    lw: float = 1e-4
+    ad: int = 2
+    lw: float = 1e-3
     tiles: int = 9
     nproc: int = 1
     tensor_tree: int = 0
