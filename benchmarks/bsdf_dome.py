@@ -23,8 +23,8 @@ from radtree.bsdf.klems import read_klems
 from radtree.config import load_project
 from radtree.pipeline.crown_bsdf import leaf_on_sample, scenario_xml
 from radtree.pipeline.trace import trace_scenario
-from radtree.trees.louvers_dome import dome_layer_radii
 from radtree.trees.envelope import dome_spec
+from radtree.trees.louvers_dome import dome_layer_radii
 
 ROOT = Path(__file__).resolve().parents[1]
 

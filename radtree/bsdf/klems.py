@@ -87,14 +87,22 @@ def read_klems(path: Path) -> KlemsBsdf:
     blocks = root.findall(".//w:AngleBasis/w:AngleBasisBlock", NS)
     if not blocks:
         raise InputError(f"{path}: no Klems AngleBasis (is it a tensor-tree XML?)")
-    lambdas, thetas = [], []
+    lambdas: list[float] = []
+    thetas: list[float] = []
+
+    def num(b: ET.Element, tag: str) -> float:
+        text = b.findtext(tag, namespaces=NS)
+        if text is None:
+            raise InputError(f"{path}: an AngleBasisBlock without {tag.split(':')[-1]}")
+        return float(text)
+
     for b in blocks:
-        n = int(b.findtext("w:nPhis", namespaces=NS))
-        lo = math.radians(float(b.findtext("w:ThetaBounds/w:LowerTheta", namespaces=NS)))
-        hi = math.radians(float(b.findtext("w:ThetaBounds/w:UpperTheta", namespaces=NS)))
+        n = int(num(b, "w:nPhis"))
+        lo = math.radians(num(b, "w:ThetaBounds/w:LowerTheta"))
+        hi = math.radians(num(b, "w:ThetaBounds/w:UpperTheta"))
         lam = math.pi * (math.sin(hi) ** 2 - math.sin(lo) ** 2) / n
         lambdas += [lam] * n
-        thetas += [float(b.findtext("w:Theta", namespaces=NS))] * n
+        thetas += [num(b, "w:Theta")] * n
     size = len(lambdas)
     mats: dict[str, np.ndarray] = {}
     for blk in root.findall(".//w:WavelengthDataBlock", NS):

@@ -17,13 +17,19 @@ from pathlib import Path
 
 from radtree.config import Project, Scenario
 from radtree.config.schema import Tree
-from radtree.engines.radiance.bsdf import BsdfRun, FluxSettings, check_bsdf, klems_bsdf, \
-    tensor_tree_bsdf, write_system
+from radtree.engines.radiance.bsdf import (
+    BsdfRun,
+    FluxSettings,
+    check_bsdf,
+    klems_bsdf,
+    tensor_tree_bsdf,
+    write_system,
+)
 from radtree.errors import ConfigError
 from radtree.fileio import write_text
 from radtree.site.frame import FacadeFrame
-from radtree.trees.build import apply_switches
 from radtree.trees.bsdf_shell import build_bsdf_crown
+from radtree.trees.build import apply_switches
 from radtree.trees.model import TreeModel
 from radtree.trees.slab import SlabSample, dome_slab, volume_slab
 from radtree.trees.volume import recommended_volume_ab

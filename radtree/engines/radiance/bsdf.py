@@ -65,7 +65,9 @@ class FluxSettings:
             raise ValueError(f"tensor_tree must be 0 or 4–6, got {self.tensor_tree}")
 
     def options(self) -> list[str]:
-        return ["-ab", str(self.ab), "-ad", str(self.ad), "-lw", f"{self.lw:g}", "-w-",
+        """rfluxmtx options: ``-u-`` (correlated sampling: the same system and options give
+        the same matrices), the ambient settings, ``-w-``, ``-n`` and ``-c``."""
+        return ["-u-", "-ab", str(self.ab), "-ad", str(self.ad), "-lw", f"{self.lw:g}", "-w-",
                 "-n", str(self.nproc), "-c", str(self.samples)]
 
 
