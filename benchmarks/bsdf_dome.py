@@ -18,10 +18,11 @@ from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
+import pandas as pd
 
 from radtree.bsdf.klems import read_klems
 from radtree.config import load_project
-from radtree.pipeline.crown_bsdf import leaf_on_sample, scenario_xml
+from radtree.pipeline.crown_bsdf import leaf_on_sample, scenario_xmls
 from radtree.pipeline.trace import trace_scenario
 from radtree.trees.envelope import dome_spec
 from radtree.trees.louvers_dome import dome_layer_radii
@@ -55,21 +56,32 @@ def main() -> None:
     ap = argparse.ArgumentParser()
     ap.add_argument("--samples", type=int, default=500)
     ap.add_argument("--scenario", default="B")
+    ap.add_argument("--explicit-cache", default=None,
+                    help="CSV of the explicit run's hourly façade means (read if present)")
     args = ap.parse_args()
     project = load_project(ROOT / "examples" / "mendoza-street")
     sc = project.scenario(args.scenario)
     bs = replace(sc, name=f"{sc.name}-bsdf", switches={
         **sc.switches, "tree.representation": "bsdf", "bsdf.samples": args.samples})
     t0 = time.perf_counter()
-    xml = scenario_xml(project, bs, progress=print)
+    bands = scenario_xmls(project, bs, progress=print)
     t_bsdf = time.perf_counter() - t0
-    print(f"crown BSDF {xml} ({t_bsdf:.0f} s; {leaf_on_sample(project, bs).notes[0][:160]}…)")
+    print(f"crown BSDFs ({t_bsdf:.0f} s): " + "; ".join(
+        f"|elevation| {lo:g}–{hi:g}°: {xml}" for lo, hi, xml in bands))
+    print(leaf_on_sample(project, bs, 0.5 * (bands[0][0] + bands[0][1])).notes[0][:200] + "…")
     out = {}
+    cache = Path(args.explicit_cache) if args.explicit_cache else None
     for label, s in (("explicit", sc), ("bsdf", bs)):
+        if label == "explicit" and cache is not None and cache.exists():
+            out[label] = pd.read_csv(cache, index_col=0)["lux"]
+            print(f"explicit: read {cache}")
+            continue
         t0 = time.perf_counter()
         rows = trace_scenario(project, s, "radiance", grids=["facade"])
         out[label] = rows.groupby("time")["lux"].mean()
         print(f"{label}: {time.perf_counter() - t0:.0f} s for {len(out[label])} hours")
+        if label == "explicit" and cache is not None:
+            out[label].to_csv(cache)
     print(f"{'time':>6} {'explicit':>9} {'bsdf':>9} {'ratio':>6}")
     for t in out["explicit"].index:
         e, b = out["explicit"][t], out["bsdf"][t]
@@ -78,7 +90,7 @@ def main() -> None:
     print(f"{'mean':>6} {e:9.1f} {b:9.1f} {b / e:6.3f}  ({100 * (b / e - 1):+.1f} %)")
     worst = float(np.max(np.abs(out["bsdf"] / out["explicit"] - 1.0)))
     print(f"largest hourly difference {100 * worst:.1f} %")
-    lat = lateral_displacement(project, bs, xml)
+    lat = lateral_displacement(project, bs, bands[len(bands) // 2][2])
     print(f"lateral displacement: stack {lat['stack_m']:.2f} m thick; "
           f"{100 * lat['scattered_share']:.0f} % of the normal transmission "
           f"({lat['t_normal']:.4f}) is scattered, and scattered light leaves the stack "

@@ -118,16 +118,28 @@ def test_bsdf_crown_scene_and_in_process_engines_refuse_it(tmp_path):
     from radtree.pipeline.trace import trace_hours
 
     built = make_scene(proj, proj.scenario("B"), dense_grid=False)
-    shell = built.scene.mesh("crown_bsdf")
-    assert isinstance(built.scene.materials["crown_bsdf"], Bsdf)
+    shells = [m for m in built.scene.meshes if m.material.startswith("crown_bsdf")]
+    assert sorted(m.name for m in shells) == [f"crown_bsdf_b{k}{h}" for k in range(3)
+                                              for h in ("", "_low")]
     assert not any(m.name == "tree_leaves" for m in built.scene.meshes)
     assert built.ab == 4
-    # every shell normal points to the dome centre (the XML's back side)
-    t = shell.triangles
-    n = np.cross(t[:, 1] - t[:, 0], t[:, 2] - t[:, 0])
     centre = np.array([proj.sensors.x_m, 0.0, proj.sensors.height_m])
-    assert np.all(np.einsum("ij,ij->i", n, t.mean(axis=1) - centre) < 0)
-    assert built.scene.materials["crown_bsdf"].to_radiance().startswith(
-        f"void BSDF crown_bsdf\n6 0 {xml.resolve()} 0 0 1 .\n0\n0\n")
+    area = 0.0
+    for m in shells:
+        assert isinstance(built.scene.materials[m.material], Bsdf)
+        # every shell normal points to the dome centre (the XML's back side)
+        t = m.triangles
+        n = np.cross(t[:, 1] - t[:, 0], t[:, 2] - t[:, 0])
+        assert np.all(np.einsum("ij,ij->i", n, t.mean(axis=1) - centre) < 0)
+        el = np.degrees(np.arcsin((t.mean(axis=1) - centre)[:, 2] / np.linalg.norm(
+            t.mean(axis=1) - centre, axis=1)))
+        k = int(m.name[len("crown_bsdf_b")])
+        assert np.all((np.abs(el) >= 30 * k - 1e-9) & (np.abs(el) <= 30 * (k + 1) + 1e-9))
+        assert np.all(el < 0) if m.name.endswith("_low") else np.all(el >= 0)
+        area += m.area()
+    r = proj.tree.dome.radius_m
+    assert area == pytest.approx(2 * math.pi * r * r, rel=0.02)   # the whole hemisphere
+    assert built.scene.materials["crown_bsdf_b1_low"].to_radiance() == (
+        f"void BSDF crown_bsdf_b1_low\n6 0 {xml.resolve()} 0 0 -1 .\n0\n0\n")
     with pytest.raises(EngineError, match="Radiance only"):
         trace_hours(proj, proj.scenario("B"), NumpyEngine(), grids=["facade"], built=built)

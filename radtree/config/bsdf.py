@@ -6,12 +6,14 @@ sensor dome (or the free crowns' envelopes) by a shell carrying the crown layer'
 
 rfluxmtx sampling: ``samples`` rays per Klems patch (``-c``), ``ab`` (0: the crown model's
 recommendation), ``ad``, ``lw``; ``tiles`` × ``tiles`` periodic copies of the sample cell.
-``elevation_deg``: the sensor dome's slats are tilted as where the shell is seen this far
-above the horizon from the dome centre. ``depth_m`` (free crowns): slab depth per crossing
+``bands``: the sensor dome's shell is cut into this many elevation bands of equal width
+(|elevation| 0–90°, the lower half mirrored), each with the BSDF of the slats as tilted at the
+band's middle elevation (the dome's slats turn with elevation); ``bands = 1``: one BSDF, the
+slats as tilted where the shell is seen ``elevation_deg`` above the horizon. ``depth_m`` (free crowns): slab depth per crossing
 of the envelope (0: the crown's vertical semi-axis, so the two crossings of a vertical line
 through the centre add up to the crown's height). ``tensor_tree``: 0, or the log2 resolution
-of an extra rank-4 tensor-tree XML. ``xml`` / ``leaf_off_xml``: use these XML files instead
-of computing them (cached under ``build/bsdf/``).
+of an extra rank-4 tensor-tree XML. ``xml``: use this leaf-on XML instead of computing it
+(computed XMLs are cached under ``build/bsdf/<scenario>/``).
 """
 
 from __future__ import annotations
@@ -36,10 +38,10 @@ class CrownBsdf(Checked):
     lw: float = field(default=1e-3, metadata=meta(0.0, 1.0, lo_open=True))
     tiles: int = field(default=9, metadata=meta(1, 41))
     elevation_deg: float = field(default=30.0, metadata=meta(0.0, 90.0))
+    bands: int = field(default=3, metadata=meta(1, 9))
     depth_m: float = field(default=0.0, metadata=meta(0.0, 50.0))
     tensor_tree: int = field(default=0, metadata=meta(0, 6))
     xml: Path | None = None
-    leaf_off_xml: Path | None = None
 
     def check(self) -> None:
         if self.tiles % 2 == 0:

@@ -52,8 +52,21 @@ def slab_depth(tree: Tree) -> float:
     return tree.bsdf.depth_m if tree.bsdf.depth_m > 0 else tree.crown.vertical_radius_m
 
 
-def leaf_on_sample(project: Project, scenario: Scenario) -> SlabSample:
-    """The planar sample of the scenario's (louvers) crown layer."""
+def band_elevations(tree: Tree, form: str) -> list[tuple[float, float, float]]:
+    """(lowest, highest, sample) |elevation| of each band of the BSDF shell, degrees: the
+    dome's ``tree.bsdf.bands`` equal bands sampled at their middles (one band: sampled at
+    ``tree.bsdf.elevation_deg``); a free crown has one band."""
+    n = tree.bsdf.bands if form == "dome" else 1
+    if n == 1:
+        return [(0.0, 90.0, tree.bsdf.elevation_deg)]
+    step = 90.0 / n
+    return [(k * step, (k + 1) * step, (k + 0.5) * step) for k in range(n)]
+
+
+def leaf_on_sample(project: Project, scenario: Scenario,
+                   elevation_deg: float | None = None) -> SlabSample:
+    """The planar sample of the scenario's (louvers) crown layer (the dome's slats tilted as
+    at ``elevation_deg``, default ``tree.bsdf.elevation_deg``)."""
     tree, form = scenario_tree(project, scenario)
     source = str(project.source)
     if scenario.model != "louvers":
@@ -61,7 +74,8 @@ def leaf_on_sample(project: Project, scenario: Scenario) -> SlabSample:
                           "BSDF is computed from the louvers crown's slats", source=source,
                           field="scenario.model")
     if form == "dome":
-        return dome_slab(tree, project.sensors, project.street, tree.bsdf.elevation_deg, source)
+        el = tree.bsdf.elevation_deg if elevation_deg is None else elevation_deg
+        return dome_slab(tree, project.sensors, project.street, el, source)
     if tree.louvers.arrangement != "volume":
         raise ConfigError("free crowns need louvers.arrangement = 'volume' for a BSDF (the "
                           "layered lens crowns are no planar slab)", source=source,
@@ -113,17 +127,25 @@ def ensure_bsdf(sample: SlabSample, settings: FluxSettings, folder: Path, name: 
     return result
 
 
-def scenario_xml(project: Project, scenario: Scenario,
-                 progress: Callable[[str], None] | None = None) -> Path:
-    """The leaf-on XML of ``scenario``: ``tree.bsdf.xml`` when given, else computed and cached
-    in ``build/bsdf/<scenario>/leaf_on/``."""
+def scenario_xmls(project: Project, scenario: Scenario,
+                  progress: Callable[[str], None] | None = None
+                  ) -> list[tuple[float, float, Path]]:
+    """The leaf-on XML of each band of ``scenario``'s BSDF shell, (lowest, highest |elevation|,
+    XML): ``tree.bsdf.xml`` for every band when given, else computed and cached in
+    ``build/bsdf/<scenario>/leaf_on[_b<k>]/``."""
     tree, form = scenario_tree(project, scenario)
+    bands = band_elevations(tree, form)
     if tree.bsdf.xml is not None:
         check_bsdf(Path(tree.bsdf.xml))
-        return Path(tree.bsdf.xml)
-    folder = project.build_dir / "bsdf" / scenario.name / "leaf_on"
-    return ensure_bsdf(leaf_on_sample(project, scenario), flux_settings(tree, form), folder,
-                       "leaf_on", progress).xml
+        return [(lo, hi, Path(tree.bsdf.xml)) for lo, hi, _ in bands]
+    out = []
+    for k, (lo, hi, el) in enumerate(bands):
+        name = "leaf_on" if len(bands) == 1 else f"leaf_on_b{k}"
+        folder = project.build_dir / "bsdf" / scenario.name / name
+        run = ensure_bsdf(leaf_on_sample(project, scenario, el), flux_settings(tree, form),
+                          folder, name, progress)
+        out.append((lo, hi, run.xml))
+    return out
 
 
 def bsdf_crown(project: Project, scenario: Scenario, frame: FacadeFrame) -> TreeModel | None:
@@ -131,9 +153,9 @@ def bsdf_crown(project: Project, scenario: Scenario, frame: FacadeFrame) -> Tree
     tree, form = scenario_tree(project, scenario)
     if tree.representation != "bsdf" or scenario.model == "none":
         return None
-    xml = scenario_xml(project, scenario)
-    model = build_bsdf_crown(tree, project.sensors, project.street, frame, form, xml,
-                             BSDF_SCENE_AB, str(project.source))
+    model = build_bsdf_crown(tree, project.sensors, project.street, frame, form,
+                             scenario_xmls(project, scenario), BSDF_SCENE_AB,
+                             str(project.source))
     model.frame = frame
     model.triangles = sum(m.n_triangles for m in model.meshes)
     model.info["triangles"] = float(model.triangles)
