@@ -16,6 +16,7 @@ from radtree.engines.radiance.binaries import run
 from radtree.engines.radiance.bsdf import FluxSettings, check_bsdf, klems_bsdf, write_system
 from radtree.errors import ConfigError, EngineError
 from radtree.optics import Bsdf, Plastic
+from radtree.pipeline.crown_bsdf import band_elevations, leaf_on_sample
 from radtree.trees.slab import branch_slab, dome_slab
 from tests.conftest import MENDOZA, copy_project, needs_radiance
 
@@ -103,6 +104,22 @@ def test_branch_slab_cover_and_config_keys():
     assert check_key("bsdf.samples", 64)[0].name == "tree.bsdf.samples"
     with pytest.raises(ConfigError, match="tree.bsdf.tiles.*odd"):
         CrownBsdf(tiles=4)
+    proj = load_project(MENDOZA)
+    with pytest.raises(ConfigError, match="model 'perforated'.*louvers"):
+        leaf_on_sample(proj, proj.scenario("C"))
+    # the dome's bands: three of 30°, sampled at their middles
+    assert band_elevations(proj.tree, "dome") == [(0.0, 30.0, 15.0), (30.0, 60.0, 45.0),
+                                                   (60.0, 90.0, 75.0)]
+    assert band_elevations(proj.tree, "free") == [(0.0, 90.0, 30.0)]
+    # the dome's slats, seen el above the horizon, are tilted |90° − α − el| from the radial
+    for el, tilt in ((15.0, 45.0), (45.0, 15.0), (75.0, 15.0)):
+        s15 = dome_slab(proj.tree, proj.sensors, proj.street, el)
+        assert s15.info["slat_tilt_deg"] == pytest.approx(tilt, abs=1e-6)
+        # cover 1: the slats tile the cell exactly, seen along the layer normal
+        quads = s15.polygons["leaf"]
+        a, b = quads[:, 2, :2] - quads[:, 0, :2], quads[:, 3, :2] - quads[:, 1, :2]
+        area = 0.5 * np.abs(a[:, 0] * b[:, 1] - a[:, 1] * b[:, 0]).sum()
+        assert area == pytest.approx(5 * s15.width * s15.height, rel=1e-9)
 
 
 @needs_radiance

@@ -5,7 +5,8 @@
 
 Without ``--xml`` it computes the leaf-on and leaf-off BSDFs of the Mendoza sensor dome's slat
 stack (scenario B) with ``--samples`` rays per Klems patch (cached in ``out/``). The room:
-4 m wide, 6 m deep, 3 m high, its north wall at y = 0 a 3.6 × 2.6 m window; work plane 0.8 m,
+4 m wide, 6 m deep (y from −6 to 0), 3 m high, its north wall at y = 0 a 3.6 × 2.6 m
+window looking north (towards the sun in Mendoza); work plane 0.8 m,
 1 m grid. Sky: ``gensky`` clear sky with sun for Mendoza, 22 December 12:30. Prints the
 work-plane mean with clear glazing (τ 0.8, honeybee ``Glass``) and with the window carrying
 the crown BSDF, leaf-on and leaf-off. The window polygon's normal points into the room:
@@ -52,7 +53,10 @@ def room_text(window) -> str:
     }
     mods = {m.identifier: m for m, _ in quads.values()}
     out = [m.to_radiance() for m in mods.values()]
-    out += [Polygon(name, verts, mod).to_radiance() for name, (mod, verts) in quads.items()]
+    # built with the window wall at y = 0 and the room at y > 0, then mirrored (y → −y, the
+    # vertex order reversed to keep the normals inside): the window looks north, to the sun
+    out += [Polygon(name, [(x, -y, z) for x, y, z in verts[::-1]], mod).to_radiance()
+            for name, (mod, verts) in quads.items()]
     return "\n".join(out) + "\n"
 
 
@@ -69,7 +73,7 @@ def sky_text() -> str:
 def workplane() -> bytes:
     xs = np.arange(0.5, ROOM_W, 1.0)
     ys = np.arange(0.5, ROOM_D, 1.0)
-    return "".join(f"{x} {y} 0.8 0 0 1\n" for y in ys for x in xs).encode()
+    return "".join(f"{x} {-y} 0.8 0 0 1\n" for y in ys for x in xs).encode()
 
 
 def trace(folder: Path, name: str, window) -> float:
