@@ -139,7 +139,7 @@ def test_bsdf_crown_scene_and_in_process_engines_refuse_it(tmp_path):
     assert sorted(m.name for m in shells) == [f"crown_bsdf_b{k}{h}" for k in range(3)
                                               for h in ("", "_low")]
     assert not any(m.name == "tree_leaves" for m in built.scene.meshes)
-    assert built.ab == 4
+    assert built.ab == 6
     centre = np.array([proj.sensors.x_m, 0.0, proj.sensors.height_m])
     area = 0.0
     for m in shells:
