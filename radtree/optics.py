@@ -175,7 +175,33 @@ class Hole:
         return ""
 
 
-Material = Plastic | Trans | Glass | Hole
+@dataclass(frozen=True)
+class Bsdf:
+    """A surface scattering by a measured or computed BSDF (LBNL/WINDOW XML, Klems or tensor
+    tree): ``void BSDF NAME 6 thickness xml ux uy uz . 0 0``. The surface normal points to the
+    XML's *back* side (genBSDF's +z, the room); ``up`` is the world direction of the XML's +y
+    (Radiance keeps it in the plane of the normal and ``up``). Radiance only: the in-process
+    engines refuse it."""
+
+    name: str
+    xml: str
+    up: tuple[float, float, float] = (0.0, 0.0, 1.0)
+    thickness: float = 0.0
+
+    def __post_init__(self) -> None:
+        if not self.xml.endswith(".xml"):
+            raise ValueError(f"material '{self.name}': BSDF data must be an .xml file, "
+                             f"got {self.xml!r}")
+        if not math.isfinite(self.thickness) or self.thickness < 0:
+            raise ValueError(f"material '{self.name}': thickness must be ≥ 0 m")
+
+    def to_radiance(self) -> str:
+        ux, uy, uz = (f"{v:g}" for v in self.up)
+        return (f"void BSDF {self.name}\n6 {self.thickness:g} {self.xml} {ux} {uy} {uz} .\n"
+                "0\n0\n")
+
+
+Material = Plastic | Trans | Glass | Hole | Bsdf
 
 
 def with_reflectance(material: Plastic, reflectance: float) -> Plastic:

@@ -15,6 +15,7 @@ import click
 
 from radtree import __version__
 from radtree.cli.annual import annual_command
+from radtree.cli.bsdf import bsdf_command
 from radtree.cli.build import build_command
 from radtree.cli.calibrate import calibrate_command
 from radtree.cli.diagnose import diagnose_command
@@ -59,6 +60,6 @@ def main(ctx: click.Context, debug: bool) -> None:
 main.add_command(new_command)   # radtree new (cli/new.py), apart from the tuple other branches extend
 for _command in (doctor_command, build_command, simulate_command, hemi_command, report_command,
                  calibrate_command, sweep_command, diagnose_command, annual_command,
-                 permeability_command, verify_command):
+                 permeability_command, verify_command, bsdf_command):
     main.add_command(_command)
 main.add_command(export_command)   # radtree export (cli/export.py)

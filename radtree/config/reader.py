@@ -22,6 +22,7 @@ from radtree.config.species import find_species, tree_defaults, unknown_species_
 from radtree.config.switches import (
     FIELD,
     TABLES,
+    TREE_TABLES,
     check_switches,
     known_text,
     lookup_key,
@@ -201,8 +202,7 @@ def parse_project(data: dict, path: Path) -> Project:
     filled = species_fill(tr)
     crowns = {t: _table(r, f"tree.{t}", base, **{k: v for k, v in filled.get(t, {}).items()
                                                    if not r.has(k)})
-              for t, r in ((t, tr.sub(t)) for t in ("dome", "crown", "homogeneous",
-                                                   "perforated", "louvers"))}
+              for t, r in ((t, tr.sub(t)) for t in TREE_TABLES)}
     tree = _table(tr, "tree", base, **crowns)
 
     se = top.sub("sensors")

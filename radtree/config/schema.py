@@ -17,6 +17,7 @@ from typing import Any, ClassVar
 from radtree.config.honeybee import HoneybeeSite
 from radtree.config.limits import Limits
 from radtree.config.photo import INCLINATION_DISTRIBUTIONS, drop_photo_defaults, photo_fields
+from radtree.config.bsdf import REPRESENTATIONS, CrownBsdf
 from radtree.config.spec import TIME_RE, Checked, meta
 from radtree.errors import ConfigError
 
@@ -229,6 +230,8 @@ class Tree(Checked):
     photo_distance_m: float = _PHOTO["photo_distance_m"]
     photo_height_m: float = _PHOTO["photo_height_m"]
     photo_zenith_deg: float = _PHOTO["photo_zenith_deg"]
+    representation: str = field(default="explicit", metadata=meta(choices=REPRESENTATIONS))
+    bsdf: CrownBsdf = field(default_factory=CrownBsdf)
 
 
 @dataclass(frozen=True)
@@ -415,6 +418,9 @@ class Project:
         if self.honeybee is not None:   # absent otherwise: other projects' hashes unchanged
             payload["honeybee"] = {**d["honeybee"], "sha256": self.honeybee.digest()}
         drop_photo_defaults(payload["tree"])  # photo fields at their defaults: hashes unchanged
+        for key, default in (("representation", "explicit"), ("bsdf", _plain(CrownBsdf()))):
+            if payload["tree"].get(key) == default:   # BSDF settings unused: hashes unchanged
+                payload["tree"].pop(key, None)
         payload["scenario"] = _plain(scenario)
         text = json.dumps(payload, sort_keys=True, default=str)
         return hashlib.sha256(text.encode()).hexdigest()[:12]

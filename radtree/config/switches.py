@@ -27,6 +27,7 @@ from dataclasses import dataclass, fields, replace
 from typing import Any
 
 from radtree.config.limits import Limits
+from radtree.config.bsdf import CrownBsdf
 from radtree.config.schema import (
     LOUVER_READINGS,
     Crown,
@@ -54,13 +55,13 @@ SWITCH = "switch"
 TABLES: dict[str, type] = {
     "site": Site, "street": Street, "light": Light, "tree": Tree, "tree.dome": Dome,
     "tree.crown": Crown, "tree.homogeneous": Homogeneous, "tree.perforated": Perforated,
-    "tree.louvers": Louvers, "sensors": Sensors, "engine": EngineParams, "office": Office,
-    "limits": Limits,
+    "tree.louvers": Louvers, "tree.bsdf": CrownBsdf, "sensors": Sensors, "engine": EngineParams,
+    "office": Office, "limits": Limits,
 }
 #: Tables whose fields a scenario switch replaces through :func:`effective_project`.
 PROJECT_SWITCH_SECTIONS = ("site", "street", "light", "sensors", "engine")
 #: The crown tables of ``[tree]`` (switch keys may start with them instead of ``tree.``).
-TREE_TABLES = ("dome", "crown", "homogeneous", "perforated", "louvers")
+TREE_TABLES = ("dome", "crown", "homogeneous", "perforated", "louvers", "bsdf")
 #: ``reflection.ground``: the street under the crown's shade, or the open street.
 REFLECTION_GROUNDS = ("shaded", "open")
 #: ``reflection.view_factor``: a street of the canyon's width, or an unbounded ground (0.5).

@@ -90,9 +90,10 @@ def make_scene(project: Project, scenario: Scenario, dense_grid: bool | None = N
     info: dict[str, float] = {}
     tree = None
     if scenario.model != "none":
+        from radtree.pipeline.crown_bsdf import bsdf_crown
         from radtree.trees.build import build_tree
 
-        tree = build_tree(project, scenario, frame)
+        tree = bsdf_crown(project, scenario, frame) or build_tree(project, scenario, frame)
         clash = set(tree.materials) & set(materials)
         if clash:
             raise RadtreeError(f"crown model materials clash with the street's: {clash}")

@@ -198,7 +198,9 @@ def _optics(scene: Scene, state: SkyState, names: list[str]) -> _Optics:
         elif isinstance(m, Hole):  # pragma: no cover - holes are removed with solid_meshes()
             ts[i] = 1.0
         else:  # pragma: no cover
-            raise EngineError(f"material '{name}' of type {type(m).__name__} is not supported")
+            raise EngineError(f"material '{name}' of type {type(m).__name__} is not supported "
+                              "by the in-process engines (a BSDF crown, [tree] representation"
+                              " = \"bsdf\", is Radiance only: use --engine radiance)")
     return _Optics(rd, td, ts, rm, tn)
 
 

@@ -1,0 +1,52 @@
+"""``[tree.bsdf]``: how the crown layer's BSDF is computed and used (``[tree] representation``).
+
+``representation = "explicit"`` (default) traces the crown's slats; ``"bsdf"`` replaces the
+sensor dome (or the free crowns' envelopes) by a shell carrying the crown layer's Klems BSDF
+(Radiance ``BSDF`` material; the NumPy and forward engines refuse it with a clear error).
+
+rfluxmtx sampling: ``samples`` rays per Klems patch (``-c``), ``ab`` (0: the crown model's
+recommendation), ``ad``, ``lw``; ``tiles`` × ``tiles`` periodic copies of the sample cell.
+``bands``: the sensor dome's shell is cut into this many elevation bands of equal width
+(|elevation| 0–90°, the lower half mirrored), each with the BSDF of the slats as tilted at the
+band's middle elevation (the dome's slats turn with elevation); ``bands = 1``: one BSDF, the
+slats as tilted where the shell is seen ``elevation_deg`` above the horizon. ``depth_m`` (free crowns): slab depth per crossing
+of the envelope (0: the crown's vertical semi-axis, so the two crossings of a vertical line
+through the centre add up to the crown's height). ``tensor_tree``: 0, or the log2 resolution
+of an extra rank-4 tensor-tree XML. ``xml``: use this leaf-on XML instead of computing it
+(computed XMLs are cached under ``build/bsdf/<scenario>/``).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import ClassVar
+
+from radtree.config.spec import Checked, SchemaError, meta
+
+REPRESENTATIONS = ("explicit", "bsdf")
+
+
+@dataclass(frozen=True)
+class CrownBsdf(Checked):
+    """The crown BSDF's sampling and files (see the module text); lengths m, angles degrees."""
+
+    TABLE: ClassVar[str] = "tree.bsdf"
+    samples: int = field(default=500, metadata=meta(1, 100000))
+    ab: int = field(default=0, metadata=meta(0, 20))
+    ad: int = field(default=2, metadata=meta(1, 100000))
+    lw: float = field(default=1e-3, metadata=meta(0.0, 1.0, lo_open=True))
+    tiles: int = field(default=9, metadata=meta(1, 41))
+    elevation_deg: float = field(default=30.0, metadata=meta(0.0, 90.0))
+    bands: int = field(default=3, metadata=meta(1, 9))
+    depth_m: float = field(default=0.0, metadata=meta(0.0, 50.0))
+    tensor_tree: int = field(default=0, metadata=meta(0, 6))
+    xml: Path | None = None
+
+    def check(self) -> None:
+        if self.tiles % 2 == 0:
+            raise SchemaError(f"got {self.tiles}, expected an odd number (a centre cell)",
+                              "tree.bsdf.tiles")
+        if self.tensor_tree not in (0, 4, 5, 6):
+            raise SchemaError(f"got {self.tensor_tree}, expected 0 or 4–6",
+                              "tree.bsdf.tensor_tree")

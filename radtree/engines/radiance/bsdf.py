@@ -1,0 +1,220 @@
+"""A crown layer's BSDF with Radiance: rfluxmtx over Klems hemispheres → wrapBSDF → checkBSDF.
+
+The recipe is genBSDF's (Radiance ``src/util/genBSDF.pl``, Klems branch), written out here
+as argument lists because the pyradiance wheel ships rfluxmtx, rmtxop, wrapBSDF and
+checkBSDF but not the genBSDF script:
+
+* the system lies in ``z ≤ 0``, +z into the room (inside), width along x, height along y;
+* the **front sender** is a polygon just outside the sample (``z = z_min − ε``, normal −z)
+  with ``#@rfluxmtx u=-Y h=-kf``; the **back sender** just inside (``z = z_max + ε``,
+  normal +z) with ``h=+kf``;
+* the receivers are the two hemispheres of the sky as ``glow`` sources: ``receiver_face``
+  (towards +z, ``h=-kf``, output ``face.dat``) and ``receiver_behind`` (towards −z,
+  ``h=+kf``, ``behind.dat``);
+* front pass: ``face.dat`` → T_f, ``behind.dat`` → R_f; back pass: ``behind.dat`` → T_b,
+  ``face.dat`` → R_b; each transposed to photopic Y with ``rmtxop -fa -t -c 0.2651 0.6701
+  0.0648`` and wrapped with ``wrapBSDF -a kf -c`` (``-c``: rfluxmtx gives flux factors,
+  wrapBSDF divides by the projected solid angle to get BSDF values).
+
+Unlike genBSDF the sample is one periodic cell tiled ``tiles`` × ``tiles`` times as Radiance
+``instance``s of the cell octree; the senders cover the centre cell only, so light may move
+sideways through the layer by up to (tiles − 1)/2 cells before it leaves the tiled area.
+The optional tensor tree (``h=-sc<2^N>``, ``rttree_reduce``) follows genBSDF's ``-t4``.
+"""
+
+from __future__ import annotations
+
+import os
+import time
+from collections.abc import Callable
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from radtree.engines.radiance.binaries import run
+from radtree.errors import EngineError
+from radtree.fileio import write_text
+from radtree.optics import Material
+
+EPS = 1e-5
+#: photopic Y of Radiance RGB (the weights genBSDF passes to rmtxop -c)
+Y_WEIGHTS = ("0.2651", "0.6701", "0.0648")
+
+
+@dataclass(frozen=True)
+class FluxSettings:
+    """rfluxmtx sampling: ``samples`` rays per Klems patch (``-c``), ``ab``, ``ad``, ``lw``;
+    ``tiles`` × ``tiles`` periodic copies of the cell; ``tensor_tree`` = 0 (Klems only) or
+    the log2 resolution of an additional anisotropic tensor tree (genBSDF ``-t4 N``)."""
+
+    samples: int = 500
+    ab: int = 6
+    ad: int = 2
+    lw: float = 1e-3
+    tiles: int = 9
+    nproc: int = 1
+    tensor_tree: int = 0
+
+    def __post_init__(self) -> None:
+        if self.samples < 1 or self.ab < 0 or self.ad < 1 or not self.lw > 0:
+            raise ValueError("rfluxmtx settings: samples ≥ 1, ab ≥ 0, ad ≥ 1, lw > 0")
+        if self.tiles < 1 or self.tiles % 2 == 0:
+            raise ValueError(f"tiles must be odd (a centre cell), got {self.tiles}")
+        if self.tensor_tree not in (0, 4, 5, 6):
+            raise ValueError(f"tensor_tree must be 0 or 4–6, got {self.tensor_tree}")
+
+    def options(self) -> list[str]:
+        """rfluxmtx options: ``-u-`` (correlated sampling: the same system and options give
+        the same matrices), the ambient settings, ``-w-``, ``-n`` and ``-c``."""
+        return ["-u-", "-ab", str(self.ab), "-ad", str(self.ad), "-lw", f"{self.lw:g}", "-w-",
+                "-n", str(self.nproc), "-c", str(self.samples)]
+
+
+@dataclass
+class BsdfRun:
+    """What one sample's run wrote: the XML, checkBSDF's report and the seconds taken."""
+
+    xml: Path
+    check: str
+    seconds: float
+    tensor_xml: Path | None = None
+
+
+def _polygon(mat: str, name: str, corners: np.ndarray) -> str:
+    coords = "\n".join("\t" + " ".join(f"{v:.6g}" for v in c) for c in corners)
+    return f"{mat} polygon {name}\n0\n0\n{3 * len(corners)}\n{coords}\n"
+
+
+def cell_text(polygons: dict[str, np.ndarray], materials: dict[str, Material]) -> str:
+    """The cell: its materials and every polygon (``MAT polygon MAT.i``)."""
+    out = ["# one periodic cell of the crown layer (radtree.trees.slab)\n"]
+    out += [materials[name].to_radiance() for name in polygons]
+    for name, polys in polygons.items():
+        out += [_polygon(name, f"{name}.{i}", p) for i, p in enumerate(polys)]
+    return "\n".join(out)
+
+
+def tiles_text(width: float, height: float, tiles: int, octree: str = "cell.oct") -> str:
+    """``tiles`` × ``tiles`` instances of the cell octree, centred on the cell at the origin."""
+    k = tiles // 2
+    out = [f"# {tiles} x {tiles} periodic copies of {octree}\n"]
+    for i in range(-k, k + 1):
+        for j in range(-k, k + 1):
+            out.append(f"void instance tile.{i + k}.{j + k}\n5 {octree} -t "
+                       f"{i * width:.6g} {j * height:.6g} 0\n0\n0\n")
+    return "\n".join(out)
+
+
+def receivers_text(hemi: str = "kf") -> str:
+    """genBSDF's two receiver hemispheres (``face.dat`` towards +z, ``behind.dat`` −z)."""
+    return (f"#@rfluxmtx h=-{hemi}\n#@rfluxmtx u=-Y o=face.dat\n\n"
+            "void glow receiver_face\n0\n0\n4 1 1 1 0\n\n"
+            "receiver_face source f_receiver\n0\n0\n4 0 0 1 180\n\n"
+            f"#@rfluxmtx h=+{hemi}\n#@rfluxmtx u=-Y o=behind.dat\n\n"
+            "void glow receiver_behind\n0\n0\n4 1 1 1 0\n\n"
+            "receiver_behind source b_receiver\n0\n0\n4 0 0 -1 180\n")
+
+
+def sender_text(front: bool, width: float, height: float, z: float, hemi: str = "kf") -> str:
+    """The front (outside, normal −z, ``h=-kf``) or back (inside, +z, ``h=+kf``) sender over
+    the centre cell [0, width] × [0, height] at depth ``z``."""
+    if front:
+        corners = np.array([[0, 0, z], [0, height, z], [width, height, z], [width, 0, z]])
+        return f"#@rfluxmtx u=-Y h=-{hemi}\n\n" + _polygon("void", "fwd_sender", corners)
+    corners = np.array([[0, 0, z], [width, 0, z], [width, height, z], [0, height, z]])
+    return f"#@rfluxmtx u=-Y h=+{hemi}\n\n" + _polygon("void", "bwd_sender", corners)
+
+
+def write_system(folder: Path, polygons: dict[str, np.ndarray], materials: dict[str, Material],
+                 width: float, height: float, thickness: float, tiles: int) -> None:
+    """cell.rad → cell.oct, tiles.rad → system.oct, senders and receivers in ``folder``."""
+    folder.mkdir(parents=True, exist_ok=True)
+    write_text(folder / "cell.rad", cell_text(polygons, materials))
+    run(["oconv", "cell.rad"], cwd=folder, stdout_path=folder / "cell.oct")
+    write_text(folder / "tiles.rad", tiles_text(width, height, tiles))
+    run(["oconv", "tiles.rad"], cwd=folder, stdout_path=folder / "system.oct")
+    write_text(folder / "receivers.rad", receivers_text())
+    write_text(folder / "fsender.rad", sender_text(True, width, height, -thickness - EPS))
+    write_text(folder / "bsender.rad", sender_text(False, width, height, EPS))
+
+
+def _to_y(folder: Path, src: str, dest: str) -> None:
+    """rmtxop -fa -t -c (photopic Y) of an rfluxmtx output, header removed (getinfo -)."""
+    data = run(["rmtxop", "-fa", "-t", "-c", *Y_WEIGHTS, src], cwd=folder)
+    body = run(["getinfo", "-"], stdin=data, cwd=folder)
+    (folder / dest).write_bytes(body)
+
+
+def flux_commands(settings: FluxSettings) -> list[list[str]]:
+    """The two rfluxmtx runs (front, back) as argument lists (run in the sample folder)."""
+    return [["rfluxmtx", *settings.options(), "-fd", sender, "receivers.rad", "-i",
+             "system.oct"] for sender in ("fsender.rad", "bsender.rad")]
+
+
+def klems_bsdf(folder: Path, settings: FluxSettings, name: str, thickness: float,
+               width: float, height: float, comment: str = "",
+               progress: Callable[[str], None] | None = None) -> BsdfRun:
+    """Run both rfluxmtx passes in ``folder`` (after :func:`write_system`) and wrap the four
+    Klems matrices into ``folder/<name>.xml``; checkBSDF must accept it."""
+    t0 = time.perf_counter()
+    parts: list[str] = []
+    for cmd, (trans, refl, tkey, rkey) in zip(flux_commands(settings), (
+            ("face.dat", "behind.dat", "tf", "rf"), ("behind.dat", "face.dat", "tb", "rb"))):
+        if progress:
+            progress(" ".join(cmd))
+        run(cmd, cwd=folder)
+        _to_y(folder, trans, f"{tkey}.dat")
+        _to_y(folder, refl, f"{rkey}.dat")
+        parts += [f"-{tkey}", f"{tkey}.dat", f"-{rkey}", f"{rkey}.dat"]
+    fields = f"t={thickness:.6g};w={width:.6g};h={height:.6g};n={name};m=radtree"
+    argv = ["wrapBSDF", "-a", "kf", "-c", "-u", "meter", "-f", fields, *parts]
+    if comment:
+        argv += ["-C", comment]
+    xml = folder / f"{name}.xml"
+    tmp = xml.with_name(xml.name + ".tmp")
+    run(argv, cwd=folder, stdout_path=tmp)
+    os.replace(tmp, xml)
+    return BsdfRun(xml, check_bsdf(xml), time.perf_counter() - t0)
+
+
+def check_bsdf(xml: Path) -> str:
+    """checkBSDF's report of ``xml``; an XML it rejects raises :class:`EngineError`."""
+    text = run(["checkBSDF", str(xml)]).decode(errors="replace")
+    if "Component" not in text:
+        raise EngineError(f"checkBSDF rejected {xml}", command=["checkBSDF", str(xml)],
+                          stderr=text)
+    return text
+
+
+def tensor_tree_bsdf(folder: Path, settings: FluxSettings, name: str, thickness: float,
+                     width: float, height: float) -> Path:
+    """A rank-4 tensor tree (genBSDF ``-t4``) beside the Klems XML: rfluxmtx over
+    Shirley–Chiu square bins ``h=±sc<2^N>``, rttree_reduce, wrapBSDF ``-a t4``."""
+    ns = 2 ** settings.tensor_tree
+    write_text(folder / "tt_receivers.rad", receivers_text(f"sc{ns}").replace(
+        "o=face.dat", "o=tt_face.dat").replace("o=behind.dat", "o=tt_behind.dat"))
+    write_text(folder / "tt_fsender.rad", sender_text(True, width, height, -thickness - EPS,
+                                                      f"sc{ns}"))
+    write_text(folder / "tt_bsender.rad", sender_text(False, width, height, EPS, f"sc{ns}"))
+    parts: list[str] = []
+    omega = f"Omega:PI/({ns}*{ns})"
+    for sender, (trans, refl, tkey, rkey) in (
+            ("tt_fsender.rad", ("tt_face.dat", "tt_behind.dat", "tf", "rf")),
+            ("tt_bsender.rad", ("tt_behind.dat", "tt_face.dat", "tb", "rb"))):
+        run(["rfluxmtx", *settings.options(), "-h", "-ff", sender, "tt_receivers.rad", "-i",
+             "system.oct"], cwd=folder)
+        for src, key, avg in ((trans, tkey, []), (refl, rkey, ["-a"])):
+            y = run(["rcalc", "-if3", "-e", omega, "-e", "Ri=$1;Gi=$2;Bi=$3",
+                     "-e", f"Yi={Y_WEIGHTS[0]}*Ri+{Y_WEIGHTS[1]}*Gi+{Y_WEIGHTS[2]}*Bi",
+                     "-e", "$1=Yi/Omega", "-of", src], cwd=folder)
+            tree = run(["rttree_reduce", *avg, "-h", "-ff", "-t", "90", "-r", "4", "-g",
+                        str(settings.tensor_tree)], stdin=y, cwd=folder)
+            (folder / f"tt_{key}.dat").write_bytes(tree)
+            parts += [f"-{key}", f"tt_{key}.dat"]
+    fields = f"t={thickness:.6g};w={width:.6g};h={height:.6g};n={name};m=radtree"
+    xml = folder / f"{name}_t4.xml"
+    run(["wrapBSDF", "-a", "t4", "-u", "meter", "-f", fields, *parts], cwd=folder,
+        stdout_path=xml)
+    check_bsdf(xml)
+    return xml

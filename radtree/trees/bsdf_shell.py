@@ -1,0 +1,107 @@
+"""The BSDF representation of a crown (``[tree] representation = "bsdf"``): the sensor dome or
+the free crowns' envelopes as a shell of the Radiance ``BSDF`` material, no slats.
+
+The shell's normals point inwards (to the sensors, inside the crown): the XML's back side,
+genBSDF's +z. Its up vector is world +z, so the XML's +y (the planar sample's "up", towards
+higher elevation on the dome) follows the shell's upward tangent, as the dome's slats are tilted
+about the horizontal tangent. The dome's slats turn with elevation, so its shell is cut into
+elevation bands, each carrying the BSDF of the slats as tilted at its middle; below the
+horizon the slats are mirrored (tilted towards lower elevations), so the lower half carries
+the same XMLs with up −z. The XML is computed by :mod:`radtree.pipeline.crown_bsdf` (or
+given as ``tree.bsdf.xml``); this module only builds the geometry.
+
+Free crowns: the envelope is closed, so light reaching the façade through a crown crosses the
+shell twice (in and out); the slab behind the XML is one crossing's depth
+(``tree.bsdf.depth_m``, default the vertical semi-axis).
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from radtree.config import Sensors, Street, Tree
+from radtree.optics import Bsdf, Plastic
+from radtree.scene import Mesh
+from radtree.site.frame import FacadeFrame
+from radtree.trees.envelope import crown_row_spec, dome_notes, dome_spec, icosphere_level, row_notes
+from radtree.trees.model import BARK_REFLECTANCE, TRUNK, TreeModel
+
+BSDF_SHELL = "crown_bsdf"
+
+
+def inward(verts: np.ndarray, faces: np.ndarray, centre: np.ndarray) -> np.ndarray:
+    """``faces`` re-wound so every triangle's normal points towards ``centre``."""
+    t = verts[faces]
+    n = np.cross(t[:, 1] - t[:, 0], t[:, 2] - t[:, 0])
+    out = np.einsum("ij,ij->i", n, t.mean(axis=1) - centre) > 0
+    faces = faces.copy()
+    faces[out] = faces[out][:, ::-1]
+    return faces
+
+
+def dome_bands(verts: np.ndarray, faces: np.ndarray, centre: np.ndarray,
+               bands: list[tuple[float, float, Path]]
+               ) -> list[tuple[str, Bsdf, np.ndarray]]:
+    """(material name, material, faces) per elevation band and half: a triangle belongs to
+    the band of its centroid's |elevation| seen from ``centre``; the upper half carries the
+    XML with up +z, the lower half the same XML with up −z (the dome's slats are mirrored
+    there: tilted towards lower elevations)."""
+    c = verts[faces].mean(axis=1) - centre
+    el = np.degrees(np.arctan2(c[:, 2], np.hypot(c[:, 0], c[:, 1])))
+    out = []
+    for k, (lo, hi, xml) in enumerate(bands):
+        last = k == len(bands) - 1
+        inside = (np.abs(el) >= lo) & ((np.abs(el) <= hi) if last else (np.abs(el) < hi))
+        for half, up, sel in (("", (0.0, 0.0, 1.0), el >= 0), ("_low", (0.0, 0.0, -1.0),
+                                                               el < 0)):
+            pick = inside & sel
+            if np.any(pick):
+                name = f"{BSDF_SHELL}{'' if len(bands) == 1 else f'_b{k}'}{half}"
+                out.append((name, Bsdf(name, str(Path(xml).resolve()), up), faces[pick]))
+    return out
+
+
+def build_bsdf_crown(tree: Tree, sensors: Sensors, street: Street, frame: FacadeFrame,
+                     form: str, bands: list[tuple[float, float, Path]], recommended_ab: int,
+                     source: str | None = None) -> TreeModel:
+    """The crown of ``form`` as a BSDF shell; ``bands``: (lowest, highest |elevation| in
+    degrees, XML) — the dome's elevation bands, one band for free crowns."""
+    xml = bands[0][2]
+    materials: dict = {}
+    meshes: list[Mesh] = []
+    notes: list[str] = []
+    if form == "dome":
+        spec = dome_spec(tree, sensors, street, source)
+        verts, faces = spec.shell(max(3, spec.segments // 4))
+        verts = frame.to_world(verts)
+        centre = frame.to_world(spec.centre[None, :])[0]
+        for name, mat, fs in dome_bands(verts, inward(verts, faces, centre), centre, bands):
+            materials[name] = mat
+            meshes.append(Mesh(name, name, verts, fs))
+        notes.extend(dome_notes(spec))
+        info = {"dome_radius_m": spec.radius, "bsdf_bands": float(len(bands))}
+    else:
+        materials[BSDF_SHELL] = Bsdf(BSDF_SHELL, str(Path(xml).resolve()))
+        spec_r = crown_row_spec(tree, sensors, street, source)
+        level = icosphere_level(360.0 / tree.crown.segments)
+        parts = []
+        for i in range(spec_r.count):
+            v, f, _ = spec_r.envelope(i, level)
+            v = frame.to_world(v)
+            inner = frame.to_world(spec_r.hull_point(i)[None, :])[0]
+            parts.append(Mesh(f"{BSDF_SHELL}_{i}", BSDF_SHELL, v, inward(v, f, inner)))
+        meshes.append(Mesh.merge(BSDF_SHELL, BSDF_SHELL, parts))
+        tv, tf = spec_r.trunks()
+        materials[TRUNK] = Plastic(TRUNK, BARK_REFLECTANCE)
+        meshes.append(Mesh("tree_trunks", TRUNK, frame.to_world(tv), tf))
+        notes.extend(row_notes(spec_r, tree, sensors))
+        info = {"clip_plane_n_m": spec_r.n_clip}
+    notes.append(f"Representation: BSDF — the crown is a shell of the Radiance BSDF material "
+                 f"({', '.join(Path(b[2]).name for b in bands)}, Klems 145 × 145), the planar "
+                 "periodic sample of its slat layer; no slats are traced. A BSDF moves light only in direction, not "
+                 "sideways: light entering a thick layer at one place leaves it at the same place.")
+    info["area_m2"] = float(sum(m.area() for m in meshes if m.material.startswith(BSDF_SHELL)))
+    return TreeModel(meshes=meshes, materials=materials, notes=notes,
+                     recommended_ab=recommended_ab, info=info, form=form, model="louvers")

@@ -1,0 +1,210 @@
+"""Planar periodic samples of a crown layer, for its BSDF (:mod:`radtree.bsdf`).
+
+A sample is one periodic cell, ``width`` × ``height`` m in x (horizontal tangent) and y
+("up"), of the crown layer, lying in ``-thickness ≤ z ≤ 0``. The Radiance BSDF convention
+(genBSDF's) holds: +z points to the *inside* (the room, the sensors), the exterior is −z. The
+engine tiles the cell periodically (every slat has its copies one period away) and samples
+the centre cell, so light may wander sideways up to the tiled margin.
+
+* :func:`dome_slab` — the sensor dome's slat shells as planar layers at the dome's layer
+  spacing: the same slat size, cover, optics and shear along the branches; slats tilted
+  about the horizontal tangent as the dome's slats are where the shell is seen at
+  ``elevation_deg`` from the dome centre (:func:`radtree.trees.louvers_dome.slat_normals`).
+  Rows are one slat high *as seen along the layer normal* (the dome's rows are one slat high
+  seen from the centre), so with cover 1 every normal line crosses every layer once.
+* :func:`volume_slab` — the free crowns' volume arrangement: slats at random through a slab of
+  ``depth`` m at the crown's fitted density ρ (:func:`radtree.trees.volume.volume_density`),
+  normals inclined α at random azimuths.
+* :func:`branch_slab` — the leaf-off state: opaque bark sticks at the branch inclination, as
+  many as give a vertical (plan-view) cover ``cover`` (Poisson: cover = 1 − exp(−Σ l·d·cos β / A)).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from radtree.config import Louvers, Sensors, Street, Tree
+from radtree.errors import ConfigError
+from radtree.optics import Material, Plastic
+from radtree.trees.envelope import dome_spec
+from radtree.trees.louvers import LouverOptics
+from radtree.trees.louvers_dome import dome_layer_radii, slat_normals
+from radtree.trees.model import BARK_REFLECTANCE, LEAF, TRUNK
+from radtree.trees.volume import _slat_corners, volume_density
+
+#: slats per cell side (at cover 1) of the periodic cell: the period is ~8 slats
+CELL_SLATS = 8
+
+
+@dataclass
+class SlabSample:
+    """One periodic cell: polygons (k, 4, 3) per material name, in metres (see module text)."""
+
+    name: str
+    polygons: dict[str, np.ndarray]
+    materials: dict[str, Material]
+    width: float
+    height: float
+    thickness: float
+    notes: list[str] = field(default_factory=list)
+    info: dict[str, float] = field(default_factory=dict)
+
+    def __post_init__(self) -> None:
+        for name, poly in self.polygons.items():
+            if name not in self.materials:
+                raise ValueError(f"slab '{self.name}': polygons of undefined material {name!r}")
+            if poly.ndim != 3 or poly.shape[1:] != (4, 3):
+                raise ValueError(f"slab '{self.name}': polygons must be (k, 4, 3)")
+        if not (self.width > 0 and self.height > 0 and self.thickness > 0):
+            raise ValueError(f"slab '{self.name}': width, height and thickness must be > 0")
+
+    @property
+    def count(self) -> int:
+        return sum(len(p) for p in self.polygons.values())
+
+
+def _to_back(polygons: dict[str, np.ndarray], margin: float = 1e-3
+             ) -> tuple[dict[str, np.ndarray], float]:
+    """Shift every polygon so the sample's front (largest z) is ``margin`` behind z = 0;
+    returns the shifted polygons and the thickness (|lowest z|)."""
+    allz = np.concatenate([p[..., 2].ravel() for p in polygons.values() if len(p)])
+    dz = -float(allz.max()) - margin
+    out = {k: p + np.array([0.0, 0.0, dz]) for k, p in polygons.items()}
+    return out, float(-(allz.min() + dz))
+
+
+def dome_slab(tree: Tree, sensors: Sensors, street: Street, elevation_deg: float = 30.0,
+              source: str | None = None) -> SlabSample:
+    """The dome's slat shells as a planar periodic stack (see the module text)."""
+    lv = tree.louvers
+    spec = dome_spec(tree, sensors, street, source)
+    radii = dome_layer_radii(spec, lv, sensors, source)
+    s, f = lv.slat_size_m, lv.cover_fraction
+    el = math.radians(elevation_deg)
+    d = np.array([[0.0, math.cos(el), math.sin(el)]])        # outward, seen from the centre
+    up = np.array([0.0, -math.sin(el), math.cos(el)])        # towards higher elevation
+    m, c = slat_normals(d, lv.inclination_deg)
+    m_local = np.array([m[0, 0], float(m[0] @ up), -float(m[0] @ d[0])])   # outward = −z
+    c0 = float(c[0])
+    # the slat's second side: in the slat plane, perpendicular to x
+    e2 = np.cross(m_local, [1.0, 0.0, 0.0])
+    e2 /= np.linalg.norm(e2)
+    e2 *= np.sign(e2[1]) or 1.0
+    e1 = np.array([1.0, 0.0, 0.0])
+    pitch_y = s * abs(e2[1])                                 # a row is one slat high, seen along z
+    cell_x = s / f
+    nx = CELL_SLATS
+    ny = max(2, int(round(CELL_SLATS * s / pitch_y)))
+    width, height = nx * cell_x, ny * pitch_y
+    tanb = math.tan(math.radians(lv.branch_inclination_deg))
+    rng_root = np.random.SeedSequence(lv.seed)
+    layers = []
+    for k, child in enumerate(rng_root.spawn(len(radii))):
+        rng = np.random.default_rng(child)
+        z = -(float(radii[k]) - float(radii[0]))
+        offset = rng.uniform(0.0, 1.0)
+        for j in range(ny):
+            if j > 0:
+                offset = (offset + c0 * f / tanb + rng.uniform(-0.25, 0.25)) % 1.0
+            left = (offset + np.arange(nx)) * cell_x
+            if f < 1.0:
+                left = left + rng.uniform(0.0, (1.0 - f) * cell_x, nx)
+            xc = left + 0.5 * s
+            yc = (j + 0.5) * pitch_y
+            centres = np.stack([xc, np.full(nx, yc), np.full(nx, z)], axis=1)
+            h1 = np.array([-0.5, 0.5, 0.5, -0.5]) * s
+            h2 = np.array([-0.5, -0.5, 0.5, 0.5]) * s
+            layers.append(centres[:, None, :] + h1[None, :, None] * e1 + h2[None, :, None] * e2)
+    quads = np.concatenate(layers)
+    depth = 0.5 * s * abs(e2[2])
+    spacing = float(radii[1] - radii[0]) if len(radii) > 1 else float("inf")
+    if depth >= 0.5 * spacing:
+        raise ConfigError(f"slat layers would touch in the planar sample (slat depth ±{depth:.2f}"
+                          f" m, layers {spacing:.2f} m apart)", source=source,
+                          field="tree.louvers.layers")
+    polys, thickness = _to_back({LEAF: quads})
+    optics = LouverOptics.of(lv)
+    notes = [f"Planar sample of the dome's {lv.layers} slat shells: layers "
+             f"{spacing if len(radii) > 1 else 0:.3f} m apart (the dome's radii "
+             f"{radii[0]:.2f}–{radii[-1]:.2f} m), slats {s:g} m, cover {f:g}, tilted "
+             f"{math.degrees(math.acos(min(1.0, c0))):.1f}° from the layer normal (the dome's "
+             f"slats where the shell is seen {elevation_deg:g}° above the horizon); periodic "
+             f"cell {width:.2f} × {height:.2f} m, {len(quads)} slats. "
+             + optics.describe() + "."]
+    info = {"layers": float(lv.layers), "layer_spacing_m": spacing if len(radii) > 1 else 0.0,
+            "slat_tilt_deg": math.degrees(math.acos(min(1.0, c0))),
+            "elevation_deg": elevation_deg, "slats": float(len(quads)),
+            "tau_crown_direct": optics.tau_crown_direct}
+    return SlabSample("dome_leaf_on", polys, {LEAF: optics.material()}, width, height,
+                      thickness, notes, info)
+
+
+def volume_slab(lv: Louvers, vertical_semi_axis_m: float, depth_m: float,
+                source: str | None = None) -> SlabSample:
+    """Slats at random through a slab of ``depth_m`` at the fitted crown density ρ."""
+    if not depth_m > 0:
+        raise ConfigError(f"got {depth_m}, expected a positive slab depth", source=source,
+                          field="tree.bsdf.depth_m")
+    s = lv.slat_size_m
+    rho = volume_density(lv, vertical_semi_axis_m)
+    width = height = CELL_SLATS * s
+    n = int(round(rho * width * height * depth_m))
+    if n < 1:
+        raise ConfigError(f"a slab of {depth_m:g} m holds no slat at density {rho:.2f} m⁻³",
+                          source=source, field="tree.bsdf.depth_m")
+    rng = np.random.default_rng(np.random.SeedSequence(lv.seed))
+    centres = rng.random((n, 3)) * [width, height, depth_m] - [0.0, 0.0, depth_m]
+    phi = rng.uniform(0.0, 2.0 * math.pi, n)
+    quads = _slat_corners(centres, phi, s, math.radians(lv.inclination_deg))
+    # the slab lies in the horizontal crown: its normal (z here) is the crown's vertical,
+    # so slat normals inclined α from vertical are inclined α from the slab normal
+    polys, thickness = _to_back({LEAF: quads})
+    optics = LouverOptics.of(lv)
+    lam = rho * s * s * math.cos(math.radians(lv.inclination_deg)) * depth_m
+    notes = [f"Planar slab of the volume crown: {n} slats of {s:g} m at the fitted density "
+             f"{rho:.2f} m⁻³ through {depth_m:.2f} m (normal line crosses {lam:.2f} slats on "
+             f"average), normals {lv.inclination_deg:g}° from the slab normal at random "
+             f"azimuths; periodic cell {width:.2f} × {height:.2f} m. "
+             + optics.describe_slat() + "."]
+    info = {"density_per_m3": rho, "depth_m": depth_m, "slats": float(n),
+            "normal_crossings": lam,
+            "tau_normal_direct": math.exp(-lam * (1.0 - optics.t_specular))}
+    return SlabSample("volume_leaf_on", polys, {LEAF: optics.material()}, width, height,
+                      thickness, notes, info)
+
+
+def branch_slab(cover: float, depth_m: float, inclination_deg: float, diameter_m: float,
+                seed: int = 1, cell_m: float = 2.4) -> SlabSample:
+    """Leaf-off: opaque square-section bark sticks (length one cell) at ``inclination_deg``
+    from the slab plane, random azimuths, with plan-view cover ``cover`` (0 < cover < 1)."""
+    if not 0.0 < cover < 1.0:
+        raise ConfigError(f"got branch cover {cover}, expected between 0 and 1",
+                          field="tree.bsdf.leaf_off")
+    beta = math.radians(inclination_deg)
+    length = min(cell_m, depth_m / max(math.sin(beta), 1e-3))
+    per_stick = length * math.cos(beta) * diameter_m
+    n = max(1, int(round(-math.log(1.0 - cover) * cell_m * cell_m / per_stick)))
+    rng = np.random.default_rng(np.random.SeedSequence(seed))
+    z0 = depth_m * rng.random(n) * (1.0 - length * math.sin(beta) / depth_m) - depth_m
+    start = np.stack([rng.random(n) * cell_m, rng.random(n) * cell_m, z0], axis=1)
+    phi = rng.uniform(0.0, 2.0 * math.pi, n)
+    axis = np.stack([np.cos(phi) * math.cos(beta), np.sin(phi) * math.cos(beta),
+                     np.full(n, math.sin(beta))], axis=1)
+    side1 = np.cross(axis, [0.0, 0.0, 1.0])
+    side1 /= np.linalg.norm(side1, axis=1)[:, None]
+    side2 = np.cross(axis, side1)
+    faces = []
+    half = 0.5 * diameter_m
+    for a, b in ((side1, side2), (side2, -side1), (-side1, -side2), (-side2, side1)):
+        p0 = start + half * (a + b)
+        p1 = start + half * (a - b)
+        faces.append(np.stack([p0, p1, p1 + length * axis, p0 + length * axis], axis=1))
+    polys, thickness = _to_back({TRUNK: np.concatenate(faces)})
+    notes = [f"Leaf-off slab: {n} opaque bark sticks (ρ {BARK_REFLECTANCE:g}) of "
+             f"{diameter_m * 100:.0f} cm × {length:.2f} m at {inclination_deg:g}° through "
+             f"{depth_m:.2f} m, plan-view cover {100 * cover:.1f} % (the bare crown's)."]
+    return SlabSample("leaf_off", polys, {TRUNK: Plastic(TRUNK, BARK_REFLECTANCE)}, cell_m,
+                      cell_m, thickness, notes, {"branch_cover": cover, "sticks": float(n)})
