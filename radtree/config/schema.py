@@ -14,10 +14,10 @@ from dataclasses import dataclass, field, fields, is_dataclass
 from pathlib import Path
 from typing import Any, ClassVar
 
+from radtree.config.bsdf import REPRESENTATIONS, CrownBsdf
 from radtree.config.honeybee import HoneybeeSite
 from radtree.config.limits import Limits
 from radtree.config.photo import INCLINATION_DISTRIBUTIONS, drop_photo_defaults, photo_fields
-from radtree.config.bsdf import REPRESENTATIONS, CrownBsdf
 from radtree.config.spec import TIME_RE, Checked, meta
 from radtree.errors import ConfigError
 

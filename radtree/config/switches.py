@@ -26,8 +26,8 @@ from collections.abc import Iterable
 from dataclasses import dataclass, fields, replace
 from typing import Any
 
-from radtree.config.limits import Limits
 from radtree.config.bsdf import CrownBsdf
+from radtree.config.limits import Limits
 from radtree.config.schema import (
     LOUVER_READINGS,
     Crown,

@@ -14,7 +14,7 @@ import numpy as np
 import trimesh
 
 from radtree.fileio import atomic_path
-from radtree.optics import Glass, Material, Trans
+from radtree.optics import Bsdf, Glass, Material, Trans
 from radtree.scene import Scene
 
 
@@ -22,7 +22,7 @@ def material_rgba(material: Material) -> list[int]:
     """Display colour (RGBA 0–255) of a material."""
     if isinstance(material, Glass):
         return [150, 200, 235, 110]
-    if isinstance(material, Trans):
+    if isinstance(material, Trans | Bsdf):     # a leaf, or a crown shell carrying its BSDF
         return [70, 140, 60, 230]
     g = int(round(60 + 195 * float(material.reflectance)))
     return [g, g, g, 255]

@@ -39,7 +39,7 @@ import tomlkit
 from radtree.config import Scenario, load_project
 from radtree.config.spec import spec_of, toml_name
 from radtree.config.species import find_species
-from radtree.config.switches import TABLES
+from radtree.config.switches import TABLES, TREE_TABLES
 from radtree.errors import ConfigError
 from radtree.fileio import write_text
 from radtree.light.clearsky import write_generated_epw
@@ -303,7 +303,7 @@ def document(template: str, site: dict[str, Any], site_source: str, data: dict[s
                            {"sky": "Perez sky from the EPW's diffuse illuminance"}))
     tree = table(TABLES["tree"], {"form": "free", "species": species},
                  {"species": "fills leaf optics, tilt and permeability left out below"})
-    for sub in ("dome", "crown", "homogeneous", "perforated", "louvers"):
+    for sub in TREE_TABLES:
         tree.add(sub, table(TABLES[f"tree.{sub}"], {}))
     doc.add("tree", tree)
     doc.add("sensors", table(TABLES["sensors"], {}))
