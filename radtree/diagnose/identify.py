@@ -40,6 +40,17 @@ GROUP_CORR = 0.95
 SNR_MIN = 3.0
 #: two-sided confidence level of the strength intervals
 CONFIDENCE = 0.95
+#: relative noise (1 σ) of a measured value when the data do not state theirs
+DEFAULT_NOISE = 0.03
+
+
+def noise_sigma(expected: np.ndarray, mc_stderr: np.ndarray, noise: float = DEFAULT_NOISE,
+                noise_lux: float = 0.0) -> np.ndarray:
+    """Noise (1 σ, lux) of a measured-minus-simulated value: the instrument's relative
+    ``noise`` of the ``expected`` value, its floor ``noise_lux``, and the Monte Carlo error of
+    the measurement's and the model's simulation (``mc_stderr`` each, NaN counts as 0)."""
+    se = np.nan_to_num(np.asarray(mc_stderr, float), nan=0.0)
+    return np.sqrt((noise * np.asarray(expected, float)) ** 2 + noise_lux ** 2 + 2 * se ** 2)
 
 
 def whiten(signatures: np.ndarray, sigma: np.ndarray | float | None) -> np.ndarray:

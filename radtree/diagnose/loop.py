@@ -62,6 +62,9 @@ class Measured:
     rows_hourly: pd.DataFrame | None = None
     left_out: list[str] = field(default_factory=list)
     unmeasured: list[str] = field(default_factory=list)
+    #: sun altitude and azimuth (degrees) per value when ``times`` are not clock times (a
+    #: campaign's observations, :mod:`.campaign_sim`); None: from the project's hours
+    sun: tuple[np.ndarray, np.ndarray] | None = None
 
     @property
     def mean(self) -> float:
@@ -256,7 +259,8 @@ def run_loop(sim: Simulator, ctx: EffectContext, start: Scenario, measured: Meas
         raise RadtreeError(f"margin must be in [0, 1), got {margin}")
     catalogue = tuple(catalogue)
     say = echo or (lambda s: None)
-    alt, az = sun_positions(ctx.project, start, measured.times)
+    alt, az = (measured.sun if measured.sun is not None
+               else sun_positions(ctx.project, start, measured.times))
     mm = measured.mean
     current = start
     run = sim.run(current)
