@@ -39,10 +39,11 @@ from __future__ import annotations
 
 import datetime as dt
 import os
-import tomllib
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
+
+import tomllib
 
 from radtree.config import Project
 from radtree.errors import ConfigError
@@ -230,6 +231,10 @@ def load_campaign(path: str | os.PathLike, project: Project | None = None) -> Ca
                               f"{', '.join(sorted(gknown))})", source=src, field=where)
         meas = _get(g, "measured", dict, src, where, {})
         pts = _get(g, "points", list, src, where, [])
+        bad = [pt for pt in pts if not isinstance(pt, list) or len(pt) != 3]
+        if bad:
+            raise ConfigError(f"points must be [u, d, z] lists of three numbers (m), got "
+                              f"{bad[0]!r}", source=src, field=f"{where}.points")
         try:
             groups.append(SensorGroup(
                 name=str(_get(g, "name", str, src, where, "")), report=_get(g, "report", str, src,
@@ -237,7 +242,7 @@ def load_campaign(path: str | os.PathLike, project: Project | None = None) -> Ca
                 grid=_get(g, "grid", str, src, where),
                 height_m=_get(g, "height_m", (int, float), src, where),
                 orientation=_get(g, "orientation", str, src, where, "facade"),
-                points=tuple(tuple(float(c) for c in pt) for pt in pts),
+                points=tuple((float(pt[0]), float(pt[1]), float(pt[2])) for pt in pts),
                 measured=tuple((str(k), rel(str(v))) for k, v in meas.items()),
                 description=str(_get(g, "description", str, src, where, ""))))
         except ConfigError as exc:

@@ -92,7 +92,7 @@ class CampaignSimulator(Simulator):
     notes: list[str] = field(default_factory=list)
     _days: dict[str, Project] = field(default_factory=dict, repr=False)
     _grid_names: dict[str, str] = field(default_factory=dict, repr=False)
-    _ctraced: dict[str, dict[str, dict[str, np.ndarray]]] = field(default_factory=dict,
+    _ctraced: dict[str, dict[str, np.ndarray]] = field(default_factory=dict,
                                                                 repr=False)
     _tmp: Any = field(default=None, repr=False)
     layout: Layout | None = field(default=None, repr=False)
@@ -161,11 +161,11 @@ class CampaignSimulator(Simulator):
                                   rays=int(self.rays or 1), seed=int(self.seed or 0),
                                   built=built)
                 for name in names:
-                    g = [res[name] for res in out.results]
-                    traced[f"{day}|{name}|lux"] = np.array([x.lux for x in g])
+                    got = [res[name] for res in out.results]
+                    traced[f"{day}|{name}|lux"] = np.array([x.lux for x in got])
                     traced[f"{day}|{name}|se"] = np.array(
                         [x.stderr if x.stderr is not None else np.full(len(x.lux), np.nan)
-                         for x in g])
+                         for x in got])
             self._ctraced[tkey] = traced
             self.traced_runs += 1
             self.trace_seconds += time.perf_counter() - t0
@@ -183,8 +183,8 @@ class CampaignSimulator(Simulator):
         hour_i = {h: i for i, h in enumerate(self.hours)}
         obs, se = [], []
         for o in self.layout.observations:
-            g = self.campaign.group(o.group)
-            key = (o.day, self._grid_names[g.geometry])
+            grp = self.campaign.group(o.group)
+            key = (o.day, self._grid_names[grp.geometry])
             row, err = values[key][hour_i[o.time]], errors[key][hour_i[o.time]]
             if o.sensor is None:
                 obs.append(float(row.mean()))

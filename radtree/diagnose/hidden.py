@@ -200,7 +200,8 @@ def selftest(project: str | os.PathLike | Project, scenario: str | None = None,
     res = SelftestResult(proj, start, noise, cases, skipped, time.perf_counter() - t0,
                          sim.traced_runs + truth_sim.traced_runs, out if write else None,
                          engine=sim.engine_name, rays=sim.rays if sim.seeded else None,
-                         seed=sim.seed if sim.seeded else None)
+                         seed=sim.seed if sim.seeded else None,
+                         campaign=campaign.summary() if campaign is not None else "")
     if write:
         from radtree.diagnose.report import write_selftest_report
 

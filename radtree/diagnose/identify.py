@@ -27,6 +27,7 @@ from __future__ import annotations
 import math
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 import pandas as pd
@@ -301,3 +302,30 @@ def joint_intervals(signatures: np.ndarray, residual: np.ndarray,
     s2 = float(np.sum((y - w @ a) ** 2) / dof)
     cov = s2 * np.linalg.inv(gram)
     return a, sps.t.ppf(0.5 + level / 2, dof) * np.sqrt(np.clip(np.diag(cov), 0, None))
+
+
+# --------------------------------------------------------------------------- a diagnosis step
+def step_identifiability(att: Any, expected: np.ndarray, mc_stderr: np.ndarray,
+                         noise: float = DEFAULT_NOISE, noise_lux: float = 0.0
+                         ) -> tuple[Identifiability, dict[str, Interval]]:
+    """Identifiability of one step's candidates (an :class:`~.attribution.Attribution`) on its
+    measured values, and the profile interval of every fitted strength (noise scale unknown:
+    ``noise`` only sets the relative weights of the values)."""
+    sigma = np.maximum(noise_sigma(expected, mc_stderr, noise, noise_lux), 1e-9)
+    names = list(att.signatures)
+    s = (np.column_stack([att.signatures[n].reference_hourly() for n in names]) if names
+         else np.zeros((len(att.residual), 0)))
+    ident = identifiability(names, s, sigma, observations=[])
+    out: dict[str, Interval] = {}
+    for n in names:
+        sig = att.signatures[n]
+        st = sig.strength
+        if sig.kind == "binary" or st is None:
+            continue
+        if sig.kind == "linear":
+            out[n] = linear_interval(sig.hourly[0], att.residual, float(sig.strengths[0]),
+                                     0.0, st.hi, sigma)
+        else:
+            xs, preds = sig.choices()
+            out[n] = profile_interval(xs, preds, att.residual, sigma)
+    return ident, out

@@ -20,6 +20,7 @@ from matplotlib.figure import Figure
 from radtree import __version__
 from radtree.diagnose.attribution import TIE_CORR
 from radtree.diagnose.effects import EFFECTS, EffectContext, candidates
+from radtree.diagnose.report_identify import ident_context
 from radtree.diagnose.residuals import RULES, DisagreementMap
 from radtree.figures import new_figure, save_png
 from radtree.fileio import write_text
@@ -252,10 +253,15 @@ def write_diagnose_report(res: DiagnoseResult, out: Path) -> list[Path]:
         "steps_table": _records(loop.steps_table()), "stop": loop.stop_reason,
         "rules": RULES, "catalogue": _catalogue(ctx, res.scenario), "tie_corr": TIE_CORR,
         "margin": res.margin, "version": __version__,
+        "ident": ident_context(loop.steps[0], out, out / "next_measurement.csv")
+        if loop.steps and loop.steps[0].identify is not None else None,
         "created": datetime.now(timezone.utc).isoformat(timespec="seconds"),
     }
     html = _env().get_template("diagnose.html.j2").render(c=c)
     files.append(write_text(out / "index.html", html))
+    ident = c["ident"]
+    if isinstance(ident, dict):
+        files.append(out / str(ident["fig"]))
     files += [out / f for f in figs.values()] + [out / s["fig"] for s in steps]
     if last:
         files.append(out / last["fig"])
@@ -289,6 +295,7 @@ def write_selftest_report(res: SelftestResult, out: Path) -> list[Path]:
         "kind": "selftest", "project": res.project, "scenario": res.scenario, "res": res,
         "table": _records(res.table()), "fig": fig, "skipped": res.skipped,
         "snr_min": SNR_MIN, "tie_corr": TIE_CORR, "version": __version__,
+        "campaign": res.campaign,
         "catalogue": _catalogue(EffectContext(res.project), res.scenario),
         "created": datetime.now(timezone.utc).isoformat(timespec="seconds"),
     }

@@ -150,5 +150,7 @@ def format_steps(res: LoopResult) -> list[str]:
                      f"{s.rmse_before:.3f} → {s.rmse_after:.3f}, CV nRMSE {s.cv_rmse_before:.3f}"
                      f" → {s.cv_rmse_after:.3f}, explained "
                      + (f"{ef:.0%}" if math.isfinite(ef) else "n/a"))
+        if s.identify is not None and s.identify.partners(s.effect):
+            lines.append(f"    {s.separability}")
     lines.append(f"  stop: {res.stop_reason}")
     return lines
