@@ -24,6 +24,7 @@ import pandas as pd
 
 from radtree.config import Project, Scenario
 from radtree.diagnose.campaign import Campaign, Layout, SensorGroup
+from radtree.diagnose.identify import noise_sigma
 from radtree.diagnose.loop import Measured
 from radtree.diagnose.simulate import FACADE, Run, Simulator
 from radtree.fileio import write_text
@@ -96,6 +97,8 @@ class CampaignSimulator(Simulator):
                                                                 repr=False)
     _tmp: Any = field(default=None, repr=False)
     layout: Layout | None = field(default=None, repr=False)
+    #: per-observation factors applied to every run (:meth:`set_weights`); None: plain lux
+    weights: np.ndarray | None = field(default=None, repr=False)
 
     def __post_init__(self) -> None:
         if self.campaign is None:
@@ -119,6 +122,27 @@ class CampaignSimulator(Simulator):
         self.layout = Layout(c, sizes)
 
     # ------------------------------------------------------------------ public
+    def set_weights(self, sc: Scenario, noise: float, noise_lux: float = 0.0) -> np.ndarray:
+        """Weight every observation by mean(σ)/σ_i, σ_i its noise in the run of ``sc``
+        (:func:`~radtree.diagnose.identify.noise_sigma`): later runs are in *noise-weighted
+        lux*, so that a least-squares fit, an RMS and an uncentred correlation over values
+        of very different size (a façade reading under the crown, an open-street horizontal
+        one ~100 × larger) count each value by its information, not its magnitude."""
+        self.weights = None
+        raw = self.run(sc)
+        sigma = np.maximum(noise_sigma(raw.lux, raw.stderr, noise, noise_lux), 1e-9)
+        self.weights = float(np.mean(sigma)) / sigma
+        return self.weights
+
+    def run(self, sc: Scenario) -> Run:
+        raw = super().run(sc)
+        if self.weights is None:
+            return raw
+        w = self.weights
+        lux = raw.lux * w
+        return replace(raw, lux=lux, stderr=raw.stderr * w, sensors=lux[None, :],
+                       rows=pd.DataFrame({"campaign": lux}, index=raw.rows.index))
+
     @property
     def labels(self) -> list[str]:
         assert self.layout is not None
@@ -206,7 +230,8 @@ def campaign_synthetic(sim: CampaignSimulator, truth: Scenario, run: Run, noise:
     (``day,time,group,sensor,measured_lux``)."""
     assert sim.layout is not None
     n = len(run.lux)
-    values = run.lux * (1.0 + noise * rng.standard_normal(n)) + noise_lux * rng.standard_normal(n)
+    raw = run.lux / sim.weights if sim.weights is not None else run.lux
+    values = raw * (1.0 + noise * rng.standard_normal(n)) + noise_lux * rng.standard_normal(n)
     values = np.maximum(values, 0.0)
     source = f"synthetic ({what})"
     if path is not None:
@@ -216,5 +241,7 @@ def campaign_synthetic(sim: CampaignSimulator, truth: Scenario, run: Run, noise:
                        f"{o.day},{o.time},{o.group},{'' if o.sensor is None else o.sensor},"
                        f"{v:.1f}\n" for o, v in zip(sim.layout.observations, values)))
         source = str(path)
-    return Measured(tuple(sim.labels), values, source, "lux", "campaign",
-                    sun=sim.sun_positions(truth))
+    w = sim.weights if sim.weights is not None else np.ones(n)
+    return Measured(tuple(sim.labels), values * w, source,
+                    "lux" if sim.weights is None else "noise-weighted lux", "campaign",
+                    sun=sim.sun_positions(truth), noise=noise, noise_lux=noise_lux)

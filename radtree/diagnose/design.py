@@ -26,6 +26,7 @@ import os
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 import pandas as pd
@@ -180,6 +181,64 @@ def _pairs(groups: list[list[str]]) -> list[tuple[str, str]]:
     return [(a, b) for g in groups for i, a in enumerate(g) for b in g[i + 1:]]
 
 
+def rank_candidates(names: list[str], signatures: np.ndarray, sigma: np.ndarray,
+                    base: np.ndarray, moves: dict[str, tuple[np.ndarray, np.ndarray]],
+                    labels: list[str] | None = None, top: int = TOP
+                    ) -> tuple[list[dict[str, Any]], Identifiability, Identifiability]:
+    """Greedy ranking (see the module doc) of candidate observation sets.
+
+    ``signatures`` (observations × effects, lux) and ``sigma`` (lux) over every observation
+    any campaign could hold; ``base``: the present campaign's observations (bool mask);
+    ``moves[name] = (add, remove)`` masks of each candidate. Returns the ranked records
+    (``candidate, separated_effects, min_correlation_after, rank, confounded_pairs_after,
+    log_det``), the present identifiability and the one after the top ``top``."""
+    obs = labels or [str(i) for i in range(len(base))]
+
+    def ident(mask: np.ndarray) -> Identifiability:
+        return identifiability(names, signatures[mask], sigma[mask],
+                               observations=[x for x, m in zip(obs, mask) if m])
+
+    before = ident(base)
+    pairs = _pairs(before.confounded)
+    ix = {n: i for i, n in enumerate(names)}
+
+    def score(m: np.ndarray) -> tuple[int, float, float, Identifiability]:
+        idn = ident(m)
+        cors = [abs(idn.correlation[ix[a], ix[b]]) for a, b in pairs]
+        left = sum(1 for a, b in pairs if not idn.separable(a, b))
+        keep = [i for i, n in enumerate(names) if not idn.below_noise(n)]
+        w = signatures[m][:, keep] / sigma[m][:, None]
+        w = w / np.linalg.norm(w, axis=0)
+        sign, logdet = np.linalg.slogdet(w.T @ w)
+        return left, max(cors) if cors else 0.0, float(logdet) if sign > 0 else -math.inf, idn
+
+    recs: list[dict[str, Any]] = []
+    remaining = list(moves)
+    current = base.copy()
+    separated = {n for n in names if before.distinguishable(n)}
+    after_top = before
+    while remaining:
+        trials = []
+        for name in remaining:
+            add, drop = moves[name]
+            m = (current & ~drop) | add
+            left, worst, logdet, idn = score(m)
+            trials.append(((left, worst, -logdet, name), name, m, idn, left, worst, logdet))
+        trials.sort(key=lambda x: x[0])
+        _, name, m, idn, left, worst, logdet = trials[0]
+        alone = {n for n in names if idn.distinguishable(n)}
+        recs.append({"candidate": name, "description": "",
+                     "separated_effects": ";".join(sorted(alone - separated)),
+                     "min_correlation_after": worst, "rank": len(recs) + 1,
+                     "confounded_pairs_after": left, "log_det": logdet})
+        separated |= alone
+        current = m
+        remaining.remove(name)
+        if len(recs) <= top:
+            after_top = idn
+    return recs, before, after_top
+
+
 def next_measurement(project: str | os.PathLike | Project, scenario: str | None = None,
                      campaign: Campaign | None = None,
                      candidates_file: str | os.PathLike | None = None,
@@ -218,55 +277,17 @@ def next_measurement(project: str | os.PathLike | Project, scenario: str | None 
     sigma = np.maximum(sigma, 1e-6)
     layout = sim.layout
 
-    def ident(mask: np.ndarray) -> Identifiability:
-        return identifiability(names, S[mask], sigma[mask],
-                               observations=[x for x, m in zip(sim.labels, mask) if m])
-
-    mask = _mask(layout, base)
-    before = ident(mask)
-    pairs = _pairs(before.confounded)
-    alone_before = {n for n in names if before.distinguishable(n)}
-
-    def score(m: np.ndarray) -> tuple[int, float, float, Identifiability]:
-        idn = ident(m)
-        ix = {n: i for i, n in enumerate(names)}
-        cors = [abs(idn.correlation[ix[a], ix[b]]) for a, b in pairs]
-        left = sum(1 for a, b in pairs if not idn.separable(a, b))
-        keep = [i for i, n in enumerate(names) if not idn.below_noise(n)]
-        w = S[m][:, keep] / sigma[m][:, None]
-        w = w / np.linalg.norm(w, axis=0)
-        sign, logdet = np.linalg.slogdet(w.T @ w)
-        return left, max(cors) if cors else 0.0, float(logdet) if sign > 0 else -math.inf, idn
-
-    recs = []
-    remaining = list(cands)
-    current = mask
-    separated_so_far = set(alone_before)
-    rank = 0
-    top_idn = before
-    chosen: list[Candidate] = []
-    while remaining:
-        rank += 1
-        trials = []
-        for c in remaining:
-            m = (current & ~_mask(layout, Campaign("x", c.addition.days, c.addition.hours,
-                                                   base.groups), c.replaces_means)
-                 if c.replaces_means else current) | _mask(layout, c.addition)
-            left, worst, logdet, idn = score(m)
-            trials.append(((left, worst, -logdet, c.name), c, m, idn, left, worst, logdet))
-        trials.sort(key=lambda t: t[0])
-        _, c, m, idn, left, worst, logdet = trials[0]
-        now_alone = {n for n in names if idn.distinguishable(n)}
-        recs.append({"candidate": c.name, "description": c.description,
-                     "separated_effects": ";".join(sorted(now_alone - separated_so_far)),
-                     "min_correlation_after": worst, "rank": rank,
-                     "confounded_pairs_after": left, "log_det": logdet})
-        separated_so_far |= now_alone
-        current = m
-        remaining.remove(c)
-        if rank <= TOP:
-            chosen.append(c)
-            top_idn = idn
+    base_mask = _mask(layout, base)
+    moves = {}
+    for c in cands:
+        drop = (_mask(layout, Campaign("x", c.addition.days, c.addition.hours, base.groups),
+                      c.replaces_means) if c.replaces_means else np.zeros(len(base_mask), bool))
+        moves[c.name] = (_mask(layout, c.addition), drop)
+    recs, before, top_idn = rank_candidates(names, S, sigma, base_mask, moves, sim.labels)
+    text = {c.name: c.description for c in cands}
+    for r in recs:
+        r["description"] = text[r["candidate"]]
+    chosen = [next(c for c in cands if c.name == r["candidate"]) for r in recs[:TOP]]
     table = pd.DataFrame(recs, columns=DESIGN_COLUMNS)
     nxt = merge(base, *[c.addition for c in chosen], name=f"{base.name} + next {len(chosen)}")
     repl = {g for c in chosen for g in c.replaces_means}
@@ -274,7 +295,7 @@ def next_measurement(project: str | os.PathLike | Project, scenario: str | None 
         nxt = Campaign(nxt.name, nxt.days, nxt.hours, tuple(
             g if g.name not in repl else SensorGroup(g.name, "sensor", g.grid, g.height_m,
                                                      g.orientation, g.points, g.measured)
-            for g in nxt.groups), nxt.noise, nxt.noise_lux, nxt.rays, True,
+            for g in nxt.groups), nxt.noise, nxt.noise_lux, nxt.rays, False,
             "the present campaign plus the top three next measurements (no readings yet)",
             nxt.direct_normal)
     design = Design(base, start, names, before, table, top_idn, nxt, 0.0)

@@ -64,7 +64,7 @@ TRUTH_SEED_OFFSET = 7919
 
 
 def _decide(sim: Simulator, ctx: EffectContext, effect: Effect, start: Scenario, noise: float,
-            echo: Echo | None, noise_lux: float = 0.0) -> HiddenCase:
+            echo: Echo | None, noise_lux: float | np.ndarray = 0.0) -> HiddenCase:
     base = effect.switch_off(ctx, start) if effect.is_on(ctx, start) else start
     if base is not start:
         base = Scenario(f"{start.name}-no-{effect.name}", base.model, base.reflection, base.sky,
@@ -161,7 +161,9 @@ def selftest(project: str | os.PathLike | Project, scenario: str | None = None,
         sim = CampaignSimulator(proj, hours, engine, rays, seed, campaign=campaign)
         truth_sim = CampaignSimulator(proj, hours, engine, sim.rays,
                                       int(sim.seed or 0) + TRUTH_SEED_OFFSET, campaign=campaign)
-        say(f"campaign {campaign.summary()} — {len(sim.labels)} observations")
+        truth_sim.weights = sim.set_weights(start, noise, noise_lux)
+        say(f"campaign {campaign.summary()} — {len(sim.labels)} observations, compared in "
+            "noise-weighted lux (each value ÷ its noise)")
         for note in sim.notes:
             say(f"  note: {note}")
     chosen = tuple(effects) if effects is not None else EFFECTS
@@ -177,7 +179,9 @@ def selftest(project: str | os.PathLike | Project, scenario: str | None = None,
             skipped[e.name] = why
             say(f"  {e.name}: skipped ({why})")
             continue
-        case = _decide(sim, ctx, e, start, noise, None, noise_lux)
+        case = _decide(sim, ctx, e, start, noise, None,
+                       noise_lux * sim.weights if isinstance(sim, CampaignSimulator)
+                       and sim.weights is not None else noise_lux)
         cases.append(case)
         say(f"  {e.name:26s} {'distinguishable' if case.distinguishable else 'not distinguishable'}"
             f": {case.reason}")

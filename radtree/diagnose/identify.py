@@ -46,12 +46,13 @@ DEFAULT_NOISE = 0.03
 
 
 def noise_sigma(expected: np.ndarray, mc_stderr: np.ndarray, noise: float = DEFAULT_NOISE,
-                noise_lux: float = 0.0) -> np.ndarray:
+                noise_lux: float | np.ndarray = 0.0) -> np.ndarray:
     """Noise (1 σ, lux) of a measured-minus-simulated value: the instrument's relative
     ``noise`` of the ``expected`` value, its floor ``noise_lux``, and the Monte Carlo error of
     the measurement's and the model's simulation (``mc_stderr`` each, NaN counts as 0)."""
     se = np.nan_to_num(np.asarray(mc_stderr, float), nan=0.0)
-    return np.sqrt((noise * np.asarray(expected, float)) ** 2 + noise_lux ** 2 + 2 * se ** 2)
+    return np.sqrt((noise * np.asarray(expected, float)) ** 2 + np.asarray(noise_lux) ** 2
+                   + 2 * se ** 2)
 
 
 def whiten(signatures: np.ndarray, sigma: np.ndarray | float | None) -> np.ndarray:
