@@ -216,7 +216,7 @@ def load_campaign(path: str | os.PathLike, project: Project | None = None) -> Ca
 
     def rel(v: str) -> str:
         q = Path(v)
-        return str(q if q.is_absolute() else (base / q))
+        return str((q if q.is_absolute() else (base / q)).resolve())
 
     groups = []
     for i, g in enumerate(data.get("group", []) or []):

@@ -51,6 +51,11 @@ from radtree.fileio import atomic_path, write_text
 DESIGN_COLUMNS = ["candidate", "description", "separated_effects", "min_correlation_after",
                   "rank", "confounded_pairs_after", "log_det"]
 TOP = 3
+#: rays per sensor of a seeded engine for the design's signatures unless given: the superset
+#: campaign is ~10 × the present one, and common random numbers keep signatures precise
+DESIGN_RAYS = 256
+#: suffix of the group that reports a mean group's sensors one by one (a candidate)
+PER_SENSOR = "_sensors"
 
 
 @dataclass(frozen=True)
@@ -95,8 +100,9 @@ def default_candidates(project: Project, base: Campaign) -> list[Candidate]:
     ]
     if facade_means:
         out.append(Candidate("per_sensor", "readings per sensor instead of the hourly means",
-                             add("s", tuple(SensorGroup(g.name, "sensor", g.grid, g.height_m,
-                                                        g.orientation, g.points)
+                             add("s", tuple(SensorGroup(f"{g.name}{PER_SENSOR}", "sensor",
+                                                        g.grid, g.height_m, g.orientation,
+                                                        g.points)
                                             for g in base.groups if g.name in facade_means)),
                              replaces_means=facade_means))
     hs = sorted(base.hours)
@@ -255,7 +261,8 @@ def next_measurement(project: str | os.PathLike | Project, scenario: str | None 
     cands = (file_candidates(candidates_file, proj, base) if candidates_file is not None
              else default_candidates(proj, base))
     union = merge(base, *[c.addition for c in cands], name="superset")
-    sim = CampaignSimulator(proj, (), engine, rays, seed, campaign=union)
+    sim = CampaignSimulator(proj, (), engine, rays or base.rays or DESIGN_RAYS, seed,
+                            campaign=union)
     assert sim.layout is not None
     say(f"next measurement {proj.name}: scenario {start.name}, {len(cands)} candidates, "
         f"superset {len(union.days)} day(s) × {len(union.hours)} hour(s) × "
@@ -294,8 +301,9 @@ def next_measurement(project: str | os.PathLike | Project, scenario: str | None 
     if repl:
         nxt = Campaign(nxt.name, nxt.days, nxt.hours, tuple(
             g if g.name not in repl else SensorGroup(g.name, "sensor", g.grid, g.height_m,
-                                                     g.orientation, g.points, g.measured)
-            for g in nxt.groups), nxt.noise, nxt.noise_lux, nxt.rays, False,
+                                                     g.orientation, g.points)
+            for g in nxt.groups if g.name.removesuffix(PER_SENSOR) not in repl
+            or not g.name.endswith(PER_SENSOR)), nxt.noise, nxt.noise_lux, nxt.rays, False,
             "the present campaign plus the top three next measurements (no readings yet)",
             nxt.direct_normal)
     design = Design(base, start, names, before, table, top_idn, nxt, 0.0)
