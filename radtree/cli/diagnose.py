@@ -1,6 +1,7 @@
 """``radtree diagnose``: name the missing physical effect, add it, re-simulate (SPEC §6).
 
     radtree diagnose PROJECT [--measured FILE.csv] [--scenario B] [--engine numpy] [--units lux]
+    radtree diagnose PROJECT --campaign FILE          # against a campaign's readings
     radtree diagnose PROJECT --selftest [--effects a,b,c] [--noise 0.03] [--campaign FILE]
     radtree diagnose PROJECT --next-measurement [--campaign FILE] [--candidates FILE]
     radtree diagnose --list-effects [PROJECT [--scenario B]]
@@ -103,8 +104,6 @@ def diagnose_command(project: str | None, measured: str | None, units: str | Non
         for line in design.lines():
             click.echo(line)
         return
-    if camp is not None and not selftest:
-        raise ConfigError("--campaign goes with --selftest or --next-measurement")
     if selftest:
         if measured is not None:
             raise ConfigError("--measured does not go with --selftest (the self-test makes "
@@ -131,7 +130,7 @@ def diagnose_command(project: str | None, measured: str | None, units: str | Non
     from radtree.diagnose.run import diagnose, format_steps
 
     res_d = diagnose(project, measured, units, scenario, engine, rays, seed, margin, max_steps,
-                     chosen, out, echo=click.echo)
+                     chosen, out, echo=click.echo, campaign=camp)
     for line in format_steps(res_d.loop):
         click.echo(line)
     click.echo(f"done in {res_d.seconds:.0f} s ({res_d.simulations} simulations): "

@@ -245,3 +245,41 @@ def campaign_synthetic(sim: CampaignSimulator, truth: Scenario, run: Run, noise:
     return Measured(tuple(sim.labels), values * w, source,
                     "lux" if sim.weights is None else "noise-weighted lux", "campaign",
                     sun=sim.sun_positions(truth), noise=noise, noise_lux=noise_lux)
+
+
+def campaign_readings(sim: CampaignSimulator) -> np.ndarray:
+    """The campaign's measured value of every observation (lux, unweighted), read from each
+    group's ``measured`` files (:func:`radtree.measurements.load_measured`: a mean group takes
+    a mean- or sensor-shaped file, a per-sensor group a sensor-shaped one with ids 0…n−1)."""
+    from radtree.errors import RadtreeError
+    from radtree.measurements import grid_mean, load_measured
+
+    assert sim.campaign is not None and sim.layout is not None
+    c = sim.campaign
+    have: dict[tuple[str, str, str, int | None], float] = {}
+    for g in c.groups:
+        for day in c.days:
+            path = g.measured_file(day)
+            if path is None:
+                raise RadtreeError(f"campaign {c.name!r}: group {g.name} has no measured file "
+                                   f"for {day} (measured = {{ \"{day}\" = \"file.csv\" }})")
+            frame, shape = load_measured(path)
+            if g.report == "mean":
+                if shape.kind == "row":
+                    raise RadtreeError(f"{path}: a per-row file cannot give group {g.name}'s mean")
+                gm = grid_mean(frame)
+                for t, v in zip(gm["time"], gm["measured_lux"]):
+                    have[(day, str(t), g.name, None)] = float(v)
+            else:
+                if shape.kind != "sensor":
+                    raise RadtreeError(f"{path}: group {g.name} reports per sensor: the file "
+                                       "needs the time,sensor,lux shape")
+                for t, s, v in zip(frame["time"], frame["sensor"], frame["measured_lux"]):
+                    have[(day, str(t), g.name, int(s))] = float(v)
+    missing = [o.label for o in sim.layout.observations
+               if (o.day, o.time, o.group, o.sensor) not in have]
+    if missing:
+        raise RadtreeError(f"campaign {c.name!r}: {len(missing)} observation(s) have no "
+                           f"measured value, e.g. {', '.join(missing[:3])}")
+    return np.array([have[(o.day, o.time, o.group, o.sensor)]
+                     for o in sim.layout.observations])

@@ -47,6 +47,15 @@ def _hour(t: str) -> float:
     return int(h) + int(m) / 60
 
 
+def _xs(times: Any) -> list[float]:
+    """x positions of the values: clock hours, or the index for a campaign's observations
+    (labelled ``DAY HH:MM GROUP``)."""
+    times = [str(t) for t in times]
+    if all(len(t) == 5 and t[2] == ":" for t in times):
+        return [_hour(t) for t in times]
+    return [float(i) for i in range(len(times))]
+
+
 def _maps(loop: LoopResult) -> list[tuple[str, DisagreementMap]]:
     out = [(f"start ({loop.start.name})", loop.start_map)]
     out += [(f"step {s.number}: + {s.effect}", s.map_after) for s in loop.steps]
@@ -64,7 +73,7 @@ def fig_residual_steps(loop: LoopResult, path: Path) -> str:
     maps = _maps(loop)
     for i, (label, dm) in enumerate(maps):
         h = dm.hourly
-        x = [_hour(t) for t in h["time"]]
+        x = _xs(h["time"])
         c = _step_colour(i, len(maps), "black")
         ax.errorbar(x, h["residual_lux"], yerr=2 * h["simulated_se_lux"].fillna(0), marker="o",
                     color=c, lw=2.2 if i in (0, len(maps) - 1) else 1.2, capsize=3,
@@ -82,7 +91,7 @@ def fig_measured(loop: LoopResult, path: Path) -> str:
     ax = fig.add_subplot()
     maps = _maps(loop)
     h0 = maps[0][1].hourly
-    x = [_hour(t) for t in h0["time"]]
+    x = _xs(h0["time"])
     ax.plot(x, h0["measured_lux"], "o-", color="black", lw=2.4, label="measured", zorder=5)
     for i, (label, dm) in enumerate(maps):
         c = _step_colour(i, len(maps), "tab:red")
@@ -156,7 +165,7 @@ def fig_rmse(loop: LoopResult, path: Path) -> str:
 def fig_candidates(att: Any, times: list[str], title: str, path: Path) -> str:
     fig = _fig(7.5, 4.2)
     ax = fig.add_subplot()
-    x = [_hour(t) for t in times]
+    x = _xs(times)
     ax.plot(x, att.residual, "o-", color="black", lw=2.5, label="residual", zorder=5)
     cmap = colormaps["tab10"]
     for i, f in enumerate(att.fits):
