@@ -34,7 +34,7 @@ def test_mendoza_data_is_a_campaign(mendoza) -> None:
 
 def test_rich_campaign_layout(mendoza) -> None:
     c = load_campaign(MENDOZA / "campaign-rich.toml", mendoza)
-    assert c.synthetic and c.rays == 256 and len(c.days) == 2
+    assert c.synthetic and c.rays == 1024 and len(c.days) == 2
     sizes = {g.geometry: (8 if g.grid else 1) for g in c.groups}
     lay = Layout(c, sizes)
     assert len(lay.observations) == 2 * 7 * (8 + 1 + 1)
