@@ -13,18 +13,16 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
-from jinja2 import Environment
 from matplotlib import colormaps
 from matplotlib.figure import Figure
 
 from radtree import __version__
 from radtree.diagnose.attribution import TIE_CORR
 from radtree.diagnose.effects import EFFECTS, EffectContext, candidates
-from radtree.diagnose.report_identify import ident_context
+from radtree.diagnose.report_identify import _env, ident_context
 from radtree.diagnose.residuals import RULES, DisagreementMap
 from radtree.figures import new_figure, save_png
 from radtree.fileio import write_text
-from radtree.resources import template_environment
 
 if TYPE_CHECKING:
     from radtree.diagnose.loop import LoopResult
@@ -181,19 +179,6 @@ def fig_candidates(att: Any, times: list[str], title: str, path: Path) -> str:
 
 
 # --------------------------------------------------------------------------- HTML
-def _env() -> Environment:
-    env = template_environment(autoescape=True, trim_blocks=True, lstrip_blocks=True)
-    env.filters["f3"] = lambda v: "–" if v is None or (isinstance(v, float) and
-                                                      not math.isfinite(v)) else f"{v:.3f}"
-    env.filters["f0"] = lambda v: "–" if v is None or (isinstance(v, float) and
-                                                      not math.isfinite(v)) else f"{v:,.0f}"
-    env.filters["pct"] = lambda v: "–" if v is None or (isinstance(v, float) and
-                                                       not math.isfinite(v)) else f"{v:.0%}"
-    env.filters["sgn"] = lambda v: "–" if v is None or (isinstance(v, float) and
-                                                       not math.isfinite(v)) else f"{v:+,.0f}"
-    return env
-
-
 def _records(df: Any) -> list[dict[str, Any]]:
     return [] if df is None else df.to_dict("records")
 

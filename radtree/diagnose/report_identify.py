@@ -12,17 +12,31 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 import pandas as pd
+from jinja2 import Environment
 
 from radtree import __version__
 from radtree.diagnose.identify import CONFIDENCE, GROUP_CORR, Identifiability, Interval
 from radtree.figures import new_figure, save_png
 from radtree.fileio import write_text
+from radtree.resources import template_environment
 
 if TYPE_CHECKING:
-    from radtree.diagnose.design import Design
     from radtree.diagnose.loop import Step
 
 DPI = 120
+
+
+def _env() -> Environment:
+    env = template_environment(autoescape=True, trim_blocks=True, lstrip_blocks=True)
+    env.filters["f3"] = lambda v: "–" if v is None or (isinstance(v, float) and
+                                                      not math.isfinite(v)) else f"{v:.3f}"
+    env.filters["f0"] = lambda v: "–" if v is None or (isinstance(v, float) and
+                                                      not math.isfinite(v)) else f"{v:,.0f}"
+    env.filters["pct"] = lambda v: "–" if v is None or (isinstance(v, float) and
+                                                       not math.isfinite(v)) else f"{v:.0%}"
+    env.filters["sgn"] = lambda v: "–" if v is None or (isinstance(v, float) and
+                                                       not math.isfinite(v)) else f"{v:+,.0f}"
+    return env
 
 
 def fig_correlation(ident: Identifiability, title: str, path: Path) -> str:
@@ -69,9 +83,8 @@ def ident_context(step: Step, out: Path, next_csv: Path | None = None) -> dict[s
             "named": step.effect, "next": nxt}
 
 
-def write_design_report(design: Design, out: Path) -> list[Path]:
-    from radtree.diagnose.report import _env
-
+def write_design_report(design: Any, out: Path) -> list[Path]:
+    """``next_measurement.html`` and its two heat maps for a :class:`~.design.Design`."""
     before = fig_correlation(design.before, f"{design.base.name}: correlations",
                              out / "next_before.png")
     after = fig_correlation(design.after_top, "with the top three next measurements",
