@@ -96,3 +96,30 @@ def test_joint_intervals_widen_for_confounded_effects() -> None:
     a, half_sep = joint_intervals(np.column_stack([x, far]), r, 0.05)
     assert half_conf[0] > 20 * half_sep[0]
     assert abs(a[0] - 1.0) <= half_sep[0]
+
+
+def test_step_identifiability_names_the_partners_and_brackets_the_strength() -> None:
+    from radtree.diagnose.attribution import Attribution, Signature
+    from radtree.diagnose.effects import Strength, get_effect
+    from radtree.diagnose.identify import step_identifiability
+
+    hours = np.array([1.0, 1.2, 1.3, 1.35, 1.3, 1.2, 1.0])
+    sky = 150.0 * hours                      # lx at 12 000 lx diffuse
+    ground = 60.0 * hours ** 1.02           # nearly the same shape
+    rng = np.random.default_rng(7)
+    measured_minus_model = 1.25 * sky + 3.0 * rng.standard_normal(7)
+
+    def sig(name: str, x: np.ndarray, ref: float, hi: float) -> Signature:
+        st = Strength(name, "", 0.0, hi, ref)
+        return Signature(get_effect(name), "linear", st, np.array([ref]), x[None, :],
+                         np.zeros((1, 1)), ["all"], [], ref)
+
+    sigs = {"sky_diffuse": sig("sky_diffuse", sky, 12000.0, 40000.0),
+            "unfiltered_ground": sig("unfiltered_ground", ground, 0.1, 1.0)}
+    att = Attribution(measured_minus_model, 1000.0, 100.0, [], sigs, {}, 0.05)
+    ident, iv = step_identifiability(att, np.full(7, 1000.0), np.full(7, 5.0))
+    assert ident.partners("sky_diffuse") == ["unfiltered_ground"]
+    assert ident.sentence("sky_diffuse").startswith(
+        "named sky_diffuse, but sky_diffuse and unfiltered_ground are not separable")
+    assert iv["sky_diffuse"].covers(15000.0) and iv["sky_diffuse"].hi - iv["sky_diffuse"].lo < 2000
+    assert iv["unfiltered_ground"].lo > 0.1   # alone, ground would need > its reference
