@@ -198,7 +198,9 @@ class Identifiability:
         others = self.partners(named)
         if not others:
             return f"named {named}; with these data it is separable from every other candidate"
-        return (f"named {named}, but {' and '.join([named] + others)} are not separable with "
+        every = [named] + others
+        listed = ", ".join(every[:-1]) + " and " + every[-1]
+        return (f"named {named}, but {listed} are not separable with "
                 "these data (whitened signatures correlate ≥ "
                 f"{self.threshold:.2f}); the choice among them is the lower CV error only")
 
@@ -310,8 +312,8 @@ def step_identifiability(att: Any, expected: np.ndarray, mc_stderr: np.ndarray,
                          noise: float = DEFAULT_NOISE, noise_lux: float = 0.0
                          ) -> tuple[Identifiability, dict[str, Interval]]:
     """Identifiability of one step's candidates (an :class:`~.attribution.Attribution`) on its
-    measured values, and the profile interval of every fitted strength (noise scale unknown:
-    ``noise`` only sets the relative weights of the values)."""
+    measured values (weighted by their noise), and the profile interval of every fitted
+    strength — of the loop's own fit: unweighted least squares, noise scale unknown."""
     sigma = np.maximum(noise_sigma(expected, mc_stderr, noise, noise_lux), 1e-9)
     names = list(att.signatures)
     s = (np.column_stack([att.signatures[n].reference_hourly() for n in names]) if names
@@ -325,8 +327,8 @@ def step_identifiability(att: Any, expected: np.ndarray, mc_stderr: np.ndarray,
             continue
         if sig.kind == "linear":
             out[n] = linear_interval(sig.hourly[0], att.residual, float(sig.strengths[0]),
-                                     0.0, st.hi, sigma)
+                                     0.0, st.hi)
         else:
             xs, preds = sig.choices()
-            out[n] = profile_interval(xs, preds, att.residual, sigma)
+            out[n] = profile_interval(xs, preds, att.residual)
     return ident, out
