@@ -61,7 +61,7 @@ def test_campaign_round_trip_and_merge(mendoza, tmp_path) -> None:
 @pytest.mark.parametrize("text, message", [
     ("[campaign]\nnoise = 0.03\nfoo = 1\n", "unknown key(s) foo"),
     ("[campaign]\n[[group]]\nname = 'x'\norientation = 'sideways'\npoints = [[0, 1, 1]]\n",
-     "orientation must be one of facade, horizontal, facing_crown, got 'sideways'"),
+     "orientation must be one of facade, horizontal, facing_crown, ground, got 'sideways'"),
     ("[campaign]\n[[group]]\nname = 'x'\npoints = [[0, 1]]\n",
      "points must be [u, d, z] lists of three numbers (m), got [0, 1]"),
     ("[campaign]\ndays = ['22/12/2024']\n[[group]]\nname = 'f'\ngrid = 'facade'\n",
@@ -86,6 +86,7 @@ def test_point_grid_orientations() -> None:
         [0, 0, 1])
     assert point_grid([(0, 1, 1)], "facing_crown", frame, "c").normals[0] == pytest.approx(
         [-1, 0, 0])
+    assert point_grid([(0, 1, 1)], "ground", frame, "d").normals[0] == pytest.approx([0, 0, -1])
 
 
 def test_ranking_prefers_the_measurement_that_separates() -> None:

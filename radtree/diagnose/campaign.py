@@ -23,7 +23,8 @@ identifiability work on the vector of observations. Example (the Mendoza study):
     name = "street_open"
     orientation = "horizontal"     # "facade" (vertical, looking out of the façade),
                                    # "horizontal" (looking up), "facing_crown" (vertical,
-                                   # looking back at the façade and the crown)
+                                   # looking back at the façade and the crown),
+                                   # "ground" (looking down at the street)
     points = [[0.0, 12.0, 1.0]]    # (u along the façade, d out from the façade, z up), m
     report = "sensor"
 
@@ -49,7 +50,7 @@ from radtree.config import Project
 from radtree.errors import ConfigError
 from radtree.measurements import normalise_time
 
-ORIENTATIONS = ("facade", "horizontal", "facing_crown")
+ORIENTATIONS = ("facade", "horizontal", "facing_crown", "ground")
 REPORTS = ("mean", "sensor")
 DEFAULT_CAMPAIGN_NOISE = 0.03
 
