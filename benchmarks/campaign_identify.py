@@ -7,8 +7,8 @@ campaign's observations (effects off in the scenario: switched on at the referen
 minus the scenario; effects on: the scenario minus the scenario with the effect off), the
 noise of every observation (the campaign's noise and twice the Monte Carlo variance, as the
 self-test), then the self-test's rule on noise-weighted values — signature RMS ≥ SNR_MIN ×
-noise RMS and |correlation| with every other effect < TIE_CORR — and the groups at
-|corr| ≥ 0.95 (radtree.diagnose.identify). Prints one line per effect and the count.
+noise RMS and (signed, uncentred) correlation with every other effect < TIE_CORR — and the
+joint-fit groups at |corr| ≥ 0.95 (radtree.diagnose.identify). Prints one line per effect and the count.
 """
 
 from __future__ import annotations
@@ -60,12 +60,12 @@ def main() -> None:
           f"{sim.rays} rays/sensor")
     for j, n in enumerate(names):
         snr = float(np.sqrt(np.mean(w[:, j] ** 2)))
-        corr = np.abs(ident.correlation[j]).copy()
+        corr = ident.correlation[j].copy()
         corr[j] = np.nan
         k = int(np.nanargmax(corr))
         ok = snr >= SNR_MIN and corr[k] < TIE_CORR
         n_ok += ok
-        print(f"  {n:26s} SNR {snr:6.2f}  max |corr| {corr[k]:.2f} ({names[k]})  "
+        print(f"  {n:26s} SNR {snr:6.2f}  max corr {corr[k]:+.2f} ({names[k]})  "
               f"{'distinguishable' if ok else 'not distinguishable'}")
     print(f"distinguishable: {n_ok} of {len(names)}; groups at |corr| ≥ 0.95: "
           + ("; ".join(" ~ ".join(g) for g in ident.confounded) or "none")

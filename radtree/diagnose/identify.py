@@ -12,7 +12,10 @@ each measured value, σ_i (lux; instrument noise and Monte Carlo error). Then:
 * the **condition number** of the whitened, column-normalised matrix says how close the set
   is to degenerate (1: orthogonal signatures; ∞: some combination is invisible);
 * **groups** are the clusters of effects linked by |correlation| ≥ ``GROUP_CORR`` (single
-  linkage): the data cannot separate the members of one group;
+  linkage): the data cannot separate the members of one group in a joint fit (an
+  anticorrelated pair too: a joint fit trades one amplitude against the other; the loop's
+  one-effect-at-a-time, non-negative fit can still tell such a pair apart by the sign of the
+  residual, which is why the self-test's rule uses the signed correlation);
 * an effect whose whitened signature norm (its SNR, √Σ(S_ij/σ_i)²) is below ``SNR_MIN`` is
   *below the noise*: not identifiable at all with these data;
 * the **confidence interval** of a fitted strength is the profile-likelihood interval
