@@ -110,3 +110,19 @@ def test_ranking_prefers_the_measurement_that_separates() -> None:
     # a·b over the 7 values: 1+4+9+16 −1 −1 −4 = 24; |a|² = |b|² = 30 + 6 = 36
     assert first["min_correlation_after"] == pytest.approx(24 / 36)
     assert after.confounded == []
+
+
+def test_rich_readings_load_in_observation_order(mendoza) -> None:
+    from radtree.diagnose.campaign_sim import CampaignSimulator, campaign_readings
+
+    c = load_campaign(MENDOZA / "campaign-rich.toml", mendoza)
+    sim = CampaignSimulator(mendoza, (), None, 16, None, campaign=c)
+    assert sim.notes == [] and len(sim.labels) == 140
+    values = campaign_readings(sim)
+    first = (MENDOZA / "data" / "campaign-rich" / "facade_2024-12-22.csv").read_text(
+        encoding="utf-8").splitlines()[3]
+    assert first.startswith("10:30,0,") and values[0] == pytest.approx(float(first.split(",")[2]))
+    open_last = (MENDOZA / "data" / "campaign-rich" / "street_open_2025-03-20.csv").read_text(
+        encoding="utf-8").splitlines()[-1]
+    assert sim.labels[-1] == "2025-03-20 16:30 street_open:0"
+    assert values[-1] == pytest.approx(float(open_last.split(",")[2]))
