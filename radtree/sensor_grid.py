@@ -51,3 +51,25 @@ def facade_dense_grid(sensors: Sensors, frame: FacadeFrame, name: str = "facade_
     rows = [f"z={zz:.2f}" for zz in Z.ravel()]
     normals = np.tile(frame.normal, (U.size, 1))
     return SensorGrid(name, frame.to_world(local), normals, rows)
+
+
+def point_grid(points, orientation: str, frame: FacadeFrame, name: str,
+               row: str = "") -> SensorGrid:
+    """Sensors at ``points`` (u along the façade, d out of the façade, z up; metres, façade
+    frame) looking ``"facade"`` (out of the façade, vertical), ``"horizontal"`` (up) or
+    ``"facing_crown"`` (vertical, back towards the façade and its crown) or ``"ground"``
+    (looking down at the street, as an albedometer's lower sensor)."""
+    local = np.asarray(points, float).reshape(-1, 3)
+    if orientation == "horizontal":
+        normal = np.array([0.0, 0.0, 1.0])
+    elif orientation == "facade":
+        normal = frame.normal
+    elif orientation == "facing_crown":
+        normal = -frame.normal
+    elif orientation == "ground":
+        normal = np.array([0.0, 0.0, -1.0])
+    else:
+        raise ValueError(f"orientation must be facade, horizontal, facing_crown or ground, "
+                         f"got {orientation!r}")
+    return SensorGrid(name, frame.to_world(local), np.tile(normal, (len(local), 1)),
+                      [row] * len(local))

@@ -1,7 +1,9 @@
 """``radtree diagnose``: name the missing physical effect, add it, re-simulate (SPEC §6).
 
     radtree diagnose PROJECT [--measured FILE.csv] [--scenario B] [--engine numpy] [--units lux]
-    radtree diagnose PROJECT --selftest [--effects a,b,c] [--noise 0.03]
+    radtree diagnose PROJECT --campaign FILE          # against a campaign's readings
+    radtree diagnose PROJECT --selftest [--effects a,b,c] [--noise 0.03] [--campaign FILE]
+    radtree diagnose PROJECT --next-measurement [--campaign FILE] [--candidates FILE]
     radtree diagnose --list-effects [PROJECT [--scenario B]]
 
 Expected failures raise :class:`radtree.errors.RadtreeError` (the one handler of
@@ -40,15 +42,27 @@ from radtree.engines.registry import ENGINES
                                 "hide; otherwise the candidates (default: the whole catalogue).")
 @click.option("--selftest", is_flag=True,
               help="Hide each effect in synthetic measurements and check it is named.")
-@click.option("--noise", type=click.FloatRange(0, 1, max_open=True), default=0.03,
-              show_default=True, help="Self-test: relative noise on each synthetic hourly value.")
+@click.option("--noise", type=click.FloatRange(0, 1, max_open=True), default=None,
+              help="Self-test: relative noise on each synthetic value [default: the "
+                   "campaign's, else 0.03].")
+@click.option("--campaign", type=click.Path(dir_okay=False, exists=True),
+              help="Measurement campaign TOML (days, hours, sensor groups, noise): the "
+                   "self-test measures what it measures; --next-measurement starts from it. "
+                   "Default: the project's façade grid mean at its hours.")
+@click.option("--next-measurement", "next_measurement", is_flag=True,
+              help="Rank candidate additions to the campaign by how well they separate the "
+                   "confounded effects → diagnose/next_measurement.csv.")
+@click.option("--candidates", type=click.Path(dir_okay=False, exists=True),
+              help="With --next-measurement: a campaign TOML whose groups/hours/days are the "
+                   "candidates (default: generated).")
 @click.option("--out", type=click.Path(file_okay=False),
               help="Output folder. Default: PROJECT/diagnose.")
 @click.option("--list-effects", is_flag=True, help="Print the effect catalogue and exit.")
 def diagnose_command(project: str | None, measured: str | None, units: str | None,
                      scenario: str | None, engine: str | None, rays: int | None, seed: int | None,
                      margin: float, max_steps: int, effects: str | None, selftest: bool,
-                     noise: float, out: str | None, list_effects: bool) -> None:
+                     noise: float | None, campaign: str | None, next_measurement: bool,
+                     candidates: str | None, out: str | None, list_effects: bool) -> None:
     """Find where simulation and measurement disagree, name the missing effect, add it.
 
     \b
@@ -73,6 +87,24 @@ def diagnose_command(project: str | None, measured: str | None, units: str | Non
     if project is None:
         raise click.UsageError("PROJECT is required (except with --list-effects)")
     chosen = parse_effects(effects)
+    camp = None
+    if campaign is not None:
+        from radtree.config import load_project
+        from radtree.diagnose.campaign import load_campaign
+
+        camp = load_campaign(campaign, load_project(project))
+    if candidates is not None and not next_measurement:
+        raise ConfigError("--candidates goes with --next-measurement")
+    if next_measurement:
+        if selftest or measured is not None:
+            raise ConfigError("--next-measurement goes without --selftest and --measured")
+        from radtree.diagnose.design import next_measurement as run_design
+
+        design = run_design(project, scenario, camp, candidates, engine, rays, seed, chosen,
+                            out, echo=click.echo)
+        for line in design.lines():
+            click.echo(line)
+        return
     if selftest:
         if measured is not None:
             raise ConfigError("--measured does not go with --selftest (the self-test makes "
@@ -80,7 +112,7 @@ def diagnose_command(project: str | None, measured: str | None, units: str | Non
         from radtree.diagnose.hidden import selftest as run_selftest
 
         res = run_selftest(project, scenario, chosen, noise, engine, rays, seed, margin,
-                           max_steps, out, echo=click.echo)
+                           max_steps, out, echo=click.echo, campaign=camp)
         table = res.table()
         click.echo("")
         cols = ["hidden_effect", "distinguishable", "named_effect", "rmse_before", "rmse_after",
@@ -99,7 +131,7 @@ def diagnose_command(project: str | None, measured: str | None, units: str | Non
     from radtree.diagnose.run import diagnose, format_steps
 
     res_d = diagnose(project, measured, units, scenario, engine, rays, seed, margin, max_steps,
-                     chosen, out, echo=click.echo)
+                     chosen, out, echo=click.echo, campaign=camp)
     for line in format_steps(res_d.loop):
         click.echo(line)
     click.echo(f"done in {res_d.seconds:.0f} s ({res_d.simulations} simulations): "

@@ -38,7 +38,10 @@ from radtree.diagnose.attribution import (
     compute_signatures,
     cosine,
 )
+from radtree.diagnose.campaign import Campaign
+from radtree.diagnose.campaign_sim import CampaignSimulator, campaign_synthetic
 from radtree.diagnose.effects import EFFECTS, Effect, EffectContext, candidates
+from radtree.diagnose.identify import DEFAULT_NOISE, noise_sigma
 from radtree.diagnose.loop import (
     DEFAULT_MAX_STEPS,
     Measured,
@@ -57,12 +60,11 @@ from radtree.diagnose.simulate import Simulator
 from radtree.errors import RadtreeError
 from radtree.fileio import atomic_path, write_text
 
-DEFAULT_NOISE = 0.03
 TRUTH_SEED_OFFSET = 7919
 
 
 def _decide(sim: Simulator, ctx: EffectContext, effect: Effect, start: Scenario, noise: float,
-            echo: Echo | None) -> HiddenCase:
+            echo: Echo | None, noise_lux: float | np.ndarray = 0.0) -> HiddenCase:
     base = effect.switch_off(ctx, start) if effect.is_on(ctx, start) else start
     if base is not start:
         base = Scenario(f"{start.name}-no-{effect.name}", base.model, base.reflection, base.sky,
@@ -78,7 +80,7 @@ def _decide(sim: Simulator, ctx: EffectContext, effect: Effect, start: Scenario,
     sx = sigs[effect.name].reference_hourly()
     expected = base_run.lux + sx
     se = np.nan_to_num(base_run.stderr, nan=0.0)
-    noise_rms = float(np.sqrt(np.mean((noise * expected) ** 2 + 2 * se ** 2)))
+    noise_rms = float(np.sqrt(np.mean(noise_sigma(expected, se, noise, noise_lux) ** 2)))
     rms = float(np.sqrt(np.mean(sx ** 2)))
     corr = {n: cosine(sx, s.reference_hourly()) for n, s in sigs.items() if n != effect.name}
     corr = {k: v for k, v in corr.items() if math.isfinite(v)}
@@ -98,9 +100,14 @@ def _decide(sim: Simulator, ctx: EffectContext, effect: Effect, start: Scenario,
 
 
 def _synthetic(truth_sim: Simulator, case: HiddenCase, noise: float, seed: int, index: int,
-               folder: Path | None, project: Project) -> Measured:
+               folder: Path | None, project: Project, noise_lux: float = 0.0) -> Measured:
     run = truth_sim.run(case.truth)
     rng = np.random.default_rng([int(seed), 4242, index])
+    if isinstance(truth_sim, CampaignSimulator):
+        return campaign_synthetic(truth_sim, case.truth, run, noise, noise_lux, rng,
+                                  None if folder is None else folder / f"{case.effect}.csv",
+                                  f"{case.base.name} + {case.effect} ({case.strength_text}), "
+                                  f"seed {seed}")
     hourly = run.lux * (1.0 + noise * rng.standard_normal(len(run.lux)))
     rows_h = run.rows * (1.0 + noise * rng.standard_normal(run.rows.shape))
     counts = truth_sim.sensors_per_row()
@@ -124,12 +131,19 @@ def _synthetic(truth_sim: Simulator, case: HiddenCase, noise: float, seed: int, 
 
 
 def selftest(project: str | os.PathLike | Project, scenario: str | None = None,
-             effects: Iterable[Effect] | None = None, noise: float = DEFAULT_NOISE,
+             effects: Iterable[Effect] | None = None, noise: float | None = None,
              engine: str | None = None, rays: int | None = None, seed: int | None = None,
              margin: float = DEFAULT_MARGIN, max_steps: int = DEFAULT_MAX_STEPS,
              out_dir: str | os.PathLike | None = None, write: bool = True,
-             echo: Echo | None = print) -> SelftestResult:
-    """Hide each effect in synthetic measurements and check the loop names it."""
+             echo: Echo | None = print, campaign: Campaign | None = None,
+             noise_lux: float = 0.0) -> SelftestResult:
+    """Hide each effect in synthetic measurements and check the loop names it.
+
+    ``campaign``: measure what the campaign measures (its days, hours, sensor groups; its
+    noise unless ``noise`` is given); default the project's façade grid mean at its hours."""
+    if campaign is not None and noise is None:
+        noise, noise_lux = campaign.noise, campaign.noise_lux
+    noise = DEFAULT_NOISE if noise is None else noise
     if not 0 <= noise < 1:
         raise RadtreeError(f"noise must be a fraction in [0, 1), got {noise}")
     t0 = time.perf_counter()
@@ -139,8 +153,19 @@ def selftest(project: str | os.PathLike | Project, scenario: str | None = None,
     ctx = EffectContext(proj)
     out = Path(out_dir) if out_dir is not None else proj.root / "diagnose"
     hours = tuple(proj.site.hours)
-    sim = Simulator(proj, hours, engine, rays, seed)
-    truth_sim = Simulator(proj, hours, engine, sim.rays, int(sim.seed or 0) + TRUTH_SEED_OFFSET)
+    if campaign is None:
+        sim = Simulator(proj, hours, engine, rays, seed)
+        truth_sim = Simulator(proj, hours, engine, sim.rays,
+                              int(sim.seed or 0) + TRUTH_SEED_OFFSET)
+    else:
+        sim = CampaignSimulator(proj, hours, engine, rays, seed, campaign=campaign)
+        truth_sim = CampaignSimulator(proj, hours, engine, sim.rays,
+                                      int(sim.seed or 0) + TRUTH_SEED_OFFSET, campaign=campaign)
+        truth_sim.weights = sim.set_weights(start, noise, noise_lux)
+        say(f"campaign {campaign.summary()} — {len(sim.labels)} observations, compared in "
+            "noise-weighted lux (each value ÷ its noise)")
+        for note in sim.notes:
+            say(f"  note: {note}")
     chosen = tuple(effects) if effects is not None else EFFECTS
     skipped: dict[str, str] = {}
     say(f"self-test {proj.name}: scenario {start.name}, noise {noise:.1%}, engine {sim.engine_name}"
@@ -154,14 +179,16 @@ def selftest(project: str | os.PathLike | Project, scenario: str | None = None,
             skipped[e.name] = why
             say(f"  {e.name}: skipped ({why})")
             continue
-        case = _decide(sim, ctx, e, start, noise, None)
+        case = _decide(sim, ctx, e, start, noise, None,
+                       noise_lux * sim.weights if isinstance(sim, CampaignSimulator)
+                       and sim.weights is not None else noise_lux)
         cases.append(case)
         say(f"  {e.name:26s} {'distinguishable' if case.distinguishable else 'not distinguishable'}"
             f": {case.reason}")
     for i, case in enumerate(cases):
         say(f"  hidden {case.effect} ({case.strength_text}) in {case.base.name}:")
         meas = _synthetic(truth_sim, case, noise, int(sim.seed or 0), i,
-                          out / "selftest" if write else None, proj)
+                          out / "selftest" if write else None, proj, noise_lux)
         case.measured = meas
         case.loop = run_loop(sim, ctx, case.base, meas, margin, max_steps, EFFECTS,
                              echo=None)
@@ -177,7 +204,8 @@ def selftest(project: str | os.PathLike | Project, scenario: str | None = None,
     res = SelftestResult(proj, start, noise, cases, skipped, time.perf_counter() - t0,
                          sim.traced_runs + truth_sim.traced_runs, out if write else None,
                          engine=sim.engine_name, rays=sim.rays if sim.seeded else None,
-                         seed=sim.seed if sim.seeded else None)
+                         seed=sim.seed if sim.seeded else None,
+                         campaign=campaign.summary() if campaign is not None else "")
     if write:
         from radtree.diagnose.report import write_selftest_report
 

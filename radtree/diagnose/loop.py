@@ -31,6 +31,12 @@ from radtree.diagnose.attribution import (
     choose_winner,
 )
 from radtree.diagnose.effects import EFFECTS, Effect, EffectContext, get_effect
+from radtree.diagnose.identify import (
+    DEFAULT_NOISE,
+    Identifiability,
+    Interval,
+    step_identifiability,
+)
 from radtree.diagnose.residuals import DisagreementMap, disagreement_map
 from radtree.diagnose.simulate import Run, Simulator
 from radtree.errors import RadtreeError
@@ -62,6 +68,12 @@ class Measured:
     rows_hourly: pd.DataFrame | None = None
     left_out: list[str] = field(default_factory=list)
     unmeasured: list[str] = field(default_factory=list)
+    #: sun altitude and azimuth (degrees) per value when ``times`` are not clock times (a
+    #: campaign's observations, :mod:`.campaign_sim`); None: from the project's hours
+    sun: tuple[np.ndarray, np.ndarray] | None = None
+    #: relative noise (1 σ) and floor (lux) of the values: the identifiability's weights
+    noise: float = DEFAULT_NOISE
+    noise_lux: float = 0.0
 
     @property
     def mean(self) -> float:
@@ -151,6 +163,13 @@ class Step:
     map_after: DisagreementMap
     rejected: list[str] = field(default_factory=list)
     project_file: Path | None = None
+    identify: Identifiability | None = None
+    intervals: dict[str, Interval] = field(default_factory=dict)
+
+    @property
+    def separability(self) -> str:
+        """"named X, but X and Y are not separable with these data" (or that X is)."""
+        return self.identify.sentence(self.effect) if self.identify is not None else ""
 
     def record(self) -> dict[str, Any]:
         return {"step": self.number, "effect": self.effect,
@@ -160,7 +179,14 @@ class Step:
                 "cv_rmse_before": self.cv_rmse_before, "cv_rmse_after": self.cv_rmse_after,
                 "mbe_before": self.mbe_before, "mbe_after": self.mbe_after,
                 "strength_text": self.strength_text, "change": self.change,
-                "tie_with": ";".join(self.tie_with), "scenario": self.scenario_after.name,
+                "tie_with": ";".join(self.tie_with),
+                "not_separable_from": ";".join(self.identify.partners(self.effect))
+                if self.identify is not None else "",
+                "strength_ci_lo": self.intervals[self.effect].lo
+                if self.effect in self.intervals else math.nan,
+                "strength_ci_hi": self.intervals[self.effect].hi
+                if self.effect in self.intervals else math.nan,
+                "scenario": self.scenario_after.name,
                 "project_file": str(self.project_file) if self.project_file else ""}
 
 
@@ -256,7 +282,8 @@ def run_loop(sim: Simulator, ctx: EffectContext, start: Scenario, measured: Meas
         raise RadtreeError(f"margin must be in [0, 1), got {margin}")
     catalogue = tuple(catalogue)
     say = echo or (lambda s: None)
-    alt, az = sun_positions(ctx.project, start, measured.times)
+    alt, az = (measured.sun if measured.sun is not None
+               else sun_positions(ctx.project, start, measured.times))
     mm = measured.mean
     current = start
     run = sim.run(current)
@@ -308,16 +335,21 @@ def run_loop(sim: Simulator, ctx: EffectContext, start: Scenario, measured: Meas
                 stop += f"; rejected after re-simulation: {', '.join(rejected)}"
             break
         w, new, new_run, after, path = chosen
+        ident, intervals = step_identifiability(att, run.lux, run.stderr, measured.noise,
+                                                measured.noise_lux)
         step = Step(k, w.effect, w.title, w.strength, w.strength_text, w.change,
-                    _why(att, w, dm), w.explained_fraction, dm.stats["nrmse"],
+                    _why(att, w, dm) + " " + ident.sentence(w.effect) + ".",
+                    w.explained_fraction, dm.stats["nrmse"],
                     after.stats["nrmse"], att.baseline_cv_lux / mm, w.cv_rmse_lux / mm,
                     dm.stats["nmbe"], after.stats["nmbe"], list(att.tie_with), att, current,
-                    new, dm, after, rejected, path)
+                    new, dm, after, rejected, path, ident, intervals)
         steps.append(step)
         say(f"    → add {w.effect} ({w.strength_text}): nRMSE {step.rmse_before:.3f} → "
             f"{step.rmse_after:.3f}, CV nRMSE {step.cv_rmse_before:.3f} → "
             f"{step.cv_rmse_after:.3f}" + (f"; tie with {', '.join(att.tie_with)}"
                                             if att.tie_with else ""))
+        if ident.partners(w.effect):
+            say(f"    {step.separability}")
         current, run, dm = new, new_run, after
         att = None
     else:

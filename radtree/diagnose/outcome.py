@@ -129,6 +129,7 @@ class SelftestResult:
     engine: str = ""
     rays: int | None = None
     seed: int | None = None
+    campaign: str = ""   # the campaign's summary ("" : the project's façade grid mean)
 
     @property
     def passed(self) -> bool:

@@ -13,17 +13,16 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
-from jinja2 import Environment
 from matplotlib import colormaps
 from matplotlib.figure import Figure
 
 from radtree import __version__
 from radtree.diagnose.attribution import TIE_CORR
 from radtree.diagnose.effects import EFFECTS, EffectContext, candidates
+from radtree.diagnose.report_identify import _env, ident_context
 from radtree.diagnose.residuals import RULES, DisagreementMap
 from radtree.figures import new_figure, save_png
 from radtree.fileio import write_text
-from radtree.resources import template_environment
 
 if TYPE_CHECKING:
     from radtree.diagnose.loop import LoopResult
@@ -46,6 +45,15 @@ def _hour(t: str) -> float:
     return int(h) + int(m) / 60
 
 
+def _xs(times: Any) -> list[float]:
+    """x positions of the values: clock hours, or the index for a campaign's observations
+    (labelled ``DAY HH:MM GROUP``)."""
+    times = [str(t) for t in times]
+    if all(len(t) == 5 and t[2] == ":" for t in times):
+        return [_hour(t) for t in times]
+    return [float(i) for i in range(len(times))]
+
+
 def _maps(loop: LoopResult) -> list[tuple[str, DisagreementMap]]:
     out = [(f"start ({loop.start.name})", loop.start_map)]
     out += [(f"step {s.number}: + {s.effect}", s.map_after) for s in loop.steps]
@@ -63,7 +71,7 @@ def fig_residual_steps(loop: LoopResult, path: Path) -> str:
     maps = _maps(loop)
     for i, (label, dm) in enumerate(maps):
         h = dm.hourly
-        x = [_hour(t) for t in h["time"]]
+        x = _xs(h["time"])
         c = _step_colour(i, len(maps), "black")
         ax.errorbar(x, h["residual_lux"], yerr=2 * h["simulated_se_lux"].fillna(0), marker="o",
                     color=c, lw=2.2 if i in (0, len(maps) - 1) else 1.2, capsize=3,
@@ -81,7 +89,7 @@ def fig_measured(loop: LoopResult, path: Path) -> str:
     ax = fig.add_subplot()
     maps = _maps(loop)
     h0 = maps[0][1].hourly
-    x = [_hour(t) for t in h0["time"]]
+    x = _xs(h0["time"])
     ax.plot(x, h0["measured_lux"], "o-", color="black", lw=2.4, label="measured", zorder=5)
     for i, (label, dm) in enumerate(maps):
         c = _step_colour(i, len(maps), "tab:red")
@@ -155,7 +163,7 @@ def fig_rmse(loop: LoopResult, path: Path) -> str:
 def fig_candidates(att: Any, times: list[str], title: str, path: Path) -> str:
     fig = _fig(7.5, 4.2)
     ax = fig.add_subplot()
-    x = [_hour(t) for t in times]
+    x = _xs(times)
     ax.plot(x, att.residual, "o-", color="black", lw=2.5, label="residual", zorder=5)
     cmap = colormaps["tab10"]
     for i, f in enumerate(att.fits):
@@ -171,19 +179,6 @@ def fig_candidates(att: Any, times: list[str], title: str, path: Path) -> str:
 
 
 # --------------------------------------------------------------------------- HTML
-def _env() -> Environment:
-    env = template_environment(autoescape=True, trim_blocks=True, lstrip_blocks=True)
-    env.filters["f3"] = lambda v: "–" if v is None or (isinstance(v, float) and
-                                                      not math.isfinite(v)) else f"{v:.3f}"
-    env.filters["f0"] = lambda v: "–" if v is None or (isinstance(v, float) and
-                                                      not math.isfinite(v)) else f"{v:,.0f}"
-    env.filters["pct"] = lambda v: "–" if v is None or (isinstance(v, float) and
-                                                       not math.isfinite(v)) else f"{v:.0%}"
-    env.filters["sgn"] = lambda v: "–" if v is None or (isinstance(v, float) and
-                                                       not math.isfinite(v)) else f"{v:+,.0f}"
-    return env
-
-
 def _records(df: Any) -> list[dict[str, Any]]:
     return [] if df is None else df.to_dict("records")
 
@@ -252,10 +247,15 @@ def write_diagnose_report(res: DiagnoseResult, out: Path) -> list[Path]:
         "steps_table": _records(loop.steps_table()), "stop": loop.stop_reason,
         "rules": RULES, "catalogue": _catalogue(ctx, res.scenario), "tie_corr": TIE_CORR,
         "margin": res.margin, "version": __version__,
+        "ident": ident_context(loop.steps[0], out, out / "next_measurement.csv")
+        if loop.steps and loop.steps[0].identify is not None else None,
         "created": datetime.now(timezone.utc).isoformat(timespec="seconds"),
     }
     html = _env().get_template("diagnose.html.j2").render(c=c)
     files.append(write_text(out / "index.html", html))
+    ident = c["ident"]
+    if isinstance(ident, dict):
+        files.append(out / str(ident["fig"]))
     files += [out / f for f in figs.values()] + [out / s["fig"] for s in steps]
     if last:
         files.append(out / last["fig"])
@@ -289,6 +289,7 @@ def write_selftest_report(res: SelftestResult, out: Path) -> list[Path]:
         "kind": "selftest", "project": res.project, "scenario": res.scenario, "res": res,
         "table": _records(res.table()), "fig": fig, "skipped": res.skipped,
         "snr_min": SNR_MIN, "tie_corr": TIE_CORR, "version": __version__,
+        "campaign": res.campaign,
         "catalogue": _catalogue(EffectContext(res.project), res.scenario),
         "created": datetime.now(timezone.utc).isoformat(timespec="seconds"),
     }

@@ -17,16 +17,20 @@ import pandas as pd
 
 from radtree.config import Project, Scenario
 from radtree.diagnose.attribution import DEFAULT_MARGIN
+from radtree.diagnose.campaign import Campaign
+from radtree.diagnose.campaign_sim import CampaignSimulator, campaign_readings
 from radtree.diagnose.effects import EFFECTS, Effect, EffectContext, candidates
 from radtree.diagnose.loop import (
     DEFAULT_MAX_STEPS,
     LoopResult,
+    Measured,
     load_measurements,
     run_loop,
     write_step_project,
 )
 from radtree.diagnose.outcome import DiagnoseResult, Echo, pick_scenario, resolve_project
 from radtree.diagnose.simulate import Simulator
+from radtree.errors import ConfigError
 from radtree.fileio import atomic_path
 
 
@@ -35,12 +39,14 @@ def diagnose(project: str | os.PathLike | Project, measured: str | os.PathLike |
              rays: int | None = None, seed: int | None = None, margin: float = DEFAULT_MARGIN,
              max_steps: int = DEFAULT_MAX_STEPS, effects: Iterable[Effect] = EFFECTS,
              out_dir: str | os.PathLike | None = None, write: bool = True,
-             echo: Echo | None = print) -> DiagnoseResult:
+             echo: Echo | None = print, campaign: Campaign | None = None) -> DiagnoseResult:
     """Run the discrepancy loop from ``scenario`` (default: the project's first) against the
     measurements (default: ``[project] measured``) and write ``PROJECT/diagnose/``.
 
     ``engine``: a registered engine name (default: the seeded engine — ``rays`` per sensor,
     default 1024, fixed ``seed``, default the project's — so switched runs share random numbers). ``margin``: relative CV improvement a step must bring.
+    ``campaign``: diagnose against the campaign's readings (every day, hour and sensor group;
+    values compared in noise-weighted lux) instead of the project's measured file.
     """
     t0 = time.perf_counter()
     say = echo or (lambda s: None)
@@ -48,11 +54,27 @@ def diagnose(project: str | os.PathLike | Project, measured: str | os.PathLike |
     sc = pick_scenario(proj, scenario)
     out = Path(out_dir) if out_dir is not None else proj.root / "diagnose"
     ctx = EffectContext(proj)
-    sim = Simulator(proj, tuple(proj.site.hours), engine, rays, seed)
-    meas = load_measurements(proj, measured, units, sim.sensors_per_row())
-    for note in meas.notes():
-        say(f"  note: {note}")
-    sim = Simulator(proj, meas.times, engine, sim.rays, sim.seed)
+    sim: Simulator
+    if campaign is not None:
+        if measured is not None:
+            raise ConfigError("--measured does not go with --campaign (the campaign names its "
+                              "measured files)")
+        csim = CampaignSimulator(proj, (), engine, rays, seed, campaign=campaign)
+        weights = csim.set_weights(sc, campaign.noise, campaign.noise_lux)
+        sim = csim
+        meas = Measured(tuple(csim.labels), campaign_readings(csim) * weights,
+                        str(campaign.source or campaign.name), "noise-weighted lux",
+                        "campaign", sun=csim.sun_positions(sc), noise=campaign.noise,
+                        noise_lux=campaign.noise_lux)
+        say(f"campaign {campaign.summary()}: {len(csim.labels)} observations")
+        for note in csim.notes:
+            say(f"  note: {note}")
+    else:
+        sim = Simulator(proj, tuple(proj.site.hours), engine, rays, seed)
+        meas = load_measurements(proj, measured, units, sim.sensors_per_row())
+        for note in meas.notes():
+            say(f"  note: {note}")
+        sim = Simulator(proj, meas.times, engine, sim.rays, sim.seed)
     say(f"diagnose {proj.name}: scenario {sc.name} ({sc.model}, {sc.reflection}), engine "
         f"{sim.engine_name}" + (f", {sim.rays} rays/sensor, seed {sim.seed}" if sim.seeded else "")
         + f", {len(meas.times)} hours, measured mean {meas.mean:.0f} lx")
@@ -150,5 +172,7 @@ def format_steps(res: LoopResult) -> list[str]:
                      f"{s.rmse_before:.3f} → {s.rmse_after:.3f}, CV nRMSE {s.cv_rmse_before:.3f}"
                      f" → {s.cv_rmse_after:.3f}, explained "
                      + (f"{ef:.0%}" if math.isfinite(ef) else "n/a"))
+        if s.identify is not None and s.identify.partners(s.effect):
+            lines.append(f"    {s.separability}")
     lines.append(f"  stop: {res.stop_reason}")
     return lines
