@@ -6,7 +6,8 @@ With ``[engine] pmap_photons = N`` every hour gets, after its octree,
 
 (global photons: every photon stored at its diffuse hits after at least one scattering event;
 caustic photons, ``pmap_caustic_photons = M``: photons that reached a diffuse surface through
-specular events only, e.g. the slats' undeviated transmission), and ``rtrace`` reads them with
+specular events only, e.g. the slats' undeviated transmission — a scene without specular
+materials stores none and mkpmap stops: leave it unset there), and ``rtrace`` reads them with
 ``-ap pmaps/HHMM.gpm B`` (and ``-ap pmaps/HHMM.cpm B``), B = ``pmap_bandwidth`` photons per
 density estimate. ``rtrace`` then computes the direct light and one ambient bounce itself
 (``-ab 1``: final gathering) and takes everything beyond that bounce from the global map —

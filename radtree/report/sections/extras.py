@@ -130,4 +130,11 @@ def extra_sections(project: Project, out: Path, echo: Callable[[str], None]
 
         html.append(Section("annual", annual_section_data(project)))
         echo("  annual: metric maps and month × hour heat maps")
+    from radtree.report.sections.method import method_section_data
+
+    method = method_section_data(project, out)
+    if method is not None:
+        html.append(Section("method", method))
+        md.append(Section("method", method))
+        echo("  the study's method: variants, findings, dome-radius scan")
     return html, md
