@@ -44,6 +44,18 @@ SCENARIOS = ("A", "B", "C", "D", "E")
 SLAT_SCALES = (0.8, 0.6, 0.5, 0.4, 0.3, 0.2)  # slat shrink factors tried in a small dome
 
 
+COLUMNS = ["variant", "radius_m", "scenario", "time", "lux", "stderr", "engine", "photons",
+           "slat_m"]
+
+
+def _resume(path: Path, photons: int) -> pd.DataFrame:
+    if not path.exists():
+        return pd.DataFrame(columns=COLUMNS)
+    t = pd.read_csv(path, dtype={"time": str})
+    keep = (t["engine"] != "forward") | (t["photons"] == photons)
+    return t.loc[keep, COLUMNS].reset_index(drop=True)
+
+
 @dataclass(frozen=True)
 class Variant:
     """One way of tracing: a label, the project overrides, the engine, what it changes."""
@@ -60,9 +72,10 @@ VARIANTS = (
             "threshold 0.05 → 0.005"),
     Variant("no threshold", {"engine.forward_splitting": False}, "forward",
             "splitting + killing → Russian roulette (unbiased), same beam"),
-    Variant("whole-scene sun, dome", {}, "numpy",
+    Variant("whole-scene sun, dome", {"engine.rays": 1024}, "numpy",
             "1 m beam → sunlight over the whole scene (converged, NumPy backward)"),
-    Variant("whole-scene sun, free crown", {"tree.form": "free"}, "numpy",
+    Variant("whole-scene sun, free crown", {"tree.form": "free", "engine.rays": 1024},
+            "numpy",
             "sensor dome → free-standing crowns, whole-scene sun (converged)"),
 )
 
@@ -101,23 +114,29 @@ def _fitting(root: Path, ov: dict[str, Any], proj: Project, name: str, engine: s
 
 def run_method_study(root: Path, *, photons: int = 1_000_000, radii: Sequence[float] = RADII_M,
                      scenarios: Sequence[str] = SCENARIOS, variants: Sequence[str] | None = None,
-                     echo: Callable[[str], None] = print) -> Path:
+                     resume: bool = True, echo: Callable[[str], None] = print) -> Path:
     """Trace every variant and the radius scan of the project in ``root``; write and return
     ``root/method/hourly.csv``. ``photons`` per hour for the forward runs (the project's count
-    is the study's reading; fewer keep the scan affordable)."""
+    is the study's reading; fewer keep the scan affordable). The file is rewritten after every
+    scenario; with ``resume`` the (variant, radius, scenario) already in it at the same photon
+    count are kept and not traced again."""
     base = load_project(root)
-    frames = []
     chosen = [v for v in VARIANTS if variants is None or v.label in variants]
     jobs: list[tuple[Variant, float]] = [(v, base.tree.dome.radius_m) for v in chosen]
     study = next(v for v in VARIANTS if v.label == STUDY)
     jobs += [(study, float(r)) for r in radii if float(r) != base.tree.dome.radius_m
              or study not in chosen]
+    out = root / FOLDER / HOURLY
+    table = _resume(out, photons) if resume else pd.DataFrame(columns=COLUMNS)
+    done = set(zip(table["variant"], table["radius_m"].astype(float), table["scenario"]))
     for variant, radius in jobs:
         ov = {**variant.overrides, "tree.dome.radius_m": radius, "engine.photons": photons,
               "sensors.dense_grid": False}
         proj = load_project(root, overrides=ov)
         proj = replace(proj, engine=replace(proj.engine, name=variant.engine))
         for name in scenarios:
+            if (variant.label, float(radius), name) in done:
+                continue
             try:
                 h, use = _fitting(root, ov, proj, name, variant.engine)
             except RadtreeError as exc:
@@ -126,14 +145,10 @@ def run_method_study(root: Path, *, photons: int = 1_000_000, radii: Sequence[fl
             h["variant"], h["radius_m"], h["engine"] = variant.label, radius, variant.engine
             h["slat_m"] = use.tree.louvers.slat_size_m
             h["photons"] = photons if variant.engine == "forward" else proj.engine.rays
-            frames.append(h)
             echo(f"  {variant.label}, dome {radius:g} m, {name}: "
                  + " ".join(f"{v:.0f}" for v in h["lux"]))
-    table = pd.concat(frames, ignore_index=True)[
-        ["variant", "radius_m", "scenario", "time", "lux", "stderr", "engine", "photons",
-         "slat_m"]]
-    out = root / FOLDER / HOURLY
-    out.parent.mkdir(parents=True, exist_ok=True)
-    with atomic_path(out) as tmp:
-        table.to_csv(tmp, index=False, float_format="%.6g")
+            table = pd.concat([table, h[COLUMNS]], ignore_index=True)
+            out.parent.mkdir(parents=True, exist_ok=True)
+            with atomic_path(out) as tmp:   # after every scenario: an interrupted run resumes
+                table.to_csv(tmp, index=False, float_format="%.6g")
     return out

@@ -145,7 +145,9 @@ def method_section_data(project: Project, out: Path) -> dict[str, Any] | None:
     m = measured.reindex(hours)
     base = float(project.tree.dome.radius_m)
     variants = [v for v in VARIANTS if v.label in set(table["variant"])]
-    rows, orders, flags = [], [], {k: [] for k in FINDINGS}
+    rows: list[list[str]] = []
+    orders: list[list[str]] = []
+    flags: dict[str, list[tuple[str, bool | None]]] = {k: [] for k in FINDINGS}
     for v in variants:
         h = _hourly_frame(table, v.label, base)
         if not h:
