@@ -4,8 +4,8 @@ volume crowns under a Perez sky): scenarios A–F at one hour, converged setting
 Per scenario and estimator it prints the façade patch mean (the 8 sensors' 0.5 m squares: the
 forward engine's detectors; the backward engines trace ``--points`` random points in each
 square, :func:`radtree.verify.compare.backward_patch_mean`), its standard error, the wall-clock
-time, the ray rate (forward: photon segments/s; NumPy: ray queries/s; Radiance: points × -ad
-ambient rays/s at the first bounce) and the time to a 1 % standard error, extrapolated as
+time, the ray rate (forward: photon ray segments/s; NumPy: sensor paths/s; Radiance: points ×
+-ad ambient rays/s at the first bounce) and the time to a 1 % standard error, extrapolated as
 t · (s.e. / 1 %)²; then the forward − backward difference in % with its combined standard
 error, against the 2 % target. The Radiance photon map (``mkpmap`` + ``rtrace -ap``, global
 and caustic photons) is the fourth estimator with ``--pmap N``.
@@ -28,17 +28,16 @@ sys.path.insert(0, str(ROOT))
 
 from radtree.config import load_project  # noqa: E402
 from radtree.engines.forward import ForwardSettings, trace_forward  # noqa: E402
-from radtree.engines.numpy.engine import DEFAULT_OPTIONS, scene_geometry  # noqa: E402
 from radtree.engines.registry import available_engines  # noqa: E402
 from radtree.light.hours import hour_states  # noqa: E402
 from radtree.pipeline.assemble import make_scene  # noqa: E402
 from radtree.verify.compare import MENDOZA, backward_patch_mean  # noqa: E402
 
 
-def _line(engine: str, seconds: float, rays: float, mean: float, se: float) -> None:
+def _line(engine: str, seconds: float, rays: float, unit: str, mean: float, se: float) -> None:
     t1 = seconds * (se / (0.01 * mean)) ** 2 if mean > 0 else math.inf
     print(f"   {engine:9s} {mean:9.1f} ± {se:6.1f} lx ({se / mean:5.2%})  {seconds:7.1f} s  "
-          f"{rays / seconds / 1e6:6.2f} M rays/s  → 1 % s.e. in {t1:8.3g} s", flush=True)
+          f"{rays / seconds / 1e3:9.1f} k {unit}/s  → 1 % s.e. in {t1:8.3g} s", flush=True)
 
 
 def main() -> None:
@@ -62,26 +61,25 @@ def main() -> None:
         st = hour_states(proj, sc, [a.hour])[0]
         scene = built.scene
         print(f" scenario {name}: {scene.n_triangles} triangles, -ab {built.ab}", flush=True)
-        geo = scene_geometry(scene, DEFAULT_OPTIONS.backend, proj.engine.workers)
         t0 = time.perf_counter()
         fw = trace_forward(scene, st, ForwardSettings(photons=a.photons, max_bounces=built.ab),
                            ["facade"])
         dt = time.perf_counter() - t0
         f_mean, f_se = fw.grid_mean("facade")
-        _line("forward", dt, fw.segments, f_mean, f_se)
+        _line("forward", dt, fw.segments, "ray segments", f_mean, f_se)
         runs = [(e, replace(proj.engine, ad=a.ad)) for e in backward]
         if a.pmap:
             runs.append(("radiance", replace(proj.engine, ad=a.ad, pmap_photons=a.pmap,
                                              pmap_caustic_photons=a.pmap)))
         for e, params in runs:
             label = "pmap" if params.pmap_photons else e
-            before = geo.caster.rays_cast
             t0 = time.perf_counter()
             bw = backward_patch_mean(e, scene, st, "facade", 0.5, ab=built.ab,
                                      points=a.points, rays=a.rays, params=params)
             dt = time.perf_counter() - t0
-            rays = (geo.caster.rays_cast - before) if e == "numpy" else 8 * a.points * a.ad
-            _line(label, dt, rays, bw.lux, bw.stderr)
+            n = len(scene.grids["facade"]) * a.points * (a.rays if e == "numpy" else a.ad)
+            _line(label, dt, n, "paths" if e == "numpy" else "first-bounce rays", bw.lux,
+                  bw.stderr)
             diff = (f_mean - bw.lux) / bw.lux
             comb = math.hypot(f_se, bw.stderr) / bw.lux
             summary.append((name, label, bw.lux, f_mean, diff, comb))

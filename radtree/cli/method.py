@@ -21,12 +21,14 @@ from radtree.cli.options import CONTEXT
 @click.option("--variant", "variants", multiple=True,
               help="Variant(s) traced (default all: study, threshold 0.005, no threshold, "
                    "whole-scene sun, dome / free crown).")
+@click.option("--file", "file", default="hourly.csv", show_default=True,
+              help="CSV name in PROJECT/method/ (parallel runs write different files).")
 def method_command(project: Path, photons: int, radii: str, scenarios: tuple[str, ...],
-                   variants: tuple[str, ...]) -> None:
+                   variants: tuple[str, ...], file: str) -> None:
     """What the study's numbers owe to its method: scenarios A–E traced as the project sets
     them (the study's TracePro method in examples/mendoza-tracepro), with the threshold, the
     beam and the crown form changed one at a time, and at every dome radius of RADII. Writes
-    PROJECT/method/hourly.csv; `radtree report` then shows the section."""
+    PROJECT/method/FILE; `radtree report` then shows the section."""
     from radtree.verify.method import SCENARIOS, run_method_study
 
     try:
@@ -36,5 +38,5 @@ def method_command(project: Path, photons: int, radii: str, scenarios: tuple[str
             from None
     out = run_method_study(project, photons=photons, radii=rs,
                            scenarios=list(scenarios) or list(SCENARIOS),
-                           variants=list(variants) or None, echo=click.echo)
+                           variants=list(variants) or None, file=file, echo=click.echo)
     click.echo(f"wrote {out}")

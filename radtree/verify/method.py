@@ -48,6 +48,16 @@ COLUMNS = ["variant", "radius_m", "scenario", "time", "lux", "stderr", "engine",
            "slat_m"]
 
 
+def read_method(root: Path) -> pd.DataFrame | None:
+    """Every ``method/*.csv`` of the project together (first occurrence of a (variant, radius,
+    scenario, hour) kept), or None when there is none."""
+    files = sorted((root / FOLDER).glob("*.csv"))
+    if not files:
+        return None
+    t = pd.concat([pd.read_csv(f, dtype={"time": str}) for f in files], ignore_index=True)
+    return t.drop_duplicates(["variant", "radius_m", "scenario", "time"]).reset_index(drop=True)
+
+
 def _resume(path: Path, photons: int) -> pd.DataFrame:
     if not path.exists():
         return pd.DataFrame(columns=COLUMNS)
@@ -114,19 +124,21 @@ def _fitting(root: Path, ov: dict[str, Any], proj: Project, name: str, engine: s
 
 def run_method_study(root: Path, *, photons: int = 1_000_000, radii: Sequence[float] = RADII_M,
                      scenarios: Sequence[str] = SCENARIOS, variants: Sequence[str] | None = None,
-                     resume: bool = True, echo: Callable[[str], None] = print) -> Path:
+                     resume: bool = True, file: str = HOURLY,
+                     echo: Callable[[str], None] = print) -> Path:
     """Trace every variant and the radius scan of the project in ``root``; write and return
     ``root/method/hourly.csv``. ``photons`` per hour for the forward runs (the project's count
     is the study's reading; fewer keep the scan affordable). The file is rewritten after every
     scenario; with ``resume`` the (variant, radius, scenario) already in it at the same photon
-    count are kept and not traced again."""
+    count are kept and not traced again. ``file``: another name in ``method/`` (runs in
+    parallel write different files; the report reads them all)."""
     base = load_project(root)
     chosen = [v for v in VARIANTS if variants is None or v.label in variants]
     jobs: list[tuple[Variant, float]] = [(v, base.tree.dome.radius_m) for v in chosen]
     study = next(v for v in VARIANTS if v.label == STUDY)
     jobs += [(study, float(r)) for r in radii if float(r) != base.tree.dome.radius_m
              or study not in chosen]
-    out = root / FOLDER / HOURLY
+    out = root / FOLDER / file
     table = _resume(out, photons) if resume else pd.DataFrame(columns=COLUMNS)
     done = set(zip(table["variant"], table["radius_m"].astype(float), table["scenario"]))
     for variant, radius in jobs:

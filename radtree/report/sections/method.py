@@ -1,5 +1,5 @@
 """The report section "what the study's numbers owe to its method" — from ``PROJECT/method/
-hourly.csv`` (written by ``radtree method``, :mod:`radtree.verify.method`); absent without it.
+*.csv`` (written by ``radtree method``, :mod:`radtree.verify.method`); absent without them.
 
 For each finding of SPEC §7 the section states a measurable test (below), evaluates it under
 every variant and names the setting that makes it appear or vanish: the variants form a chain
@@ -32,7 +32,7 @@ from radtree.config import Project
 from radtree.figures import new_figure, save_png
 from radtree.measurements import hourly_grid_means
 from radtree.stats import nrmse
-from radtree.verify.method import FOLDER, HOURLY, STUDY, VARIANTS
+from radtree.verify.method import STUDY, VARIANTS, read_method
 
 LOW_SUN = ("10:30", "11:30", "15:30", "16:30")
 MIDDAY = ("12:30", "13:30", "14:30")
@@ -134,13 +134,12 @@ def _radius_figure(table: pd.DataFrame, m: pd.Series, radii: list[float], path: 
 def method_section_data(project: Project, out: Path) -> dict[str, Any] | None:
     """The section's data (None without ``method/hourly.csv`` or measurements); writes the
     radius figure into the report folder ``out``."""
-    path = project.root / FOLDER / HOURLY
-    if not path.exists() or project.measured is None:
+    table = read_method(project.root)
+    if table is None or project.measured is None:
         return None
     measured = hourly_grid_means(project.measured)
     if measured is None:
         return None
-    table = pd.read_csv(path, dtype={"time": str})
     hours = [h for h in measured.index if h in set(table["time"])]
     m = measured.reindex(hours)
     base = float(project.tree.dome.radius_m)
