@@ -117,7 +117,7 @@ def _radius_figure(table: pd.DataFrame, m: pd.Series, radii: list[float], path: 
         ax.set_xticks(x[::2], hours[::2], fontsize=6)
         ax.set_ylabel("façade mean (lx)", fontsize=7)
         ax.tick_params(labelsize=6)
-    axes[0].legend(fontsize=5)
+    max(axes[:-1], key=lambda a: len(a.get_lines())).legend(fontsize=5)
     ax = axes[-1]
     for i, name in enumerate(names):
         vals = [nrmse(m.to_numpy(), h.reindex(hours).to_numpy()) if (h := _hourly_frame(
