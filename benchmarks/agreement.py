@@ -49,9 +49,11 @@ def main() -> None:
     ap.add_argument("--pmap", type=int, default=0, help="photon map photons (0: not run)")
     ap.add_argument("--scenarios", nargs="+", default=["A", "B", "C", "D", "E", "F"])
     ap.add_argument("--hour", default="12:30")
+    ap.add_argument("--backward", nargs="+", default=None,
+                    help="backward engines compared (default: every available one)")
     a = ap.parse_args()
     proj = load_project(MENDOZA, overrides={"site.hours": [a.hour], "sensors.dense_grid": False})
-    backward = [e.name for e in available_engines() if e.name != "forward"]
+    backward = a.backward or [e.name for e in available_engines() if e.name != "forward"]
     print(f"Mendoza example, {a.hour}: forward {a.photons} photons; backward {a.points} points "
           f"per 0.5 m patch (NumPy {a.rays} paths each, Radiance -ad {a.ad})")
     summary = []
