@@ -96,5 +96,6 @@ def reduced_dome_project(hour: str = "12:30", scenario_overrides: dict | None = 
     ov: dict[str, Any] = dict(REDUCED[crown])
     ov["site.hours"] = [hour]
     ov["sensors.dense_grid"] = False
+    ov["sensors.dense_hours"] = [hour]
     ov.update(scenario_overrides or {})
     return load_project(MENDOZA, overrides=ov)
