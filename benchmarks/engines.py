@@ -31,7 +31,7 @@ sys.path.insert(0, str(ROOT))
 
 from radtree.config import EngineParams, Sensors, Street  # noqa: E402
 from radtree.engines.numpy import describe, trace  # noqa: E402
-from radtree.engines.numpy.engine import DEFAULT_OPTIONS, _geometry  # noqa: E402
+from radtree.engines.numpy.engine import DEFAULT_OPTIONS, scene_geometry  # noqa: E402
 from radtree.engines.numpy.raycast import BVHCaster, EmbreeCaster, embree_available  # noqa: E402
 from radtree.engines.numpy.sampling import cosine_hemisphere  # noqa: E402
 from radtree.engines.numpy.scenes import dome_slats, sky_state  # noqa: E402
@@ -113,7 +113,7 @@ def engine_hour(quick: bool) -> Scene:
     st = sky_state("perez", **HOUR)
     p = EngineParams(rays=1024 if quick else 4096, max_bounces=8)
     t = time.perf_counter()
-    geo = _geometry(sc, DEFAULT_OPTIONS.backend, p.workers)
+    geo = scene_geometry(sc, DEFAULT_OPTIONS.backend, p.workers)
     prep = time.perf_counter() - t
     geo.caster.rays_cast = 0
     t = time.perf_counter()
@@ -137,7 +137,7 @@ def engine_hour(quick: bool) -> Scene:
         built = make_scene(project, scenario, dense_grid=False)
         state = hour_states(project, scenario, ["11:30"])[0]
         pp = EngineParams(rays=p.rays, max_bounces=max(8, built.ab))
-        _geometry(built.scene, DEFAULT_OPTIONS.backend, pp.workers)
+        scene_geometry(built.scene, DEFAULT_OPTIONS.backend, pp.workers)
         t = time.perf_counter()
         rr = trace(built.scene, state, pp)["facade"]
         dt = time.perf_counter() - t

@@ -31,7 +31,7 @@ sys.path.insert(0, str(ROOT))
 from radtree.config import load_project  # noqa: E402
 from radtree.engines.forward import ForwardSettings, trace_forward  # noqa: E402
 from radtree.engines.numpy import trace_hour  # noqa: E402
-from radtree.engines.numpy.engine import DEFAULT_OPTIONS, _geometry  # noqa: E402
+from radtree.engines.numpy.engine import DEFAULT_OPTIONS, scene_geometry  # noqa: E402
 from radtree.light.hours import hour_states  # noqa: E402
 from radtree.pipeline.assemble import make_scene  # noqa: E402
 from radtree.verify.compare import MENDOZA, REDUCED_DOME  # noqa: E402
@@ -56,7 +56,7 @@ def run(label: str, overrides: dict, scenarios: list[str], photons: int, rays: i
         built = make_scene(proj, sc, dense_grid=False)
         st = hour_states(proj, sc, [HOUR])[0]
         scene = built.scene
-        geo = _geometry(scene, DEFAULT_OPTIONS.backend, proj.engine.workers)
+        geo = scene_geometry(scene, DEFAULT_OPTIONS.backend, proj.engine.workers)
         print(f" scenario {name}: {scene.n_triangles} triangles, -ab {built.ab}")
         # forward (warm the geometry cache first: the same caster for both engines)
         trace_forward(scene, st, ForwardSettings(photons=1000, max_bounces=built.ab),

@@ -10,7 +10,7 @@ import pandas as pd
 import pytest
 from click.testing import CliRunner
 
-from radtree.verify import Check, energy_checks, transmission_checks
+from radtree.verify import Check, energy_checks, sphere_checks, transmission_checks
 from radtree.verify.leaves import (
     LEAF_DISTRIBUTIONS,
     g_function,
@@ -67,6 +67,24 @@ def test_transmission_check_reduced():
         assert c.expected == pytest.approx(expected)
         assert c.tolerance < 0.1 * expected
         assert c.passed
+
+
+def test_floating_spheres_match_their_numerical_integral():
+    checks = sphere_checks(realisations=1, photons=60_000, zeniths=(30.0,))
+    (c,) = checks
+    print(c)
+    assert 0.3 < c.expected < 0.7          # the spheres shade part of the floor, not all of it
+    assert c.tolerance < 0.03 * c.expected
+    assert c.passed
+
+
+def test_sphere_integral_of_a_single_sphere_overhead():
+    # one sphere straight above a point: optical depth G·u·2R, u = 3·LAI/(4R)
+    from radtree.verify.spheres import Spheres, optical_depth
+
+    sp = Spheres(np.array([[0.0, 0.0, 2.0]]), 1.0, 3.75)
+    tau = optical_depth(np.array([[0.0, 0.0, 0.0], [5.0, 0.0, 0.0]]), np.array([0, 0, 1.0]), sp)
+    assert tau == pytest.approx([0.5 * 3.75 * 2.0, 0.0])
 
 
 def test_energy_checks_pass():

@@ -23,6 +23,7 @@ from radtree.cli.doctor import doctor_command
 from radtree.cli.errors import RadtreeGroup
 from radtree.cli.export import export_command
 from radtree.cli.hemi import hemi_command
+from radtree.cli.method import method_command
 from radtree.cli.new import new_command
 from radtree.cli.options import CONTEXT
 from radtree.cli.permeability import permeability_command
@@ -60,6 +61,6 @@ def main(ctx: click.Context, debug: bool) -> None:
 main.add_command(new_command)   # radtree new (cli/new.py), apart from the tuple other branches extend
 for _command in (doctor_command, build_command, simulate_command, hemi_command, report_command,
                  calibrate_command, sweep_command, diagnose_command, annual_command,
-                 permeability_command, verify_command, bsdf_command):
+                 permeability_command, verify_command, bsdf_command, method_command):
     main.add_command(_command)
 main.add_command(export_command)   # radtree export (cli/export.py)

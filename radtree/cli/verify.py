@@ -14,7 +14,7 @@ from radtree.cli.options import CONTEXT
 @click.command("verify", context_settings=CONTEXT)
 @click.option("--full", is_flag=True,
               help="The long version: more photons and leaf layers, scenarios A and B of the "
-                   "reduced dome at 10:30, 12:30 and 14:30.")
+                   "reduced dome and the free volume crown at 10:30, 12:30 and 14:30.")
 @click.option("--out", type=click.Path(dir_okay=False, path_type=Path),
               default=Path("verify.csv"), show_default=True, help="Where to write the table.")
 @click.option("--backward", multiple=True,
@@ -22,8 +22,9 @@ from radtree.cli.options import CONTEXT
                    "available one).")
 def verify_command(full: bool, out: Path, backward: tuple[str, ...]) -> None:
     """Physics checks: uncollided transmission through random leaf layers against
-    exp(−G·LAI/cos θ), energy conservation, forward vs backward engines on the reduced
-    Mendoza louvers dome. Writes OUT (check, engine, expected, got, tolerance, passed)."""
+    exp(−G·LAI/cos θ) and under floating spheres against its numerical integral, energy
+    conservation, forward vs backward engines on the reduced Mendoza louvers dome and a free
+    volume crown. Writes OUT (check, engine, expected, got, tolerance, passed)."""
     from radtree.verify.suite import run_verify
 
     outcome = run_verify(out, full=full, backward=list(backward) or None,

@@ -325,8 +325,15 @@ class EngineParams(Checked):
     beam_diameter_m: float | None = field(default=None, metadata=meta(0.0, lo_open=True))
     patch_m: float = field(default=0.5, metadata=meta(0.0, lo_open=True))
     forward_batches: int = field(default=16, metadata=meta(2))
+    # Radiance photon map (radtree.engines.radiance.pmap): global photons per hour (None = no
+    # photon map, plain rtrace -I), caustic photons (None = none), photons per density estimate
+    pmap_photons: int | None = field(default=None, metadata=meta(1))
+    pmap_caustic_photons: int | None = field(default=None, metadata=meta(1))
+    pmap_bandwidth: int = field(default=50, metadata=meta(1))
 
 
+#: the :class:`EngineParams` fields only the Radiance photon map reads
+PMAP_KEYS = ("pmap_photons", "pmap_caustic_photons", "pmap_bandwidth")
 #: the :class:`EngineParams` fields only the forward engine reads
 FORWARD_KEYS = ("photons", "forward_threshold", "forward_splitting", "beam_diameter_m",
                 "patch_m", "forward_batches")
@@ -412,7 +419,7 @@ class Project:
         if payload["tree"].get("species") is None:  # no species: hashes unchanged
             payload["tree"].pop("species", None)
         payload["engine"].pop("workers", None)
-        for key in FORWARD_KEYS:  # forward-engine settings at their defaults: hashes unchanged
+        for key in FORWARD_KEYS + PMAP_KEYS:  # at their defaults: hashes unchanged
             if payload["engine"].get(key) == getattr(EngineParams, key):
                 payload["engine"].pop(key, None)
         if self.honeybee is not None:   # absent otherwise: other projects' hashes unchanged

@@ -27,6 +27,7 @@ from radtree.optics import Plastic, Trans
 from radtree.scene import Mesh, Scene, SensorGrid, quad
 from radtree.verify.compare import backward_patch_mean, backward_patch_values, reduced_dome_project
 from radtree.verify.leaves import LEAF_DISTRIBUTIONS, leaf_layer, uncollided_transmission
+from radtree.verify.spheres import place_spheres, sphere_leaves, sphere_transmission
 
 FORWARD = "forward"
 DNI = 100000.0
@@ -132,6 +133,59 @@ def transmission_checks(realisations: int = 4, photons: int = 20_000, points: in
     return out
 
 
+# ----------------------------------------------------------------- floating spheres
+
+
+def sphere_checks(realisations: int = 2, photons: int = 100_000, points: int = 32,
+                  engines: tuple[str, ...] = (FORWARD,), zeniths: tuple[float, ...] = ZENITHS,
+                  progress: Callable[[str], None] | None = None) -> list[Check]:
+    """Uncollided transmission under RAMI-HET01-like floating spheres
+    (:mod:`radtree.verify.spheres`; black leaves, no floor) on 36 horizontal 1 m detectors
+    (6 m × 6 m at the floor) against the numerical integral over each detector of
+    exp(−G·u·Σ chords); ``realisations`` independent leaf placements in one sphere layout.
+    Standard error from the spread of (got − expected) over detectors and realisations."""
+    spheres = place_spheres(np.random.default_rng(5))
+    xs = np.arange(-2.5, 3.0, 1.0)
+    X, Y = np.meshgrid(xs, xs)
+    pts = np.column_stack([X.ravel(), Y.ravel(), np.full(X.size, 0.01)])
+    det = SensorGrid("facade", pts, np.tile(UP, (X.size, 1)))
+    diffs: dict[tuple[str, float], list[np.ndarray]] = {(e, z): [] for e in engines
+                                                        for z in zeniths}
+    expect: dict[float, np.ndarray] = {}
+    for r in range(realisations):
+        leaves = sphere_leaves("leaves", "black", spheres, np.random.default_rng(2000 + r))
+        scene = Scene([leaves], {"black": Plastic("black", 0.0)}, {"facade": det})
+        for z in zeniths:
+            st = sky_state("none", altitude=90.0 - z, azimuth=0.0, dni=DNI, ground_glow=False)
+            if z not in expect:
+                expect[z] = sphere_transmission(pts, 1.0, np.asarray(st.sun.vector, float),
+                                                spheres)
+            direct = DNI * math.cos(math.radians(z))
+            for e in engines:
+                if e == FORWARD:
+                    value = trace_forward(scene, st, ForwardSettings(
+                        photons=photons, batches=4, max_bounces=0, beam_diameter_m=9.0,
+                        patch_m=1.0, seed=r + 1)).grids["facade"].lux
+                else:
+                    value = backward_patch_values(e, scene, st, "facade", 1.0, ab=0,
+                                                  points=points, rays=1,
+                                                  seed=r + 1).mean(axis=1)
+                diffs[e, z].append(np.asarray(value) / direct - expect[z])
+    out = []
+    for z in zeniths:
+        expected = float(expect[z].mean())
+        name = f"floating spheres (RAMI HET01 / 10) uncollided transmission zenith {z:g}°"
+        for e in engines:
+            d = np.concatenate(diffs[e, z])
+            se = float(d.std(ddof=1) / math.sqrt(len(d)))
+            out.append(Check(name, e, expected, expected + float(d.mean()),
+                             _tolerance(expected, se, 0.01)))
+            if progress:
+                progress(f"{name}: expected {expected:.4f}, {e} "
+                         f"{expected + float(d.mean()):.4f} ± {se:.4f}")
+    return out
+
+
 # ----------------------------------------------------------------- energy
 
 
@@ -183,8 +237,10 @@ def energy_checks(photons: int = 40_000) -> list[Check]:
 def agreement_checks(hours: tuple[str, ...] = ("12:30",), scenarios: tuple[str, ...] = ("A",),
                      photons: int = 16_000_000, points: int = 16, rays: int = 192,
                      ad: int | None = 256, backward: list[str] | None = None,
+                     crown: str = "louvers dome",
                      progress: Callable[[str], None] | None = None) -> list[Check]:
-    """Forward vs backward engines on the reduced Mendoza louvers dome: the 8 sensors' 0.5 m
+    """Forward vs backward engines on the reduced Mendoza louvers dome (or another ``crown``
+    of :data:`radtree.verify.compare.REDUCED`): the 8 sensors' 0.5 m
     patch mean per scenario and hour (expected = the backward engine's value). ``points``
     random points per patch, ``rays`` paths per point (NumPy), ``-ad ad`` (Radiance; None =
     the project's)."""
@@ -196,7 +252,7 @@ def agreement_checks(hours: tuple[str, ...] = ("12:30",), scenarios: tuple[str, 
         e.name for e in available_engines() if e.name != FORWARD]
     out = []
     for hour in hours:
-        proj = reduced_dome_project(hour)
+        proj = reduced_dome_project(hour, crown=crown)
         params = proj.engine if ad is None else replace(proj.engine, ad=int(ad))
         for name in scenarios:
             sc = proj.scenario(name)
@@ -209,7 +265,7 @@ def agreement_checks(hours: tuple[str, ...] = ("12:30",), scenarios: tuple[str, 
                 bw = backward_patch_mean(e, built.scene, st, "facade", 0.5, ab=built.ab,
                                          points=points, rays=rays, params=params)
                 comb = math.hypot(se, bw.stderr)
-                label = (f"agreement: reduced Mendoza louvers dome {name} {hour}, façade patch "
+                label = (f"agreement: reduced Mendoza {crown} {name} {hour}, façade patch "
                          f"mean, forward vs {e}")
                 out.append(Check(label, FORWARD, bw.lux, got, _tolerance(bw.lux, comb, 0.02)))
                 if progress:

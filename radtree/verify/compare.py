@@ -25,9 +25,19 @@ MENDOZA = Path(__file__).resolve().parents[2] / "examples" / "mendoza-street"
 #: the reduced Mendoza louvers dome: a 6.5 m piece of a 6 m wide street between 8.5 m high
 #: façades (a small scene keeps the forward engine's launch disc small), the 5-layer louvers
 #: dome of radius 3 m (instead of 4 m) on the sensors, one hour
-REDUCED_DOME = {"street.length_m": 6.5, "street.width_m": 6.0,
+REDUCED_DOME: dict[str, Any] = {"street.length_m": 6.5, "street.width_m": 6.0,
                 "street.building_height_m": 8.5, "street.opposite_building_height_m": 8.5,
                 "tree.dome.radius_m": 3.0}
+#: the free volume crown: one free-standing louvers crown of slats scattered through its volume
+#: (``louvers.arrangement = "volume"``), radius 2.5 m, centre at the sensors' height, trunk
+#: 2.5 m from the façade, in the same reduced street
+REDUCED_FREE: dict[str, Any] = {**{k: v for k, v in REDUCED_DOME.items() if not k.startswith("tree.dome")},
+                "tree.form": "free", "tree.louvers.arrangement": "volume",
+                "tree.crown.count": 1, "tree.crown.radius_m": 2.5,
+                "tree.crown.vertical_radius_m": 2.5, "tree.crown.base_height_m": 2.5,
+                "tree.crown.trunk_distance_m": 2.5}
+#: the agreement checks' crown forms by label
+REDUCED: dict[str, dict[str, Any]] = {"louvers dome": REDUCED_DOME, "free volume crown": REDUCED_FREE}
 
 
 @dataclass
@@ -79,11 +89,13 @@ def backward_patch_mean(engine: str, scene: Scene, state: SkyState, grid: str, s
     return PatchMean(float(per_point.mean()), float(per_point.std(ddof=1) / np.sqrt(points)))
 
 
-def reduced_dome_project(hour: str = "12:30", scenario_overrides: dict | None = None
-                         ) -> Project:
-    """The shipped Mendoza example reduced (:data:`REDUCED_DOME`) to one hour."""
-    ov: dict[str, Any] = dict(REDUCED_DOME)
+def reduced_dome_project(hour: str = "12:30", scenario_overrides: dict | None = None,
+                         crown: str = "louvers dome") -> Project:
+    """The shipped Mendoza example reduced (:data:`REDUCED_DOME`, or another form of
+    :data:`REDUCED` by label) to one hour."""
+    ov: dict[str, Any] = dict(REDUCED[crown])
     ov["site.hours"] = [hour]
     ov["sensors.dense_grid"] = False
+    ov["sensors.dense_hours"] = [hour]
     ov.update(scenario_overrides or {})
     return load_project(MENDOZA, overrides=ov)

@@ -1,6 +1,7 @@
 """Run the physics suite and write ``verify.csv`` (``check, engine, expected, got, tolerance,
 passed``). Quick mode (default) fits in ≈ 2 minutes on 2 cores; ``full`` traces more photons,
-more leaf layers, scenarios A and B of the reduced dome at three hours."""
+more leaf layers, the floating spheres by NumPy too, scenarios A and B of the reduced dome and of
+the free volume crown at three hours."""
 
 from __future__ import annotations
 
@@ -12,7 +13,13 @@ from pathlib import Path
 import pandas as pd
 
 from radtree.fileio import atomic_path
-from radtree.verify.checks import Check, agreement_checks, energy_checks, transmission_checks
+from radtree.verify.checks import (
+    Check,
+    agreement_checks,
+    energy_checks,
+    sphere_checks,
+    transmission_checks,
+)
 
 COLUMNS = ["check", "engine", "expected", "got", "tolerance", "passed"]
 
@@ -41,15 +48,20 @@ def run_verify(out: Path, full: bool = False, backward: list[str] | None = None,
     if full:
         checks += transmission_checks(realisations=16, photons=200_000, points=64,
                                       progress=echo)
+        checks += sphere_checks(realisations=8, photons=400_000, points=64,
+                                engines=("forward", "numpy"), progress=echo)
         checks += energy_checks(photons=200_000)
-        checks += agreement_checks(hours=("10:30", "12:30", "14:30"), scenarios=("A", "B"),
-                                   photons=40_000_000, points=64, rays=128, ad=2048,
-                                   backward=backward,
-                                   progress=echo)
+        for crown in ("louvers dome", "free volume crown"):
+            checks += agreement_checks(hours=("10:30", "12:30", "14:30"), scenarios=("A", "B"),
+                                       photons=40_000_000, points=64, rays=128, ad=2048,
+                                       backward=backward, crown=crown, progress=echo)
     else:
         checks += transmission_checks(progress=echo)
+        checks += sphere_checks(progress=echo)
         checks += energy_checks()
         checks += agreement_checks(backward=backward, progress=echo)
+        checks += agreement_checks(backward=backward, crown="free volume crown",
+                                   photons=4_000_000, progress=echo)
     outcome = VerifyOutcome(checks, Path(out), time.perf_counter() - t0)
     outcome.path.parent.mkdir(parents=True, exist_ok=True)
     with atomic_path(outcome.path) as tmp:

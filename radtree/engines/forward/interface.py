@@ -7,7 +7,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from radtree.engines.base import GridResult
-from radtree.engines.forward.run import trace_forward
+from radtree.engines.forward.run import check_beam, trace_forward
 from radtree.engines.forward.settings import ForwardSettings
 from radtree.engines.numpy.inprocess import InProcessEngine
 from radtree.engines.numpy.raycast import embree_available
@@ -43,8 +43,13 @@ class ForwardEngine(InProcessEngine):
 
     def prepare(self, scene: Scene, states: list[SkyState], params: EngineParams, ab: int,
                 folder: Path | None = None) -> ForwardPlan:
-        return ForwardPlan(scene, {s.label: s for s in states},
-                           ForwardSettings.from_params(params, ab), int(params.workers or 1))
+        """The plan; a sun beam that misses the target grid at any hour is a ConfigError
+        before anything is traced."""
+        settings = ForwardSettings.from_params(params, ab)
+        for st in states:
+            check_beam(scene, st, settings)
+        return ForwardPlan(scene, {s.label: s for s in states}, settings,
+                           int(params.workers or 1))
 
     def trace(self, plan: ForwardPlan, label: str, grids: list[str] | None = None
               ) -> dict[str, GridResult]:

@@ -18,7 +18,7 @@ from radtree.engines.forward.detectors import PatchDetectors
 from radtree.engines.forward.settings import ForwardSettings
 from radtree.engines.forward.sources import EnvironmentSource, SunSource, bounding_sphere
 from radtree.engines.forward.tracer import ForwardTracer, Ledger, Photons
-from radtree.engines.numpy.engine import _Environment, _geometry, _optics
+from radtree.engines.numpy.engine import Environment, scene_geometry, scene_optics
 from radtree.errors import ConfigError, EngineError
 from radtree.light.sky import SkyState
 from radtree.scene import Scene
@@ -50,27 +50,35 @@ def target_grid(scene: Scene) -> str:
     return "facade" if "facade" in scene.grids else next(iter(scene.grids))
 
 
-def sun_source(scene: Scene, state: SkyState, settings: ForwardSettings, sphere
-               ) -> SunSource:
-    """The hour's sun: over the whole bounding sphere, or the beam aimed at the target grid's
-    centre (every sensor of that grid must lie inside the beam)."""
-    sun = np.asarray(state.sun.vector, float)
-    if settings.beam_diameter_m is None:
-        return SunSource(sun, state.direct_normal_lux, sphere.centre, sphere.radius,
-                         sphere.radius + 1.0)
+def check_beam(scene: Scene, state: SkyState, settings: ForwardSettings) -> None:
+    """Raise one :class:`ConfigError` (field ``engine.beam_diameter_m``) when the sun beam,
+    aimed at the centre of the target grid along the hour's sun, misses one of its sensors."""
+    if settings.beam_diameter_m is None or not state.sun_on:
+        return
     name = target_grid(scene)
     pts = scene.grids[name].points
-    target = pts.mean(axis=0)
-    radius = settings.beam_diameter_m / 2.0
-    dist = float(np.linalg.norm(target - sphere.centre)) + sphere.radius + 1.0
-    src = SunSource(sun, state.direct_normal_lux, target, radius, dist)
+    sun = np.asarray(state.sun.vector, float)
+    src = SunSource(sun, state.direct_normal_lux, pts.mean(axis=0), 1.0, 1.0)
     need = float(src.distance_to_axis(pts).max())
-    if need > radius:
+    if need > settings.beam_diameter_m / 2.0:
         raise ConfigError(
             f"the {settings.beam_diameter_m:g} m sun beam aimed at the centre of grid '{name}' "
             f"misses its sensors at {state.time} (the farthest is {need:.3f} m from the beam "
             f"axis: a diameter ≥ {2 * need:.3f} m is needed)", field="engine.beam_diameter_m")
-    return src
+
+
+def sun_source(scene: Scene, state: SkyState, settings: ForwardSettings, sphere
+               ) -> SunSource:
+    """The hour's sun: over the whole bounding sphere, or the beam aimed at the target grid's
+    centre (every sensor of that grid must lie inside the beam: :func:`check_beam`)."""
+    sun = np.asarray(state.sun.vector, float)
+    if settings.beam_diameter_m is None:
+        return SunSource(sun, state.direct_normal_lux, sphere.centre, sphere.radius,
+                         sphere.radius + 1.0)
+    check_beam(scene, state, settings)
+    target = scene.grids[target_grid(scene)].points.mean(axis=0)
+    dist = float(np.linalg.norm(target - sphere.centre)) + sphere.radius + 1.0
+    return SunSource(sun, state.direct_normal_lux, target, settings.beam_diameter_m / 2.0, dist)
 
 
 def trace_forward(scene: Scene, state: SkyState, settings: ForwardSettings,
@@ -85,7 +93,7 @@ def trace_forward(scene: Scene, state: SkyState, settings: ForwardSettings,
     missing = [g for g in names if g not in scene.grids]
     if missing:
         raise EngineError(f"unknown sensor grid(s): {', '.join(missing)}")
-    geo = _geometry(scene, backend, workers)
+    geo = scene_geometry(scene, backend, workers)
     det = PatchDetectors({n: scene.grids[n] for n in names}, settings.patch_m)
     pts = np.vstack([geo.vertices, det.corners().reshape(-1, 3)])
     sphere = bounding_sphere(pts)
@@ -93,12 +101,12 @@ def trace_forward(scene: Scene, state: SkyState, settings: ForwardSettings,
     if state.sun_on:
         sources.append(sun_source(scene, state, settings, sphere))
     if settings.beam_diameter_m is None:  # a beam is the study's only source: no sky, no glow
-        env = EnvironmentSource(_Environment(state), sphere)
+        env = EnvironmentSource(Environment(state), sphere)
         if env.cdf is not None and env.flux > 0:
             sources.append(env)
     rng = np.random.default_rng(np.random.SeedSequence(
         [int(settings.seed) & 0xFFFFFFFF, zlib.crc32((label or state.label).encode())]))
-    tracer = ForwardTracer(geo, _optics(scene, state, geo.material_names), det,
+    tracer = ForwardTracer(geo, scene_optics(scene, state, geo.material_names), det,
                            settings.batches, threshold=settings.threshold,
                            splitting=settings.splitting, max_bounces=settings.max_bounces,
                            max_specular=settings.max_specular, chunk=settings.chunk, rng=rng)

@@ -30,7 +30,7 @@ import numpy as np
 
 from radtree.engines.forward.detectors import PatchDetectors
 from radtree.engines.forward.sources import Launch
-from radtree.engines.numpy.engine import _Geometry, _Optics, glass_coefficients
+from radtree.engines.numpy.engine import Geometry, Optics, glass_coefficients
 from radtree.engines.numpy.sampling import cosine_hemisphere, mirror
 
 
@@ -102,7 +102,7 @@ class Photons:
 class ForwardTracer:
     """Transport of photon sets through one scene's geometry with one hour's optics."""
 
-    def __init__(self, geo: _Geometry, optics: _Optics, detectors: PatchDetectors, batches: int,
+    def __init__(self, geo: Geometry, optics: Optics, detectors: PatchDetectors, batches: int,
                  *, threshold: float, splitting: bool, max_bounces: int, max_specular: int,
                  chunk: int, rng: np.random.Generator):
         self.geo, self.opt, self.det = geo, optics, detectors

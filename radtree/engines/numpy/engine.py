@@ -99,7 +99,7 @@ def describe(backend: str = "auto") -> str:
 # --------------------------------------------------------------------------- geometry + optics
 
 
-class _Geometry:
+class Geometry:
     """All light-interacting triangles of a scene, with their material index and ray caster."""
 
     def __init__(self, scene: Scene, backend: str, workers: int):
@@ -131,7 +131,7 @@ class _Geometry:
         self.caster: RayCaster = make_caster(self.vertices, self.faces, backend, workers)
 
 
-_GEOMETRY_CACHE: dict[int, tuple[weakref.ref, str, _Geometry]] = {}
+_GEOMETRY_CACHE: dict[int, tuple[weakref.ref, str, Geometry]] = {}
 _GEOMETRY_LOCK = threading.Lock()
 
 
@@ -147,7 +147,7 @@ def _fingerprint(scene: Scene, backend: str, workers: int) -> str:
     return h.hexdigest()
 
 
-def _geometry(scene: Scene, backend: str, workers: int) -> _Geometry:
+def scene_geometry(scene: Scene, backend: str, workers: int) -> Geometry:
     """The scene's triangles and ray caster, cached across hours of the same scene.
 
     Thread-safe: the scenario runner traces several hours of one scene in parallel threads
@@ -159,7 +159,7 @@ def _geometry(scene: Scene, backend: str, workers: int) -> _Geometry:
         hit = _GEOMETRY_CACHE.get(key)
         if hit is not None and hit[0]() is scene and hit[1] == fp:
             return hit[2]
-        geo = _Geometry(scene, backend, workers)
+        geo = Geometry(scene, backend, workers)
         for k in [k for k, v in _GEOMETRY_CACHE.items() if v[0]() is None]:
             del _GEOMETRY_CACHE[k]
         _GEOMETRY_CACHE[key] = (weakref.ref(scene), fp, geo)
@@ -167,7 +167,7 @@ def _geometry(scene: Scene, backend: str, workers: int) -> _Geometry:
 
 
 @dataclass
-class _Optics:
+class Optics:
     """Per-material coefficients (arrays indexed by material index)."""
 
     rd: np.ndarray  # diffuse reflectance
@@ -181,7 +181,7 @@ class _Optics:
         return bool(np.any(self.ts > 0) or np.any(np.isfinite(self.glass_tn)))
 
 
-def _optics(scene: Scene, state: SkyState, names: list[str]) -> _Optics:
+def scene_optics(scene: Scene, state: SkyState, names: list[str]) -> Optics:
     k = len(names)
     rd, td, ts, rm = np.zeros(k), np.zeros(k), np.zeros(k), np.zeros(k)
     tn = np.full(k, np.nan)
@@ -201,7 +201,7 @@ def _optics(scene: Scene, state: SkyState, names: list[str]) -> _Optics:
             raise EngineError(f"material '{name}' of type {type(m).__name__} is not supported "
                               "by the in-process engines (a BSDF crown, [tree] representation"
                               " = \"bsdf\", is Radiance only: use --engine radiance)")
-    return _Optics(rd, td, ts, rm, tn)
+    return Optics(rd, td, ts, rm, tn)
 
 
 def glass_coefficients(cos_i: np.ndarray, transmissivity: np.ndarray
@@ -226,7 +226,7 @@ def glass_coefficients(cos_i: np.ndarray, transmissivity: np.ndarray
     return t, r
 
 
-class _Environment:
+class Environment:
     """Luminance (cd/m²) of whatever an escaping ray sees: sky above, distant ground below."""
 
     def __init__(self, state: SkyState):
@@ -251,12 +251,12 @@ class _Environment:
 
 
 class _Tracer:
-    def __init__(self, geo: _Geometry, optics: _Optics, state: SkyState, params: EngineParams,
+    def __init__(self, geo: Geometry, optics: Optics, state: SkyState, params: EngineParams,
                  opts: TraceOptions):
         self.geo = geo
         self.caster = geo.caster
         self.opt = optics
-        self.env = _Environment(state)
+        self.env = Environment(state)
         self.state = state
         self.max_bounces = int(params.max_bounces)
         self.opts = opts
@@ -479,8 +479,8 @@ def trace(scene: Scene, state: SkyState, params: EngineParams, grids: list[str] 
     if params.rays < 1:
         raise EngineError(f"engine.rays must be ≥ 1, got {params.rays}")
     seed = params.seed if seed is None else seed
-    geo = _geometry(scene, options.backend, int(getattr(params, "workers", 2) or 1))
-    tracer = _Tracer(geo, _optics(scene, state, geo.material_names), state, params, options)
+    geo = scene_geometry(scene, options.backend, int(getattr(params, "workers", 2) or 1))
+    tracer = _Tracer(geo, scene_optics(scene, state, geo.material_names), state, params, options)
     return {name: _trace_grid(tracer, scene.grids[name], params.rays, _grid_seed(seed, name))
             for name in names}
 

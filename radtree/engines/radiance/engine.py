@@ -33,6 +33,9 @@ def run_hour(plan: BuildPlan, hour: str, dry_run: bool = False,
     folder = plan.folder
     oct_rel = f"octrees/{hour}.oct"
     commands: list[tuple[list[str], str | None, str]] = [(plan.oconv_command(hour), None, oct_rel)]
+    mkpmap = plan.mkpmap_command(hour)
+    if mkpmap is not None:
+        commands.append((mkpmap, None, f"pmaps/{hour}.log"))
     use = [g for g in plan.grids if grids is None or g in grids]
     for g in use:
         commands.append((plan.rtrace_command(hour), f"grids/{g}.pts", f"results/{hour}_{g}.rgb"))
@@ -44,6 +47,8 @@ def run_hour(plan: BuildPlan, hour: str, dry_run: bool = False,
         return {}
     (folder / "octrees").mkdir(exist_ok=True)
     (folder / "results").mkdir(exist_ok=True)
+    if mkpmap is not None:
+        (folder / "pmaps").mkdir(exist_ok=True)
     results: dict[str, GridResult] = {}
     for argv, stdin, stdout in commands:
         out = folder / stdout

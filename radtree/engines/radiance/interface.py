@@ -9,6 +9,7 @@ from radtree.engines.base import Engine, GridResult
 from radtree.engines.radiance.binaries import find_radiance, require_radiance
 from radtree.engines.radiance.binaries import version as radiance_version
 from radtree.engines.radiance.engine import run_hour
+from radtree.engines.radiance.pmap import PhotonMap
 from radtree.engines.radiance.writer import BuildPlan, rtrace_options, write_build
 from radtree.fileio import write_text
 
@@ -51,7 +52,8 @@ class RadianceEngine(Engine):
                 "radiance_origin": install.origin if install else None}
 
     def sampling(self, params: EngineParams) -> str:
-        return f"-ad {params.ad} -lw {params.lw:g}"
+        pm = PhotonMap.from_params(params)
+        return f"-ad {params.ad} -lw {params.lw:g}" + (f", {pm.describe()}" if pm else "")
 
     def prepare(self, scene: Scene, states: list[SkyState], params: EngineParams, ab: int,
                 folder: Path | None = None) -> BuildPlan:
@@ -64,7 +66,8 @@ class RadianceEngine(Engine):
         plan = BuildPlan(folder=folder, hours=[s.label for s in states], grids=list(scene.grids),
                          scene_files=["materials.rad"], hour_files={},
                          rtrace_opts=rtrace_options(params, ab),
-                         states={s.label: s for s in states})
+                         states={s.label: s for s in states},
+                         photon_map=PhotonMap.from_params(params))
         geometry = sorted(str(p.relative_to(folder)) for p in (folder / "geometry").glob("*.rad"))
         for st in states:
             files = []

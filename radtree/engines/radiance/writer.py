@@ -23,6 +23,7 @@ import numpy as np
 import radtree
 from radtree.config import EngineParams
 from radtree.engines.radiance.binaries import RadianceInstall
+from radtree.engines.radiance.pmap import FINAL_GATHER_AB, PhotonMap
 from radtree.engines.radiance.sky import ANALYTIC_SKY_CAL, sky_text
 from radtree.fileio import write_text
 from radtree.light.sky import SkyState
@@ -52,7 +53,10 @@ def materials_text(materials: Mapping[str, Material], ground: str | None = None)
 
 def rtrace_options(params: EngineParams, ab: int) -> list[str]:
     """rtrace options for illuminance: -I (irradiance at points), -h (no header), -u- (correlated
-    sampling: the same octree and options give the same numbers) and the ambient parameters."""
+    sampling: the same octree and options give the same numbers) and the ambient parameters.
+    With a photon map (``pmap_photons``) rtrace computes one ambient bounce (final gathering)."""
+    if PhotonMap.from_params(params) is not None:
+        ab = FINAL_GATHER_AB
     return [
         "-h", "-I", "-u-", "-ab", str(ab), "-ad", str(params.ad), "-as", str(params.as_),
         "-ar", str(params.ar), "-aa", f"{params.aa:g}", "-lw", f"{params.lw:g}",
@@ -71,6 +75,7 @@ class BuildPlan:
     rtrace_opts: list[str]
     states: dict[str, SkyState] = field(default_factory=dict)
     hour_grids: dict[str, list[str]] = field(default_factory=dict)   # default: every grid
+    photon_map: PhotonMap | None = None                               # mkpmap before rtrace
 
     def grids_at(self, hour: str) -> list[str]:
         """Grids the Makefile traces at ``hour`` (label HHMM)."""
@@ -80,7 +85,12 @@ class BuildPlan:
         return ["oconv", *self.scene_files, *self.hour_files[hour]]
 
     def rtrace_command(self, hour: str) -> list[str]:
-        return ["rtrace", *self.rtrace_opts, f"octrees/{hour}.oct"]
+        pm = self.photon_map.rtrace_args(hour) if self.photon_map else []
+        return ["rtrace", *self.rtrace_opts, *pm, f"octrees/{hour}.oct"]
+
+    def mkpmap_command(self, hour: str) -> list[str] | None:
+        """The hour's ``mkpmap`` (None without a photon map)."""
+        return self.photon_map.mkpmap_command(hour) if self.photon_map else None
 
 
 def write_build(scene: Scene, states: list[SkyState], params: EngineParams, ab: int,
@@ -127,7 +137,8 @@ def write_build(scene: Scene, states: list[SkyState], params: EngineParams, ab: 
                      scene_files=scene_files, hour_files=hour_files,
                      rtrace_opts=rtrace_options(params, ab),
                      states={s.label: s for s in states},
-                     hour_grids=dict(hour_grids or {}))
+                     hour_grids=dict(hour_grids or {}),
+                     photon_map=PhotonMap.from_params(params))
     write_makefile(plan, install, scenario)
     return plan
 
@@ -142,6 +153,11 @@ def write_makefile(plan: BuildPlan, install: RadianceInstall | None, scenario: s
         efficacy=f"{WHITE_EFFICACY:g}", weights=[f"{w:.3f}" for w in PHOTOPIC_RGB],
         bin_dir=str(install.bin_dir) if install else "/usr/local/bin",
         raypath=install.raypath if install else ".:/usr/local/lib/ray",
+        mkpmap={h: " ".join(plan.mkpmap_command(h) or []) for h in plan.hours},
+        pmaps={h: [f for _, f in plan.photon_map.files(h)] if plan.photon_map else []
+               for h in plan.hours},
+        rtrace_pmap={h: " ".join(plan.photon_map.rtrace_args(h)) if plan.photon_map else ""
+                     for h in plan.hours},
     )
     write_text(plan.folder / "Makefile", text)
 

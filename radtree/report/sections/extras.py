@@ -145,4 +145,12 @@ def extra_sections(project: Project, out: Path, echo: Callable[[str], None]
     p_html, p_md = photo_sections(project, out)
     html += p_html
     md += p_md
+
+    from radtree.report.sections.method import method_section_data
+
+    method = method_section_data(project, out)
+    if method is not None:
+        html.append(Section("method", method))
+        md.append(Section("method", method))
+        echo("  the study's method: variants, findings, dome-radius scan")
     return html, md
