@@ -15,6 +15,7 @@ from typing import Any
 
 import tomllib
 
+from radtree.config.district import DISTRICT_KEYS, read_district
 from radtree.config.schema import Project, Scenario, Site, Street, parse_time
 from radtree.config.spec import SchemaError, Spec, spec_for, spec_of, toml_name
 from radtree.config.switches import (
@@ -167,6 +168,8 @@ def parse_project(data: dict, path: Path) -> Project:
     proj.check_unknown(table_keys("project"))
 
     s = top.sub("site", required=True)
+    district = read_district(s.data, base, src)   # [site] trees / buildings (own module)
+    s.data = {k: v for k, v in s.data.items() if k not in DISTRICT_KEYS}
     hours_raw = s.raw("hours")
     if not isinstance(hours_raw, list) or not hours_raw:
         raise s.error("hours", f"expected a non-empty list of 'HH:MM' times, got {hours_raw!r}")
@@ -223,7 +226,7 @@ def parse_project(data: dict, path: Path) -> Project:
     return Project(name=name, root=path.parent, source=path, site=site, street=street,
                    light=light, tree=tree, sensors=sensors, engine=engine,
                    scenarios=scenarios, measured=measured, measured_rows=measured_rows,
-                   office=office, extra_geometry=tuple(extra))
+                   office=office, extra_geometry=tuple(extra), district=district)
 
 
 def _scenarios(top: _Reader, src: str) -> tuple[Scenario, ...]:

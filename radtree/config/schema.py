@@ -347,6 +347,7 @@ class Project:
     measured_rows: Path | None = None
     office: Office | None = None
     extra_geometry: tuple[tuple[Path, str], ...] = ()
+    district: Any = None   # radtree.config.district.District: [site] trees / buildings
 
     @property
     def build_dir(self) -> Path:
@@ -379,9 +380,22 @@ class Project:
         for key in FORWARD_KEYS:  # forward-engine settings at their defaults: hashes unchanged
             if payload["engine"].get(key) == getattr(EngineParams, key):
                 payload["engine"].pop(key, None)
+        if self.district is not None:   # inventory inputs: their file contents count too
+            payload["district"] = d["district"]
+            payload["district_files"] = _file_digests(self.district)
         payload["scenario"] = _plain(scenario)
         text = json.dumps(payload, sort_keys=True, default=str)
         return hashlib.sha256(text.encode()).hexdigest()[:12]
+
+
+def _file_digests(district: Any) -> dict[str, str]:
+    """SHA-256 of the inventory files, so an edited inventory makes its builds stale."""
+    out = {}
+    for name in ("trees", "buildings"):
+        p = getattr(district, name)
+        if p is not None:
+            out[name] = hashlib.sha256(Path(p).read_bytes()).hexdigest()[:16]
+    return out
 
 
 def _plain(obj: Any) -> Any:

@@ -9,7 +9,12 @@ from radtree.engines.base import Engine, GridResult
 from radtree.engines.radiance.binaries import find_radiance, require_radiance
 from radtree.engines.radiance.binaries import version as radiance_version
 from radtree.engines.radiance.engine import run_hour
-from radtree.engines.radiance.writer import BuildPlan, rtrace_options, write_build
+from radtree.engines.radiance.writer import (
+    BuildPlan,
+    prototype_octree,
+    rtrace_options,
+    write_build,
+)
 from radtree.fileio import write_text
 
 if TYPE_CHECKING:
@@ -66,6 +71,8 @@ class RadianceEngine(Engine):
                          rtrace_opts=rtrace_options(params, ab),
                          states={s.label: s for s in states})
         geometry = sorted(str(p.relative_to(folder)) for p in (folder / "geometry").glob("*.rad"))
+        plan.prototypes = {prototype_octree(p.stem): str(p.relative_to(folder))
+                           for p in sorted((folder / "geometry" / "prototypes").glob("*.rad"))}
         for st in states:
             files = []
             ground = folder / "skies" / f"{st.label}_ground.rad"
