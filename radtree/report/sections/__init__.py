@@ -22,7 +22,8 @@ from radtree.resources import template_environment
 
 #: The optional sections, in page order (each has ``sections/<name>.html.j2``; the ones the
 #: Markdown report shows also ``.md.j2``).
-OPTIONAL = ("office", "sweep", "realisations", "permeability_scan", "diagnose", "annual")
+OPTIONAL = ("office", "sweep", "realisations", "permeability_scan", "diagnose", "annual",
+            "facades")
 
 
 @dataclass(frozen=True)

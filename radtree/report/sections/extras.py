@@ -130,4 +130,12 @@ def extra_sections(project: Project, out: Path, echo: Callable[[str], None]
 
         html.append(Section("annual", annual_section_data(project)))
         echo("  annual: metric maps and month × hour heat maps")
+    if project.district is not None:
+        from radtree.report.sections.facades import facades_data
+
+        facades = facades_data(project, out)
+        if facades is not None:
+            html.append(Section("facades", facades))
+            md.append(Section("facades", facades))
+            echo(f"  every façade: site plan of {facades['features']} façades")
     return html, md
