@@ -3,11 +3,9 @@
 from __future__ import annotations
 
 import json
-import math
 from pathlib import Path
 
 import numpy as np
-import pandas as pd
 import pytest
 
 from radtree.config import load_project
@@ -207,3 +205,151 @@ def test_one_tree_inventory_reproduces_hand_written_free_crown(tmp_path):
     b = trace_scenario(p_inv, p_inv.scenario("T"), engine="numpy")
     assert len(a) == 8 and a["lux"].min() > 0
     np.testing.assert_array_equal(a["lux"].to_numpy(), b["lux"].to_numpy())
+
+
+def _tree_meshes(p):
+    from radtree.pipeline.assemble import make_scene
+
+    scene = make_scene(p, p.scenario("T")).scene
+    return {m.material: m for m in scene.meshes if m.material.startswith("leaf")}
+
+
+@needs_radiance
+def test_one_tree_inventory_radiance_text_and_lux_match(tmp_path):
+    """The same on Radiance: the in-place crown is written polygon for polygon (only names
+    differ) and rtrace gives the same façade lux."""
+    from radtree.pipeline.trace import trace_scenario
+
+    inv = district(tmp_path / "inv", trees=[point("T1", 0.0, 3.5)], buildings=None,
+                   extra=STREET)
+    p_inv = load_project(inv)
+    from radtree.trees.district import species_louvers
+    from radtree.trees.species import load_species
+
+    lv = species_louvers(p_inv.tree.louvers, load_species("morus_alba"))
+    hand = tmp_path / "hand"
+    hand.mkdir()
+    (hand / "dni.csv").write_text(DNI)
+    louvers = "\n".join(f"{k} = {getattr(lv, k)!r}" for k in (
+        "reflectance", "transmittance", "specular_fraction", "slat_size_m", "inclination_deg",
+        "crossings"))
+    (hand / "radtree.toml").write_text(SITE + STREET + CROWN + REST.replace(
+        'arrangement = "volume"', 'arrangement = "volume"\n' + louvers))
+    p_hand = load_project(hand)
+    a_mesh = _tree_meshes(p_hand)["leaf"]
+    b_mesh = _tree_meshes(p_inv)["leaf_morus_alba"]
+    assert a_mesh.n_triangles > 1000
+    np.testing.assert_array_equal(a_mesh.vertices, b_mesh.vertices)
+    a = trace_scenario(p_hand, p_hand.scenario("T"), engine="radiance")
+    b = trace_scenario(p_inv, p_inv.scenario("T"), engine="radiance")
+    np.testing.assert_array_equal(a["lux"].to_numpy(), b["lux"].to_numpy())
+
+
+# ---------------------------------------------------------------- instancing
+def test_instance_transform_matches_radiance_order():
+    from radtree.scene import Instance
+
+    inst = Instance("p", (10.0, 20.0, 3.0), rotate_z_deg=90.0, scale=2.0)
+    np.testing.assert_allclose(inst.apply(np.array([[1.0, 0.0, 0.5]])), [[10.0, 22.0, 4.0]],
+                               atol=1e-12)
+
+
+def test_radiance_instance_text():
+    from radtree.engines.radiance.writer import instances_text
+    from radtree.optics import Plastic
+    from radtree.scene import Instance, Mesh, Scene, SensorGrid
+
+    tri = Mesh("leaf", "m", np.eye(3), np.array([[0, 1, 2]]))
+    grid = SensorGrid("g", np.zeros((1, 3)), np.array([[0, 1, 0]]))
+    scene = Scene([], {"m": Plastic("m", 0.5)}, {"g": grid}, prototypes={"crown_a": [tri]},
+                  instances=[Instance("crown_a", (1.5, -2.0, 4.25), 30.0, 0.8)])
+    assert instances_text(scene).splitlines()[2:] == [
+        "void instance crown_a.0",
+        "9 octrees/prototype_crown_a.oct -rz 30.0000 -s 0.800000 -t 1.50000 -2.00000 4.25000",
+        "0", "0"]
+    assert scene.n_triangles == 1 and scene.instanced_triangles() == 1
+    np.testing.assert_array_equal(scene.solid_meshes()[0].vertices,
+                                  np.eye(3) @ np.array([[0.8660254037844387, 0.5, 0],
+                                                        [-0.5, 0.8660254037844387, 0],
+                                                        [0, 0, 1]]) * 0.8 + [1.5, -2.0, 4.25])
+
+
+def test_stored_crowns_do_not_grow_with_tree_count(tmp_path):
+    """4 vs 16 mulberries along the street: one prototype crown either way; only trunks and
+    instance lines grow."""
+    from radtree.pipeline.assemble import make_scene
+
+    def scene(n: int, folder: Path):
+        rows = [point(f"T{i}", -12 + 24 * i / (n - 1), 4.0 + 0.5 * (i % 2)) for i in range(n)]
+        p = load_project(district(folder, trees=rows))
+        return make_scene(p, p.scenario("T")).scene
+
+    s4, s16 = scene(4, tmp_path / "a"), scene(16, tmp_path / "b")
+    assert len(s4.prototypes) == len(s16.prototypes) == 1
+    leaves = {k: sum(m.n_triangles for m in v) for k, v in s16.prototypes.items()}
+    trunk = s4.mesh("tree_trunks").n_triangles // 4
+    assert s16.n_triangles - s4.n_triangles == 12 * trunk
+    assert s16.instanced_triangles() == 16 * sum(leaves.values()) == 4 * s4.instanced_triangles()
+    assert len(s16.instances) == 16
+
+
+# ---------------------------------------------------------------- every façade
+UTM = "EPSG:32719"   # UTM zone 19 S: Mendoza at about E 513 000, N 6 361 000
+E0, N0 = 513000.0, 6361000.0
+
+
+def _utm(features: list[dict]) -> list[dict]:
+    out = json.loads(json.dumps(features))
+    for f in out:
+        g = f["geometry"]
+        if g["type"] == "Point":
+            g["coordinates"] = [g["coordinates"][0] + E0, g["coordinates"][1] + N0]
+        else:
+            g["coordinates"] = [[[x + E0, y + N0] for x, y in ring] for ring in g["coordinates"]]
+    return out
+
+
+def test_facades_geojson_and_dask_resume(tmp_path):
+    """A UTM-projected district on the NumPy engine, on Dask (one local worker): one feature
+    per façade with its coordinates back in UTM, the results labelled building/facade/storey,
+    the same numbers as the in-process run, and a rerun reuses every part."""
+    from functools import partial
+
+    from radtree.pipeline.simulate import simulate_project
+    from radtree.sweep.scheduler import map_jobs
+
+    root = tmp_path / "d"
+    root.mkdir()
+    (root / "dni.csv").write_text(DNI)
+    (root / "trees.geojson").write_text(fc(_utm(TREES), UTM))
+    (root / "buildings.geojson").write_text(fc(_utm(BUILDINGS), UTM))
+    (root / "radtree.toml").write_text(
+        SITE + 'trees = "trees.geojson"\nbuildings = "buildings.geojson"\n'
+        'facade_spacing_m = 15.0\nfacade_chunk = 4\n' + REST.replace("rays = 48", "rays = 8"))
+    p = load_project(root)
+    quiet = {"echo": lambda _m: None, "progress": False}
+    out = simulate_project(p, "numpy", executor=partial(_dask, map_jobs), **quiet)
+    assert out is not None and out.computed == 3    # 10 façades in chunks of 4
+    t = out.table
+    assert set(t["building"]) == {"N1", "N2", "S1"} and t["storey"].max() == 2
+    assert set(t.groupby("facade")["storey"].nunique()) <= {2, 3}
+    gj = json.loads((root / "results" / "facades.geojson").read_text())
+    assert gj["type"] == "FeatureCollection" and len(gj["features"]) == 10
+    assert gj["crs"]["properties"]["name"] == UTM
+    n1 = next(f for f in gj["features"] if f["id"] == "N1:0")
+    np.testing.assert_allclose(n1["geometry"]["coordinates"], [[E0 - 15, N0 + 10], [E0, N0 + 10]],
+                               atol=1e-6)
+    mean = t[t["facade"] == "N1:0"]["lux"].mean()
+    assert n1["properties"]["lux_T_12:30"] == pytest.approx(mean, abs=0.05)
+    again = simulate_project(p, "numpy", **quiet)
+    assert again is not None and again.computed == 0 and again.reused == 3
+    fresh = simulate_project(p, "numpy", resume=False, **quiet)
+    assert fresh is not None
+    key = ["grid", "sensor"]
+    a = t.sort_values(key)["lux"].to_numpy()
+    b = fresh.table.sort_values(key)["lux"].to_numpy()
+    np.testing.assert_array_equal(a, b)
+
+
+def _dask(map_jobs, fn, jobs):
+    return map_jobs(fn, jobs, "local", 1)

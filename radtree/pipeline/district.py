@@ -14,6 +14,7 @@ import time
 
 from radtree.config import Project, Scenario, effective_project
 from radtree.errors import ConfigError, RadtreeError
+from radtree.optics import Material
 from radtree.scene import Scene
 from radtree.sensor_grid import facade_circle, facade_dense_grid
 from radtree.site.buildings import building_meshes, facade_grids, ground_mesh
@@ -36,9 +37,10 @@ def district_scene(project: Project, scenario: Scenario, dense_grid: bool | None
 
         species_of(inputs.trees, str(d.trees))
     notes: list[str] = []
+    materials: dict[str, Material]
     if inputs.buildings:
-        meshes, materials = building_meshes(inputs.buildings)
-        materials = {**materials, "ground": street_materials(project.street)["ground"]}
+        meshes, walls = building_meshes(inputs.buildings)
+        materials = {**walls, "ground": street_materials(project.street)["ground"]}
         meshes.append(ground_mesh(inputs.buildings, inputs.trees))
         grids = facade_grids(inputs.facades, d.facade_spacing_m, d.window_height_m,
                              project.sensors.offset_m, d.facade_chunk)

@@ -70,7 +70,7 @@ class Facade:
     @property
     def azimuth_deg(self) -> float:
         """Compass direction the face looks towards (clockwise from north)."""
-        return round(math.degrees(math.atan2(self.normal[0], self.normal[1])), 6) % 360.0
+        return (round(math.degrees(math.atan2(self.normal[0], self.normal[1])), 6) + 360.0) % 360.0
 
 
 def read_buildings(path: Path, frame_crs: str, latitude: float, longitude: float,

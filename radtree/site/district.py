@@ -11,6 +11,8 @@ from __future__ import annotations
 from dataclasses import dataclass
 from pathlib import Path
 
+import numpy as np
+
 from radtree.config import Project
 from radtree.errors import ConfigError
 from radtree.site.buildings import (
@@ -82,7 +84,7 @@ def check_trees_in_canyon(project: Project, trees: list[InventoryTree], source: 
     frame = FacadeFrame(azimuth_deg=project.street.facade_azimuth_deg)
     st = project.street
     for t in trees:
-        u, n, _ = frame.to_local([t.x, t.y, 0.0])
+        u, n, _ = frame.to_local(np.array([t.x, t.y, 0.0]))
         where = f"feature {t.id!r}"
         if not 0.0 < n < st.width_m or abs(u) > st.length_m / 2.0:
             raise ConfigError(f"tree stands inside a building (n = {n:.2f} m across a "

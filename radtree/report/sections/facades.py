@@ -11,10 +11,25 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
+import pandas as pd
 
 from radtree.config import Project
+from radtree.stats import FACADE_GRID
 
 PLAN_FILE = "facades_plan.png"
+
+
+def as_one_facade_grid(results: pd.DataFrame) -> pd.DataFrame:
+    """The façade-chunk grids of an inventory project (rows with a ``facade``) as the one
+    ``facade`` grid the core report sections read: its hourly means are then the means over
+    every simulated façade sensor; sensors renumbered per scenario × hour."""
+    if "facade" not in results.columns or results["facade"].isna().all():
+        return results
+    out = results.copy()
+    on = out["facade"].notna()
+    out.loc[on, "grid"] = FACADE_GRID
+    out.loc[on, "sensor"] = out[on].groupby(["scenario", "time"]).cumcount()
+    return out
 
 
 def _scenarios(props: list[dict[str, Any]]) -> list[str]:

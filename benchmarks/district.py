@@ -1,0 +1,114 @@
+"""District benchmark: wall time and peak memory of the synthetic Mendoza district
+(``examples/district``) — the 7 hours of the ``trees`` scenario on 1 and 2 Dask workers, with
+60 and 240 trees, per engine.
+
+Each case copies the example to a scratch folder (``/tmp/district_bench_*``, removed
+afterwards unless ``--keep``), regenerates the inventory with ``make_district.py --trees N``
+(same 12 buildings and façade sensors; trees spread along the same sidewalks), then runs, each
+in its own process, ``radtree build`` and ``radtree simulate -s trees --engine E --scheduler
+local --workers W --fresh``. Peak memory is the largest sum of the resident set sizes of the
+command's whole process tree (Dask workers and rtrace included), sampled every 0.1 s with
+psutil. Targets (Radiance): ≤ 5 min for the 7 hours on 2 cores, ≤ 2 GiB, memory and build
+time at 240 trees ≤ 1.3 × those at 60 (crowns are instanced: one octree per species).
+
+Run: ``.venv/bin/python benchmarks/district.py [--engines radiance numpy] [--trees 60 240]
+[--workers 1 2] [--keep]``.
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import shutil
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+import psutil
+
+ROOT = Path(__file__).resolve().parents[1]
+EXAMPLE = ROOT / "examples" / "district"
+GIB = 1024.0 ** 3
+
+
+def run_measured(argv: list[str], cwd: Path) -> tuple[float, float, str]:
+    """Wall time (s), peak RSS of the whole process tree (bytes) and the output's tail."""
+    env = dict(os.environ, PYTHONPATH=str(ROOT))
+    t0 = time.perf_counter()
+    proc = subprocess.Popen(argv, cwd=cwd, env=env, stdout=subprocess.PIPE,
+                            stderr=subprocess.STDOUT, text=True)
+    root = psutil.Process(proc.pid)
+    peak = 0.0
+    while proc.poll() is None:
+        try:
+            procs = [root, *root.children(recursive=True)]
+            peak = max(peak, float(sum(p.memory_info().rss for p in procs if p.is_running())))
+        except psutil.Error:
+            pass
+        time.sleep(0.1)
+    wall = time.perf_counter() - t0
+    out = proc.stdout.read() if proc.stdout else ""
+    if proc.returncode:
+        raise RuntimeError(f"{' '.join(argv)} failed ({proc.returncode}):\n{out[-3000:]}")
+    return wall, peak, out.strip().splitlines()[-1] if out.strip() else ""
+
+
+def case(engine: str, trees: int, workers: list[int], keep: bool) -> list[dict]:
+    work = Path(tempfile.mkdtemp(prefix=f"district_bench_{engine}_{trees}_"))
+    proj = work / "district"
+    shutil.copytree(EXAMPLE, proj, ignore=shutil.ignore_patterns("build", "results", "report"))
+    py = sys.executable
+    subprocess.run([py, str(proj / "make_district.py"), "--trees", str(trees), "--out",
+                    str(proj / "data")], check=True, capture_output=True)
+    rows = []
+    try:
+        bwall, bpeak, _ = run_measured([py, "-m", "radtree.cli", "build", str(proj),
+                                        "-s", "trees"], work)
+        for w in workers:
+            swall, speak, tail = run_measured(
+                [py, "-m", "radtree.cli", "simulate", str(proj), "-s", "trees", "--engine",
+                 engine, "--scheduler", "local", "--workers", str(w), "--fresh"], work)
+            rows.append({"engine": engine, "trees": trees, "workers": w, "build_s": bwall,
+                         "build_peak_gib": bpeak / GIB, "simulate_s": swall,
+                         "simulate_peak_gib": speak / GIB, "tail": tail})
+            print(f"  {engine:8s} {trees:4d} trees  {w} worker(s): build {bwall:6.1f} s "
+                  f"{bpeak / GIB:5.2f} GiB | simulate 7 h {swall:7.1f} s "
+                  f"{speak / GIB:5.2f} GiB   ({tail})", flush=True)
+    finally:
+        if not keep:
+            shutil.rmtree(work, ignore_errors=True)
+    return rows
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--engines", nargs="+", default=["radiance", "numpy"])
+    ap.add_argument("--trees", nargs="+", type=int, default=[60, 240])
+    ap.add_argument("--workers", nargs="+", type=int, default=[1, 2])
+    ap.add_argument("--keep", action="store_true")
+    args = ap.parse_args()
+    print(f"district benchmark: {os.cpu_count()} cores, load {os.getloadavg()[0]:.1f}")
+    rows = []
+    for engine in args.engines:
+        for n in args.trees:
+            rows += case(engine, n, args.workers, args.keep)
+    print("\nsummary (targets for Radiance: simulate ≤ 300 s on 2 workers, ≤ 2 GiB; "
+          "240-tree build time and memory ≤ 1.3 × 60-tree):")
+    for engine in args.engines:
+        got = {(r["trees"], r["workers"]): r for r in rows if r["engine"] == engine}
+        lo, hi = min(args.trees), max(args.trees)
+        w = max(args.workers)
+        if (lo, w) in got and (hi, w) in got:
+            a, b = got[(lo, w)], got[(hi, w)]
+            print(f"  {engine}: {hi}/{lo} trees — build time ×{b['build_s'] / a['build_s']:.2f}, "
+                  f"build memory ×{b['build_peak_gib'] / a['build_peak_gib']:.2f}, simulate "
+                  f"time ×{b['simulate_s'] / a['simulate_s']:.2f}, simulate memory "
+                  f"×{b['simulate_peak_gib'] / a['simulate_peak_gib']:.2f}; worst simulate "
+                  f"{max(r['simulate_s'] for r in got.values()):.0f} s, peak "
+                  f"{max(r['simulate_peak_gib'] for r in got.values()):.2f} GiB")
+
+
+if __name__ == "__main__":
+    main()
