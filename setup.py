@@ -30,6 +30,6 @@ DATA_PACKAGES = _data_packages()
 setup(
     packages=[*find_packages(include=["radtree", "radtree.*"]), *DATA_PACKAGES],
     package_dir=DATA_PACKAGES,
-    package_data={p: ["*.j2", "*.rad", "*.md"] for p in DATA_PACKAGES},
+    package_data={p: ["*.j2", "*.rad", "*.md", "*.toml"] for p in DATA_PACKAGES},
     include_package_data=False,
 )

@@ -429,3 +429,52 @@ def test_report_section_without_results(tmp_path):
     p = copy_project(tmp_path / "p")
     data = annual_section_data(load_project(p))
     assert "No annual results" in render_section(Section("annual", data))
+
+
+@needs_radiance
+def test_species_phenology_weighs_leafed_and_bare_hour_by_hour(tiny_project):
+    """[tree] species: the crown of each hour from the species' leaf area (Morus alba in
+    Mendoza: leaves out 15 Sep → full 15 Oct, fall 15 Apr → bare 1 Jun)."""
+    from radtree.annual.run import AnnualOptions, compute_annual
+    from radtree.config import load_project
+
+    project = load_project(tiny_project, {"tree.species": "morus_alba"})
+    res = compute_annual(project, AnnualOptions(nproc=1), echo=lambda s: None)
+    wea, g = res.wea, "facade"
+    on, off, with_ = (res.total[k][g].astype(np.float64) for k in ("leaf_on", "leaf_off", "with"))
+    assert res.leaf_fraction is not None and res.leaf_weight is not None
+
+    def at(m: int, d: int, h: float) -> int:
+        return int(np.flatnonzero((wea.month == m) & (wea.day == d) & (wea.hour == h))[0])
+
+    sep30, jan15, jul15 = at(9, 30, 12.5), at(1, 15, 12.5), at(7, 15, 12.5)
+    f = (15 + 0.5 / 24) / 30                       # half way through leaf-out
+    assert res.leaf_fraction[sep30] == pytest.approx(f)
+    lai = 5.8 - 1.39
+    w = (1 - np.exp(-0.5 * f * lai)) / (1 - np.exp(-0.5 * lai))    # ≈ 0.75
+    assert res.leaf_weight[sep30] == pytest.approx(w)
+    np.testing.assert_allclose(with_[:, sep30], off[:, sep30] + w * (on - off)[:, sep30],
+                               rtol=1e-5)
+    np.testing.assert_allclose(with_[:, jan15], on[:, jan15], rtol=1e-6)     # full leaf
+    np.testing.assert_allclose(with_[:, jul15], off[:, jul15], rtol=1e-6)    # bare
+    # every hour lies between the leafed and the bare crown …
+    assert np.all(with_ >= np.minimum(on, off) - 1e-3) and np.all(with_ <= np.maximum(on, off) + 1e-3)
+    # … and the year between the binary switch's longest season (leaf-out start 15 Sep → bare
+    # 1 Jun) and shortest (full leaf 15 Oct → leaf fall start 15 Apr): the ramps lie between
+    occ = res.occupied
+
+    def year(leaf: LeafSchedule) -> np.ndarray:
+        return np.where(leaf.in_leaf(wea.month, wea.day)[None, :], on, off)
+
+    longest, shortest = year(LeafSchedule("09-15", "06-01")), year(LeafSchedule("10-15", "04-15"))
+
+    m_long, m_short, m_with = (float(x[:, occ].mean()) for x in (longest, shortest, with_))
+    assert min(m_long, m_short) < m_with < max(m_long, m_short)    # 34111 < 34332 < 34581 lx
+    # the binary switch at the ramps' middles (30 Sep, 8 May) is what the ramps average to
+    # to first order: within 1 % here
+    middle = float(year(LeafSchedule("09-30", "05-09"))[:, occ].mean())
+    assert abs(m_with / middle - 1) < 0.01
+    # 221 of 365 days at least half in leaf at noon: 30 Sep (273) → 31 Dec and 1 Jan → 8 May (128)
+    noon = wea.hour == 12.5
+    assert int(res.in_leaf[noon].sum()) == 93 + 128
+    assert "phenology of Morus alba" in " ".join(res.notes)

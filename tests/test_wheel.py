@@ -36,6 +36,8 @@ PROBE = textwrap.dedent("""
     print(json.dumps({"radtree": radtree.__file__, "templates": str(resources.folder("templates")),
                       "makefile": make, "leaf": resources.material_text("leaf"),
                       "materials": resources.material_files(),
+                      "species": sorted(p.name for p in resources.folder("materials")
+                                        .joinpath("species").iterdir()),
                       "sections": sorted(p.name for p in resources.folder("templates")
                                          .joinpath("sections").iterdir())}))
 """)
@@ -76,4 +78,5 @@ def test_wheel_ships_templates_and_materials(tmp_path: Path) -> None:
     assert "octrees/1200.oct: $(SCENE) skies/1200.sky" in got["makefile"]
     assert "void trans leaf" in got["leaf"] and "7 0.61 0.61 0.61 0 0 0.8197 0.9" in got["leaf"]
     assert got["materials"] == ["concrete.rad", "glazing.rad", "leaf.rad", "paint.rad"]
+    assert "morus_alba.toml" in got["species"] and "morus_alba.rad" in got["species"]
     assert "provenance.html.j2" in got["sections"]

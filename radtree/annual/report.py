@@ -93,7 +93,7 @@ def _heatmap_grid(project: Project, data: dict, meta: dict, grid: str, out: Path
     month, hour = data["month"], data["hour"]
     with_ = metrics.month_hour_mean(data[f"total__with__{grid}"], month, hour)
     without = metrics.month_hour_mean(data[f"total__without__{grid}"], month, hour)
-    in_leaf = data["in_leaf"]
+    in_leaf = data["leaf_fraction"] if "leaf_fraction" in data else data["in_leaf"]
     leaf_frac = np.array([in_leaf[month == m].mean() for m in range(1, 13)])
     state = ["leaf" if f > 0.999 else "bare" if f < 0.001 else f"{100 * f:.0f}% leaf"
              for f in leaf_frac]
@@ -120,9 +120,10 @@ def _heatmap_grid(project: Project, data: dict, meta: dict, grid: str, out: Path
         for x in occ:
             ax.axvline(x, color="white" if nrm is not None else "black", lw=0.6, ls="--")
         fig.colorbar(im, ax=ax, shrink=0.85).ax.tick_params(labelsize=7)
-    fig.suptitle(f"Month × hour mean illuminance on the {grid} grid — crown in leaf "
-                 f"{meta.get('leaf_on')} → {meta.get('leaf_off')} (MM-DD); dashed: occupancy",
-                 fontsize=10)
+    season = (f"phenology of {meta['phenology']['species']}" if "phenology" in meta else
+              f"in leaf {meta.get('leaf_on')} → {meta.get('leaf_off')} (MM-DD)")
+    fig.suptitle(f"Month × hour mean illuminance on the {grid} grid — crown {season}; "
+                 "dashed: occupancy", fontsize=10)
     return _save(fig, out)
 
 

@@ -52,6 +52,7 @@ import pandas as pd
 import radtree.annual.metrics as metrics
 from radtree.annual.branches import BranchParams, build_leaf_off
 from radtree.annual.coefficients import CoefficientRunner, TraceParams
+from radtree.annual.phenology import Phenology, blend, phenology_of
 from radtree.annual.schedule import (
     DEFAULT_OCCUPANCY,
     LeafSchedule,
@@ -112,6 +113,9 @@ class AnnualOptions:
     epw: Path | None = None
     grids: tuple[str, ...] | None = None
     branches: BranchParams = field(default_factory=BranchParams)
+    #: with ``[tree] species``: the crown of each hour from the species' phenology
+    #: (:mod:`radtree.annual.phenology`) instead of the ``leaf`` dates (False: the dates)
+    species_phenology: bool = True
 
     def __post_init__(self) -> None:
         if self.mf < 1 or self.sun_mf < 1:
@@ -141,6 +145,10 @@ class AnnualResult:
     ground_reflectance: float
     notes: list[str]
     timing: dict[str, float]
+    #: (8760,) leaf area fraction f and weight w of each hour (species phenology), else None
+    leaf_fraction: np.ndarray | None = None
+    leaf_weight: np.ndarray | None = None
+    phenology: Phenology | None = None
 
 
 # ---------------------------------------------------------------- scene choice
@@ -346,21 +354,32 @@ def compute_annual(project: Project, options: AnnualOptions | None = None,
         if bar is not None:
             bar.close()
 
-    in_leaf = options.leaf.in_leaf(wea.month, wea.day)
-    for store in (total, direct):
-        store["with"] = {g: np.where(in_leaf[None, :], store["leaf_on"][g], store["leaf_off"][g])
-                         for g in grids}
+    phen = phenology_of(project, options.species_phenology)
+    fraction = weight = None
+    if phen is None:
+        in_leaf = options.leaf.in_leaf(wea.month, wea.day)
+        for store in (total, direct):
+            store["with"] = {g: np.where(in_leaf[None, :], store["leaf_on"][g],
+                                         store["leaf_off"][g]) for g in grids}
+    else:
+        fraction = phen.leaf_fraction(wea.month, wea.day, wea.hour)
+        weight = phen.weight(fraction)
+        in_leaf = fraction >= 0.5
+        for store in (total, direct):
+            store["with"] = {g: blend(store["leaf_on"][g], store["leaf_off"][g], weight)
+                             for g in grids}
     occ = occupied(wea.hour, options.occupancy)
     grid_geo = {g: {"points": scenes["leaf_on"].grids[g].points,
                     "normals": scenes["leaf_on"].grids[g].normals} for g in grids}
-    notes.append(f"Crown {options.leaf.describe()}.")
+    notes.append(f"Crown {options.leaf.describe() if phen is None else phen.describe()}.")
     notes += METHOD_NOTES
     timing["total_s"] = time.perf_counter() - t0
     return AnnualResult(project=project, options=options, weather=weather, wea=wea,
                         grids=grid_geo, total=total, direct=direct, in_leaf=in_leaf,
                         occupied=occ, scenarios={"with": with_sc.name,
                                                  "without": without_sc.name},
-                        trace=trace, sun_trace=sun_trace, ground_reflectance=rho, notes=notes, timing=timing)
+                        trace=trace, sun_trace=sun_trace, ground_reflectance=rho, notes=notes, timing=timing,
+                        leaf_fraction=fraction, leaf_weight=weight, phenology=phen)
 
 
 # ---------------------------------------------------------------- tables
@@ -427,6 +446,9 @@ def write_annual(result: AnnualResult, figures: bool = True) -> AnnualOutcome:
         "month": result.wea.month, "day": result.wea.day, "hour": result.wea.hour,
         "in_leaf": result.in_leaf, "occupied": result.occupied,
     }
+    if result.leaf_fraction is not None and result.leaf_weight is not None:
+        arrays["leaf_fraction"] = result.leaf_fraction
+        arrays["leaf_weight"] = result.leaf_weight
     for g, geo in result.grids.items():
         arrays[f"points__{g}"] = geo["points"]
         arrays[f"normals__{g}"] = geo["normals"]
@@ -454,6 +476,10 @@ def write_annual(result: AnnualResult, figures: bool = True) -> AnnualOutcome:
         "grids": {g: len(v["points"]) for g, v in result.grids.items()},
         "notes": result.notes, "timing": result.timing,
     }
+    if result.phenology is not None:
+        meta["phenology"] = {"species": result.phenology.species.key,
+                             "latitude": result.phenology.latitude_deg,
+                             "describe": result.phenology.describe()}
     mp = write_text(res / "annual" / "annual_meta.json", json.dumps(meta, indent=2,
                                                                      default=str))
     figs: list[Path] = []

@@ -21,6 +21,7 @@ from radtree.cli.diagnose import diagnose_command
 from radtree.cli.doctor import doctor_command
 from radtree.cli.errors import RadtreeGroup
 from radtree.cli.hemi import hemi_command
+from radtree.cli.new import new_command
 from radtree.cli.options import CONTEXT
 from radtree.cli.permeability import permeability_command
 from radtree.cli.report import report_command
@@ -56,5 +57,5 @@ def main(ctx: click.Context, debug: bool) -> None:
 
 for _command in (doctor_command, build_command, simulate_command, hemi_command, report_command,
                  calibrate_command, sweep_command, diagnose_command, annual_command,
-                 permeability_command, verify_command):
+                 permeability_command, verify_command, new_command):
     main.add_command(_command)

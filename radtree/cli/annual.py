@@ -39,11 +39,19 @@ from radtree.cli.options import CONTEXT
 @click.option("-j", "--processes", default=2, show_default=True, type=click.IntRange(1, 64),
               help="rcontrib processes.")
 @click.option("--no-figures", is_flag=True, help="Skip the PNG figures.")
+@click.option("--dates", "use_dates", is_flag=True,
+              help="With [tree] species: use the --leaf-on/--leaf-off switch instead of the "
+                   "species' hourly phenology (leaf area ramps).")
 def annual_command(project: Path, leaf_on: str, leaf_off: str, mf: int, sun_mf: int,
                    occupancy: str, epw: Path | None, with_scenario: str | None,
                    without_scenario: str | None, ab: int | None, ad: int | None,
-                   lw: float | None, processes: int, no_figures: bool) -> None:
+                   lw: float | None, processes: int, no_figures: bool,
+                   use_dates: bool = False) -> None:
     """Annual daylight (8760 h) with a deciduous tree: UDI, DA, sDA, ASE, monthly means.
+
+    The crown is in leaf from --leaf-on to --leaf-off; with ``[tree] species`` each hour
+    instead weighs the leafed and the bare crown by the species' leaf area (leaf-out and
+    leaf-fall ramps; --dates keeps the switch).
 
     Writes PROJECT/results/annual.csv, annual_summary.csv, annual_monthly.csv and
     results/annual/ (hourly arrays, coefficients, figures).
@@ -55,7 +63,8 @@ def annual_command(project: Path, leaf_on: str, leaf_off: str, mf: int, sun_mf: 
     options = AnnualOptions(
         leaf=LeafSchedule(leaf_on, leaf_off), mf=mf, sun_mf=sun_mf,
         occupancy=parse_occupancy(occupancy), ab=ab, ad=ad, lw=lw, nproc=processes,
-        with_scenario=with_scenario, without_scenario=without_scenario, epw=epw)
+        with_scenario=with_scenario, without_scenario=without_scenario, epw=epw,
+        species_phenology=not use_dates)
     click.echo(f"annual: {proj.name}")
     out = run_annual(proj, options, echo=click.echo, progress=True,
                      figures=not no_figures)

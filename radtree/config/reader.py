@@ -18,6 +18,7 @@ import tomllib
 from radtree.config.district import DISTRICT_KEYS, read_district
 from radtree.config.schema import Project, Scenario, Site, Street, parse_time
 from radtree.config.spec import SchemaError, Spec, spec_for, spec_of, toml_name
+from radtree.config.species import find_species, tree_defaults, unknown_species_message
 from radtree.config.switches import (
     FIELD,
     TABLES,
@@ -197,8 +198,11 @@ def parse_project(data: dict, path: Path) -> Project:
                        "or an 'epw' weather file")
 
     tr = top.sub("tree")
-    crowns = {t: _table(tr.sub(t), f"tree.{t}", base)
-              for t in ("dome", "crown", "homogeneous", "perforated", "louvers")}
+    filled = species_fill(tr)
+    crowns = {t: _table(r, f"tree.{t}", base, **{k: v for k, v in filled.get(t, {}).items()
+                                                   if not r.has(k)})
+              for t, r in ((t, tr.sub(t)) for t in ("dome", "crown", "homogeneous",
+                                                   "perforated", "louvers"))}
     tree = _table(tr, "tree", base, **crowns)
 
     se = top.sub("sensors")
@@ -227,6 +231,20 @@ def parse_project(data: dict, path: Path) -> Project:
                    light=light, tree=tree, sensors=sensors, engine=engine,
                    scenarios=scenarios, measured=measured, measured_rows=measured_rows,
                    office=office, extra_geometry=tuple(extra), district=district)
+
+
+def species_fill(tr: _Reader) -> dict[str, dict[str, float]]:
+    """``[tree] species``: the crown-table fields its species fills (those the file does not
+    give are taken, see :func:`radtree.config.species.tree_defaults`); {} without a species."""
+    if not tr.has("species"):
+        return {}
+    name = tr.value("species", Spec("str"))
+    sp = find_species(name)
+    if sp is None:
+        raise tr.error("species", unknown_species_message(name))
+    given = {t: dict(tr.data[t]) for t in ("louvers", "homogeneous", "perforated")
+             if isinstance(tr.data.get(t), dict)}
+    return tree_defaults(sp, given)
 
 
 def _scenarios(top: _Reader, src: str) -> tuple[Scenario, ...]:

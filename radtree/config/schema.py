@@ -202,6 +202,9 @@ class Tree(Checked):
     homogeneous: Homogeneous = field(default_factory=Homogeneous)
     perforated: Perforated = field(default_factory=Perforated)
     louvers: Louvers = field(default_factory=Louvers)
+    #: a species of the library (materials/species/, key or name): fills the leaf optics, slat
+    #: inclination and permeability that the [tree.*] tables leave out (radtree.config.species)
+    species: str | None = field(default=None, metadata=meta(switch=False))
 
 
 @dataclass(frozen=True)
@@ -376,6 +379,8 @@ class Project:
         d = self.to_dict()
         payload = {k: d[k] for k in ("site", "street", "light", "tree", "sensors", "engine",
                                      "office", "extra_geometry")}
+        if payload["tree"].get("species") is None:  # no species: hashes unchanged
+            payload["tree"].pop("species", None)
         payload["engine"].pop("workers", None)
         for key in FORWARD_KEYS:  # forward-engine settings at their defaults: hashes unchanged
             if payload["engine"].get(key) == getattr(EngineParams, key):

@@ -35,6 +35,7 @@ from radtree.trees.homogeneous import build_homogeneous
 from radtree.trees.louvers import build_louvers
 from radtree.trees.model import TreeModel
 from radtree.trees.perforated import build_perforated
+from radtree.trees.species import load_species
 
 __all__ = ["TreeModel", "apply_switches", "build_crown", "build_tree", "resolve_form"]
 
@@ -97,6 +98,11 @@ def build_crown(project: Project, model: str, form: str, frame: FacadeFrame,
     else:
         raise ConfigError(f"got {model!r}, expected homogeneous, perforated, louvers or none",
                           source=source, field="scenario.model")
+    if tree.species is not None and model != "none":
+        sp = load_species(tree.species)
+        result.notes.insert(0, f"Species {sp.name} ({sp.common_name}, "
+                            f"materials/species/{sp.key}.toml) fills the leaf optics, leaf tilt "
+                            f"and permeability the [tree.*] tables leave out: {sp.describe()}.")
     result.build_seconds = time.perf_counter() - t0
     result.frame = frame
     result.triangles = sum(m.n_triangles for m in result.meshes)
