@@ -191,13 +191,13 @@ def test_one_tree_inventory_reproduces_hand_written_free_crown(tmp_path):
     inv = district(tmp_path / "inv", trees=[point("T1", 0.0, 3.5)], buildings=None,
                    extra=STREET)
     p_inv = load_project(inv)
-    lv = species_louvers(p_inv.tree.louvers, load_species("morus_alba"))
+    lv = species_louvers(p_inv.tree, load_species("morus_alba"))
     hand = tmp_path / "hand"
     hand.mkdir()
     (hand / "dni.csv").write_text(DNI)
     louvers = "\n".join(f"{k} = {getattr(lv, k)!r}" for k in (
-        "reflectance", "transmittance", "specular_fraction", "slat_size_m", "inclination_deg",
-        "crossings"))
+        "reflectance", "transmittance", "specular_fraction", "inclination_deg",
+        "cover_fraction"))
     (hand / "radtree.toml").write_text(SITE + STREET + CROWN + REST.replace(
         'arrangement = "volume"', 'arrangement = "volume"\n' + louvers))
     p_hand = load_project(hand)
@@ -226,13 +226,13 @@ def test_one_tree_inventory_radiance_text_and_lux_match(tmp_path):
     from radtree.trees.district import species_louvers
     from radtree.trees.species import load_species
 
-    lv = species_louvers(p_inv.tree.louvers, load_species("morus_alba"))
+    lv = species_louvers(p_inv.tree, load_species("morus_alba"))
     hand = tmp_path / "hand"
     hand.mkdir()
     (hand / "dni.csv").write_text(DNI)
     louvers = "\n".join(f"{k} = {getattr(lv, k)!r}" for k in (
-        "reflectance", "transmittance", "specular_fraction", "slat_size_m", "inclination_deg",
-        "crossings"))
+        "reflectance", "transmittance", "specular_fraction", "inclination_deg",
+        "cover_fraction"))
     (hand / "radtree.toml").write_text(SITE + STREET + CROWN + REST.replace(
         'arrangement = "volume"', 'arrangement = "volume"\n' + louvers))
     p_hand = load_project(hand)

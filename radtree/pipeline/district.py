@@ -71,7 +71,7 @@ def district_scene(project: Project, scenario: Scenario, dense_grid: bool | None
 
         tr, _ = apply_switches(project.tree, scenario.switches, source=str(project.source),
                                root=project.root)
-        tree = inventory_crowns(project, inputs.trees, tr.louvers, d.instancing)
+        tree = inventory_crowns(project, inputs.trees, tr, d.instancing)
         clash = set(tree.materials) & set(materials)
         if clash:
             raise RadtreeError(f"crown materials clash with the buildings': {clash}")

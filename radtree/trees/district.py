@@ -7,13 +7,12 @@ b = (height_m − crown_base_m) / 2, lowest point at crown_base_m, on a trunk (b
 the row's ``trunk_diameter_m`` (else ``[tree.crown] trunk_diameter_m``) up to base + b/2 — as
 :func:`radtree.trees.envelope.crown_row_spec` lays out one crown of the hand-written row.
 
-Leaf optics from the species: slat reflectance = leaf reflectance, slat transmittance = the
-leaf's global transmittance, specular fraction = (global − diffuse) / global (the reading of
-SPEC §1 and ``leaf_optics.csv``), slat size = leaf size, slat inclination = mean leaf tilt.
-Leaf density from the leaf-on LAI: a spheroid of density ρ slats/m³ has LAI (leaf area per
-crown-projected area) ρ s² · 4b/3; with ρ = crossings·cover/(s² cos α · 2b) (volume.py)
-that is LAI = 2·crossings·cover/(3 cos α), so crossings = 1.5 · LAI · cos α / cover.
-The other louvers fields (arrangement, cover, seed, realisations) are the project's.
+Leaf optics from the species, by the species library's mapping
+(:func:`radtree.trees.species.species_tree`): slat reflectance and transmittance = the leaf's,
+specular fraction = its direct share, slat inclination = the mean leaf tilt, and the cover
+fraction solved so the crown passes the species' leaf-on permeability. The other louvers fields
+(arrangement, slat size, layers/crossings, seed, realisations) are the project's (after the
+scenario's switches). Crown sizes: :func:`radtree.trees.species.crown_size` of the row.
 
 Instancing (``[site] instancing = "auto"``): trees of a species share ONE crown per
 realisation — built once at the species' median size and aspect, then placed per tree
@@ -34,7 +33,7 @@ from dataclasses import replace
 
 import numpy as np
 
-from radtree.config import Louvers, Project
+from radtree.config import Louvers, Project, Tree
 from radtree.errors import ConfigError
 from radtree.optics import Plastic, Trans
 from radtree.scene import Instance, Mesh
@@ -44,18 +43,17 @@ from radtree.trees.geometry import polygons_to_mesh
 from radtree.trees.louvers import LouverOptics, check_louvers
 from radtree.trees.louvers_free import build_free_louvers
 from radtree.trees.model import BARK_REFLECTANCE, TRUNK, TreeModel
+from radtree.trees.species import Species, known_species, load_species, species_tree
 from radtree.trees.volume import build_volume_louvers, recommended_volume_ab
 
 TREE_SEED_STEP = 7919
 PROTOTYPE_SEED_STEP = 104729
 
 
-def species_of(trees: list[InventoryTree], source: str) -> dict[str, object]:
+def species_of(trees: list[InventoryTree], source: str) -> dict[str, Species]:
     """The species record of every tree (by the tree id); ConfigError naming the feature and
     listing the known species otherwise."""
-    from radtree.trees.species import known_species, load_species
-
-    out: dict[str, object] = {}
+    out: dict[str, Species] = {}
     for t in trees:
         try:
             out[t.id] = load_species(t.species)
@@ -66,16 +64,11 @@ def species_of(trees: list[InventoryTree], source: str) -> dict[str, object]:
     return out
 
 
-def species_louvers(lv: Louvers, sp: object) -> Louvers:
-    """The project's louvers with the species' leaf optics, leaf size, tilt and LAI."""
-    tg = float(sp.leaf_transmittance_global)          # type: ignore[attr-defined]
-    td = float(sp.leaf_transmittance_diffuse)         # type: ignore[attr-defined]
-    tilt = float(sp.mean_leaf_tilt_deg)               # type: ignore[attr-defined]
-    crossings = 1.5 * float(sp.lai_leaf_on) * math.cos(math.radians(tilt)) / lv.cover_fraction  # type: ignore[attr-defined]
-    return replace(lv, reflectance=float(sp.leaf_reflectance),  # type: ignore[attr-defined]
-                   transmittance=tg, specular_fraction=(tg - td) / tg if tg > 0 else 0.0,
-                   slat_size_m=float(sp.leaf_size_m), inclination_deg=tilt,  # type: ignore[attr-defined]
-                   crossings=min(60.0, crossings))
+def species_louvers(tree: Tree, sp: Species) -> Louvers:
+    """``tree``'s louvers with the species' leaf optics, slat inclination (mean leaf tilt) and
+    the cover fraction that makes the crown pass the species' leaf-on permeability — the
+    species library's own mapping (:func:`radtree.trees.species.species_tree`)."""
+    return species_tree(tree, sp).louvers
 
 
 def single_spec(centre: np.ndarray, a: float, b: float, trunk_radius: float,
@@ -97,13 +90,15 @@ def yaw_of(tree_id: str) -> float:
     return float(zlib.crc32(tree_id.encode()) % 3600) / 10.0
 
 
-def inventory_crowns(project: Project, trees: list[InventoryTree], lv: Louvers,
+def inventory_crowns(project: Project, trees: list[InventoryTree], tree: Tree,
                      instancing: str = "auto") -> TreeModel:
-    """The crowns of every inventory tree (louvers model, free form) as one TreeModel."""
+    """The crowns of every inventory tree (louvers model, free form) as one TreeModel;
+    ``tree``: the project's [tree] after the scenario's switches."""
+    lv = tree.louvers
     source = str(project.source)
     species = species_of(trees, source)
-    keys = list(dict.fromkeys(str(species[t.id].key) for t in trees))  # type: ignore[attr-defined]
-    by_key = {k: [t for t in trees if species[t.id].key == k] for k in keys}  # type: ignore[attr-defined]
+    keys = list(dict.fromkeys(str(species[t.id].key) for t in trees))
+    by_key = {k: [t for t in trees if species[t.id].key == k] for k in keys}
     default_rt = project.tree.crown.trunk_diameter_m / 2.0
     materials: dict = {TRUNK: Plastic(TRUNK, BARK_REFLECTANCE)}
     leaves: list[Mesh] = []
@@ -115,7 +110,7 @@ def inventory_crowns(project: Project, trees: list[InventoryTree], lv: Louvers,
     index = {t.id: i for i, t in enumerate(trees)}
     for j, key in enumerate(keys):
         group = by_key[key]
-        slv = species_louvers(lv, species[group[0].id])
+        slv = species_louvers(tree, species[group[0].id])
         check_louvers(slv, source)
         mat = f"leaf_{key}"
         o = LouverOptics.of(slv)
@@ -167,9 +162,9 @@ def inventory_crowns(project: Project, trees: list[InventoryTree], lv: Louvers,
             if not shared:
                 notes.append(f"{key}: {len(group)} crown(s) built in place ({len(f)} "
                              "triangles).")
-        notes.append(f"{key} leaves: " + o.describe_slat() + f"; crossings {slv.crossings:.2f} "
-                     f"from LAI {species[group[0].id].lai_leaf_on:g}, slats "  # type: ignore[attr-defined]
-                     f"{slv.slat_size_m:g} m at {slv.inclination_deg:g}°.")
+        notes.append(f"{key} leaves: " + o.describe_slat() + f"; slats {slv.slat_size_m:g} m "
+                     f"at {slv.inclination_deg:g}° (species leaf tilt), permeability "
+                     f"{species[group[0].id].permeability_leaf_on:g}.")
     meshes = leaves + [Mesh("tree_trunks", TRUNK, np.vstack(trunks_v), np.vstack(trunks_f))]
     notes.insert(0, f"Tree inventory: {len(trees)} trees of {len(keys)} species "
                     f"({', '.join(f'{k} {len(v)}' for k, v in by_key.items())}); "
