@@ -117,6 +117,12 @@ def prepare_scenario(project: Project, sc: Scenario, engine: Engine,
     states = hour_states(project, sc, hours)
     seconds = time.perf_counter() - t0
     built = make_scene(project, sc)
+    scene = built.scene
+    if scene.instances and not engine.instancing:
+        extra = scene.instanced_triangles()
+        echo(f"  {sc.name}: the {engine.name} engine has no instancing — {len(scene.instances)} "
+             f"crowns expanded to {extra} triangles (~{extra * 9 * 8 / 2**20:.0f} MiB of "
+             f"vertices, vs {scene.n_triangles} stored for Radiance)")
     folder = ensure_built(project, sc, echo) if engine.uses_build_folder else None
     plan = engine.prepare(built.scene, states, effective_project(project, sc).engine, built.ab,
                           folder)

@@ -32,6 +32,7 @@ class RadianceEngine(Engine):
     missing_hint = "Radiance was not found (install pyradiance, or use --engine numpy)"
     uses_build_folder = True
     seeded = False
+    instancing = True
 
     @classmethod
     def available(cls) -> bool:
