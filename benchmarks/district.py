@@ -8,7 +8,8 @@ afterwards unless ``--keep``), regenerates the inventory with ``make_district.py
 in its own process, ``radtree build`` and ``radtree simulate -s trees --engine E --scheduler
 local --workers W --fresh``. Peak memory is the largest sum of the resident set sizes of the
 command's whole process tree (Dask workers and rtrace included), sampled every 0.1 s with
-psutil. Targets (Radiance): ≤ 5 min for the 7 hours on 2 cores, ≤ 2 GiB, memory and build
+psutil; CPU is the tree's user + system time (``getrusage``), which a busy machine inflates
+less than the wall time. Targets (Radiance): ≤ 5 min for the 7 hours on 2 cores, ≤ 2 GiB, memory and build
 time at 240 trees ≤ 1.3 × those at 60 (crowns are instanced: one octree per species).
 
 Run: ``.venv/bin/python benchmarks/district.py [--engines radiance numpy] [--trees 60 240]
@@ -19,6 +20,7 @@ from __future__ import annotations
 
 import argparse
 import os
+import resource
 import shutil
 import subprocess
 import sys
@@ -33,9 +35,11 @@ EXAMPLE = ROOT / "examples" / "district"
 GIB = 1024.0 ** 3
 
 
-def run_measured(argv: list[str], cwd: Path) -> tuple[float, float, str]:
-    """Wall time (s), peak RSS of the whole process tree (bytes) and the output's tail."""
+def run_measured(argv: list[str], cwd: Path) -> tuple[float, float, float, str]:
+    """Wall time (s), peak RSS of the whole process tree (bytes), CPU time of the tree (user +
+    system s, every waited-for descendant: Dask workers, rtrace) and the output's tail."""
     env = dict(os.environ, PYTHONPATH=str(ROOT))
+    ru0 = resource.getrusage(resource.RUSAGE_CHILDREN)
     t0 = time.perf_counter()
     proc = subprocess.Popen(argv, cwd=cwd, env=env, stdout=subprocess.PIPE,
                             stderr=subprocess.STDOUT, text=True)
@@ -49,10 +53,12 @@ def run_measured(argv: list[str], cwd: Path) -> tuple[float, float, str]:
             pass
         time.sleep(0.1)
     wall = time.perf_counter() - t0
+    ru1 = resource.getrusage(resource.RUSAGE_CHILDREN)
+    cpu = (ru1.ru_utime - ru0.ru_utime) + (ru1.ru_stime - ru0.ru_stime)
     out = proc.stdout.read() if proc.stdout else ""
     if proc.returncode:
         raise RuntimeError(f"{' '.join(argv)} failed ({proc.returncode}):\n{out[-3000:]}")
-    return wall, peak, out.strip().splitlines()[-1] if out.strip() else ""
+    return wall, peak, cpu, out.strip().splitlines()[-1] if out.strip() else ""
 
 
 def case(engine: str, trees: int, workers: list[int], keep: bool) -> list[dict]:
@@ -64,18 +70,20 @@ def case(engine: str, trees: int, workers: list[int], keep: bool) -> list[dict]:
                     str(proj / "data")], check=True, capture_output=True)
     rows = []
     try:
-        bwall, bpeak, _ = run_measured([py, "-m", "radtree.cli", "build", str(proj),
+        bwall, bpeak, bcpu, _ = run_measured([py, "-m", "radtree.cli", "build", str(proj),
                                         "-s", "trees"], work)
         for w in workers:
-            swall, speak, tail = run_measured(
+            swall, speak, scpu, tail = run_measured(
                 [py, "-m", "radtree.cli", "simulate", str(proj), "-s", "trees", "--engine",
                  engine, "--scheduler", "local", "--workers", str(w), "--fresh"], work)
             rows.append({"engine": engine, "trees": trees, "workers": w, "build_s": bwall,
-                         "build_peak_gib": bpeak / GIB, "simulate_s": swall,
+                         "build_peak_gib": bpeak / GIB, "build_cpu_s": bcpu,
+                         "simulate_s": swall, "simulate_cpu_s": scpu,
                          "simulate_peak_gib": speak / GIB, "tail": tail})
             print(f"  {engine:8s} {trees:4d} trees  {w} worker(s): build {bwall:6.1f} s "
-                  f"{bpeak / GIB:5.2f} GiB | simulate 7 h {swall:7.1f} s "
-                  f"{speak / GIB:5.2f} GiB   ({tail})", flush=True)
+                  f"(CPU {bcpu:6.1f} s) {bpeak / GIB:5.2f} GiB | simulate 7 h {swall:7.1f} s "
+                  f"(CPU {scpu:7.1f} s) {speak / GIB:5.2f} GiB, load "
+                  f"{os.getloadavg()[0]:.1f}   ({tail})", flush=True)
     finally:
         if not keep:
             shutil.rmtree(work, ignore_errors=True)
@@ -102,9 +110,11 @@ def main() -> None:
         w = max(args.workers)
         if (lo, w) in got and (hi, w) in got:
             a, b = got[(lo, w)], got[(hi, w)]
-            print(f"  {engine}: {hi}/{lo} trees — build time ×{b['build_s'] / a['build_s']:.2f}, "
+            print(f"  {engine}: {hi}/{lo} trees — build time ×{b['build_s'] / a['build_s']:.2f} "
+                  f"(CPU ×{b['build_cpu_s'] / a['build_cpu_s']:.2f}), "
                   f"build memory ×{b['build_peak_gib'] / a['build_peak_gib']:.2f}, simulate "
-                  f"time ×{b['simulate_s'] / a['simulate_s']:.2f}, simulate memory "
+                  f"time ×{b['simulate_s'] / a['simulate_s']:.2f} (CPU "
+                  f"×{b['simulate_cpu_s'] / a['simulate_cpu_s']:.2f}), simulate memory "
                   f"×{b['simulate_peak_gib'] / a['simulate_peak_gib']:.2f}; worst simulate "
                   f"{max(r['simulate_s'] for r in got.values()):.0f} s, peak "
                   f"{max(r['simulate_peak_gib'] for r in got.values()):.2f} GiB")

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import math
 from pathlib import Path
 
 import numpy as np
@@ -353,3 +354,21 @@ def test_facades_geojson_and_dask_resume(tmp_path):
 
 def _dask(map_jobs, fn, jobs):
     return map_jobs(fn, jobs, "local", 1)
+
+
+def test_csv_inventory_in_lonlat_matches_geojson(tmp_path):
+    """The same two trees as a CSV (lon, lat columns) and as GeoJSON: same local positions;
+    a degree of longitude at 32.89° S spans 111 412.84 cos φ − 93.5 cos 3φ ≈ 93 580 m (WGS 84)."""
+    from radtree.site.inventory import read_trees
+
+    dlon = 1.0 / (111_412.84 * math.cos(math.radians(LAT)) - 93.5 * math.cos(3 * math.radians(LAT)))
+    rows = [("T1", LON + 10 * dlon, LAT), ("T2", LON, LAT)]
+    csv = tmp_path / "trees.csv"
+    csv.write_text("id,lon,lat,species,height_m,crown_diameter_m,crown_base_m\n" + "".join(
+        f"{i},{x!r},{y!r},morus_alba,8,5,3\n" for i, x, y in rows))
+    gj = tmp_path / "trees.geojson"
+    gj.write_text(fc([point(i, x, y) for i, x, y in rows]))
+    a, _ = read_trees(csv, "EPSG:4326", LAT, LON)
+    b, _ = read_trees(gj, "EPSG:4326", LAT, LON)
+    assert [(t.id, t.x, t.y) for t in a] == [(t.id, t.x, t.y) for t in b]
+    assert a[0].x == pytest.approx(10.0, abs=0.01) and abs(a[0].y) < 0.01

@@ -70,7 +70,8 @@ def simulate_command(project: str, scenarios: tuple[str, ...], engine: str,
     else:
         click.echo("façade sensor means (lux):")
         click.echo(facade_means(out.table).round(0).to_string())
-    click.echo(f"{out.computed} tasks traced, {out.reused} reused, "
+    unit = "tasks" if p.district is not None else "hours"   # inventories: hour × façade chunk
+    click.echo(f"{out.computed} {unit} traced, {out.reused} reused, "
                f"{time.perf_counter() - t:.1f} s → {out.path}")
 
 
