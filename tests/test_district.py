@@ -358,7 +358,7 @@ def _dask(map_jobs, fn, jobs):
 
 def test_csv_inventory_in_lonlat_matches_geojson(tmp_path):
     """The same two trees as a CSV (lon, lat columns) and as GeoJSON: same local positions;
-    a degree of longitude at 32.89° S spans 111 412.84 cos φ − 93.5 cos 3φ ≈ 93 580 m (WGS 84)."""
+    a degree of longitude at 32.89° S spans 111 412.84 cos φ − 93.5 cos 3φ ≈ 93 570 m (WGS 84)."""
     from radtree.site.inventory import read_trees
 
     dlon = 1.0 / (111_412.84 * math.cos(math.radians(LAT)) - 93.5 * math.cos(3 * math.radians(LAT)))
