@@ -116,7 +116,7 @@ def facade_features(project: Project, table) -> dict:   # type: ignore[no-untype
         if frame is not None:
             xs, ys = frame.to_source(xs, ys)
         props: dict = {"building": f.building, "facade": f.id,
-                       "azimuth_deg": round(f.azimuth_deg, 2), "length_m": round(f.length_m, 3),
+                       "azimuth_deg": round(f.azimuth_deg, 2) % 360.0, "length_m": round(f.length_m, 3),
                        "storeys": f.storeys, "sensors": int(counts.get(f.id, 0)) if len(rows) else 0}
         if f.id in means.index.get_level_values(0):
             sub = means.loc[f.id]
