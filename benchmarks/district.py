@@ -12,6 +12,23 @@ psutil; CPU is the tree's user + system time (``getrusage``), which a busy machi
 less than the wall time. Targets (Radiance): ≤ 5 min for the 7 hours on 2 cores, ≤ 2 GiB, memory and build
 time at 240 trees ≤ 1.3 × those at 60 (crowns are instanced: one octree per species).
 
+Measured 2026-12-01 on the shared 2-core machine at load average 12–24 (other jobs running, so
+wall times are inflated; CPU = the process tree's user + system seconds), 7 hours, ``trees``:
+
+    engine    trees workers  build wall/CPU/peak      simulate wall/CPU/peak
+    radiance     60   1      35.5 s / 4.2 s / 0.24 GiB  172 s / 34 s / 0.48 GiB
+    radiance     60   2      35.5 s / 4.2 s / 0.24 GiB  132 s / 34 s / 0.49 GiB
+    radiance    240   1      11.5 s / 3.4 s / 0.24 GiB  607 s / 151 s / 0.49 GiB
+    radiance    240   2      11.5 s / 3.4 s / 0.24 GiB  592 s / 168 s / 0.61 GiB
+    numpy        60   1      14.9 s / 3.2 s / 0.24 GiB   89 s / 16 s / 0.56 GiB
+    numpy        60   2      14.9 s / 3.2 s / 0.24 GiB  112 s / 25 s / 0.86 GiB
+    numpy       240   1      22.6 s / 3.6 s / 0.24 GiB  205 s / 33 s / 0.71 GiB
+    numpy       240   2      22.6 s / 3.6 s / 0.24 GiB  126 s / 38 s / 1.12 GiB
+
+Radiance 240/60: build CPU ×0.81, build memory ×1.00, simulate memory ×1.26 (2 workers); the
+tracing itself grows (CPU ×4.9): rays meet ~4× as many crowns. NumPy (crowns expanded, no
+instancing): simulate memory ×1.30, CPU ×1.5.
+
 Run: ``.venv/bin/python benchmarks/district.py [--engines radiance numpy] [--trees 60 240]
 [--workers 1 2] [--keep]``.
 """
