@@ -138,6 +138,10 @@ def test_new_refuses_to_overwrite_and_bad_requests(tmp_path: Path) -> None:
     with pytest.raises(ConfigError, match="district template needs --trees"):
         new_project(tmp_path / "b", template="district")
     assert not (tmp_path / "b").exists()
+    hb = tmp_path / "model.hbjson"
+    hb.write_text('{"type": "Model", "rooms": []}')
+    with pytest.raises(ConfigError, match="office template and --honeybee both build"):
+        new_project(tmp_path / "c", honeybee=hb, template="office")
 
 
 def test_site_from_inputs_and_epw(tmp_path: Path) -> None:

@@ -27,6 +27,7 @@ from radtree.trees.species import (
     load_species,
     louvers_cover_fraction,
     species_library,
+    species_tree,
     tree_defaults,
 )
 from tests.conftest import MENDOZA, copy_project
@@ -138,6 +139,11 @@ def test_louvers_cover_fraction_matches_permeability() -> None:
     given = {"louvers": {"layers": 5, "transmittance": 0.5, "specular_fraction": 0.9}}
     assert tree_defaults(morus, given)["louvers"]["cover_fraction"] == \
         round((1 - 0.055 ** 0.2) / (1 - 0.45), 4)
+    # a volume crown of given crossings keeps its density; without crossings it uses layers
+    volume = {"arrangement": "volume", "crossings": 14.6}
+    assert "cover_fraction" not in tree_defaults(morus, {"louvers": volume})["louvers"]
+    assert tree_defaults(morus, {"louvers": {"arrangement": "volume"}})["louvers"][
+        "cover_fraction"] == round((1 - 0.055 ** 0.25) / 0.52, 4)
 
 
 def test_crown_size_from_inventory_row() -> None:
@@ -218,3 +224,21 @@ def test_phenology_hourly_fraction_and_beer_weights() -> None:
                                rtol=1e-6)
     assert "leaves out from day 258, full leaf day 288, leaf fall days 105–152" in \
         morus.describe()
+
+
+def test_species_tree_from_a_species_and_a_size() -> None:
+    p = load_project(MENDOZA)
+    sp = load_species("platanus_x_acerifolia")
+    size = crown_size(sp, 14.0, 12.0, 4.0)                    # radius 6, semi-axis 5
+    t = species_tree(p.tree, sp, size, keep=["louvers.layers", "louvers.inclination_deg"])
+    assert (t.crown.radius_m, t.crown.vertical_radius_m, t.crown.base_height_m) == (6, 5, 4)
+    assert t.crown.trunk_distance_m == p.tree.crown.trunk_distance_m
+    lv = t.louvers
+    assert (lv.reflectance, lv.transmittance, lv.specular_fraction) == (0.09, 0.06, 0.0)
+    assert (lv.layers, lv.inclination_deg) == (5, 30.0)        # kept as the project has them
+    assert LouverOptics.of(lv).tau_crown_direct == pytest.approx(0.218, rel=1e-3)
+    assert t.homogeneous.permeability == 0.218 and t.perforated.openness == 0.218
+    dense = replace(p.tree, louvers=replace(p.tree.louvers, arrangement="volume", crossings=9.0))
+    assert species_tree(dense, sp).louvers.cover_fraction == 1.0          # its own density
+    untouched = species_tree(p.tree, sp)
+    assert untouched.crown == p.tree.crown and untouched.louvers.inclination_deg == 44.2

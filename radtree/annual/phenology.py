@@ -25,10 +25,11 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
-from radtree.annual.schedule import day_of_year
+from radtree.annual.schedule import LeafSchedule, day_of_year
 from radtree.config import Project
 from radtree.trees.species import Species, load_species
 
@@ -89,3 +90,23 @@ def blend(leaf_on: np.ndarray, leaf_off: np.ndarray, weight: np.ndarray) -> np.n
     w = np.asarray(weight, np.float64)[None, :]
     off = leaf_off.astype(np.float64)
     return (off + w * (leaf_on.astype(np.float64) - off)).astype(leaf_on.dtype)
+
+
+def crown_year(total: dict[str, dict[str, np.ndarray]], direct: dict[str, dict[str, np.ndarray]],
+               grids: list[str], wea: Any, leaf: LeafSchedule, phen: Phenology | None
+               ) -> tuple[np.ndarray, np.ndarray | None, np.ndarray | None]:
+    """Fill ``total["with"]`` and ``direct["with"]`` (grid → (sensors, hours)) from the leafed
+    and bare crowns: by ``leaf``'s dates (each day one or the other), or with ``phen`` hour by
+    hour (:func:`blend`). Returns (in leaf per hour — f ≥ 0.5 with ``phen`` —, f, w)."""
+    if phen is None:
+        in_leaf = leaf.in_leaf(wea.month, wea.day)
+        for store in (total, direct):
+            store["with"] = {g: np.where(in_leaf[None, :], store["leaf_on"][g],
+                                         store["leaf_off"][g]) for g in grids}
+        return in_leaf, None, None
+    fraction = phen.leaf_fraction(wea.month, wea.day, wea.hour)
+    weight = phen.weight(fraction)
+    for store in (total, direct):
+        store["with"] = {g: blend(store["leaf_on"][g], store["leaf_off"][g], weight)
+                         for g in grids}
+    return fraction >= 0.5, fraction, weight

@@ -52,7 +52,7 @@ import pandas as pd
 import radtree.annual.metrics as metrics
 from radtree.annual.branches import BranchParams, build_leaf_off
 from radtree.annual.coefficients import CoefficientRunner, TraceParams
-from radtree.annual.phenology import Phenology, blend, phenology_of
+from radtree.annual.phenology import Phenology, crown_year, phenology_of
 from radtree.annual.schedule import (
     DEFAULT_OCCUPANCY,
     LeafSchedule,
@@ -355,19 +355,7 @@ def compute_annual(project: Project, options: AnnualOptions | None = None,
             bar.close()
 
     phen = phenology_of(project, options.species_phenology)
-    fraction = weight = None
-    if phen is None:
-        in_leaf = options.leaf.in_leaf(wea.month, wea.day)
-        for store in (total, direct):
-            store["with"] = {g: np.where(in_leaf[None, :], store["leaf_on"][g],
-                                         store["leaf_off"][g]) for g in grids}
-    else:
-        fraction = phen.leaf_fraction(wea.month, wea.day, wea.hour)
-        weight = phen.weight(fraction)
-        in_leaf = fraction >= 0.5
-        for store in (total, direct):
-            store["with"] = {g: blend(store["leaf_on"][g], store["leaf_off"][g], weight)
-                             for g in grids}
+    in_leaf, fraction, weight = crown_year(total, direct, grids, wea, options.leaf, phen)
     occ = occupied(wea.hour, options.occupancy)
     grid_geo = {g: {"points": scenes["leaf_on"].grids[g].points,
                     "normals": scenes["leaf_on"].grids[g].normals} for g in grids}

@@ -13,7 +13,10 @@ the crowns being bare from about **1 June** (``06-01``). Leaf growth and leaf fa
 gradual; the switch puts the whole transition on one date, so dates are parameters
 (``radtree annual --leaf-on MM-DD --leaf-off MM-DD``). Measured seasonal permeabilities of
 Mendoza's street trees (e.g. Cantón, Cortegoso & de Rosa 1994, *Energy and Buildings* 20)
-are the place to calibrate both the dates and the bare crown.
+are the place to calibrate both the dates and the bare crown. With ``[tree] species`` the
+annual run uses the species' hourly phenology instead (:mod:`radtree.annual.phenology`: leaf
+area ramps, Beer's-law weights between the leafed and the bare crown); ``--dates`` keeps this
+switch.
 
 **Occupancy.** Hours whose middle lies in ``[start, end)`` local standard time, every day of
 the year (default 8:00–18:00: the ten hours 8–9 … 17–18). Occupied hours before sunrise or

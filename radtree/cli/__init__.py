@@ -55,7 +55,8 @@ def main(ctx: click.Context, debug: bool) -> None:
     ctx.obj["debug"] = debug
 
 
+main.add_command(new_command)   # radtree new (cli/new.py), apart from the tuple other branches extend
 for _command in (doctor_command, build_command, simulate_command, hemi_command, report_command,
                  calibrate_command, sweep_command, diagnose_command, annual_command,
-                 permeability_command, verify_command, new_command):
+                 permeability_command, verify_command):
     main.add_command(_command)

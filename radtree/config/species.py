@@ -318,7 +318,9 @@ def tree_defaults(sp: Species, given: dict[str, dict[str, Any]] | None = None
 
     ``given``: the values the project gives (table → field → value); the louvers cover
     fraction is solved (:func:`louvers_cover_fraction`) for the slat optics and layer count in
-    use — given or filled — so that the crown passes the species' leaf-on permeability."""
+    use — given or filled — so that the crown passes the species' leaf-on permeability (for
+    the ``volume`` arrangement too, whose crossings then default to ``layers``; not when it
+    gives ``crossings``: that density is the project's, e.g. calibrated)."""
     t = sp.leaf_transmittance_global
     louvers: dict[str, float] = {
         "reflectance": sp.leaf_reflectance, "transmittance": t,
@@ -326,12 +328,23 @@ def tree_defaults(sp: Species, given: dict[str, dict[str, Any]] | None = None
         "inclination_deg": sp.mean_leaf_tilt_deg}
     used = {**louvers, **(given or {}).get("louvers", {})}
     try:
+        explicit_density = (used.get("arrangement", Louvers.arrangement) == "volume"
+                            and float(used.get("crossings", Louvers.crossings)) > 0)
+    except (TypeError, ValueError):
+        explicit_density = False
+    if explicit_density:      # a volume crown of given crossings: its density is set
+        return _other_tables(sp, louvers)
+    try:
         layers = int(used.get("layers", Louvers.layers))
         direct = float(used["transmittance"]) * float(used["specular_fraction"])
     except (TypeError, ValueError):   # a bad given value: the reader reports it
         layers, direct = Louvers.layers, sp.leaf_transmittance_direct
     louvers["cover_fraction"] = round(louvers_cover_fraction(
         sp.permeability_leaf_on, direct, max(layers, 1)), 4)
+    return _other_tables(sp, louvers)
+
+
+def _other_tables(sp: Species, louvers: dict[str, float]) -> dict[str, dict[str, float]]:
     return {
         "louvers": louvers,
         "homogeneous": {"reflectance": sp.leaf_reflectance,

@@ -65,6 +65,11 @@ DISTRICT_LINES = [
     "facade_chunk = 8   # façades per traced grid (the unit of work on Dask); default 8",
     'instancing = "auto"   # "auto" (one instance octree per species × realisation) | "never"',
 ]
+#: the ``[site]`` keys of a Honeybee model (read by the Honeybee site's reader)
+HONEYBEE_LINES = [
+    "honeybee_grid_spacing_m = 0.5   # m; grids generated for rooms without one; default 0.5",
+    "honeybee_workplane_m = 0.8   # m; their height above each floor; default 0.8",
+]
 
 
 @dataclass
@@ -289,9 +294,9 @@ def document(template: str, site: dict[str, Any], site_source: str, data: dict[s
             s[key].comment(about + " (copied into data/)")
         else:
             s.add(tomlkit.comment(f'{key} = "data/…"   # {about}; not given'))
-    if template == "district":
-        for line in DISTRICT_LINES:
-            s.add(tomlkit.comment(line))
+    for line in (DISTRICT_LINES if template == "district" else []) + (
+            HONEYBEE_LINES if "honeybee" in data else []):
+        s.add(tomlkit.comment(line))
     doc.add("site", s)
     doc.add("street", table(TABLES["street"], {}))
     doc.add("light", table(TABLES["light"], light,
@@ -346,6 +351,9 @@ def new_project(folder: Path, trees: Path | None = None, buildings: Path | None 
     template = template or ("district" if buildings is not None else "street")
     if template not in TEMPLATES:
         raise ConfigError(f"unknown template {template!r} (known: {', '.join(TEMPLATES)})")
+    if template == "office" and honeybee is not None:
+        raise ConfigError("the office template and --honeybee both build the rooms: use the "
+                          "Honeybee model with --template street (or district)")
     if template == "district" and trees is None and buildings is None:
         raise ConfigError("the district template needs --trees and/or --buildings")
     for p in (trees, buildings, honeybee, epw):

@@ -101,7 +101,9 @@ def species_tree(tree: Tree, sp: Species, size: CrownSize | None = None,
     for name in kept:
         table, _, attr = name.partition(".")
         given.setdefault(table, {})[attr] = getattr(getattr(tree, table), attr)
-    given.setdefault("louvers", {})["layers"] = tree.louvers.layers
+    given.setdefault("louvers", {}).update(layers=tree.louvers.layers,
+                                           arrangement=tree.louvers.arrangement,
+                                           crossings=tree.louvers.crossings)
     tables = {}
     for table, values in tree_defaults(sp, given).items():
         new = {k: v for k, v in values.items() if f"{table}.{k}" not in kept}
