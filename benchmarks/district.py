@@ -25,7 +25,16 @@ wall times are inflated; CPU = the process tree's user + system seconds), 7 hour
     numpy       240   1      22.6 s / 3.6 s / 0.24 GiB  205 s / 33 s / 0.71 GiB
     numpy       240   2      22.6 s / 3.6 s / 0.24 GiB  126 s / 38 s / 1.12 GiB
 
-Radiance 240/60: build CPU ×0.81, build memory ×1.00, simulate memory ×1.26 (2 workers); the
+Rerun 22:16–22:26 UTC at load 5–10, Radiance (after the species library's leaf-angle update):
+
+    radiance     60   1       9.2 s / 3.4 s / 0.24 GiB   89 s /  32 s / 0.37 GiB
+    radiance     60   2       9.2 s / 3.4 s / 0.24 GiB   78 s /  34 s / 0.48 GiB
+    radiance    240   1       8.5 s / 3.4 s / 0.24 GiB  241 s / 120 s / 0.38 GiB
+    radiance    240   2       8.5 s / 3.4 s / 0.24 GiB  150 s / 133 s / 0.58 GiB
+
+i.e. 240/60: build time ×0.93 (CPU ×1.00), build memory ×1.00, simulate memory ×1.19.
+
+First run, Radiance 240/60: build CPU ×0.81, build memory ×1.00, simulate memory ×1.26 (2 workers); the
 tracing itself grows (CPU ×4.9): rays meet ~4× as many crowns. NumPy (crowns expanded, no
 instancing): simulate memory ×1.30, CPU ×1.5.
 
