@@ -66,12 +66,14 @@ def quad(name: str, material: str, corners: np.ndarray) -> Mesh:
 
 @dataclass
 class SensorGrid:
-    """Named illuminance sensors: ``points`` (N, 3) m, unit ``normals`` (N, 3), ``rows`` labels."""
+    """Named illuminance sensors: ``points`` (N, 3) m, unit ``normals`` (N, 3), ``rows`` labels;
+    ``labels``: further per-sensor columns of the results table (e.g. building, facade, storey)."""
 
     name: str
     points: np.ndarray
     normals: np.ndarray
     rows: list[str] = field(default_factory=list)
+    labels: dict[str, list] = field(default_factory=dict)
 
     def __post_init__(self) -> None:
         self.points = np.asarray(self.points, dtype=float).reshape(-1, 3)
@@ -88,6 +90,9 @@ class SensorGrid:
             self.rows = [""] * len(self.points)
         if len(self.rows) != len(self.points):
             raise ValueError(f"sensor grid '{self.name}': one row label per point is needed")
+        for key, values in self.labels.items():
+            if len(values) != len(self.points):
+                raise ValueError(f"sensor grid '{self.name}': one {key} per point is needed")
 
     def __len__(self) -> int:
         return len(self.points)
@@ -100,28 +105,72 @@ class SensorGrid:
         return "\n".join(lines) + "\n"
 
 
+@dataclass(frozen=True)
+class Instance:
+    """A placed copy of a prototype (a list of meshes in its own frame): rotated
+    ``rotate_z_deg`` counter-clockwise about +z, scaled uniformly by ``scale``, then moved by
+    ``translate`` (m) — Radiance's ``-rz A -s S -t X Y Z`` order."""
+
+    prototype: str
+    translate: tuple[float, float, float]
+    rotate_z_deg: float = 0.0
+    scale: float = 1.0
+
+    def apply(self, v: np.ndarray) -> np.ndarray:
+        a = np.radians(self.rotate_z_deg)
+        c, s = np.cos(a), np.sin(a)
+        rot = np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
+        return (np.asarray(v, float) @ rot.T) * self.scale + np.asarray(self.translate, float)
+
+
 @dataclass
 class Scene:
-    """Geometry + materials + sensor grids. ``notes`` say what the scene contains, for reports."""
+    """Geometry + materials + sensor grids. ``notes`` say what the scene contains, for reports.
+
+    ``prototypes`` (name → meshes) placed by ``instances``: an engine that instances
+    (Radiance) writes each prototype once; the others see them expanded by
+    :meth:`solid_meshes` (cost: :meth:`instanced_triangles`)."""
 
     meshes: list[Mesh]
     materials: dict[str, Material]
     grids: dict[str, SensorGrid]
     notes: list[str] = field(default_factory=list)
     ground_material: str = "ground"
+    prototypes: dict[str, list[Mesh]] = field(default_factory=dict)
+    instances: list[Instance] = field(default_factory=list)
 
     def __post_init__(self) -> None:
-        for m in self.meshes:
+        for m in [*self.meshes, *(p for ms in self.prototypes.values() for p in ms)]:
             if m.material not in self.materials:
                 raise ValueError(f"mesh '{m.name}' uses undefined material '{m.material}'")
+        for inst in self.instances:
+            if inst.prototype not in self.prototypes:
+                raise ValueError(f"instance of unknown prototype '{inst.prototype}'")
 
     @property
     def n_triangles(self) -> int:
-        return sum(m.n_triangles for m in self.meshes)
+        """Triangles as stored (each prototype once)."""
+        return (sum(m.n_triangles for m in self.meshes)
+                + sum(m.n_triangles for ms in self.prototypes.values() for m in ms))
+
+    def instanced_triangles(self) -> int:
+        """Triangles the instances stand for when expanded."""
+        per = {k: sum(m.n_triangles for m in ms) for k, ms in self.prototypes.items()}
+        return sum(per[i.prototype] for i in self.instances)
+
+    def own_solid_meshes(self) -> list[Mesh]:
+        """Meshes that interact with light (holes left out), prototypes not expanded."""
+        return [m for m in self.meshes if not isinstance(self.materials[m.material], Hole)]
 
     def solid_meshes(self) -> list[Mesh]:
-        """Meshes that interact with light (holes left out)."""
-        return [m for m in self.meshes if not isinstance(self.materials[m.material], Hole)]
+        """Meshes that interact with light (holes left out), instances expanded."""
+        out = self.own_solid_meshes()
+        for k, inst in enumerate(self.instances):
+            for m in self.prototypes[inst.prototype]:
+                if not isinstance(self.materials[m.material], Hole):
+                    out.append(Mesh(f"{m.name}@{k}", m.material, inst.apply(m.vertices),
+                                    m.faces))
+        return out
 
     def mesh(self, name: str) -> Mesh:
         for m in self.meshes:

@@ -20,11 +20,14 @@ from radtree.engines.registry import ENGINE_CHOICES
 @click.option("--workers", type=int, default=None, help="Parallel hours (default: engine.workers).")
 @click.option("--dry-run", is_flag=True, help="Print the commands, run nothing.")
 @click.option("--fresh", is_flag=True, help="Recompute every hour (ignore finished parts).")
+@click.option("--scheduler", default=None, metavar="local|tcp://HOST:PORT",
+              help="Distribute scenario × hour × realisation × façade-chunk tasks on Dask "
+                   "(local: one worker process per core, or --workers); same resume.")
 @click.option("--convergence", is_flag=True,
               help="Run the façade sensors over increasing -ab/-ad and print the change per step.")
 def simulate_command(project: str, scenarios: tuple[str, ...], engine: str,
                      hours: tuple[str, ...], workers: int | None, dry_run: bool, fresh: bool,
-                     convergence: bool) -> None:
+                     convergence: bool, scheduler: str | None) -> None:
     """Trace every scenario × hour of PROJECT → PROJECT/results/illuminance.csv.
 
     One row per scenario × hour × grid × sensor: scenario, model, datetime, time, grid,
@@ -46,13 +49,32 @@ def simulate_command(project: str, scenarios: tuple[str, ...], engine: str,
     eng = resolve_engine(p, engine)
     click.echo(f"engine: {eng.name}" + (" (auto)" if engine == "auto" else ""))
     t = time.perf_counter()
+    executor = None
+    if scheduler is not None:
+        from functools import partial
+
+        from radtree.sweep.scheduler import map_jobs
+
+        executor = partial(_on_dask, map_jobs, scheduler, workers)
+        click.echo(f"scheduler: dask {scheduler}")
     out = simulate_project(p, eng, list(scenarios) or None, list(hours) or None, workers,
-                           dry_run=dry_run, echo=click.echo, resume=not fresh)
+                           dry_run=dry_run, echo=click.echo, resume=not fresh,
+                           executor=executor)
     if out is None:
         return
     from radtree.pipeline.results import facade_means
 
-    click.echo("façade sensor means (lux):")
-    click.echo(facade_means(out.table).round(0).to_string())
-    click.echo(f"{out.computed} hours traced, {out.reused} reused, "
+    if "facade" in out.table.columns and out.table["facade"].notna().any():
+        click.echo("building façade means (lux):")
+        click.echo(out.table.groupby(["scenario", "time"])["lux"].mean().unstack("time")
+                   .round(0).to_string())
+    else:
+        click.echo("façade sensor means (lux):")
+        click.echo(facade_means(out.table).round(0).to_string())
+    unit = "tasks" if p.district is not None else "hours"   # inventories: hour × façade chunk
+    click.echo(f"{out.computed} {unit} traced, {out.reused} reused, "
                f"{time.perf_counter() - t:.1f} s → {out.path}")
+
+
+def _on_dask(map_jobs, scheduler, workers, fn, jobs):   # type: ignore[no-untyped-def]
+    return map_jobs(fn, jobs, scheduler, workers)

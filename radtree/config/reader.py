@@ -15,6 +15,7 @@ from typing import Any
 
 import tomllib
 
+from radtree.config.district import DISTRICT_KEYS, read_district
 from radtree.config.honeybee import read_honeybee
 from radtree.config.schema import Project, Scenario, Site, Street, parse_time
 from radtree.config.spec import SchemaError, Spec, spec_for, spec_of, toml_name
@@ -172,6 +173,8 @@ def parse_project(data: dict, path: Path) -> Project:
     s = top.sub("site", required=True)
     s.data = dict(s.data)  # [site] honeybee = "model.hbjson" (radtree.config.honeybee)
     honeybee = read_honeybee(s.data, base, src)
+    district = read_district(s.data, base, src)   # [site] trees / buildings (own module)
+    s.data = {k: v for k, v in s.data.items() if k not in DISTRICT_KEYS}
     hours_raw = s.raw("hours")
     if not isinstance(hours_raw, list) or not hours_raw:
         raise s.error("hours", f"expected a non-empty list of 'HH:MM' times, got {hours_raw!r}")
@@ -232,7 +235,7 @@ def parse_project(data: dict, path: Path) -> Project:
                    light=light, tree=tree, sensors=sensors, engine=engine,
                    scenarios=scenarios, measured=measured, measured_rows=measured_rows,
                    office=office, extra_geometry=tuple(extra), honeybee=honeybee,
-                   limits=limits)
+                   limits=limits, district=district)
 
 
 def species_fill(tr: _Reader) -> dict[str, dict[str, float]]:

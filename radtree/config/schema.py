@@ -386,6 +386,7 @@ class Project:
     extra_geometry: tuple[tuple[Path, str], ...] = ()
     honeybee: HoneybeeSite | None = None   # [site] honeybee (radtree.config.honeybee)
     limits: Limits = field(default_factory=Limits)
+    district: Any = None   # radtree.config.district.District: [site] trees / buildings
 
     @property
     def build_dir(self) -> Path:
@@ -428,6 +429,8 @@ class Project:
         for key, default in (("representation", "explicit"), ("bsdf", _plain(CrownBsdf()))):
             if payload["tree"].get(key) == default:   # BSDF settings unused: hashes unchanged
                 payload["tree"].pop(key, None)
+        if self.district is not None:   # inventory inputs: relative path + content (_file_key)
+            payload["district"] = d["district"]
         payload["scenario"] = _plain(scenario)
         text = json.dumps(payload, sort_keys=True, default=str)
         return hashlib.sha256(text.encode()).hexdigest()[:12]

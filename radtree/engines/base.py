@@ -54,6 +54,9 @@ class Engine(ABC):
     missing_hint: ClassVar[str] = "it is not available here"
     uses_build_folder: ClassVar[bool] = False
     seeded: ClassVar[bool] = False
+    #: the engine places a scene's prototypes by reference (Radiance ``instance``); the others
+    #: trace them expanded (:meth:`radtree.scene.Scene.solid_meshes`)
+    instancing: ClassVar[bool] = False
 
     @classmethod
     @abstractmethod

@@ -53,6 +53,10 @@ def scene_ab(project: Project, tree_ab: int | None) -> int:
 
 def make_scene(project: Project, scenario: Scenario, dense_grid: bool | None = None) -> BuiltScene:
     """The in-memory scene of one scenario: street canyon, crown model, sensor grids."""
+    if project.district is not None:   # [site] trees / buildings
+        from radtree.pipeline.district import district_scene
+
+        return district_scene(project, scenario, dense_grid, scene_ab, BuiltScene)  # type: ignore[no-any-return]
     project = effective_project(project, scenario)
     frame = facade_frame(project)
     materials: dict = dict(street_materials(project.street))

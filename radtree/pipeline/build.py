@@ -62,7 +62,7 @@ def build_project(project: Project, scenarios: list[str] | None = None,
             at = {st.label: hour_grids(project, st.time, names, None, sc) for st in states}
             engine.write_folder(built.scene, states, effective_project(project, sc).engine,
                                 built.ab, tmp, sc.name, at)
-            if pictures and built.tree is not None:
+            if pictures and built.tree is not None and project.district is None:
                 from radtree.trees.picture import render_model_png
 
                 render_model_png(built.tree, built.scene, tmp / "model.png")

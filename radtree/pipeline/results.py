@@ -29,10 +29,13 @@ RESULT_COLUMNS = [
     "scenario", "model", "datetime", "time", "grid", "sensor", "row", "x", "y", "z",
     "lux", "lux_stderr", "engine", "params_hash",
 ]
+#: optional per-sensor columns of inventory projects (sensor grids' ``labels``): the building
+#: id, the façade ``BUILDING:FACE`` and the storey (0 = ground); absent in other tables
+OPTIONAL_COLUMNS = ("building", "facade", "storey")
 #: what a table must have to be read back
 REQUIRED_COLUMNS = ("scenario", "model", "time", "grid", "sensor", "row", "lux")
 _DTYPES = {"scenario": str, "time": str, "row": str, "grid": str, "params_hash": str,
-           "engine": str, "model": str, "reflection": str}
+           "engine": str, "model": str, "reflection": str, "building": str, "facade": str}
 
 
 def results_path(project: Project) -> Path:
@@ -56,6 +59,7 @@ def hour_rows(project: Project, sc: Scenario, st: SkyState, scene: Scene,
             "engine": engine, "params_hash": phash,
             "lux_traced": gr.lux, "lux_reflected_calc": extra,
             "reflection": sc.reflection,
+            **{k: list(v) for k, v in grid.labels.items()},
         }))
     return pd.concat(frames, ignore_index=True)
 
@@ -65,7 +69,8 @@ def in_column_order(table: pd.DataFrame, scenario_order: list[str]) -> pd.DataFr
     order = {s: i for i, s in enumerate(scenario_order)}
     table = table.sort_values(["scenario", "time", "grid", "sensor"],
                               key=lambda c: c.map(order) if c.name == "scenario" else c)
-    cols = RESULT_COLUMNS + [c for c in table.columns if c not in RESULT_COLUMNS]
+    head = RESULT_COLUMNS + [c for c in OPTIONAL_COLUMNS if c in table.columns]
+    cols = head + [c for c in table.columns if c not in head]
     return table[cols].reset_index(drop=True)
 
 

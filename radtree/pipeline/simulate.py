@@ -12,7 +12,7 @@ import threading
 import time
 from collections.abc import Callable
 from concurrent.futures import ThreadPoolExecutor, as_completed
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any
 
@@ -33,6 +33,7 @@ from radtree.pipeline.manifest import manifest
 from radtree.pipeline.parts import check_part, write_part
 from radtree.pipeline.realisations import merge_realisations, parent_name, selected
 from radtree.pipeline.results import hour_rows, in_column_order, merge_write, results_path
+from radtree.scene import Scene
 
 RESUME = "finished hours are kept in results/parts/; run the same command again to resume"
 
@@ -59,6 +60,50 @@ class _Prepared:
     seconds: float   # hour states (sun, sky, weather)
 
 
+@dataclass
+class TraceJob:
+    """One unit of work: a scenario's hour on some grids (a façade chunk), written to ``part``.
+    ``plan`` None: the worker prepares the scenario itself (in-memory engines on Dask)."""
+
+    engine: Engine
+    plan: Any
+    project: Project
+    scenario: Scenario
+    state: SkyState
+    grids: list[str]
+    scene: Scene            # the grids only
+    phash: str
+    part: Path
+
+
+_WORKER_PLANS: dict[tuple[str, str], Any] = {}
+
+
+def trace_job(job: TraceJob) -> pd.DataFrame:
+    """Trace one job and write its part file atomically (runs in a thread or a Dask worker)."""
+    plan = job.plan
+    if plan is None:   # a worker process of an in-memory engine: prepare once per scenario
+        key = (job.scenario.name, job.phash)
+        if key not in _WORKER_PLANS:
+            _WORKER_PLANS.clear()
+            _WORKER_PLANS[key] = prepare_scenario(job.project, job.scenario, job.engine,
+                                                  None, lambda _m: None).plan
+        plan = _WORKER_PLANS[key]
+    res = trace_hour(job.engine, plan, job.scenario, job.state, job.grids)
+    df = hour_rows(job.project, job.scenario, job.state, job.scene, res, job.engine.name,
+                   job.phash)
+    write_part(job.part, df)
+    return df
+
+
+def task_chunks(project: Project, grids: list[str]) -> list[list[str]]:
+    """The grids of one hour split into tasks: one per façade chunk for an inventory project
+    with buildings (grids ``facades_000`` …), else all grids in one task."""
+    if project.district is not None and project.district.buildings is not None:
+        return [[g] for g in grids]
+    return [grids]
+
+
 def resolve_engine(project: Project, engine: str | Engine = "auto") -> Engine:
     """The engine to run: an instance as given, or by name (``auto`` → the project's
     ``engine.name``, itself ``auto`` → Radiance when found, else NumPy)."""
@@ -77,6 +122,12 @@ def prepare_scenario(project: Project, sc: Scenario, engine: Engine,
     states = hour_states(project, sc, hours)
     seconds = time.perf_counter() - t0
     built = make_scene(project, sc)
+    scene = built.scene
+    if scene.instances and not engine.instancing:
+        extra = scene.instanced_triangles()
+        echo(f"  {sc.name}: the {engine.name} engine has no instancing — {len(scene.instances)} "
+             f"crowns expanded to {extra} triangles (~{extra * 9 * 8 / 2**20:.0f} MiB of "
+             f"vertices, vs {scene.n_triangles} stored for Radiance)")
     folder = ensure_built(project, sc, echo) if engine.uses_build_folder else None
     plan = engine.prepare(built.scene, states, effective_project(project, sc).engine, built.ab,
                           folder)
@@ -87,9 +138,14 @@ def simulate_project(project: Project, engine: str | Engine = "auto",
                      scenarios: list[str] | None = None, hours: list[str] | None = None,
                      workers: int | None = None, dry_run: bool = False,
                      echo: Callable[[str], None] = print, progress: bool = True,
-                     resume: bool = True, grids: list[str] | None = None
+                     resume: bool = True, grids: list[str] | None = None,
+                     executor: Callable[[Callable, list], Any] | None = None
                      ) -> SimulationOutcome | None:
-    """Trace every selected scenario × hour and write ``results/illuminance.csv``."""
+    """Trace every selected scenario × hour and write ``results/illuminance.csv``.
+
+    ``executor(fn, jobs)``: yields ``fn(job)`` for every :class:`TraceJob` as they complete
+    (e.g. on Dask, :func:`radtree.sweep.scheduler.map_jobs`); default a thread pool of
+    ``workers``. Either way finished parts are kept and reused on the next run."""
     eng = resolve_engine(project, engine)
     chosen = selected(project, scenarios)
     workers = workers or project.engine.workers
@@ -113,48 +169,56 @@ def simulate_project(project: Project, engine: str | Engine = "auto",
     make_folder(parts_dir)
     lock = threading.Lock()
     frames: list[pd.DataFrame] = []
-    todo = []
+    todo: list[TraceJob] = []
     reused = 0
     for sc, st in tasks:
-        part = parts_dir / f"{sc.name}_{st.label}_{eng.name}_{prepared[sc.name].phash}.csv"
-        rows, why = check_part(part, sc.name, st.time, prepared[sc.name].phash) if resume and \
-            part.exists() else (None, "")
-        if rows is not None:
-            frames.append(rows)
-            reused += 1
-        else:
+        prep = prepared[sc.name]
+        use = hour_grids(project, st.time, list(prep.built.scene.grids), grids, sc)
+        for chunk in task_chunks(project, use):
+            tag = f"_{chunk[0]}" if len(chunk) == 1 and project.district is not None else ""
+            part = parts_dir / f"{sc.name}_{st.label}{tag}_{eng.name}_{prep.phash}.csv"
+            rows, why = check_part(part, sc.name, st.time, prep.phash) if resume and \
+                part.exists() else (None, "")
+            if rows is not None:
+                frames.append(rows)
+                reused += 1
+                continue
             if why:
                 echo(f"  results/parts/{part.name} {why}: recomputing it")
-            todo.append((sc, st, part))
+            sub = Scene([], {}, {g: prep.built.scene.grids[g] for g in chunk})
+            todo.append(TraceJob(eng, prep.plan, project, sc, st, chunk, sub, prep.phash, part))
 
-    def work(item: tuple[Scenario, SkyState, Path]) -> pd.DataFrame:
-        sc, st, part = item
-        prep = prepared[sc.name]
+    def work(job: TraceJob) -> pd.DataFrame:
         t = time.perf_counter()
-        use = hour_grids(project, st.time, list(prep.built.scene.grids), grids, sc)
-        res = trace_hour(eng, prep.plan, sc, st, use)
-        df = hour_rows(project, sc, st, prep.built.scene, res, eng.name, prep.phash)
-        write_part(part, df)
+        df = trace_job(job)
         with lock:
-            timing[sc.name]["tracing_s"] += time.perf_counter() - t
+            timing[job.scenario.name]["tracing_s"] += time.perf_counter() - t
         return df
 
     if todo:
         bar = progress_bar(None, f"simulate ({eng.name})", progress, total=len(todo))
-        with ThreadPoolExecutor(max_workers=max(1, workers)) as pool:
-            futures = {pool.submit(work, item): item for item in todo}
-            try:
-                for fut in as_completed(futures):
-                    frames.append(fut.result())
+        try:
+            if executor is not None:
+                light = [replace(j, plan=None) if not eng.uses_build_folder else j for j in todo]
+                for df in executor(trace_job, light):
+                    frames.append(df)
                     if bar is not None:
                         bar.update(1)
-            except BaseException:
-                for f in futures:
-                    f.cancel()
-                raise
-            finally:
-                if bar is not None:
-                    bar.close()
+            else:
+                with ThreadPoolExecutor(max_workers=max(1, workers)) as pool:
+                    futures = {pool.submit(work, item): item for item in todo}
+                    try:
+                        for fut in as_completed(futures):
+                            frames.append(fut.result())
+                            if bar is not None:
+                                bar.update(1)
+                    except BaseException:
+                        for f in futures:
+                            f.cancel()
+                        raise
+        finally:
+            if bar is not None:
+                bar.close()
     table = pd.concat(frames, ignore_index=True)
     parents = list(dict.fromkeys(parent_name(sc.name) for sc in chosen))
     table, per_realisation = merge_realisations(
@@ -168,6 +232,11 @@ def simulate_project(project: Project, engine: str | Engine = "auto",
                      echo=echo):
         merge_write(out, table, parents)   # table, timing and manifest: one reader sees all
         _write_direct_sun(project, chosen, prepared)
+        if project.district is not None and project.district.buildings is not None:
+            from radtree.pipeline.district import write_facades_geojson
+
+            write_facades_geojson(project, pd.read_csv(out, dtype={"facade": str,
+                                                                   "building": str}))
         _merge_timing(project.results_dir / "timing.csv", tdf)
         write_text(project.results_dir / "manifest.json", json.dumps(
             manifest(project, extra={"engine": eng.name, "scenarios": [s.name for s in chosen]}),

@@ -337,6 +337,10 @@ def collect(project: Project, echo: Callable[[str], None] = print) -> ReportData
     """Read the results layout and compute every table the report shows."""
     notes: list[str] = []
     results = read_results(project)
+    if project.district is not None:   # every façade of an inventory: one façade grid here
+        from radtree.report.sections.facades import as_one_facade_grid
+
+        results = as_one_facade_grid(results)
     if results[results["grid"].astype(str) == FACADE_GRID].empty:
         raise RadtreeError(f"{results_path(project)}: no rows for the façade sensor grid "
                            f"'{FACADE_GRID}'")

@@ -13,7 +13,8 @@ from __future__ import annotations
 import os
 import uuid
 import warnings
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
+from typing import Any
 
 from radtree.errors import RadtreeError
 from radtree.sweep.cases import CaseResult, CaseSpec, run_case
@@ -45,25 +46,9 @@ def execute(specs: list[CaseSpec], scheduler: str = "local", workers: int | None
             take(run_case(spec))
         return results
 
-    import logging
+    from dask.distributed import as_completed
 
-    from dask.distributed import Client, LocalCluster, as_completed
-
-    cluster = None
-    if scheduler == "local":
-        n = min(workers or default_workers(), len(specs))
-        with warnings.catch_warnings():  # "port 8787 in use": the scheduler picks another
-            warnings.simplefilter("ignore", UserWarning)
-            cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True,
-                                   dashboard_address=None, host="127.0.0.1",
-                                   silence_logs=logging.ERROR)
-        client = Client(cluster)
-    else:
-        try:
-            client = Client(scheduler, timeout=30)
-        except (OSError, TimeoutError) as exc:
-            raise RadtreeError(f"cannot connect to the dask scheduler at {scheduler}: {exc}"
-                               ) from exc
+    client, cluster = open_client(scheduler, workers, len(specs))
     token = uuid.uuid4().hex[:8]
     futures = []
     try:
@@ -93,3 +78,50 @@ def execute(specs: list[CaseSpec], scheduler: str = "local", workers: int | None
         if cluster is not None:
             cluster.close()
     return results
+
+
+def open_client(scheduler: str, workers: int | None, tasks: int) -> tuple[Any, Any]:
+    """A dask Client (and the LocalCluster it owns, or None) for ``scheduler``: ``"local"``
+    (``workers`` single-threaded processes on 127.0.0.1, default one per core) or an address."""
+    import logging
+
+    from dask.distributed import Client, LocalCluster
+
+    if scheduler == "local":
+        n = max(1, min(workers or default_workers(), tasks))
+        with warnings.catch_warnings():  # "port 8787 in use": the scheduler picks another
+            warnings.simplefilter("ignore", UserWarning)
+            cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True,
+                                   dashboard_address=None, host="127.0.0.1",
+                                   silence_logs=logging.ERROR)
+        return Client(cluster), cluster
+    try:
+        return Client(scheduler, timeout=30), None
+    except (OSError, TimeoutError) as exc:
+        raise RadtreeError(f"cannot connect to the dask scheduler at {scheduler}: {exc}"
+                           ) from exc
+
+
+def map_jobs(fn: Callable[[Any], Any], jobs: list[Any], scheduler: str = "local",
+             workers: int | None = None) -> Iterator[Any]:
+    """Yield ``fn(job)`` for every job as the Dask tasks complete (``simulate --scheduler``:
+    one task per scenario × hour × realisation × façade chunk). A failed task raises (the
+    parts finished so far stay on disk: the next run resumes)."""
+    if not jobs:
+        return
+    from dask.distributed import as_completed
+
+    client, cluster = open_client(scheduler, workers, len(jobs))
+    token = uuid.uuid4().hex[:8]
+    futures = [client.submit(fn, job, key=f"radtree-trace-{i}-{token}", pure=False)
+               for i, job in enumerate(jobs)]
+    try:
+        for fut in as_completed(futures):
+            yield fut.result()
+    finally:
+        for fut in futures:
+            if not fut.done():
+                fut.cancel()
+        client.close()
+        if cluster is not None:
+            cluster.close()

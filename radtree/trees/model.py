@@ -5,7 +5,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 from radtree.optics import Material
-from radtree.scene import Mesh
+from radtree.scene import Instance, Mesh
 from radtree.site.frame import FacadeFrame
 
 # Material names used by the crown models; they must not clash with the street's
@@ -37,9 +37,13 @@ class TreeModel:
     model: str = "none"
     frame: FacadeFrame | None = None  # the façade frame the crown was built in
     photo: dict | None = None  # provenance of a photo-derived crown (radtree.trees.photo)
+    # inventory crowns shared by several trees (radtree.trees.district): prototype meshes
+    # in their own frame and where each tree places one (radtree.scene.Instance)
+    prototypes: dict[str, list[Mesh]] = field(default_factory=dict)
+    instances: list[Instance] = field(default_factory=list)
 
     def __post_init__(self) -> None:
-        for m in self.meshes:
+        for m in [*self.meshes, *(p for ms in self.prototypes.values() for p in ms)]:
             if m.material not in self.materials:
                 raise ValueError(f"mesh '{m.name}' uses undefined material '{m.material}'")
         if not self.triangles:

@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import os
 import tempfile
+import threading
 from pathlib import Path
 
 import numpy as np
@@ -32,7 +33,10 @@ def run_hour(plan: BuildPlan, hour: str, dry_run: bool = False,
     """
     folder = plan.folder
     oct_rel = f"octrees/{hour}.oct"
-    commands: list[tuple[list[str], str | None, str]] = [(plan.oconv_command(hour), None, oct_rel)]
+    commands: list[tuple[list[str], str | None, str]] = [
+        (argv, None, oct_) for argv, oct_ in plan.prototype_commands()
+        if dry_run or not (folder / oct_).exists()]
+    commands.append((plan.oconv_command(hour), None, oct_rel))
     mkpmap = plan.mkpmap_command(hour)
     if mkpmap is not None:
         commands.append((mkpmap, None, f"pmaps/{hour}.log"))
@@ -52,7 +56,7 @@ def run_hour(plan: BuildPlan, hour: str, dry_run: bool = False,
     results: dict[str, GridResult] = {}
     for argv, stdin, stdout in commands:
         out = folder / stdout
-        tmp = out.with_name(out.name + ".tmp")
+        tmp = out.with_name(f"{out.name}.{os.getpid()}.{threading.get_ident()}.tmp")
         data = (folder / stdin).read_bytes() if stdin else None
         try:
             run(argv, stdin=data, cwd=folder, stdout_path=tmp)
@@ -64,7 +68,7 @@ def run_hour(plan: BuildPlan, hour: str, dry_run: bool = False,
         rgb_path = folder / f"results/{hour}_{g}.rgb"
         lux = read_rgb_as_lux(rgb_path, expected=None)
         lux_path = folder / f"results/{hour}_{g}.lux"
-        tmp = lux_path.with_name(lux_path.name + ".tmp")
+        tmp = lux_path.with_name(f"{lux_path.name}.{os.getpid()}.{threading.get_ident()}.tmp")
         np.savetxt(tmp, lux, fmt="%.6g")
         os.replace(tmp, lux_path)
         results[g] = GridResult(lux, None)

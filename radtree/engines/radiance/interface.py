@@ -10,7 +10,12 @@ from radtree.engines.radiance.binaries import find_radiance, require_radiance
 from radtree.engines.radiance.binaries import version as radiance_version
 from radtree.engines.radiance.engine import run_hour
 from radtree.engines.radiance.pmap import PhotonMap
-from radtree.engines.radiance.writer import BuildPlan, rtrace_options, write_build
+from radtree.engines.radiance.writer import (
+    BuildPlan,
+    prototype_octree,
+    rtrace_options,
+    write_build,
+)
 from radtree.fileio import write_text
 
 if TYPE_CHECKING:
@@ -28,6 +33,7 @@ class RadianceEngine(Engine):
     missing_hint = "Radiance was not found (install pyradiance, or use --engine numpy)"
     uses_build_folder = True
     seeded = False
+    instancing = True
 
     @classmethod
     def available(cls) -> bool:
@@ -69,6 +75,8 @@ class RadianceEngine(Engine):
                          states={s.label: s for s in states},
                          photon_map=PhotonMap.from_params(params))
         geometry = sorted(str(p.relative_to(folder)) for p in (folder / "geometry").glob("*.rad"))
+        plan.prototypes = {prototype_octree(p.stem): str(p.relative_to(folder))
+                           for p in sorted((folder / "geometry" / "prototypes").glob("*.rad"))}
         for st in states:
             files = []
             ground = folder / "skies" / f"{st.label}_ground.rad"

@@ -43,6 +43,23 @@ def mesh_to_radiance(mesh: Mesh) -> str:
     return "\n".join(out)
 
 
+def instances_text(scene: Scene) -> str:
+    """``geometry/instances.rad``: one ``instance`` per placed crown, its prototype's frozen
+    octree turned (``-rz``, degrees counter-clockwise), scaled (``-s``) and moved (``-t``)."""
+    out = [f"# {len(scene.instances)} instances of {len(scene.prototypes)} prototype octrees\n"]
+    for k, inst in enumerate(scene.instances):
+        x, y, z = inst.translate
+        out.append(f"void instance {inst.prototype}.{k}\n9 {prototype_octree(inst.prototype)} "
+                   f"-rz {inst.rotate_z_deg:.4f} -s {inst.scale:.6f} -t {x:.5f} {y:.5f} {z:.5f}"
+                   "\n0\n0\n")
+    return "\n".join(out)
+
+
+def prototype_octree(name: str) -> str:
+    """Where a prototype's frozen octree is made (relative to the build folder)."""
+    return f"octrees/prototype_{name}.oct"
+
+
 def materials_text(materials: Mapping[str, Material], ground: str | None = None) -> str:
     """``materials.rad``: every material's Radiance entry (as in ``materials/*.rad``), without
     holes (not written) and without the ground ``ground`` (written per hour in ``skies/``)."""
@@ -76,6 +93,12 @@ class BuildPlan:
     states: dict[str, SkyState] = field(default_factory=dict)
     hour_grids: dict[str, list[str]] = field(default_factory=dict)   # default: every grid
     photon_map: PhotonMap | None = None                               # mkpmap before rtrace
+    prototypes: dict[str, str] = field(default_factory=dict)   # octree → its geometry file
+
+    def prototype_commands(self) -> list[tuple[list[str], str]]:
+        """``oconv -f`` of each prototype (frozen: instances need their octree whole)."""
+        return [(["oconv", "-f", *self.scene_files, rad], oct_)
+                for oct_, rad in self.prototypes.items()]
 
     def grids_at(self, hour: str) -> list[str]:
         """Grids the Makefile traces at ``hour`` (label HHMM)."""
@@ -108,10 +131,19 @@ def write_build(scene: Scene, states: list[SkyState], params: EngineParams, ab: 
     write_text(folder / "materials.rad", materials_text(scene.materials, scene.ground_material))
     scene_files = ["materials.rad"]
     geometry_files = []
-    for mesh in scene.solid_meshes():
+    for mesh in scene.own_solid_meshes():
         rel = f"geometry/{mesh.name}.rad"
         write_text(folder / rel, mesh_to_radiance(mesh))
         geometry_files.append(rel)
+    prototypes: dict[str, str] = {}
+    if scene.instances:
+        (folder / "geometry" / "prototypes").mkdir(exist_ok=True)
+        for name, meshes in scene.prototypes.items():
+            rel = f"geometry/prototypes/{name}.rad"
+            write_text(folder / rel, "\n".join(mesh_to_radiance(m) for m in meshes))
+            prototypes[prototype_octree(name)] = rel
+        write_text(folder / "geometry" / "instances.rad", instances_text(scene))
+        geometry_files.append("geometry/instances.rad")
     for grid in scene.grids.values():
         write_text(folder / "grids" / f"{grid.name}.pts", grid.to_pts())
     for name, cal in ANALYTIC_SKY_CAL.items():
@@ -137,7 +169,7 @@ def write_build(scene: Scene, states: list[SkyState], params: EngineParams, ab: 
                      scene_files=scene_files, hour_files=hour_files,
                      rtrace_opts=rtrace_options(params, ab),
                      states={s.label: s for s in states},
-                     hour_grids=dict(hour_grids or {}),
+                     hour_grids=dict(hour_grids or {}), prototypes=prototypes,
                      photon_map=PhotonMap.from_params(params))
     write_makefile(plan, install, scenario)
     return plan
@@ -158,6 +190,7 @@ def write_makefile(plan: BuildPlan, install: RadianceInstall | None, scenario: s
                for h in plan.hours},
         rtrace_pmap={h: " ".join(plan.photon_map.rtrace_args(h)) if plan.photon_map else ""
                      for h in plan.hours},
+        prototypes=plan.prototypes,
     )
     write_text(plan.folder / "Makefile", text)
 

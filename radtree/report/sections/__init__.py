@@ -23,7 +23,7 @@ from radtree.resources import template_environment
 #: The optional sections, in page order (each has ``sections/<name>.html.j2``; the ones the
 #: Markdown report shows also ``.md.j2``).
 OPTIONAL = ("office", "sweep", "realisations", "permeability_scan", "diagnose", "annual",
-            "direct_sun", "photo_check", "method")
+            "direct_sun", "photo_check", "method", "facades")
 OPTIONAL += ("honeybee", "view3d")  # type: ignore[assignment]  # issue 19 (own line: merges)
 
 

@@ -153,4 +153,13 @@ def extra_sections(project: Project, out: Path, echo: Callable[[str], None]
         html.append(Section("method", method))
         md.append(Section("method", method))
         echo("  the study's method: variants, findings, dome-radius scan")
+
+    if project.district is not None:
+        from radtree.report.sections.facades import facades_data
+
+        facades = facades_data(project, out)
+        if facades is not None:
+            html.append(Section("facades", facades))
+            md.append(Section("facades", facades))
+            echo(f"  every façade: site plan of {facades['features']} façades")
     return html, md

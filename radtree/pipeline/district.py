@@ -1,0 +1,144 @@
+"""The scene of a project with a tree inventory and/or building footprints (``[site] trees``,
+``[site] buildings``; :mod:`radtree.config.district`).
+
+With buildings: extruded footprints, one ground rectangle (the street's reflectance, per hour
+as in the canyon) and sensor grids on the selected façades (``facades_000`` …, every sensor
+labelled building / facade / storey). Without buildings: the street canyon and its façade
+circle (and dense map), as in the hand-written project. Crowns: one per inventory tree
+(:func:`radtree.trees.district.inventory_crowns`), louvers model (free form), or none.
+"""
+
+from __future__ import annotations
+
+import time
+
+from radtree.config import Project, Scenario, effective_project
+from radtree.errors import ConfigError, RadtreeError
+from radtree.optics import Material
+from radtree.scene import Scene
+from radtree.sensor_grid import facade_circle, facade_dense_grid
+from radtree.site.buildings import building_meshes, facade_grids, ground_mesh
+from radtree.site.district import load_district
+from radtree.site.frame import FacadeFrame
+from radtree.site.street import street_materials, street_meshes
+
+INVENTORY_MODELS = ("louvers", "none")
+
+
+def district_scene(project: Project, scenario: Scenario, dense_grid: bool | None,
+                   scene_ab, built_scene_cls):   # type: ignore[no-untyped-def]
+    """The BuiltScene of ``scenario`` for an inventory project (see the module doc)."""
+    project = effective_project(project, scenario)
+    d = project.district
+    inputs = load_district(project)
+    # species are checked for every scenario (also 'none'): nothing is built with a bad one
+    if inputs.trees:
+        from radtree.trees.district import species_of
+
+        species_of(inputs.trees, str(d.trees))
+    notes: list[str] = []
+    materials: dict[str, Material]
+    if inputs.buildings:
+        meshes, walls = building_meshes(inputs.buildings)
+        materials = {**walls, "ground": street_materials(project.street)["ground"]}
+        meshes.append(ground_mesh(inputs.buildings, inputs.trees))
+        grids = facade_grids(inputs.facades, d.facade_spacing_m, d.window_height_m,
+                             project.sensors.offset_m, d.facade_chunk)
+        notes.append(f"District: {len(inputs.buildings)} buildings, {len(inputs.facades)} "
+                     f"façades with sensors ({sum(len(g) for g in grids.values())} sensors "
+                     f"every {d.facade_spacing_m:g} m, {d.window_height_m:g} m above each "
+                     f"storey floor), {len(inputs.trees)} trees.")
+    else:
+        frame = FacadeFrame(azimuth_deg=project.street.facade_azimuth_deg)
+        materials = dict(street_materials(project.street))
+        meshes = street_meshes(project.street, frame)
+        grids = {"facade": facade_circle(project.sensors, frame)}
+        if project.sensors.dense_grid if dense_grid is None else dense_grid:
+            grids["facade_map"] = facade_dense_grid(project.sensors, frame)
+        notes.append(f"street canyon {project.street.width_m:g} m wide with "
+                     f"{len(inputs.trees)} inventory tree(s)")
+    t0 = time.perf_counter()
+    tree = None
+    prototypes: dict = {}
+    instances: list = []
+    if scenario.model not in INVENTORY_MODELS:
+        raise ConfigError(f"got {scenario.model!r}: inventory crowns are built with the louvers "
+                          f"model (or none)", source=str(project.source),
+                          field=f"scenario {scenario.name}.model")
+    if scenario.model != "none" and inputs.trees:
+        from radtree.trees.build import apply_switches
+        from radtree.trees.district import inventory_crowns
+
+        tr, _ = apply_switches(project.tree, scenario.switches, source=str(project.source),
+                               root=project.root)
+        tree = inventory_crowns(project, inputs.trees, tr, d.instancing)
+        clash = set(tree.materials) & set(materials)
+        if clash:
+            raise RadtreeError(f"crown materials clash with the buildings': {clash}")
+        materials.update(tree.materials)
+        meshes = meshes + list(tree.meshes)
+        prototypes, instances = tree.prototypes, tree.instances
+        notes += tree.notes
+    seconds = time.perf_counter() - t0
+    scene = Scene(meshes, materials, grids, notes, prototypes=prototypes, instances=instances)
+    if instances:
+        notes.append(f"Instancing: {len(instances)} crowns placed from {len(prototypes)} "
+                     f"prototype(s), {scene.n_triangles} triangles stored; engines without "
+                     f"instancing expand them to {scene.instanced_triangles()} crown triangles.")
+    ab = scene_ab(project, None if tree is None else tree.recommended_ab)
+    return built_scene_cls(scenario, scene, ab, notes, scene.n_triangles, seconds,
+                           dict(tree.info) if tree else {}, tree)
+
+
+def facades_path(project: Project):   # type: ignore[no-untyped-def]
+    """``PROJECT/results/facades.geojson``."""
+    return project.results_dir / "facades.geojson"
+
+
+def facade_features(project: Project, table) -> dict:   # type: ignore[no-untyped-def]
+    """A GeoJSON FeatureCollection: one LineString per simulated façade (its footprint edge,
+    coordinates in the input CRS), properties: building, facade, azimuth_deg (the way it
+    looks, clockwise from north), length_m, storeys, sensors, and per scenario the façade-mean
+    illuminance of each hour ``lux_<scenario>_<HH:MM>`` and over the hours ``lux_<scenario>``
+    (lx, mean over the façade's sensors and storeys)."""
+    import numpy as np
+
+    inputs = load_district(project)
+    rows = table[table["facade"].notna()] if "facade" in table.columns else table.iloc[0:0]
+    means = rows.groupby(["facade", "scenario", "time"])["lux"].mean()
+    counts = rows[rows["scenario"] == rows["scenario"].iloc[0]].groupby("facade")["sensor"] \
+        .count() / max(1, rows["time"].nunique()) if len(rows) else {}
+    frame = inputs.frame
+    feats = []
+    for f in inputs.facades:
+        xs = np.array([f.start[0], f.end[0]])
+        ys = np.array([f.start[1], f.end[1]])
+        if frame is not None:
+            xs, ys = frame.to_source(xs, ys)
+        props: dict = {"building": f.building, "facade": f.id,
+                       "azimuth_deg": round(f.azimuth_deg, 2) % 360.0, "length_m": round(f.length_m, 3),
+                       "storeys": f.storeys, "sensors": int(counts.get(f.id, 0)) if len(rows) else 0}
+        if f.id in means.index.get_level_values(0):
+            sub = means.loc[f.id]
+            for (scen, hour), lux in sub.items():
+                props[f"lux_{scen}_{hour}"] = round(float(lux), 1)
+            for scen, g in sub.groupby(level=0):
+                props[f"lux_{scen}"] = round(float(g.mean()), 1)
+        feats.append({"type": "Feature", "id": f.id, "properties": props,
+                      "geometry": {"type": "LineString",
+                                   "coordinates": [[float(x), float(y)] for x, y in zip(xs, ys)]}})
+    out: dict = {"type": "FeatureCollection", "features": feats}
+    if frame is not None and frame.crs not in ("EPSG:4326", "local"):
+        out["crs"] = {"type": "name", "properties": {"name": frame.crs}}
+    return out
+
+
+def write_facades_geojson(project: Project, table) -> object:   # type: ignore[no-untyped-def]
+    """Write ``results/facades.geojson`` (atomically); returns its path."""
+    import json
+
+    from radtree.fileio import write_text
+
+    path = facades_path(project)
+    write_text(path, json.dumps(facade_features(project, table), indent=1))
+    return path

@@ -1,0 +1,226 @@
+"""Tree inventories and building footprints read from GeoJSON / CSV into the local frame.
+
+The local frame: a transverse Mercator projection centred on the site origin (``[site]
+latitude, longitude``, WGS 84), so x points east and y north (grid north = true north on the
+central meridian), metres, z up (``pyproj``). Inputs are in longitude/latitude (``EPSG:4326``,
+the GeoJSON default of RFC 7946) or in a projected CRS named by the GeoJSON file's ``crs``
+member (``{"type": "name", "properties": {"name": "EPSG:32719"}}``) or by ``[site] crs``
+(CSV: columns ``x, y``, or ``lon, lat`` for geographic coordinates).
+
+Every problem raises one :class:`~radtree.errors.ConfigError` naming the file and the feature
+id (``feature 'T017'``): missing or non-positive sizes, unknown CRS, self-intersecting or
+degenerate footprints, repeated ids. Species, buildings-vs-trees clashes are checked where
+both are known (:func:`check_trees_against_buildings`, :mod:`radtree.trees.district`).
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from dataclasses import dataclass
+from functools import lru_cache
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from radtree.errors import ConfigError
+
+TREE_REQUIRED = ("species", "height_m", "crown_diameter_m", "crown_base_m")
+
+
+@dataclass(frozen=True)
+class LocalFrame:
+    """Source CRS ↔ local metric frame at the site origin (x east, y north, metres)."""
+
+    crs: str
+    latitude: float
+    longitude: float
+
+    def _local(self) -> str:
+        return (f"+proj=tmerc +lat_0={self.latitude!r} +lon_0={self.longitude!r} +k=1 +x_0=0 "
+                "+y_0=0 +ellps=WGS84 +units=m +no_defs")
+
+    def to_local(self, x: np.ndarray, y: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        if self.crs == "local":
+            return np.asarray(x, float), np.asarray(y, float)
+        t = _transformer(self.crs, self._local())
+        return tuple(np.asarray(v, float) for v in t.transform(x, y))  # type: ignore[return-value]
+
+    def to_source(self, x: np.ndarray, y: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        if self.crs == "local":
+            return np.asarray(x, float), np.asarray(y, float)
+        t = _transformer(self._local(), self.crs)
+        return tuple(np.asarray(v, float) for v in t.transform(x, y))  # type: ignore[return-value]
+
+
+@lru_cache(maxsize=16)
+def _transformer(src: str, dst: str) -> Any:
+    from pyproj import Transformer
+
+    return Transformer.from_crs(src, dst, always_xy=True)
+
+
+def check_crs(crs: str, source: str) -> str:
+    """``crs`` if pyproj knows it, else ConfigError naming the file."""
+    from pyproj import CRS
+    from pyproj.exceptions import CRSError
+
+    if crs == "local":   # already x east, y north in metres from the site origin
+        return crs
+    try:
+        CRS.from_user_input(crs)
+    except CRSError as exc:
+        raise ConfigError(f"unknown CRS {crs!r} ({exc})", source=source, field="crs") from None
+    return crs
+
+
+@dataclass(frozen=True)
+class Feature:
+    """One inventory feature: id, geometry coordinates in the source CRS, properties."""
+
+    id: str
+    kind: str                      # "Point" | "Polygon"
+    coords: Any
+    props: dict[str, Any]
+
+
+def read_features(path: Path, default_crs: str, kind: str, prefix: str
+                  ) -> tuple[list[Feature], str]:
+    """Features of a GeoJSON FeatureCollection (or, for points, a CSV) and their CRS."""
+    src = str(path)
+    if path.suffix.lower() == ".csv":
+        if kind != "Point":
+            raise ConfigError("footprints must be a GeoJSON file of polygons", source=src)
+        return _csv_points(path, default_crs, prefix)
+    try:
+        data = json.loads(path.read_text(encoding="utf-8"))
+    except (OSError, ValueError) as exc:
+        raise ConfigError(f"not valid GeoJSON: {exc}", source=src) from None
+    if not isinstance(data, dict) or data.get("type") != "FeatureCollection":
+        raise ConfigError("expected a GeoJSON FeatureCollection", source=src)
+    crs = default_crs
+    named = (data.get("crs") or {}).get("properties", {}).get("name")
+    if named:
+        crs = str(named)
+    check_crs(crs, src)
+    out = []
+    for i, f in enumerate(data.get("features") or []):
+        props = dict((f or {}).get("properties") or {})
+        fid = str(props.get("id", f.get("id", f"{prefix}{i + 1}")))
+        geom = (f or {}).get("geometry") or {}
+        gtype = geom.get("type")
+        coords = geom.get("coordinates")
+        if gtype == "MultiPolygon" and kind == "Polygon" and coords and len(coords) == 1:
+            gtype, coords = "Polygon", coords[0]
+        if gtype != kind or coords is None:
+            raise ConfigError(f"geometry {gtype!r}, expected a {kind}", source=src,
+                              field=f"feature {fid!r}")
+        out.append(Feature(fid, kind, coords, props))
+    if not out:
+        raise ConfigError("no features", source=src)
+    _unique_ids(out, src)
+    return out, crs
+
+
+def _csv_points(path: Path, default_crs: str, prefix: str) -> tuple[list[Feature], str]:
+    import pandas as pd
+
+    src = str(path)
+    df = pd.read_csv(path)
+    if {"lon", "lat"} <= set(df.columns):
+        xs, ys, crs = df["lon"], df["lat"], "EPSG:4326"
+    elif {"x", "y"} <= set(df.columns):
+        xs, ys, crs = df["x"], df["y"], default_crs
+    else:
+        raise ConfigError("expected columns lon, lat or x, y", source=src)
+    check_crs(crs, src)
+    out = []
+    for i, row in enumerate(df.to_dict("records")):
+        props = {k: v for k, v in row.items() if not (isinstance(v, float) and math.isnan(v))}
+        fid = str(props.get("id", f"{prefix}{i + 1}"))
+        out.append(Feature(fid, "Point", [float(xs.iloc[i]), float(ys.iloc[i])], props))
+    if not out:
+        raise ConfigError("no rows", source=src)
+    _unique_ids(out, src)
+    return out, crs
+
+
+def _unique_ids(features: list[Feature], src: str) -> None:
+    seen: set[str] = set()
+    for f in features:
+        if f.id in seen:
+            raise ConfigError("id repeats", source=src, field=f"feature {f.id!r}")
+        seen.add(f.id)
+
+
+def number(f: Feature, key: str, src: str, *, lo: float = 0.0, lo_open: bool = True,
+           hi: float | None = None, default: float | None = None) -> float:
+    """A numeric property of a feature, checked; ConfigError naming the feature id."""
+    where = f"feature {f.id!r}"
+    if key not in f.props or f.props[key] is None or f.props[key] == "":
+        if default is not None:
+            return default
+        raise ConfigError(f"missing {key}", source=src, field=where)
+    try:
+        v = float(f.props[key])
+    except (TypeError, ValueError):
+        raise ConfigError(f"{key} = {f.props[key]!r}, expected a number", source=src,
+                          field=where) from None
+    if not math.isfinite(v) or (v <= lo if lo_open else v < lo) or (hi is not None and v > hi):
+        bound = f"{'>' if lo_open else '≥'} {lo:g}" + (f" and ≤ {hi:g}" if hi is not None else "")
+        raise ConfigError(f"{key} = {v:g}, expected {bound}", source=src, field=where)
+    return v
+
+
+@dataclass(frozen=True)
+class InventoryTree:
+    """One tree in the local frame: trunk at (x, y) m, total ``height_m``, crown diameter and
+    crown base height (m above the street); ``species`` as written in the inventory."""
+
+    id: str
+    x: float
+    y: float
+    species: str
+    height_m: float
+    crown_diameter_m: float
+    crown_base_m: float
+    crown_shape: str | None = None
+    photo: str | None = None
+    trunk_diameter_m: float | None = None
+
+    @property
+    def crown_radius_m(self) -> float:
+        return self.crown_diameter_m / 2.0
+
+    @property
+    def vertical_radius_m(self) -> float:
+        return (self.height_m - self.crown_base_m) / 2.0
+
+
+def read_trees(path: Path, frame_crs: str, latitude: float, longitude: float
+               ) -> tuple[list[InventoryTree], LocalFrame]:
+    """The inventory's trees in the local frame (checked row by row)."""
+    src = str(path)
+    feats, crs = read_features(path, frame_crs, "Point", "T")
+    frame = LocalFrame(crs, latitude, longitude)
+    pts = np.array([[float(c) for c in f.coords[:2]] for f in feats])
+    xs, ys = frame.to_local(pts[:, 0], pts[:, 1])
+    trees = []
+    for f, x, y in zip(feats, xs, ys):
+        where = f"feature {f.id!r}"
+        if not str(f.props.get("species", "")).strip():
+            raise ConfigError("missing species", source=src, field=where)
+        h = number(f, "height_m", src)
+        d = number(f, "crown_diameter_m", src)
+        base = number(f, "crown_base_m", src, lo_open=False)
+        if base >= h:
+            raise ConfigError(f"crown_base_m {base:g} is not below height_m {h:g}", source=src,
+                              field=where)
+        td = number(f, "trunk_diameter_m", src, default=-1.0)
+        trees.append(InventoryTree(
+            f.id, float(x), float(y), str(f.props["species"]).strip(), h, d, base,
+            (str(f.props["crown_shape"]) if f.props.get("crown_shape") else None),
+            (str(f.props["photo"]) if f.props.get("photo") else None),
+            None if td < 0 else td))
+    return trees, frame
