@@ -95,6 +95,19 @@ def _left_by_dead_process(holder: dict) -> bool:
 
 
 @contextlib.contextmanager
+def _holding(key: str, fd: int) -> Iterator[None]:
+    """Record this process as holding the lock ``key`` (file descriptor ``fd``) while inside,
+    so that a nested :func:`folder_lock` of the same file re-enters it."""
+    with _guard:
+        _held[key] = [fd, 1]
+    try:
+        yield
+    finally:
+        with _guard:
+            del _held[key]
+
+
+@contextlib.contextmanager
 def folder_lock(folder: str | os.PathLike, command: str, wait: bool = False,
                 echo: Callable[[str], None] | None = None, name: str = LOCK_NAME,
                 shared: bool = False) -> Iterator[Path]:
@@ -139,13 +152,8 @@ def folder_lock(folder: str | os.PathLike, command: str, wait: bool = False,
                 echo(f"waiting for {describe(holder)} to release {folder}")
             fcntl.flock(fd, mode)
         if shared:
-            with _guard:
-                _held[key] = [fd, 1]
-            try:
+            with _holding(key, fd):
                 yield path
-            finally:
-                with _guard:
-                    del _held[key]
             return
         previous = read_holder(path)
         if echo and _left_by_dead_process(previous):
@@ -156,13 +164,10 @@ def folder_lock(folder: str | os.PathLike, command: str, wait: bool = False,
                              "since": datetime.now(timezone.utc).isoformat(timespec="seconds")})
         os.ftruncate(fd, 0)
         os.pwrite(fd, record.encode(), 0)
-        with _guard:
-            _held[key] = [fd, 1]
         try:
-            yield path
+            with _holding(key, fd):
+                yield path
         finally:
-            with _guard:
-                del _held[key]
             os.ftruncate(fd, 0)   # released: an empty file names no holder
     finally:
         os.close(fd)

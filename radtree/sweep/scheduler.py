@@ -71,12 +71,7 @@ def execute(specs: list[CaseSpec], scheduler: str = "local", workers: int | None
                                  error=what, error_type=type(exc).__name__)
             take(res)
     finally:
-        for fut in futures:
-            if not fut.done():
-                fut.cancel()
-        client.close()
-        if cluster is not None:
-            cluster.close()
+        _shut_down(futures, client, cluster)
     return results
 
 
@@ -102,6 +97,16 @@ def open_client(scheduler: str, workers: int | None, tasks: int) -> tuple[Any, A
                            ) from exc
 
 
+def _shut_down(futures: list[Any], client: Any, cluster: Any) -> None:
+    """Cancel what has not finished, close the client and (when we started it) the cluster."""
+    for fut in futures:
+        if not fut.done():
+            fut.cancel()
+    client.close()
+    if cluster is not None:
+        cluster.close()
+
+
 def map_jobs(fn: Callable[[Any], Any], jobs: list[Any], scheduler: str = "local",
              workers: int | None = None) -> Iterator[Any]:
     """Yield ``fn(job)`` for every job as the Dask tasks complete (``simulate --scheduler``:
@@ -119,9 +124,4 @@ def map_jobs(fn: Callable[[Any], Any], jobs: list[Any], scheduler: str = "local"
         for fut in as_completed(futures):
             yield fut.result()
     finally:
-        for fut in futures:
-            if not fut.done():
-                fut.cancel()
-        client.close()
-        if cluster is not None:
-            cluster.close()
+        _shut_down(futures, client, cluster)
