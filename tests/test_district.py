@@ -186,6 +186,17 @@ def test_one_tree_inventory_reproduces_hand_written_free_crown(tmp_path):
     gives the façade illuminance of the hand-written row of one free crown with the species'
     leaf optics written out — exactly, on the NumPy engine (same seeds)."""
     from radtree.pipeline.trace import trace_scenario
+
+    p_inv, p_hand = _one_tree_projects(tmp_path)
+    a = trace_scenario(p_hand, p_hand.scenario("T"), engine="numpy")
+    b = trace_scenario(p_inv, p_inv.scenario("T"), engine="numpy")
+    assert len(a) == 8 and a["lux"].min() > 0
+    np.testing.assert_array_equal(a["lux"].to_numpy(), b["lux"].to_numpy())
+
+
+def _one_tree_projects(tmp_path):
+    """The one-tree inventory (Morus alba at x 0, y 3.5 in the canyon) and the hand-written
+    project of one free crown with the species' leaf optics written out."""
     from radtree.trees.district import species_louvers
     from radtree.trees.species import load_species
 
@@ -201,11 +212,7 @@ def test_one_tree_inventory_reproduces_hand_written_free_crown(tmp_path):
         "cover_fraction"))
     (hand / "radtree.toml").write_text(SITE + STREET + CROWN + REST.replace(
         'arrangement = "volume"', 'arrangement = "volume"\n' + louvers))
-    p_hand = load_project(hand)
-    a = trace_scenario(p_hand, p_hand.scenario("T"), engine="numpy")
-    b = trace_scenario(p_inv, p_inv.scenario("T"), engine="numpy")
-    assert len(a) == 8 and a["lux"].min() > 0
-    np.testing.assert_array_equal(a["lux"].to_numpy(), b["lux"].to_numpy())
+    return p_inv, load_project(hand)
 
 
 def _tree_meshes(p):
@@ -221,22 +228,7 @@ def test_one_tree_inventory_radiance_text_and_lux_match(tmp_path):
     differ) and rtrace gives the same façade lux."""
     from radtree.pipeline.trace import trace_scenario
 
-    inv = district(tmp_path / "inv", trees=[point("T1", 0.0, 3.5)], buildings=None,
-                   extra=STREET)
-    p_inv = load_project(inv)
-    from radtree.trees.district import species_louvers
-    from radtree.trees.species import load_species
-
-    lv = species_louvers(p_inv.tree, load_species("morus_alba"))
-    hand = tmp_path / "hand"
-    hand.mkdir()
-    (hand / "dni.csv").write_text(DNI)
-    louvers = "\n".join(f"{k} = {getattr(lv, k)!r}" for k in (
-        "reflectance", "transmittance", "specular_fraction", "inclination_deg",
-        "cover_fraction"))
-    (hand / "radtree.toml").write_text(SITE + STREET + CROWN + REST.replace(
-        'arrangement = "volume"', 'arrangement = "volume"\n' + louvers))
-    p_hand = load_project(hand)
+    p_inv, p_hand = _one_tree_projects(tmp_path)
     a_mesh = _tree_meshes(p_hand)["leaf"]
     b_mesh = _tree_meshes(p_inv)["leaf_morus_alba"]
     assert a_mesh.n_triangles > 1000
