@@ -18,7 +18,7 @@ from radtree.config import load_project
 from radtree.errors import ConfigError
 from radtree.optics import Glass, Plastic, Trans, transmissivity_from_transmittance
 
-from .conftest import SHARED, copy_project
+from .conftest import CHESTNUT, copy_project
 
 
 def run(args: list[str], env: dict | None = None):
@@ -153,7 +153,7 @@ def test_hemi_missing_and_corrupt(tmp_path):
 
 
 def test_hemi_mask_outside_image(tmp_path):
-    photo = SHARED / "data/fisheye/chestnut_coolpix4500_fc-e8.jpg"
+    photo = CHESTNUT
     r = run(["hemi", str(photo), "--mask", "5000,852,754", "--out", str(tmp_path / "o")])
     assert_clear_failure(r, "mask")
 

@@ -23,8 +23,9 @@ from radtree.hemi import (
     render_fisheye,
 )
 from radtree.hemi.mask import CircularMask
+from tests.conftest import CHESTNUT
 
-PHOTO = Path(__file__).resolve().parents[2] / "shared/data/fisheye/chestnut_coolpix4500_fc-e8.jpg"
+PHOTO = CHESTNUT
 pytestmark = pytest.mark.skipif(not PHOTO.exists(), reason="shared test photo not available")
 GRID = RingGrid(5, 8, 0.0, 75.0)
 

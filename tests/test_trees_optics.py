@@ -30,10 +30,11 @@ from radtree.trees.envelope import crown_row_spec
 from radtree.trees.geometry import fibonacci_hemisphere, hemisphere_mesh, triangle_solid_angles
 from radtree.trees.perforated import gap_pattern_for, random_gap_pattern
 from radtree.trees.raycast import DirectTracer
+from tests.conftest import CHESTNUT
 
 ROOT = Path(__file__).resolve().parents[1]
 EXAMPLE = ROOT / "examples" / "mendoza-street"
-PHOTO = ROOT.parent / "shared" / "data" / "fisheye" / "chestnut_coolpix4500_fc-e8.jpg"
+PHOTO = CHESTNUT
 
 
 @pytest.fixture(scope="module")
