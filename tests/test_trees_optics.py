@@ -157,7 +157,7 @@ def test_perforated_from_photo(project, frame, centre, dirs):
                    mask=(1136.0, 852.0, 754.0))
     tree = replace(project.tree, perforated=perf)
     tm = build_crown(project, "perforated", "dome", frame, tree)
-    assert "photo chestnut" in " ".join(tm.notes)
+    assert f"photo {PHOTO.name}" in " ".join(tm.notes) and "chestnut" in PHOTO.name
     t = DirectTracer(tm.meshes, tm.materials).transmission(centre, dirs)
     assert 0.01 < tm.info["openness_pattern"] < 0.2
     assert t.mean() == pytest.approx(tm.info["openness_pattern"], rel=0.01)
