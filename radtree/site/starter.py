@@ -24,7 +24,6 @@ commented ``# key = default`` lines to uncomment. The file is loaded with
 
 from __future__ import annotations
 
-import csv
 import inspect
 import json
 import shutil
@@ -44,6 +43,7 @@ from radtree.errors import ConfigError
 from radtree.fileio import write_text
 from radtree.light.clearsky import write_generated_epw
 from radtree.light.weather import read_epw
+from radtree.site.inventory import read_features
 
 TEMPLATES = ("street", "office", "district")
 #: the site without an EPW or geographic inputs: the reference study (SPEC.md §1)
@@ -97,11 +97,6 @@ class Inputs:
         return out
 
 
-def _geographic(crs: Any) -> bool:
-    name = str(((crs or {}).get("properties") or {}).get("name", "EPSG:4326")).upper()
-    return name.endswith(("4326", "CRS84"))
-
-
 def _points(coords: Any) -> list[tuple[float, float]]:
     if isinstance(coords, list | tuple) and len(coords) >= 2 and all(
             isinstance(c, int | float) for c in coords[:2]):
@@ -113,35 +108,22 @@ def _points(coords: Any) -> list[tuple[float, float]]:
 
 
 def read_inputs(trees: Path | None, buildings: Path | None, honeybee: Path | None) -> Inputs:
-    """Count the inputs (plain json/csv); ConfigError naming the file when it cannot be read."""
+    """Count the inputs; ConfigError naming the file when it cannot be read."""
     info = Inputs()
-    for path, kind in ((trees, "trees"), (buildings, "buildings")):
+    for path, kind, geometry in ((trees, "trees", "Point"), (buildings, "buildings", "Polygon")):
         if path is None:
             continue
-        try:
-            if path.suffix.lower() == ".csv":
-                with path.open(newline="", encoding="utf-8") as fh:
-                    rows = list(csv.DictReader(fh))
-                feats = [{"properties": r} for r in rows]
-                for r in rows:
-                    lon, lat = r.get("lon", r.get("longitude")), r.get("lat", r.get("latitude"))
-                    if lon not in (None, "") and lat not in (None, ""):
-                        info.lonlat.append((float(lon), float(lat)))
-            else:
-                data = json.loads(path.read_text(encoding="utf-8"))
-                if not isinstance(data, dict) or data.get("type") != "FeatureCollection":
-                    raise ValueError("expected a GeoJSON FeatureCollection")
-                feats = list(data.get("features") or [])
-                if _geographic(data.get("crs")):
-                    for f in feats:
-                        info.lonlat += _points(((f or {}).get("geometry") or {})
-                                               .get("coordinates"))
-        except (OSError, ValueError, UnicodeDecodeError) as exc:
+        try:   # the district reader's parsing (radtree.site.inventory); counted here only
+            feats, crs = read_features(path, "EPSG:4326", geometry, kind[0].upper())
+        except ConfigError as exc:
             raise ConfigError(f"{path}: cannot read the {kind} ({exc})") from None
+        if crs.upper().endswith(("4326", "CRS84")):
+            for f in feats:
+                info.lonlat += _points(f.coords)
         if kind == "trees":
             info.trees = len(feats)
-            info.species = Counter(str(((f or {}).get("properties") or {}).get("species", "")
-                                       ).strip() or "(no species)" for f in feats)
+            info.species = Counter(str(f.props.get("species", "")).strip() or "(no species)"
+                                   for f in feats)
         else:
             info.buildings = len(feats)
     if honeybee is not None:
