@@ -14,6 +14,7 @@ work). Select a backend with :func:`make_caster` or the environment variable
 from __future__ import annotations
 
 import os
+import threading
 from concurrent.futures import ThreadPoolExecutor
 from typing import Protocol
 
@@ -26,9 +27,12 @@ class RayCaster(Protocol):
     name: str
     rays_cast: int  # rays queried so far (statistics)
 
-    def first_hit(self, origins: np.ndarray, directions: np.ndarray
+    def first_hit(self, origins: np.ndarray, directions: np.ndarray, parallel: bool = True
                   ) -> tuple[np.ndarray, np.ndarray]:
-        """(triangle index or -1, distance or inf) per ray; directions must be unit vectors."""
+        """(triangle index or -1, distance or inf) per ray; directions must be unit vectors.
+
+        ``parallel=False``: answer in the calling thread (a caller that is itself one of
+        several worker threads)."""
         ...
 
 
@@ -55,7 +59,13 @@ def _plane_distance(tris_v0: np.ndarray, normals: np.ndarray, centroids: np.ndar
 
 
 class EmbreeCaster:
-    """trimesh's ``RayMeshIntersector`` (embreex) with the batch split over worker threads."""
+    """trimesh's ``RayMeshIntersector`` (embreex) with the batch split over worker threads.
+
+    Each thread converts its chunk of rays exactly as ``RayMeshIntersector.intersects_first``
+    does (float32, directions re-unitised, shifted and scaled into trimesh's Embree frame),
+    queries Embree (which releases the GIL) and computes the float64 plane distances of its
+    hits, so that only the result arrays are assembled in the calling thread.
+    """
 
     name = "embree"
 
@@ -75,31 +85,45 @@ class EmbreeCaster:
         self.chunk = chunk
         self._pool = ThreadPoolExecutor(self.workers) if self.workers > 1 else None
         self.rays_cast = 0
+        self._count_lock = threading.Lock()
         # build the Embree scene now (trimesh builds it lazily on first query)
         self._intersector.intersects_first(np.zeros((1, 3)), np.array([[0.0, 0.0, 1.0]]))
+        self._embree = self._intersector._scene  # trimesh's scaled Embree scene
 
     def _query(self, o: np.ndarray, d: np.ndarray) -> np.ndarray:
-        return np.asarray(self._intersector.intersects_first(o, d), dtype=np.int64)
+        """Triangle index per ray: the arithmetic of ``RayMeshIntersector.intersects_first``
+        (identical float32 inputs to Embree) without its per-call overhead."""
+        from trimesh.util import unitize
 
-    def first_hit(self, origins: np.ndarray, directions: np.ndarray
+        wrap = self._embree
+        o32 = np.array(o, dtype=np.float32)
+        d32 = unitize(np.array(d, dtype=np.float32))
+        scaled = (o32.astype(np.float64) - wrap.origin) * wrap.scale
+        return np.asarray(wrap.scene.run(scaled.astype(np.float32), d32.astype(np.float32)),
+                          dtype=np.int64)
+
+    def _chunk(self, o: np.ndarray, d: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        idx = self._query(o, d)
+        t = np.full(len(o), np.inf)
+        hit = idx >= 0
+        if hit.any():
+            t[hit] = _plane_distance(self._v0, self._normals, self._centroids, o[hit], d[hit],
+                                     idx[hit])
+        return idx, t
+
+    def first_hit(self, origins: np.ndarray, directions: np.ndarray, parallel: bool = True
                   ) -> tuple[np.ndarray, np.ndarray]:
         n = len(origins)
         if n == 0:
             return np.zeros(0, np.int64), np.zeros(0)
-        self.rays_cast += n
-        if self._pool is not None and n >= 4096:
+        with self._count_lock:
+            self.rays_cast += n
+        if parallel and self._pool is not None and n >= 2048:
             step = min(self.chunk, -(-n // self.workers))
             parts = [slice(i, min(i + step, n)) for i in range(0, n, step)]
-            idx = np.concatenate(list(self._pool.map(
-                lambda s: self._query(origins[s], directions[s]), parts)))
-        else:
-            idx = self._query(origins, directions)
-        t = np.full(n, np.inf)
-        hit = idx >= 0
-        if hit.any():
-            t[hit] = _plane_distance(self._v0, self._normals, self._centroids, origins[hit],
-                                     directions[hit], idx[hit])
-        return idx, t
+            res = list(self._pool.map(lambda s: self._chunk(origins[s], directions[s]), parts))
+            return np.concatenate([r[0] for r in res]), np.concatenate([r[1] for r in res])
+        return self._chunk(origins, directions)
 
 
 def _unit_normals(tris: np.ndarray) -> np.ndarray:
@@ -210,7 +234,7 @@ class BVHCaster:
         tmax = np.maximum(t1, t2).min(axis=1)
         return tmin, tmax >= tmin
 
-    def first_hit(self, origins: np.ndarray, directions: np.ndarray
+    def first_hit(self, origins: np.ndarray, directions: np.ndarray, parallel: bool = True
                   ) -> tuple[np.ndarray, np.ndarray]:
         n = len(origins)
         self.rays_cast += n
@@ -288,7 +312,7 @@ class NullCaster:
     name = "none"
     rays_cast = 0
 
-    def first_hit(self, origins: np.ndarray, directions: np.ndarray
+    def first_hit(self, origins: np.ndarray, directions: np.ndarray, parallel: bool = True
                   ) -> tuple[np.ndarray, np.ndarray]:
         n = len(origins)
         self.rays_cast += n
