@@ -130,6 +130,12 @@ class _Tracer:
         self.dni = float(state.direct_normal_lux)
         self.sun = np.asarray(state.sun.vector, float)
         self.sun = self.sun / np.linalg.norm(self.sun)
+        # per-triangle optics (one gather per query instead of material index + coefficients)
+        mat = geo.tri_material
+        self.tri_coef = np.stack([optics.rd, optics.td, optics.ts, optics.rm], axis=1)[mat]
+        self.tri_glass_tn = optics.glass_tn[mat]
+        self.tri_glass = np.isfinite(self.tri_glass_tn)
+        self.glass_any = bool(self.tri_glass.any())
 
     # -- sun
     def sun_directions(self, k: int, rng: Draws | np.random.Generator) -> np.ndarray:
@@ -153,22 +159,25 @@ class _Tracer:
         o = np.array(origins, float)
         d = np.array(dirs, float)
         passes = self.opt.any_specular_pass
+        normals, ts = self.geo.normals, self.tri_coef[:, 2]
         for layer in range(self.opts.max_shadow_layers):
             tri, t = self.caster.first_hit(o, d, parallel)
-            hit = tri >= 0
-            if not hit.any():
+            sel = np.flatnonzero(tri >= 0)
+            if len(sel) == 0:
                 return vis
-            idx, o, d, tri, t = idx[hit], o[hit], d[hit], tri[hit], t[hit]
+            if len(sel) < len(tri):
+                idx, o, d, tri, t = idx[sel], o[sel], d[sel], tri[sel], t[sel]
             if not passes:
                 vis[idx] = 0.0
                 return vis
-            mat = self.geo.tri_material[tri]
-            ng = self.geo.normals[tri]
-            cosd = np.einsum("ij,ij->i", d, ng)
-            f = self.opt.ts[mat].copy()
-            glass = np.isfinite(self.opt.glass_tn[mat])
-            if glass.any():
-                f[glass] = glass_coefficients(cosd[glass], self.opt.glass_tn[mat][glass])[0]
+            f = ts[tri]
+            ng = cosd = None
+            if self.glass_any:
+                ng = normals[tri]
+                cosd = np.einsum("ij,ij->i", d, ng)
+                glass = self.tri_glass[tri]
+                if glass.any():
+                    f[glass] = glass_coefficients(cosd[glass], self.tri_glass_tn[tri][glass])[0]
             vis[idx] *= f
             # Russian roulette on faint shadow rays (unbiased: survivors are promoted)
             v = vis[idx]
@@ -179,12 +188,18 @@ class _Tracer:
                 keep = rng.random(int(faint.sum())) * SHADOW_ROULETTE < v[faint]
                 v[faint] = np.where(keep, SHADOW_ROULETTE, 0.0)
                 vis[idx] = v
-            go = v > 0
-            nf = np.where((cosd < 0)[:, None], ng, -ng)
-            o = (o + t[:, None] * d - nf * self.eps)[go]
-            idx, d = idx[go], d[go]
-            if len(idx) == 0:
+            go = np.flatnonzero(v > 0)
+            if len(go) == 0:
                 return vis
+            if len(go) < len(v):
+                idx, o, d, t, tri = idx[go], o[go], d[go], t[go], tri[go]
+                if ng is not None and cosd is not None:
+                    ng, cosd = ng[go], cosd[go]
+            if ng is None or cosd is None:
+                ng = normals[tri]
+                cosd = np.einsum("ij,ij->i", d, ng)
+            nf = np.where((cosd < 0)[:, None], ng, -ng)
+            o = o + t[:, None] * d - nf * self.eps
         vis[idx] = 0.0
         return vis
 
@@ -220,7 +235,7 @@ class _Tracer:
         beta = np.ones(k)
         depth = np.ones(k, np.int64)
         nspec = np.zeros(k, np.int64)
-        geo, opt, eps = self.geo, self.opt, self.eps
+        geo, eps = self.geo, self.eps
         thr = self.opts.roulette_weight
         bounce = 0
         while len(alive):
@@ -240,8 +255,8 @@ class _Tracer:
             cosd = np.einsum("ij,ij->i", d, ng)
             front = cosd < 0
             nf = np.where(front[:, None], ng, -ng)  # normal on the side the ray came from
-            mat = geo.tri_material[tri]
-            rd, td = opt.rd[mat], opt.td[mat]
+            coef = self.tri_coef[tri]  # diffuse R, diffuse T, specular T, mirror (a copy)
+            rd, td = coef[:, 0], coef[:, 1]
 
             # next-event estimation towards the sun
             if self.sun_on:
@@ -256,12 +271,12 @@ class _Tracer:
                     acc[alive[need]] += beta[need] * self.dni * f[need] * vis
 
             # scattering events: diffuse reflect, diffuse transmit, specular transmit, mirror
-            coef = np.stack([rd, td, opt.ts[mat], opt.rm[mat]], axis=1)
-            glass = np.isfinite(opt.glass_tn[mat])
-            if glass.any():
-                tg, rg = glass_coefficients(cosd[glass], opt.glass_tn[mat][glass])
-                coef[glass, 2] = tg
-                coef[glass, 3] = rg
+            if self.glass_any:
+                glass = self.tri_glass[tri]
+                if glass.any():
+                    tg, rg = glass_coefficients(cosd[glass], self.tri_glass_tn[tri][glass])
+                    coef[glass, 2] = tg
+                    coef[glass, 3] = rg
             coef[:, :2] *= (depth < self.max_bounces)[:, None]
             coef[:, 2:] *= (nspec < self.opts.max_specular)[:, None]
             total = coef.sum(axis=1)

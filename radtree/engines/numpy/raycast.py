@@ -47,15 +47,21 @@ def embree_available() -> bool:
 
 def _plane_distance(tris_v0: np.ndarray, normals: np.ndarray, centroids: np.ndarray,
                     origins: np.ndarray, directions: np.ndarray, idx: np.ndarray) -> np.ndarray:
-    """Distance along each ray to the plane of its hit triangle (float64)."""
+    """Distance along each ray to the plane of its hit triangle (float64; a ray parallel to
+    the plane gets the distance of the triangle's centroid along it)."""
     n = normals[idx]
     denom = np.einsum("ij,ij->i", directions, n)
     num = np.einsum("ij,ij->i", tris_v0[idx] - origins, n)
-    grazing = np.abs(denom) < 1e-12
+    grazing = np.flatnonzero(np.abs(denom) < 1e-12)
     with np.errstate(divide="ignore", invalid="ignore"):
-        t = np.where(grazing, np.einsum("ij,ij->i", centroids[idx] - origins, directions),
-                     num / np.where(grazing, 1.0, denom))
-    return np.maximum(t, 0.0)
+        if len(grazing):
+            denom[grazing] = 1.0
+        t = num / denom
+    if len(grazing):
+        g = idx[grazing]
+        t[grazing] = np.einsum("ij,ij->i", centroids[g] - origins[grazing],
+                               directions[grazing])
+    return np.maximum(t, 0.0, out=t)
 
 
 class EmbreeCaster:
@@ -98,7 +104,9 @@ class EmbreeCaster:
         wrap = self._embree
         o32 = np.array(o, dtype=np.float32)
         d32 = unitize(np.array(d, dtype=np.float32))
-        scaled = (o32.astype(np.float64) - wrap.origin) * wrap.scale
+        scaled = o32.astype(np.float64)
+        scaled -= wrap.origin
+        scaled *= wrap.scale
         return np.asarray(wrap.scene.run(scaled.astype(np.float32), d32.astype(np.float32)),
                           dtype=np.int64)
 
