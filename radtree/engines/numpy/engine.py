@@ -114,6 +114,16 @@ def describe(backend: str = "auto") -> str:
 # --------------------------------------------------------------------------- the tracer
 
 
+def _rows(d: np.ndarray, sel: np.ndarray | None) -> np.ndarray:
+    """``d[sel]`` (``sel``: indices or a mask; None: all rows, copied) — except that a
+    broadcast row (stride 0, the point sun's direction) stays a broadcast row."""
+    if d.ndim == 2 and d.strides[0] == 0:
+        k = len(d) if sel is None else (int(np.count_nonzero(sel)) if sel.dtype == bool
+                                        else len(sel))
+        return np.broadcast_to(d[0], (k, d.shape[1]))
+    return np.array(d) if sel is None else d[sel]
+
+
 class _Tracer:
     def __init__(self, geo: Geometry, optics: Optics, state: SkyState, params: EngineParams,
                  opts: TraceOptions):
@@ -157,7 +167,7 @@ class _Tracer:
         vis = np.ones(k)
         idx = np.arange(k)
         o = np.array(origins, float)
-        d = np.array(dirs, float)
+        d = _rows(np.asarray(dirs, float), None)  # a point sun stays one broadcast row
         passes = self.opt.any_specular_pass
         normals, ts = self.geo.normals, self.tri_coef[:, 2]
         for layer in range(self.opts.max_shadow_layers):
@@ -166,7 +176,7 @@ class _Tracer:
             if len(sel) == 0:
                 return vis
             if len(sel) < len(tri):
-                idx, o, d, tri, t = idx[sel], o[sel], d[sel], tri[sel], t[sel]
+                idx, o, d, tri, t = idx[sel], o[sel], _rows(d, sel), tri[sel], t[sel]
             if not passes:
                 vis[idx] = 0.0
                 return vis
@@ -192,7 +202,7 @@ class _Tracer:
             if len(go) == 0:
                 return vis
             if len(go) < len(v):
-                idx, o, d, t, tri = idx[go], o[go], d[go], t[go], tri[go]
+                idx, o, d, t, tri = idx[go], o[go], _rows(d, go), t[go], tri[go]
                 if ng is not None and cosd is not None:
                     ng, cosd = ng[go], cosd[go]
             if ng is None or cosd is None:
@@ -215,7 +225,8 @@ class _Tracer:
         cos = np.einsum("ij,ij->i", normals, dirs)
         need = cos > 0
         if need.any():
-            out[need] = self.dni * cos[need] * self.shadow(points[need], dirs[need], rng)
+            out[need] = self.dni * cos[need] * self.shadow(points[need],
+                                                               _rows(dirs, need), rng)
         return out
 
     # -- paths
@@ -267,7 +278,7 @@ class _Tracer:
                 need = f > 0
                 if need.any():
                     so = p[need] + nf[need] * (eps * np.sign(cs[need]))[:, None]
-                    vis = self.shadow(so, sd[need], rng, (bounce, 1), parallel)
+                    vis = self.shadow(so, _rows(sd, need), rng, (bounce, 1), parallel)
                     acc[alive[need]] += beta[need] * self.dni * f[need] * vis
 
             # scattering events: diffuse reflect, diffuse transmit, specular transmit, mirror

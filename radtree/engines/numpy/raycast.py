@@ -103,7 +103,10 @@ class EmbreeCaster:
 
         wrap = self._embree
         o32 = np.array(o, dtype=np.float32)
-        d32 = unitize(np.array(d, dtype=np.float32))
+        if d.ndim == 2 and d.strides[0] == 0 and len(d):  # one direction (a point sun)
+            d32 = np.tile(unitize(np.array(d[:1], dtype=np.float32)), (len(d), 1))
+        else:
+            d32 = unitize(np.array(d, dtype=np.float32))
         scaled = o32.astype(np.float64)
         scaled -= wrap.origin
         scaled *= wrap.scale
@@ -115,7 +118,8 @@ class EmbreeCaster:
         t = np.full(len(o), np.inf)
         hit = idx >= 0
         if hit.any():
-            t[hit] = _plane_distance(self._v0, self._normals, self._centroids, o[hit], d[hit],
+            dh = d[hit] if d.strides[0] else np.broadcast_to(d[0], (int(hit.sum()), 3))
+            t[hit] = _plane_distance(self._v0, self._normals, self._centroids, o[hit], dh,
                                      idx[hit])
         return idx, t
 
