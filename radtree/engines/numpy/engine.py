@@ -65,7 +65,7 @@ from radtree.engines.numpy.geometry import (
     scene_optics,
 )
 from radtree.engines.numpy.lockstep import Draws, LockstepRandom, SerialDraws
-from radtree.engines.numpy.raycast import embree_available
+from radtree.engines.numpy.raycast import embree_available, first_hits
 from radtree.engines.numpy.sampling import cosine_hemisphere, mirror, uniform_cone
 from radtree.errors import EngineError
 from radtree.light.sky import SkyState
@@ -171,26 +171,23 @@ class _Tracer:
         passes = self.opt.any_specular_pass
         normals, ts = self.geo.normals, self.tri_coef[:, 2]
         for layer in range(self.opts.max_shadow_layers):
-            tri, t = self.caster.first_hit(o, d, parallel)
-            sel = np.flatnonzero(tri >= 0)
-            if len(sel) == 0:
+            h = first_hits(self.caster, o, d, normals, parallel)
+            if len(h.sel) == 0:
                 return vis
-            if len(sel) < len(tri):
-                idx, o, d, tri, t = idx[sel], o[sel], _rows(d, sel), tri[sel], t[sel]
+            tri, t, ng, cosd = h.tri, h.t, h.normal, h.cos
+            if len(h.sel) < len(o):
+                idx, o, d = idx[h.sel], o[h.sel], _rows(d, h.sel)
             if not passes:
                 vis[idx] = 0.0
                 return vis
             f = ts[tri]
-            ng = cosd = None
             if self.glass_any:
-                ng = normals[tri]
-                cosd = np.einsum("ij,ij->i", d, ng)
                 glass = self.tri_glass[tri]
                 if glass.any():
                     f[glass] = glass_coefficients(cosd[glass], self.tri_glass_tn[tri][glass])[0]
-            vis[idx] *= f
+            v = vis[idx] * f
+            vis[idx] = v
             # Russian roulette on faint shadow rays (unbiased: survivors are promoted)
-            v = vis[idx]
             faint = (v > 0) & (v < SHADOW_ROULETTE)
             if rng is not None and faint.any():
                 if tag:
@@ -202,12 +199,7 @@ class _Tracer:
             if len(go) == 0:
                 return vis
             if len(go) < len(v):
-                idx, o, d, t, tri = idx[go], o[go], _rows(d, go), t[go], tri[go]
-                if ng is not None and cosd is not None:
-                    ng, cosd = ng[go], cosd[go]
-            if ng is None or cosd is None:
-                ng = normals[tri]
-                cosd = np.einsum("ij,ij->i", d, ng)
+                idx, o, d, t, ng, cosd = idx[go], o[go], _rows(d, go), t[go], ng[go], cosd[go]
             nf = np.where((cosd < 0)[:, None], ng, -ng)
             o = o + t[:, None] * d - nf * self.eps
         vis[idx] = 0.0
