@@ -9,7 +9,7 @@ Prints (no timing assertions):
    Perez sky + sun of 11:30) at the default budget, and on the Mendoza project's own louvers
    crown (``radtree.pipeline.assemble.make_scene``) when that builds;
 3. the NumPy engine's ray throughput against raw Embree on the very same rays: every
-   first-hit query of one traced hour is recorded, then replayed through embreex's
+   Embree query of one traced hour is recorded, then replayed through embreex's
    ``EmbreeScene.run`` (float32 rays already in trimesh's Embree frame, chunks of 65 536 over
    the same number of threads) and through the engine's ``EmbreeCaster.first_hit`` in one call
    (conversions and float64 distances included); the engine's rays/s over raw Embree's is the
@@ -174,23 +174,22 @@ def _replay_raw(caster: EmbreeCaster, o: np.ndarray, d: np.ndarray, workers: int
 
 def _recorded_queries(caster: EmbreeCaster, work: Any, *args: Any
                       ) -> tuple[np.ndarray, np.ndarray, int]:
-    """Every ray ``work(*args)`` casts with ``caster.first_hit`` (origins, directions,
-    calls)."""
+    """Every ray ``work(*args)`` sends to Embree through ``caster`` (origins, directions,
+    queries): recorded at the caster's one Embree call, whichever caster method made it."""
     casts: list[tuple[np.ndarray, np.ndarray]] = []
     lock = threading.Lock()
-    original = caster.first_hit
+    original = caster._query
 
-    def recording(o: np.ndarray, d: np.ndarray, parallel: bool = True
-                  ) -> tuple[np.ndarray, np.ndarray]:
+    def recording(o: np.ndarray, d: np.ndarray) -> np.ndarray:
         with lock:
             casts.append((np.array(o), np.array(d)))
-        return original(o, d, parallel)
+        return original(o, d)
 
-    caster.first_hit = recording  # type: ignore[method-assign]
+    caster._query = recording  # type: ignore[method-assign]
     try:
         work(*args)
     finally:
-        caster.first_hit = original  # type: ignore[method-assign]
+        caster._query = original  # type: ignore[method-assign]
     return (np.concatenate([c[0] for c in casts]), np.concatenate([c[1] for c in casts]),
             len(casts))
 
