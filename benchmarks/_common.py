@@ -10,7 +10,7 @@ also after ``sys.exit`` or an exception — one line is printed::
 
 Peak RSS is ``resource.getrusage(...).ru_maxrss`` (KiB on Linux): for ``RUSAGE_CHILDREN`` it
 is the largest single terminated, waited-for descendant (an rtrace, a Dask worker), not their
-sum. The load average is the 1-minute one at the start and at the end: on a shared machine
+sum; a child forked from a large Python process counts the pages it shared with its parent. The load average is the 1-minute one at the start and at the end: on a shared machine
 (the session's 2 cores serve several jobs) wall times are only comparable at equal load, CPU
 times and ratios measured back to back in one process more so.
 """
