@@ -20,9 +20,16 @@ The fit scans log u × log x (61 × 15 points) and refines the best point with L
 hemi's own ellipsoidal x / mean tilt and LAI of the photo are reported beside it. With ``louvers.inclination_distribution = "fixed"``
 only u is fitted (the inclination stays ``inclination_deg``, e.g. the study's 30°).
 
-Clumping: the model's slats are placed at random (no clumping); hemi's clumping index
-``clumping_lx`` of the photo is reported beside the fit, the fitted u is an *effective*
-density (it reproduces the photo's gaps, not the true leaf area of a clumped crown).
+Clumping (:mod:`radtree.trees.clumping`): with ``louvers.clumping`` Ω < 1 the crown's slats
+are grouped in clusters and the model's gap is exp(−u·G·Ω·L) (Ω per direction,
+:func:`~radtree.trees.clumping.clumped_g`), so the fitted u is the *true* density (LAI_true =
+LAI_eff / Ω). With ``louvers.clumping_fit`` Ω is estimated from the photo(s)
+(:func:`fit_omega`): the photo's Lang & Xiang clumping index ``clumping_lx`` — the
+between-segment variance of its gaps — is matched by that of cluster realisations of the
+crown fitted at each Ω of :data:`OMEGA_GRID` (u and x refitted at every Ω, so the model keeps
+reproducing the ring gap fractions), Ω interpolated where the two agree, then u and x fitted
+at that Ω. At the defaults (Ω = 1, no fit) the slats are placed at random and hemi's
+``clumping_lx`` of the photo is only reported beside the fit.
 
 Several photos (``photo`` names a folder, all taken at the same camera point): one joint fit
 over all their cells, plus one fit per photo whose spread (s.d.) is reported.
@@ -43,6 +50,7 @@ from radtree.hemi import HemiResult
 from radtree.hemi.directions import up_to_world
 from radtree.hemi.metrics import DEFAULT_GAP_FLOOR
 from radtree.site.frame import FacadeFrame
+from radtree.trees.clumping import clumped_g, lx_clumping, realised_gaps
 from radtree.trees.envelope import CrownRowSpec
 from radtree.trees.leaf_angles import mean_projection, mean_tilt
 from radtree.trees.photo import PhotoSource, analyse_photo, provenance, with_source
@@ -50,6 +58,9 @@ from radtree.trees.photo import PhotoSource, analyse_photo, provenance, with_sou
 CELL_SAMPLES = (6, 10)    # zenith × azimuth directions per ring × segment cell
 X_BOUNDS = (0.1, 10.0)
 U_BOUNDS = (1e-3, 20.0)
+#: the clumping indices at which the model's Lang & Xiang clumping is computed (fit_omega)
+OMEGA_GRID = (1.0, 0.9, 0.8, 0.7, 0.6, 0.5, 0.4, 0.3)
+CLUSTER_REALISATIONS = 6   # cluster draws per Ω (seeds 0–5) whose clumping_lx is averaged
 
 
 @dataclass(frozen=True)
@@ -66,6 +77,10 @@ class CrownFit:
     lai_photo: float
     clumping_photo: float
     per_photo: tuple[tuple[float, float | None], ...]
+    clumping: float = 1.0            # the crown's Ω (fitted when clumping_fitted)
+    clumping_fitted: bool = False
+    clumping_lx_model: float = math.nan   # the fitted crown's clumping_lx (cluster draws)
+    clumping_curve: tuple[tuple[float, float], ...] = ()   # (Ω, model clumping_lx)
 
     @property
     def mean_tilt_deg(self) -> float | None:
@@ -86,7 +101,15 @@ class CrownFit:
                 "mean_tilt_deg": self.mean_tilt_deg, "crossings": self.crossings,
                 "gap_rms_cells": self.rms, "gap_rms_rings": self.ring_rms,
                 "lai_eff_photo": self.lai_photo, "clumping_lx_photo": self.clumping_photo,
-                **self.spread()}
+                **self.spread(), **self.clumping_dict()}
+
+    def clumping_dict(self) -> dict[str, Any]:
+        """The clumping entries (none for an unclumped crown that was not fitted)."""
+        if self.clumping >= 1.0 and not self.clumping_fitted:
+            return {}
+        return {"clumping_omega": self.clumping, "clumping_fitted": self.clumping_fitted,
+                "clumping_lx_model": self.clumping_lx_model,
+                "clumping_curve": [list(p) for p in self.clumping_curve]}
 
 
 @dataclass
@@ -100,6 +123,8 @@ class CellPaths:
     weight: np.ndarray
     shape: tuple[int, int]
     ring_weight: np.ndarray   # each ring's share of the analysed solid angle
+    direction: np.ndarray | None = None   # (cells, samples, 3) local unit vectors
+    camera: np.ndarray | None = None      # the rays' origin (local, m)
 
 
 def cell_paths(result: HemiResult, camera: np.ndarray, spec: CrownRowSpec,
@@ -126,7 +151,7 @@ def cell_paths(result: HemiResult, camera: np.ndarray, spec: CrownRowSpec,
     ring_w = -np.diff(np.cos(np.radians(ze)))
     return CellPaths(length.reshape(Z.shape), np.abs(d[:, 2]).reshape(Z.shape),
                      blocked.reshape(Z.shape), np.sin(np.radians(Z)), shape,
-                     ring_w / ring_w.sum())
+                     ring_w / ring_w.sum(), d.reshape(*Z.shape, 3), np.asarray(camera, float))
 
 
 def slat_projection(paths: CellPaths, x: float | None, fixed_deg: float) -> np.ndarray:
@@ -193,9 +218,10 @@ def crown_paths(spec: CrownRowSpec, camera: np.ndarray, d: np.ndarray
 
 
 def predicted_gaps(paths: CellPaths, lad: float, x: float | None, fixed_deg: float,
-                   g: np.ndarray | None = None) -> np.ndarray:
-    """P̄_ij (rings × segments) for density ``lad`` and distribution x (None: fixed angle)."""
-    g = slat_projection(paths, x, fixed_deg) if g is None else g
+                   g: np.ndarray | None = None, omega: float = 1.0) -> np.ndarray:
+    """P̄_ij (rings × segments) for density ``lad``, distribution x (None: fixed angle) and
+    clumping ``omega`` (``g``: the effective G·Ω already)."""
+    g = clumped_g(slat_projection(paths, x, fixed_deg), omega) if g is None else g
     p = np.where(paths.blocked, 0.0, np.exp(-lad * g * paths.length))
     return ((p * paths.weight).sum(axis=1) / paths.weight.sum(axis=1)).reshape(paths.shape)
 
@@ -206,10 +232,12 @@ def _ring_log(gaps: np.ndarray) -> np.ndarray:
         return np.log(np.maximum(np.nanmean(gaps, axis=1), DEFAULT_GAP_FLOOR))
 
 
-def _fit(targets: list[np.ndarray], paths: list[CellPaths], fixed_deg: float | None
+def _fit(targets: list[np.ndarray], paths: list[CellPaths], fixed_deg: float | None,
+         omega: float = 1.0, start: tuple[float, float | None] | None = None
          ) -> tuple[float, float | None, float]:
-    """Least squares over all cells of all photos → (lad, x or None, RMS): a scan over
-    log u × log x, then L-BFGS-B from the best point."""
+    """Least squares over all cells of all photos → (lad, x or None, RMS) at clumping
+    ``omega``: a scan over log u × log x (skipped from ``start``), then L-BFGS-B from the
+    best point."""
     rings = [_ring_log(t) for t in targets]
     ok = [np.isfinite(r) for r in rings]
     weights = [p.ring_weight for p in paths]
@@ -223,13 +251,15 @@ def _fit(targets: list[np.ndarray], paths: list[CellPaths], fixed_deg: float | N
         return total
 
     def gs_of(x: float | None) -> list[np.ndarray]:
-        return [slat_projection(p, x, fixed) for p in paths]
+        return [clumped_g(slat_projection(p, x, fixed), omega) for p in paths]
 
     us = np.exp(np.linspace(math.log(U_BOUNDS[0]), math.log(U_BOUNDS[1]), 61))
     xs: list[float | None] = ([None] if fixed_deg is not None else
                               list(np.exp(np.linspace(math.log(X_BOUNDS[0]),
                                                       math.log(X_BOUNDS[1]), 15))))
     best: tuple[float, float, float | None] = (math.inf, 1.0, None)
+    if start is not None:
+        us, xs = np.array([start[0]]), [start[1]]
     for x in xs:
         gs = gs_of(x)
         for u in us:
@@ -248,8 +278,48 @@ def _fit(targets: list[np.ndarray], paths: list[CellPaths], fixed_deg: float | N
     v = res.x if res.fun <= best[0] else np.array(v0)
     lad = float(np.exp(v[0]))
     x = None if fixed_deg is not None else float(np.exp(v[1]))
-    cells = [predicted_gaps(p, lad, x, fixed) - t for p, t in zip(paths, targets)]
+    cells = [predicted_gaps(p, lad, x, fixed, omega=omega) - t for p, t in zip(paths, targets)]
     return lad, x, float(np.sqrt(np.nanmean(np.concatenate([c.ravel() for c in cells]) ** 2)))
+
+
+def fit_omega(targets: list[np.ndarray], paths: list[CellPaths], grids: list[Any],
+              fixed_deg: float | None, spec: CrownRowSpec, radius: float
+              ) -> tuple[float, float, tuple[tuple[float, float], ...]]:
+    """Ω from the photos' Lang & Xiang clumping index: (Ω, the photos' clumping_lx, the curve
+    (Ω, model clumping_lx) over :data:`OMEGA_GRID`). At every Ω the crown is refitted (u, x)
+    and the model's clumping_lx is the mean over :data:`CLUSTER_REALISATIONS` cluster draws
+    (:func:`~radtree.trees.clumping.realised_gaps`; at Ω = 1 the random slats' expected gaps);
+    Ω is interpolated linearly where the curve crosses the photos' value (1 when the photos
+    show no more clumping than random slats, the grid's end when more than its last point)."""
+    target = float(np.nanmean([lx_clumping(t, g) for t, g in zip(targets, grids)]))
+    fixed = fixed_deg or 0.0
+    curve: list[tuple[float, float]] = []
+    start: tuple[float, float | None] | None = None
+    for omega in OMEGA_GRID:
+        lad, x, _ = _fit(targets, paths, fixed_deg, omega, start)
+        start = (lad, x)
+        lxs = []
+        for p, g in zip(paths, grids):
+            if omega >= 1.0:
+                lxs.append(lx_clumping(predicted_gaps(p, lad, x, fixed), g))
+                continue
+            assert p.direction is not None and p.camera is not None
+            gk = slat_projection(p, x, fixed)
+            for k in range(CLUSTER_REALISATIONS):
+                gaps = realised_gaps(p.direction, gk, p.weight, p.blocked, p.camera,
+                                     spec.centres, spec.a, spec.b, lad, omega, radius,
+                                     np.random.default_rng([k, 16]), p.shape)
+                lxs.append(lx_clumping(gaps, g))
+        curve.append((omega, float(np.nanmean(lxs))))
+    om = np.array([c[0] for c in curve])
+    lx = np.minimum.accumulate(np.array([c[1] for c in curve]))   # monotone in Ω
+    if not math.isfinite(target) or target >= lx[0]:
+        return 1.0, target, tuple(curve)
+    if target <= lx[-1]:
+        return float(om[-1]), target, tuple(curve)
+    i = int(np.argmax(lx <= target))           # first grid point at or below the target
+    f = (lx[i - 1] - target) / max(lx[i - 1] - lx[i], 1e-12)
+    return float(om[i - 1] + f * (om[i] - om[i - 1])), target, tuple(curve)
 
 
 _CACHE: dict[Any, tuple[CrownFit, list[HemiResult]]] = {}
@@ -262,7 +332,8 @@ def fit_crown(src: PhotoSource, camera: np.ndarray, spec: CrownRowSpec, lv: Louv
     key = (tuple((str(p), p.stat().st_mtime) for p in images), src.lens, src.mask,
            src.zenith_deg, tuple(camera.round(6)), spec.a, spec.b, spec.n_clip,
            tuple(spec.centres.ravel().round(6)), lv.inclination_distribution,
-           lv.inclination_deg, frame.azimuth_deg)
+           lv.inclination_deg, frame.azimuth_deg, lv.clumping, lv.cluster_radius_m,
+           lv.clumping_fit)
     if key in _CACHE:
         return _CACHE[key]
     results = [analyse_photo(p, src) for p in images]
@@ -276,10 +347,14 @@ def fit_crown(src: PhotoSource, camera: np.ndarray, spec: CrownRowSpec, lv: Louv
                           "crosses a crown within the analysed zenith range: check "
                           "tree.photo_x_m, photo_distance_m, photo_height_m and the crown "
                           "table", field="tree.photo_height_m")
-    lad, x, rms = _fit(targets, paths, fixed)
-    per = tuple(_fit([t], [p], fixed)[:2] for t, p in zip(targets, paths)
+    omega, curve = lv.clumping, ()
+    if lv.clumping_fit:
+        omega, _, curve = fit_omega(targets, paths, [r.table.grid for r in results], fixed,
+                                    spec, lv.cluster_radius_m)
+    lad, x, rms = _fit(targets, paths, fixed, omega)
+    per = tuple(_fit([t], [p], fixed, omega)[:2] for t, p in zip(targets, paths)
                 ) if len(results) > 1 else ((lad, x),)
-    model = [predicted_gaps(p, lad, x, fixed or 0.0) for p in paths]
+    model = [predicted_gaps(p, lad, x, fixed or 0.0, omega=omega) for p in paths]
     ring_d = [np.nanmean(mg, axis=1) - np.nanmean(t, axis=1) for mg, t in zip(model, targets)]
     ring_rms = float(np.sqrt(np.nanmean(np.concatenate(ring_d) ** 2)))
     fitted_lv = replace(lv, inclination_distribution="ellipsoidal" if x is not None
@@ -289,9 +364,18 @@ def fit_crown(src: PhotoSource, camera: np.ndarray, spec: CrownRowSpec, lv: Louv
     crossings = lad * mean_cos(fitted_lv) * 2.0 * spec.b / lv.cover_fraction
     fit = CrownFit(lad, x, crossings, rms, ring_rms,
                    float(np.nanmean([r.metrics.lai_eff for r in results])),
-                   float(np.nanmean([r.metrics.clumping_lx for r in results])), per)
+                   float(np.nanmean([r.metrics.clumping_lx for r in results])), per,
+                   omega, lv.clumping_fit, _model_lx(curve, omega), curve)
     _CACHE[key] = (fit, results)
     return fit, results
+
+
+def _model_lx(curve: tuple[tuple[float, float], ...], omega: float) -> float:
+    """The model's clumping_lx at ``omega``, interpolated on the fit's curve (NaN without)."""
+    if not curve:
+        return math.nan
+    om = np.array([c[0] for c in curve])[::-1]
+    return float(np.interp(omega, om, np.array([c[1] for c in curve])[::-1]))
 
 
 def fitted_louvers(lv: Louvers, src: PhotoSource, spec: CrownRowSpec, camera: np.ndarray,
@@ -304,6 +388,7 @@ def fitted_louvers(lv: Louvers, src: PhotoSource, spec: CrownRowSpec, camera: np
     except ConfigError as exc:
         raise with_source(exc, source) from None
     new = replace(lv, arrangement="volume", crossings=float(np.clip(fit.crossings, 0.01, 60.0)),
+                  clumping=float(np.clip(fit.clumping, 0.1, 1.0)),
                   inclination_distribution="ellipsoidal" if fit.x is not None else "fixed",
                   ellipsoid_x=fit.x if fit.x is not None else lv.ellipsoid_x)
     return new, fit, provenance(src, results, {**fit.as_dict(),
