@@ -48,9 +48,9 @@ from radtree.config import Louvers, Sensors
 from radtree.errors import ConfigError
 from radtree.hemi import HemiResult
 from radtree.hemi.directions import up_to_world
-from radtree.hemi.metrics import DEFAULT_GAP_FLOOR
+from radtree.hemi.metrics import DEFAULT_GAP_FLOOR, RingGrid
 from radtree.site.frame import FacadeFrame
-from radtree.trees.clumping import clumped_g, lx_clumping, realised_gaps
+from radtree.trees.clumping import cast_slats, clumped_g, lx_clumping
 from radtree.trees.envelope import CrownRowSpec
 from radtree.trees.leaf_angles import mean_projection, mean_tilt
 from radtree.trees.photo import PhotoSource, analyse_photo, provenance, with_source
@@ -59,8 +59,10 @@ CELL_SAMPLES = (6, 10)    # zenith × azimuth directions per ring × segment cel
 X_BOUNDS = (0.1, 10.0)
 U_BOUNDS = (1e-3, 20.0)
 #: the clumping indices at which the model's Lang & Xiang clumping is computed (fit_omega)
-OMEGA_GRID = (1.0, 0.9, 0.8, 0.7, 0.6, 0.5, 0.4, 0.3)
-CLUSTER_REALISATIONS = 6   # cluster draws per Ω (seeds 0–5) whose clumping_lx is averaged
+OMEGA_GRID = (1.0, 0.85, 0.7, 0.55, 0.4, 0.25)
+CLUSTER_REALISATIONS = 5   # crowns drawn per Ω (seeds 1001–1005) whose clumping_lx is averaged
+CAST_SAMPLES = (10, 16)    # ray-cast directions per cell of those crowns (fit_omega)
+CLUMPING_SEGMENTS = 8      # azimuth segments of the grid the clumping is compared on
 
 
 @dataclass(frozen=True)
@@ -125,14 +127,19 @@ class CellPaths:
     ring_weight: np.ndarray   # each ring's share of the analysed solid angle
     direction: np.ndarray | None = None   # (cells, samples, 3) local unit vectors
     camera: np.ndarray | None = None      # the rays' origin (local, m)
+    zenith: np.ndarray | None = None      # (cells, samples) the photo's angles, degrees
+    azimuth: np.ndarray | None = None
+    grid: RingGrid | None = None
 
 
 def cell_paths(result: HemiResult, camera: np.ndarray, spec: CrownRowSpec,
-               frame: FacadeFrame) -> CellPaths:
-    """March the sample rays of every cell of ``result``'s grid from ``camera`` (local)."""
-    grid = result.table.grid
+               frame: FacadeFrame, samples: tuple[int, int] = CELL_SAMPLES,
+               grid: RingGrid | None = None) -> CellPaths:
+    """March the sample rays (``samples``: zenith × azimuth per cell) of every cell of
+    ``result``'s grid (or ``grid``) from ``camera`` (local)."""
+    grid = result.table.grid if grid is None else grid
     ze, ae = grid.ring_edges, grid.segment_edges
-    nz, na = CELL_SAMPLES
+    nz, na = samples
     fz = (np.arange(nz) + 0.5) / nz
     fa = (np.arange(na) + 0.5) / na
     zs, az = [], []
@@ -151,7 +158,8 @@ def cell_paths(result: HemiResult, camera: np.ndarray, spec: CrownRowSpec,
     ring_w = -np.diff(np.cos(np.radians(ze)))
     return CellPaths(length.reshape(Z.shape), np.abs(d[:, 2]).reshape(Z.shape),
                      blocked.reshape(Z.shape), np.sin(np.radians(Z)), shape,
-                     ring_w / ring_w.sum(), d.reshape(*Z.shape, 3), np.asarray(camera, float))
+                     ring_w / ring_w.sum(), d.reshape(*Z.shape, 3), np.asarray(camera, float),
+                     Z, A, grid)
 
 
 def slat_projection(paths: CellPaths, x: float | None, fixed_deg: float) -> np.ndarray:
@@ -218,10 +226,13 @@ def crown_paths(spec: CrownRowSpec, camera: np.ndarray, d: np.ndarray
 
 
 def predicted_gaps(paths: CellPaths, lad: float, x: float | None, fixed_deg: float,
-                   g: np.ndarray | None = None, omega: float = 1.0) -> np.ndarray:
+                   g: np.ndarray | None = None, omega: float = 1.0,
+                   cluster: tuple[float, float] = (0.5, 0.3)) -> np.ndarray:
     """P̄_ij (rings × segments) for density ``lad``, distribution x (None: fixed angle) and
-    clumping ``omega`` (``g``: the effective G·Ω already)."""
-    g = clumped_g(slat_projection(paths, x, fixed_deg), omega) if g is None else g
+    clumping ``omega`` of clusters ``cluster`` = (radius, slat side) m (``g``: the effective
+    G·Ω already)."""
+    g = (clumped_g(slat_projection(paths, x, fixed_deg), omega, *cluster) if g is None
+         else g)
     p = np.where(paths.blocked, 0.0, np.exp(-lad * g * paths.length))
     return ((p * paths.weight).sum(axis=1) / paths.weight.sum(axis=1)).reshape(paths.shape)
 
@@ -233,8 +244,8 @@ def _ring_log(gaps: np.ndarray) -> np.ndarray:
 
 
 def _fit(targets: list[np.ndarray], paths: list[CellPaths], fixed_deg: float | None,
-         omega: float = 1.0, start: tuple[float, float | None] | None = None
-         ) -> tuple[float, float | None, float]:
+         omega: float = 1.0, start: tuple[float, float | None] | None = None,
+         cluster: tuple[float, float] = (0.5, 0.3)) -> tuple[float, float | None, float]:
     """Least squares over all cells of all photos → (lad, x or None, RMS) at clumping
     ``omega``: a scan over log u × log x (skipped from ``start``), then L-BFGS-B from the
     best point."""
@@ -251,7 +262,7 @@ def _fit(targets: list[np.ndarray], paths: list[CellPaths], fixed_deg: float | N
         return total
 
     def gs_of(x: float | None) -> list[np.ndarray]:
-        return [clumped_g(slat_projection(p, x, fixed), omega) for p in paths]
+        return [clumped_g(slat_projection(p, x, fixed), omega, *cluster) for p in paths]
 
     us = np.exp(np.linspace(math.log(U_BOUNDS[0]), math.log(U_BOUNDS[1]), 61))
     xs: list[float | None] = ([None] if fixed_deg is not None else
@@ -278,48 +289,108 @@ def _fit(targets: list[np.ndarray], paths: list[CellPaths], fixed_deg: float | N
     v = res.x if res.fun <= best[0] else np.array(v0)
     lad = float(np.exp(v[0]))
     x = None if fixed_deg is not None else float(np.exp(v[1]))
-    cells = [predicted_gaps(p, lad, x, fixed, omega=omega) - t for p, t in zip(paths, targets)]
+    cells = [predicted_gaps(p, lad, x, fixed, omega=omega, cluster=cluster) - t
+             for p, t in zip(paths, targets)]
     return lad, x, float(np.sqrt(np.nanmean(np.concatenate([c.ravel() for c in cells]) ** 2)))
 
 
-def fit_omega(targets: list[np.ndarray], paths: list[CellPaths], grids: list[Any],
-              fixed_deg: float | None, spec: CrownRowSpec, radius: float
-              ) -> tuple[float, float, tuple[tuple[float, float], ...]]:
-    """Ω from the photos' Lang & Xiang clumping index: (Ω, the photos' clumping_lx, the curve
-    (Ω, model clumping_lx) over :data:`OMEGA_GRID`). At every Ω the crown is refitted (u, x)
-    and the model's clumping_lx is the mean over :data:`CLUSTER_REALISATIONS` cluster draws
-    (:func:`~radtree.trees.clumping.realised_gaps`; at Ω = 1 the random slats' expected gaps);
-    Ω is interpolated linearly where the curve crosses the photos' value (1 when the photos
-    show no more clumping than random slats, the grid's end when more than its last point)."""
-    target = float(np.nanmean([lx_clumping(t, g) for t, g in zip(targets, grids)]))
-    fixed = fixed_deg or 0.0
+def pooled(targets: list[np.ndarray], paths: list[CellPaths]
+           ) -> tuple[list[np.ndarray], list[CellPaths]]:
+    """The photos taken from one camera on one grid (one :class:`CellPaths`) pooled: their
+    mean ring × segment gaps, the expected gaps the model predicts (fitting each photo's own
+    noisy logarithms would bias a clumped crown's fit)."""
+    groups: dict[int, tuple[CellPaths, list[np.ndarray]]] = {}
+    for t, p in zip(targets, paths):
+        groups.setdefault(id(p), (p, []))[1].append(t)
+    return ([np.nanmean(np.array(ts), axis=0) if len(ts) > 1 else ts[0]
+             for _, ts in groups.values()], [p for p, _ in groups.values()])
+
+
+def sampled_gaps(result: HemiResult, paths: CellPaths) -> np.ndarray:
+    """The photo's ring × segment gaps sampled at ``paths``'s directions (sky or not)."""
+    assert paths.zenith is not None and paths.azimuth is not None
+    sky = np.asarray(result.sky_predicate(outside=False)(paths.zenith.ravel(),
+                                                         paths.azimuth.ravel()), float)
+    p = sky.reshape(paths.weight.shape)
+    return ((p * paths.weight).sum(axis=1) / paths.weight.sum(axis=1)).reshape(paths.shape)
+
+
+def fit_omega(targets: list[np.ndarray], paths: list[CellPaths], dense: CellPaths,
+              photos: list[HemiResult], fixed_deg: float | None, spec: CrownRowSpec,
+              lv: Louvers) -> tuple[float, tuple[float, float | None], tuple[tuple[float, float], ...]]:
+    """Ω from the photos' Lang & Xiang clumping index: (Ω, the (u, x) fitted nearest to it,
+    the curve (Ω, model clumping_lx) over :data:`OMEGA_GRID`). At every Ω the crown is refitted (u, x)
+    and the model's clumping_lx is the mean over :data:`CLUSTER_REALISATIONS` crowns drawn
+    like the generator's (:func:`~radtree.trees.volume.draw_crown_slats`) and ray-cast along
+    ``dense``'s sample directions (:func:`~radtree.trees.clumping.cast_slats`); the photos'
+    clumping_lx is taken at the same directions (:func:`sampled_gaps`), so both share the
+    sampling. A quadratic least-squares fit through the curve (made monotone) is solved for
+    the photos' value: Ω = 1 when the photos show no more clumping than random slats, the
+    grid's end when more than its last point."""
+    assert dense.grid is not None
+    grid = dense.grid
+    target = float(np.nanmean([lx_clumping(sampled_gaps(r, dense), grid) for r in photos]))
+    cluster = (lv.cluster_radius_m, lv.slat_size_m)
     curve: list[tuple[float, float]] = []
+    fits: list[tuple[float, float | None]] = []
     start: tuple[float, float | None] | None = None
+    mean_t, mean_p = pooled(targets, paths)
     for omega in OMEGA_GRID:
-        lad, x, _ = _fit(targets, paths, fixed_deg, omega, start)
+        lad, x, _ = _fit(mean_t, mean_p, fixed_deg, omega, start, cluster)
         start = (lad, x)
-        lxs = []
-        for p, g in zip(paths, grids):
-            if omega >= 1.0:
-                lxs.append(lx_clumping(predicted_gaps(p, lad, x, fixed), g))
-                continue
-            assert p.direction is not None and p.camera is not None
-            gk = slat_projection(p, x, fixed)
-            for k in range(CLUSTER_REALISATIONS):
-                gaps = realised_gaps(p.direction, gk, p.weight, p.blocked, p.camera,
-                                     spec.centres, spec.a, spec.b, lad, omega, radius,
-                                     np.random.default_rng([k, 16]), p.shape)
-                lxs.append(lx_clumping(gaps, g))
+        fits.append(start)
+        lxs = [lx_clumping(cast_gaps(dense, spec, _fitted_table(lv, spec, lad, x, omega),
+                                     1001 + k), grid)
+               for k in range(CLUSTER_REALISATIONS)]
         curve.append((omega, float(np.nanmean(lxs))))
     om = np.array([c[0] for c in curve])
-    lx = np.minimum.accumulate(np.array([c[1] for c in curve]))   # monotone in Ω
-    if not math.isfinite(target) or target >= lx[0]:
-        return 1.0, target, tuple(curve)
-    if target <= lx[-1]:
-        return float(om[-1]), target, tuple(curve)
-    i = int(np.argmax(lx <= target))           # first grid point at or below the target
-    f = (lx[i - 1] - target) / max(lx[i - 1] - lx[i], 1e-12)
-    return float(om[i - 1] + f * (om[i] - om[i - 1])), target, tuple(curve)
+    lx = np.array([c[1] for c in curve])
+    ok = np.isfinite(lx)
+    if not math.isfinite(target) or ok.sum() < 3:
+        return 1.0, fits[0], tuple(curve)
+    # a quadratic through the noisy curve, made monotone, solved for the photos' value
+    fine = np.linspace(om.min(), 1.0, 751)
+    smooth = np.maximum.accumulate(np.polyval(np.polyfit(om[ok], lx[ok], 2), fine))
+    if target >= smooth[-1]:
+        omega_hat = 1.0
+    elif target <= smooth[0]:
+        omega_hat = float(fine[0])
+    else:
+        omega_hat = float(np.interp(target, smooth, fine))
+    return omega_hat, fits[int(np.argmin(np.abs(om - omega_hat)))], tuple(curve)
+
+
+def _fitted_table(lv: Louvers, spec: CrownRowSpec, lad: float, x: float | None,
+                  omega: float) -> Louvers:
+    """The louvers table of density ``lad``, distribution x (None: fixed) and clumping."""
+    from radtree.trees.volume import mean_cos
+
+    new = replace(lv, arrangement="volume", clumping=omega,
+                  inclination_distribution="ellipsoidal" if x is not None else "fixed",
+                  ellipsoid_x=x if x is not None else lv.ellipsoid_x)
+    return replace(new, crossings=float(np.clip(
+        lad * mean_cos(new) * 2.0 * spec.b / lv.cover_fraction, 0.01, 60.0)))
+
+
+def cast_gaps(paths: CellPaths, spec: CrownRowSpec, lv: Louvers, seed: int) -> np.ndarray:
+    """Ring × segment gaps of one crown drawn like the generator's (seed ``seed``; slats
+    whose centre lies in the crown's share of the row), ray-cast along ``paths``'s sample
+    directions (0 where a trunk blocks)."""
+    from radtree.trees.volume import draw_crown_slats, slat_edges, slats_per_crown
+
+    assert paths.direction is not None and paths.camera is not None
+    d = paths.direction.reshape(-1, 3)
+    hit = paths.blocked.ravel().copy()
+    per = slats_per_crown(spec, lv)
+    lv = replace(lv, seed=seed)
+    for ti, child in enumerate(np.random.SeedSequence(seed).spawn(spec.count)):
+        c, phi, tilt, _ = draw_crown_slats(np.random.default_rng(child), spec, lv, ti, per)
+        lo, hi = spec.strips[ti]
+        own = (c[:, 1] >= spec.n_clip) & (c[:, 0] >= lo) & (c[:, 0] <= hi)
+        e1, e2 = slat_edges(phi, tilt)
+        hit |= cast_slats(d, paths.camera, c[own], e1[own], e2[own], lv.slat_size_m)
+    p = (~hit).reshape(paths.weight.shape).astype(float)
+    return ((p * paths.weight).sum(axis=1) / paths.weight.sum(axis=1)).reshape(paths.shape)
 
 
 _CACHE: dict[Any, tuple[CrownFit, list[HemiResult]]] = {}
@@ -348,13 +419,23 @@ def fit_crown(src: PhotoSource, camera: np.ndarray, spec: CrownRowSpec, lv: Louv
                           "tree.photo_x_m, photo_distance_m, photo_height_m and the crown "
                           "table", field="tree.photo_height_m")
     omega, curve = lv.clumping, ()
+    cluster = (lv.cluster_radius_m, lv.slat_size_m)
+    start: tuple[float, float | None] | None = None
     if lv.clumping_fit:
-        omega, _, curve = fit_omega(targets, paths, [r.table.grid for r in results], fixed,
-                                    spec, lv.cluster_radius_m)
-    lad, x, rms = _fit(targets, paths, fixed, omega)
-    per = tuple(_fit([t], [p], fixed, omega)[:2] for t, p in zip(targets, paths)
-                ) if len(results) > 1 else ((lad, x),)
-    model = [predicted_gaps(p, lad, x, fixed or 0.0, omega=omega) for p in paths]
+        g0 = results[0].table.grid
+        dense = cell_paths(results[0], camera, spec, frame, CAST_SAMPLES,
+                           RingGrid(g0.rings, CLUMPING_SEGMENTS, g0.zenith_start,
+                                    g0.zenith_end))
+        omega, start, curve = fit_omega(targets, paths, dense, results, fixed, spec, lv)
+    mean_t, mean_p = pooled(targets, paths)
+    lad, x, _ = _fit(mean_t, mean_p, fixed, omega, start, cluster)
+    rms = float(np.sqrt(np.nanmean(np.concatenate([
+        (predicted_gaps(p, lad, x, fixed or 0.0, omega=omega, cluster=cluster) - t).ravel()
+        for p, t in zip(paths, targets)]) ** 2)))
+    per = tuple(_fit([t], [p], fixed, omega, (lad, x), cluster)[:2]   # from the joint fit
+                for t, p in zip(targets, paths)) if len(results) > 1 else ((lad, x),)
+    model = [predicted_gaps(p, lad, x, fixed or 0.0, omega=omega, cluster=cluster)
+             for p in paths]
     ring_d = [np.nanmean(mg, axis=1) - np.nanmean(t, axis=1) for mg, t in zip(model, targets)]
     ring_rms = float(np.sqrt(np.nanmean(np.concatenate(ring_d) ** 2)))
     fitted_lv = replace(lv, inclination_distribution="ellipsoidal" if x is not None
