@@ -39,7 +39,6 @@ from functools import lru_cache
 
 import numpy as np
 from scipy.optimize import brentq
-from scipy.signal import fftconvolve
 from scipy.spatial import cKDTree
 
 from radtree.hemi.metrics import DEFAULT_GAP_FLOOR, GapTable, RingGrid, lai_lang_xiang, lai_miller
@@ -66,7 +65,9 @@ def cluster_omega(m: float, radius: float, slat: float, g: float) -> float:
     kxx, kyy = np.meshgrid(kx, kx, indexing="ij")
     disc = (kxx * kxx + kyy * kyy <= r_s * r_s).astype(float)
     disc *= area / max(disc.sum() * h * h, 1e-30)      # exact area on the grid
-    p = fftconvolve(f * h * h, disc, mode="same")
+    n = GRID_CELLS + disc.shape[0]           # zero-padded: no wrap-around
+    full = np.fft.irfft2(np.fft.rfft2(f * h * h, (n, n)) * np.fft.rfft2(disc, (n, n)), (n, n))
+    p = full[k:k + GRID_CELLS, k:k + GRID_CELLS]   # "same" part, centred on the cluster
     p *= 1.0 / max(p.sum() * h * h, 1e-30) * area        # ∫p = A
     sigma = float((1.0 - np.exp(-m * p)).sum() * h * h)
     return sigma / (m * area) if m > 0 else 1.0
