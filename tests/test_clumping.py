@@ -20,9 +20,9 @@ def test_cluster_model_limits():
     """Small slats: the Boolean cluster tends to the turbid sphere, Ω(τ) = 3(1 − P)/(2τ) with
     P = 2(1 − (1 + τ)e^−τ)/τ²; Ω = 1 needs no clusters and leaves G untouched."""
     from radtree.trees.clumping import (
+        clumped_g,
         cluster_lad,
         cluster_omega,
-        clumped_g,
         slats_per_cluster,
     )
 

@@ -24,15 +24,19 @@ Clumping (:mod:`radtree.trees.clumping`): with ``louvers.clumping`` Ω < 1 the c
 are grouped in clusters and the model's gap is exp(−u·G·Ω·L) (Ω per direction,
 :func:`~radtree.trees.clumping.clumped_g`), so the fitted u is the *true* density (LAI_true =
 LAI_eff / Ω). With ``louvers.clumping_fit`` Ω is estimated from the photo(s)
-(:func:`fit_omega`): the photo's Lang & Xiang clumping index ``clumping_lx`` — the
-between-segment variance of its gaps — is matched by that of cluster realisations of the
-crown fitted at each Ω of :data:`OMEGA_GRID` (u and x refitted at every Ω, so the model keeps
-reproducing the ring gap fractions), Ω interpolated where the two agree, then u and x fitted
-at that Ω. At the defaults (Ω = 1, no fit) the slats are placed at random and hemi's
-``clumping_lx`` of the photo is only reported beside the fit.
+(:func:`fit_omega`): the photos' Lang & Xiang clumping index — the between-segment variance of
+their log gaps, on a finer grid (:data:`CLUMPING_SEGMENTS` segments, the photos sampled at
+:data:`CAST_SAMPLES` directions per cell) — is matched by that of crowns drawn like the
+generator's and ray-cast along the same directions, at each Ω of :data:`OMEGA_GRID` (u and x
+refitted at every Ω, so the model keeps reproducing the ring gap fractions); Ω is solved on a
+quadratic through that curve, then u and x fitted at it. At the defaults (Ω = 1, no fit) the
+slats are placed at random and hemi's ``clumping_lx`` of the photo is only reported beside
+the fit.
 
-Several photos (``photo`` names a folder, all taken at the same camera point): one joint fit
-over all their cells, plus one fit per photo whose spread (s.d.) is reported.
+Several photos (``photo`` names a folder, all taken at the same camera point): one fit to
+their mean ring × segment gaps (:func:`pooled`: the expected gaps the model predicts — fitting
+each photo's own logarithms biases a clumped crown's fit), plus one fit per photo whose
+spread (s.d.) is reported.
 """
 
 from __future__ import annotations
@@ -422,7 +426,8 @@ def fit_crown(src: PhotoSource, camera: np.ndarray, spec: CrownRowSpec, lv: Louv
                           "crosses a crown within the analysed zenith range: check "
                           "tree.photo_x_m, photo_distance_m, photo_height_m and the crown "
                           "table", field="tree.photo_height_m")
-    omega, curve = lv.clumping, ()
+    omega = lv.clumping
+    curve: tuple[tuple[float, float], ...] = ()
     cluster = (lv.cluster_radius_m, lv.slat_size_m)
     start: tuple[float, float | None] | None = None
     if lv.clumping_fit:
