@@ -89,6 +89,7 @@ class CrownFit:
     clumping_fitted: bool = False
     clumping_lx_model: float = math.nan   # the fitted crown's clumping_lx (cluster draws)
     clumping_curve: tuple[tuple[float, float], ...] = ()   # (Ω, model clumping_lx)
+    clumping_lx_target: float = math.nan   # the photos' clumping_lx on the fit's grid
 
     @property
     def mean_tilt_deg(self) -> float | None:
@@ -117,6 +118,7 @@ class CrownFit:
             return {}
         return {"clumping_omega": self.clumping, "clumping_fitted": self.clumping_fitted,
                 "clumping_lx_model": self.clumping_lx_model,
+                "clumping_lx_photo_fit_grid": self.clumping_lx_target,
                 "clumping_curve": [list(p) for p in self.clumping_curve]}
 
 
@@ -323,10 +325,13 @@ def sampled_gaps(result: HemiResult, paths: CellPaths) -> np.ndarray:
 
 def fit_omega(targets: list[np.ndarray], paths: list[CellPaths], dense: CellPaths,
               photos: list[HemiResult], fixed_deg: float | None, spec: CrownRowSpec,
-              lv: Louvers) -> tuple[float, tuple[float, float | None], tuple[tuple[float, float], ...]]:
+              lv: Louvers
+              ) -> tuple[float, tuple[float, float | None], tuple[tuple[float, float], ...],
+                         float]:
     """Ω from the photos' Lang & Xiang clumping index: (Ω, the (u, x) fitted nearest to it,
-    the curve (Ω, model clumping_lx) over :data:`OMEGA_GRID`). At every Ω the crown is refitted (u, x)
-    and the model's clumping_lx is the mean over :data:`CLUSTER_REALISATIONS` crowns drawn
+    the curve (Ω, model clumping_lx) over :data:`OMEGA_GRID`, stopped two points past the
+    photos' value, and that value on ``dense``'s grid). At every Ω the crown is refitted
+    (u, x) and the model's clumping_lx is the mean over :data:`CLUSTER_REALISATIONS` crowns drawn
     like the generator's (:func:`~radtree.trees.volume.draw_crown_slats`) and ray-cast along
     ``dense``'s sample directions (:func:`~radtree.trees.clumping.cast_slats`); the photos'
     clumping_lx is taken at the same directions (:func:`sampled_gaps`), so both share the
@@ -355,7 +360,7 @@ def fit_omega(targets: list[np.ndarray], paths: list[CellPaths], dense: CellPath
     lx = np.array([c[1] for c in curve])
     ok = np.isfinite(lx)
     if not math.isfinite(target) or ok.sum() < 3:
-        return 1.0, fits[0], tuple(curve)
+        return 1.0, fits[0], tuple(curve), target
     # a quadratic through the noisy curve, made monotone, solved for the photos' value
     fine = np.linspace(om.min(), 1.0, 751)
     smooth = np.maximum.accumulate(np.polyval(np.polyfit(om[ok], lx[ok], 2), fine))
@@ -365,7 +370,7 @@ def fit_omega(targets: list[np.ndarray], paths: list[CellPaths], dense: CellPath
         omega_hat = float(fine[0])
     else:
         omega_hat = float(np.interp(target, smooth, fine))
-    return omega_hat, fits[int(np.argmin(np.abs(om - omega_hat)))], tuple(curve)
+    return omega_hat, fits[int(np.argmin(np.abs(om - omega_hat)))], tuple(curve), target
 
 
 def _fitted_table(lv: Louvers, spec: CrownRowSpec, lad: float, x: float | None,
@@ -428,6 +433,7 @@ def fit_crown(src: PhotoSource, camera: np.ndarray, spec: CrownRowSpec, lv: Louv
                           "table", field="tree.photo_height_m")
     omega = lv.clumping
     curve: tuple[tuple[float, float], ...] = ()
+    lx_target = math.nan
     cluster = (lv.cluster_radius_m, lv.slat_size_m)
     start: tuple[float, float | None] | None = None
     if lv.clumping_fit:
@@ -435,7 +441,8 @@ def fit_crown(src: PhotoSource, camera: np.ndarray, spec: CrownRowSpec, lv: Louv
         dense = cell_paths(results[0], camera, spec, frame, CAST_SAMPLES,
                            RingGrid(g0.rings, CLUMPING_SEGMENTS, g0.zenith_start,
                                     g0.zenith_end))
-        omega, start, curve = fit_omega(targets, paths, dense, results, fixed, spec, lv)
+        omega, start, curve, lx_target = fit_omega(targets, paths, dense, results, fixed,
+                                                   spec, lv)
     mean_t, mean_p = pooled(targets, paths)
     lad, x, _ = _fit(mean_t, mean_p, fixed, omega, start, cluster)
     rms = float(np.sqrt(np.nanmean(np.concatenate([
@@ -455,7 +462,7 @@ def fit_crown(src: PhotoSource, camera: np.ndarray, spec: CrownRowSpec, lv: Louv
     fit = CrownFit(lad, x, crossings, rms, ring_rms,
                    float(np.nanmean([r.metrics.lai_eff for r in results])),
                    float(np.nanmean([r.metrics.clumping_lx for r in results])), per,
-                   omega, lv.clumping_fit, _model_lx(curve, omega), curve)
+                   omega, lv.clumping_fit, _model_lx(curve, omega), curve, lx_target)
     _CACHE[key] = (fit, results)
     return fit, results
 
