@@ -24,6 +24,7 @@ from dataclasses import field
 from pathlib import Path
 from typing import Any
 
+from radtree.config.clumping import CLUMPING_DEFAULTS
 from radtree.config.spec import meta
 
 PHOTO_DIRECTIONS = ("facade", "upward")
@@ -63,7 +64,7 @@ ADDED_DEFAULTS: dict[str, dict[str, Any]] = {
          "photo_x_m": 2.0, "photo_distance_m": 3.0, "photo_height_m": 1.5,
          "photo_zenith_deg": 90.0},
     "perforated": {"seed": 1, "realisations": 1},
-    "louvers": {"inclination_distribution": "fixed", "ellipsoid_x": 1.0},
+    "louvers": {"inclination_distribution": "fixed", "ellipsoid_x": 1.0, **CLUMPING_DEFAULTS},
 }
 
 

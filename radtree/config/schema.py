@@ -15,6 +15,7 @@ from pathlib import Path
 from typing import Any, ClassVar
 
 from radtree.config.bsdf import REPRESENTATIONS, CrownBsdf
+from radtree.config.clumping import clumping_fields
 from radtree.config.honeybee import HoneybeeSite
 from radtree.config.limits import Limits
 from radtree.config.photo import INCLINATION_DISTRIBUTIONS, drop_photo_defaults, photo_fields
@@ -25,6 +26,7 @@ CROWN_MODELS = ("homogeneous", "perforated", "louvers", "none")
 TREE_FORMS = ("dome", "free")
 LOUVER_ARRANGEMENTS = ("layers", "volume")
 _PHOTO = photo_fields()
+_CLUMPING = clumping_fields()
 REFLECTION_MODES = ("traced", "calculated")
 SKY_CHOICES = ("none", "perez")
 #: Presets of the louvers slat optics (the switch ``"louvers.reading"``): the study's reading
@@ -199,6 +201,10 @@ class Louvers(Checked):
     inclination_distribution: str = field(default="fixed", metadata=meta(
         choices=INCLINATION_DISTRIBUTIONS))
     ellipsoid_x: float = field(default=1.0, metadata=meta(0.05, 20.0))
+    # volume slats grouped in clusters of clumping index Ω (radtree.config.clumping)
+    clumping: float = _CLUMPING["clumping"]
+    cluster_radius_m: float = _CLUMPING["cluster_radius_m"]
+    clumping_fit: bool = _CLUMPING["clumping_fit"]
 
     def check(self) -> None:
         if self.reflectance + self.transmittance > 1:

@@ -40,7 +40,8 @@ DEFAULT_SIZE = 1000
 @dataclass
 class Rendering:
     """A rendered fisheye: ``image`` (H × W uint8, 255 sky), its ``geometry``, the photo
-    point (world, m), the photo source and the seconds spent (build, cast)."""
+    point (world, m), the photo source and the seconds spent (build, cast wall; cast_cpu:
+    the process CPU time of the cast, all threads)."""
 
     image: NDArray[np.uint8]
     geometry: FisheyeGeometry
@@ -113,6 +114,7 @@ def render_scenario(project: Project, sc: Scenario, size: int = DEFAULT_SIZE,
     built = make_scene(project, sc, dense_grid=False)
     resolve_form(project, sc)
     t1 = time.perf_counter()
+    c1 = time.process_time()
     meshes = [] if built.tree is None else list(built.tree.meshes)
     verts, faces, off = [], [], 0
     for m in meshes:
@@ -132,7 +134,8 @@ def render_scenario(project: Project, sc: Scenario, size: int = DEFAULT_SIZE,
     box[field.valid] = np.where(sky, 255, 0).astype(np.uint8)
     t2 = time.perf_counter()
     return Rendering(image, geometry, camera, src,
-                     {"build": t1 - t0, "cast": t2 - t1, "triangles": float(off)})
+                     {"build": t1 - t0, "cast": t2 - t1, "triangles": float(off),
+                      "cast_cpu": time.process_time() - c1})
 
 
 def radiance_picture(project: Project, sc: Scenario, hour: str, size: int, out: Any,

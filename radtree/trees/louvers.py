@@ -52,6 +52,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import Any
 
 from radtree.config import LOUVER_ARRANGEMENTS, Louvers, Sensors, Street, Tree
 from radtree.errors import ConfigError
@@ -249,9 +250,8 @@ def build_louvers(tree: Tree, sensors: Sensors, street: Street, frame: FacadeFra
                 f"0–{src.zenith_deg:g}°): leaf area density {fit.lad:.3f} m²/m³, {tilt}; "
                 f"vertical crossings {lv.crossings:.2f}; gap-fraction RMS {fit.rms:.4f} "
                 f"(cells), {fit.ring_rms:.4f} (rings); the photo's LAI_eff "
-                f"{fit.lai_photo:.3f}, clumping {fit.clumping_photo:.3f} (not modelled: the "
-                "slats are placed at random, the density is an effective one)."
-                + _spread_text(fit.spread()))
+                f"{fit.lai_photo:.3f}, clumping {fit.clumping_photo:.3f} "
+                + _clumping_fit_text(fit) + _spread_text(fit.spread()))
         if volume:
             polys, ginfo = build_volume_louvers(spec_r, lv, source)
         else:
@@ -328,6 +328,19 @@ def build_louvers(tree: Tree, sensors: Sensors, street: Street, frame: FacadeFra
     info.update(ginfo)
     return TreeModel(meshes=meshes, materials=materials, notes=notes, recommended_ab=ab,
                      info=info, form=form, model="louvers", photo=photo)
+
+
+def _clumping_fit_text(fit: Any) -> str:
+    """How the fit treated clumping (radtree.trees.clumping), for the notes."""
+    if fit.clumping >= 1.0 and not fit.clumping_fitted:
+        return ("(not modelled: the slats are placed at random, the density is an effective "
+                "one).")
+    how = ("estimated from the photos: their Lang & Xiang clumping matched by cluster "
+           f"realisations of the fitted crown (model {fit.clumping_lx_model:.3f} on the "
+           "fit's 32-segment grid)" if fit.clumping_fitted else "as configured")
+    return (f"(hemi's 8 segments). Slats grouped in clusters, clumping index Ω = "
+            f"{fit.clumping:.3f} {how}; the density is the true one, LAI_true = "
+            "LAI_eff / Ω.")
 
 
 def _spread_text(spread: dict[str, float]) -> str:

@@ -35,6 +35,12 @@ specular transmittance T_s the undeviated (direct) transmission is exp(−λ·(1
 turbid-medium Beer–Lambert law. For the Mendoza crowns (a 5 m, b 4.75 m, s 0.3 m, α 30°) the
 horizontal diameter crosses λ_h = 0.387 · crossings slats, the vertical axis ``crossings``.
 
+Clumping (``louvers.clumping`` Ω < 1). The same slats (same count, sizes, inclinations,
+azimuths) grouped in spherical clusters of radius ``cluster_radius_m`` scattered uniformly at
+random in the crown, each slat uniform in its cluster (:mod:`radtree.trees.clumping`): the
+density ρ stays the true one and a path crosses on average Ω·λ(Ω) slats' worth of cover (the
+λ figures below are for random slats). Ω = 1 draws exactly the unclumped crown.
+
 Ambient bounces. The light that crosses many slats does so mostly as *specular*
 transmission (followed by shadow and specular rays, not ambient bounces); only the diffuse
 share (T_d, R) needs ``-ab``. The recommended ``-ab`` therefore does not grow with the
@@ -56,6 +62,7 @@ import numpy as np
 
 from radtree.config import Louvers
 from radtree.errors import ConfigError
+from radtree.trees.clumping import cluster_lad, clustered_slat_centres
 from radtree.trees.crown_clip import cut_to_share, touches_share, trunk_clash
 from radtree.trees.envelope import CrownRowSpec
 from radtree.trees.leaf_angles import draw_inclinations, mean_projection, mean_tilt, projection_g
@@ -142,22 +149,54 @@ def _slat_corners(centres: np.ndarray, phi: np.ndarray, s: float,
                   alpha: float | np.ndarray) -> np.ndarray:
     """(k, 4, 3) corners of s × s squares, normal inclined ``alpha`` (rad; one or one per
     slat) at azimuth ``phi``, one edge horizontal."""
-    ca = np.broadcast_to(np.cos(alpha), phi.shape)
-    sa = np.broadcast_to(np.sin(alpha), phi.shape)
-    cp, sp = np.cos(phi), np.sin(phi)
-    e1 = np.stack([-sp, cp, np.zeros_like(phi)], axis=1)            # horizontal edge
-    e2 = np.stack([-ca * cp, -ca * sp, sa], axis=1)  # up the slope
+    e1, e2 = slat_edges(phi, alpha)    # horizontal edge, up the slope
     h1 = np.array([-0.5, 0.5, 0.5, -0.5]) * s
     h2 = np.array([-0.5, -0.5, 0.5, 0.5]) * s
     return (centres[:, None, :] + h1[None, :, None] * e1[:, None, :]
             + h2[None, :, None] * e2[:, None, :])
 
 
+def slats_per_crown(spec: CrownRowSpec, lv: Louvers) -> int:
+    """Slats drawn in each crown spheroid: round(ρ · 4/3 π a² b)."""
+    return int(round(volume_density(lv, spec.b) * 4.0 / 3.0 * math.pi * spec.a ** 2 * spec.b))
+
+
+def draw_crown_slats(rng: np.random.Generator, spec: CrownRowSpec, lv: Louvers, ti: int,
+                     per: int) -> tuple[np.ndarray, np.ndarray, float | np.ndarray, int]:
+    """Crown ``ti``'s ``per`` slats before any clipping: centres (local m; in clusters when
+    ``lv.clumping`` < 1, :mod:`radtree.trees.clumping`), normal azimuths φ and inclinations
+    (rad; one for a fixed inclination), and the number of clusters (0 unclumped)."""
+    c = spec.centres[ti]
+    a, b = spec.a, spec.b
+    x, phi = _draw_nested(rng, per)
+    n_cl = 0
+    if lv.clumping < 1.0:   # slats grouped in clusters
+        centres, n_cl = clustered_slat_centres(
+            np.random.default_rng([lv.seed, ti, 11]), x, c, a, b, lv.slat_size_m,
+            lv.clumping, lv.cluster_radius_m)
+    else:
+        centres = c + x * np.array([a, a, b])
+    tilt: float | np.ndarray = math.radians(lv.inclination_deg)
+    if lv.inclination_distribution == "ellipsoidal":
+        tilt = draw_inclinations(np.random.default_rng([lv.seed, ti, 7]), per, lv.ellipsoid_x)
+    return centres, phi, tilt, n_cl
+
+
+def slat_edges(phi: np.ndarray, tilt: float | np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Unit edge vectors (k, 3) of the slats of :func:`_slat_corners`: horizontal, up the
+    slope."""
+    ca = np.broadcast_to(np.cos(tilt), phi.shape)
+    sa = np.broadcast_to(np.sin(tilt), phi.shape)
+    cp, sp = np.cos(phi), np.sin(phi)
+    e1 = np.stack([-sp, cp, np.zeros_like(phi)], axis=1)
+    e2 = np.stack([-ca * cp, -ca * sp, sa], axis=1)
+    return e1, e2
+
+
 def build_volume_louvers(spec: CrownRowSpec, lv: Louvers, source: str | None = None
                          ) -> tuple[list[np.ndarray], dict[str, float]]:
     """Slat polygons (local coordinates) of the volume arrangement and geometry info."""
     s = lv.slat_size_m
-    alpha = math.radians(lv.inclination_deg)
     if mean_cos(lv) < 1e-6:
         raise ConfigError("vertical slats (inclination 90°) give no vertical crossings: the "
                           "volume density is undefined", source=source,
@@ -169,19 +208,15 @@ def build_volume_louvers(spec: CrownRowSpec, lv: Louvers, source: str | None = N
                           "fewer crossings", source=source, field="tree.louvers.slat_size_m")
     rho = volume_density(lv, spec.b)
     a, b = spec.a, spec.b
-    per = int(round(rho * 4.0 / 3.0 * math.pi * a * a * b))
+    per = slats_per_crown(spec, lv)
     polys: list[np.ndarray] = []
-    cut = dropped_trunk = in_crown = 0
+    cut = dropped_trunk = in_crown = clusters = 0
     for ti, child in enumerate(np.random.SeedSequence(lv.seed).spawn(spec.count)):
         rng = np.random.default_rng(child)
         c = spec.centres[ti]
         lo, hi = spec.strips[ti]
-        x, phi = _draw_nested(rng, per)
-        centres = c + x * np.array([a, a, b])
-        tilt: float | np.ndarray = alpha
-        if lv.inclination_distribution == "ellipsoidal":
-            tilt = draw_inclinations(np.random.default_rng([lv.seed, ti, 7]), per,
-                                     lv.ellipsoid_x)
+        centres, phi, tilt, n_cl = draw_crown_slats(rng, spec, lv, ti, per)
+        clusters += n_cl
         corners = _slat_corners(centres, phi, s, tilt)
         rho_plan = np.hypot(centres[:, 0] - c[0], centres[:, 1] - c[1])
         clash = trunk_clash(rho_plan, corners[:, :, 2].min(axis=1), spec, s)
@@ -208,6 +243,10 @@ def build_volume_louvers(spec: CrownRowSpec, lv: Louvers, source: str | None = N
         "lambda_vertical": rho * s * s * g_v * 2.0 * b,
         "lambda_horizontal": rho * s * s * g_h * 2.0 * a,
     }
+    if lv.clumping < 1.0:   # λ above are for random slats; clumped ones cross Ω times as many
+        info.update({"clumping": lv.clumping, "clusters": float(clusters),
+                     "cluster_radius_m": lv.cluster_radius_m,
+                     "cluster_lad_m2_m3": cluster_lad(lv.clumping, lv.cluster_radius_m, s)})
     return polys, info
 
 
@@ -226,7 +265,18 @@ def volume_note(lv: Louvers, info: dict[str, float], slats: int, t_specular: flo
         f"(2b); λ horizontal {info['lambda_horizontal_per_m']:.3f}/m, {lam_h:.2f} through the "
         f"centre (2a). Direct (specular, T_s {t_specular:.3f}) transmission exp(−λ(1 − T_s)): "
         f"vertical {math.exp(-lam_v * (1 - t_specular)):.3g}, horizontal "
-        f"{math.exp(-lam_h * (1 - t_specular)):.3g}.")
+        f"{math.exp(-lam_h * (1 - t_specular)):.3g}." + _clumping_text(info))
+
+
+def _clumping_text(info: dict[str, float]) -> str:
+    """The clusters of clumped slats (louvers.clumping < 1), for the notes."""
+    if "clumping" not in info:
+        return ""
+    return (f" Clumped foliage: the slats grouped in {int(info['clusters'])} spherical "
+            f"clusters of radius {info['cluster_radius_m']:g} m (leaf area density "
+            f"{info['cluster_lad_m2_m3']:.2f} m²/m³ inside a cluster) at random in the crowns, "
+            f"clumping index Ω = {info['clumping']:.3f}: the mean gap along a path is that of "
+            f"random slats at Ω times the density (the λ above are for random slats).")
 
 
 def _tilt_text(lv: Louvers) -> str:
