@@ -3,6 +3,7 @@
 For every sensor and hour (lux, as :mod:`radtree.annual.run`)
 
     E(h) = Σ_g V_g · T_g(state) · D_g(state) · s(h)    sky through the crown
+         + Σ_g V_g · R_g(state) · D'_g(state) · s(h)   sky reflected by the crown
          + V_sky · s(h)                                sky that misses the crown (by-pass)
          + sun(h, state)                               direct and reflected sun
 
@@ -18,6 +19,10 @@ For every sensor and hour (lux, as :mod:`radtree.annual.run`)
   ``D`` holds no crown and serves both states. A free crown is crossed twice (in through the
   far side of its envelope, out through the group): the far side is traced in ``D`` as the
   state's ``BSDF`` material, so a free crown's ``D`` is computed per leaf state;
+* ``R``, ``D'`` — the crown reflects light arriving from the sensors' side (the sky, the
+  street, a façade lit through the crown) back to them: ``R`` is the XML's reflection on that
+  side (:func:`radtree.engines.radiance.threephase.room_reflection_xml`), ``D'`` the group →
+  sky seen from the sensors' side (the crown of the state in the scene), per leaf state;
 * ``s`` — ``gendaymtx -s`` (the Perez sky without its sun), as the default method;
 * ``Σ_g V_g·T_g·D_g`` — ``rmtxop V_g T.xml D_g`` per group (sensors × sky patches), once per
   leaf state; times ``s`` for the 8760 hours in NumPy (``dctimestep``'s product).
@@ -31,10 +36,9 @@ the tree is computed as the default method does (there is no crown to factor out
 
 A second weather file reruns ``gendaymtx`` and the products only (the sun coefficients
 are reused when the sun positions are the same, i.e. the same site); a second leaf state
-reuses ``V`` (and the dome's ``D``). Neglected: light the crown reflects back from its
-sensor side (``V`` ends on the shell; the BSDF's reflection of light arriving from the
-sensors' side, e.g. off the façade, is not applied) — the default method with the same BSDF
-crown includes it.
+reuses ``V`` (and the dome's ``D``). Not ray traced: light crossing the shell is turned
+by the Klems BSDF of its group, whose frame is the group's mean normal (facets within 55°
+of it); the BSDF of a planar periodic sample holds no lateral displacement.
 """
 
 from __future__ import annotations
@@ -206,7 +210,7 @@ class ThreePhase:
         scene = _without_shell(_scene_with(self.bare, self.models["leaf_on"]))  # trunks stay
         octree_text = scene_text(scene, self.rho)
         ambient = self.trace.ambient()
-        key = "|".join([receivers, octree_text, self.points, " ".join(ambient)])
+        key = "|".join(["-I+ -faf", receivers, octree_text, self.points, " ".join(ambient)])
 
         def compute() -> Path:
             t0 = time.perf_counter()
@@ -227,38 +231,45 @@ class ThreePhase:
             files.append(f)
         return files, m[:, len(self.groups) * KLEMS:]
 
-    def daylight(self, state: str) -> list[Path]:
-        """The daylight matrix of every group (the dome's: one for both states)."""
+    def daylight(self, state: str, room_side: bool = False) -> list[Path]:
+        """The daylight matrix of every group: of the light it transmits into the room (the
+        dome's: one for both states), or (``room_side``) of the light arriving at it from
+        the room's side, which it reflects back."""
         with_crown = _scene_with(self.bare, self.models[state])
-        scene = _without_shell(with_crown) if self.inside else with_crown
-        text = scene_text(scene, self.rho) + "".join(
+        own = self.inside and not room_side      # the dome's outward D meets no crown
+        scene = _without_shell(with_crown) if own else with_crown
+        text = scene_text(scene, self.rho) + ("" if own else "".join(
             Path(m.xml).read_text() for m in self.models[state].materials.values()
-            if not self.inside and isinstance(m, Bsdf))
+            if isinstance(m, Bsdf)))
         # rays per Klems patch (-c) carry the sampling: path tracing, 2 rays per bounce
         ambient = ["-ab", str(self.trace.ab), "-ad", "2", "-lw",
                    f"{max(self.trace.lw, D_LW_MIN):g}", "-aa", "0"]
         octree: list[Path] = []
         out = []
         t0 = time.perf_counter()
+        tag = "r" if room_side else "g"
         for k, g in enumerate(self.groups):
-            sender = rad3.sender_text(g.triangles, g.normal)
+            sender = rad3.sender_text(g.triangles, g.normal, room_side)
             key = "|".join([sender, text, " ".join(ambient), str(self.samples), str(self.mf)])
 
             def compute(k: int = k, sender: str = sender) -> Path:
                 if not octree:
                     octree.append(_octree(self.folder, f"daylight_{state}", scene, self.rho))
-                return rad3.daylight_matrix(self.folder, octree[0], f"d{k}", sender, self.mf,
-                                            self.samples, ambient, self.trace.nproc)
+                return rad3.daylight_matrix(self.folder, octree[0], f"{tag}{k}", sender,
+                                            self.mf, self.samples, ambient, self.trace.nproc)
 
-            out.append(self._cached(f"daylight_g{k}", key, compute))
-        self.timing[f"daylight_{state}_s"] = time.perf_counter() - t0
+            out.append(self._cached(f"daylight_{tag}{k}", key, compute))
+        name = f"daylight_{'room_' if room_side else ''}{state}_s"
+        self.timing[name] = time.perf_counter() - t0
         if octree:
-            self.echo(f"    rfluxmtx daylight matrices ({state}): {len(self.groups)} groups, "
-                      f"-c {self.samples}, {self.timing[f'daylight_{state}_s']:.0f} s")
+            self.echo(f"    rfluxmtx daylight matrices ({state}{', room side' if room_side else ''}"
+                      f"): {len(self.groups)} groups, -c {self.samples}, "
+                      f"{self.timing[name]:.0f} s")
         return out
 
-    def transmission(self, state: str) -> list[Path]:
-        """T of every group: its band's XML (turned for free crowns)."""
+    def transmission(self, state: str, reflection: bool = False) -> list[Path]:
+        """T of every group: its band's XML (turned for free crowns); ``reflection``: the
+        XML of its reflection back into the room."""
         mats = self.models[state].materials
         out = []
         for g in self.groups:
@@ -267,17 +278,22 @@ class ThreePhase:
             xml = Path(mat.xml)
             if not self.inside:
                 xml = rad3.turned_xml(xml, self.folder / f"{state}_{g.material}_turned.xml")
+            if reflection:
+                xml = rad3.room_reflection_xml(xml, self.folder /
+                                               f"{state}_{g.material}_room_reflection.xml")
             out.append(xml)
         return out
 
     def coefficients(self, state: str, views: list[Path], v_sky: np.ndarray) -> np.ndarray:
         """(sensors, patches, 3) daylight coefficients of the state: Σ_g V_g·T_g·D_g
-        (``rmtxop``) + V_sky."""
-        days = self.daylight(state)
+        + Σ_g V_g·R_g·D'_g (``rmtxop``) + V_sky."""
+        days, back = self.daylight(state), self.daylight(state, room_side=True)
         t0 = time.perf_counter()
         dc = v_sky.astype(np.float64)
         for v, t, d in zip(views, self.transmission(state), days):
             dc = dc + rad3.multiply(v, t, d)
+        for v, r, d in zip(views, self.transmission(state, reflection=True), back):
+            dc = dc + rad3.multiply(v, r, d)
         self.timing[f"rmtxop_{state}_s"] = time.perf_counter() - t0
         return dc.astype(np.float32)
 

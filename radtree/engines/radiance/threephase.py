@@ -36,6 +36,8 @@ from radtree.fileio import write_text
 
 #: a daylight-matrix sender sits this far behind its facets (on the shell's far side)
 SENDER_OFFSET_M = 0.002
+_REFLECT = {"Reflection Back": "Transmission Front", "Reflection Front": "Transmission Back",
+            "Transmission Front": "Reflection Back", "Transmission Back": "Reflection Front"}
 _SWAP = {"Transmission Front": "Transmission Back", "Transmission Back": "Transmission Front",
          "Reflection Front": "Reflection Back", "Reflection Back": "Reflection Front"}
 
@@ -72,12 +74,15 @@ def group_receivers_text(groups: list[tuple[np.ndarray, np.ndarray]]) -> str:
     return "\n".join(out)
 
 
-def sender_text(triangles: np.ndarray, normal: np.ndarray) -> str:
+def sender_text(triangles: np.ndarray, normal: np.ndarray, room_side: bool = False) -> str:
     """The daylight-matrix sender of one group: its facets moved :data:`SENDER_OFFSET_M`
-    away from the room, ``h=-kf`` (rays leave away from the room)."""
+    away from the room, ``h=-kf`` (rays leave away from the room: the light the group
+    transmits); ``room_side``: moved towards the room, ``h=+kf`` (rays leave into the room:
+    the light the group reflects back into it)."""
     n = np.asarray(normal, float)
-    moved = np.asarray(triangles, float) - SENDER_OFFSET_M * n
-    return f"#@rfluxmtx h=-kf u={default_up(n)}\n\n" + _polygons("void", "tp_sender", moved)
+    sign, hemi = (1.0, "+kf") if room_side else (-1.0, "-kf")
+    moved = np.asarray(triangles, float) + sign * SENDER_OFFSET_M * n
+    return f"#@rfluxmtx h={hemi} u={default_up(n)}\n\n" + _polygons("void", "tp_sender", moved)
 
 
 def read_matrix(data: bytes, what: str) -> np.ndarray:
@@ -99,10 +104,11 @@ def read_matrix(data: bytes, what: str) -> np.ndarray:
 
 def view_matrix(folder: Path, octree: Path, points: str, n_points: int,
                 receivers: str, ambient: list[str], nproc: int) -> np.ndarray:
-    """(sensors, columns, 3) ``V``: sensor points → the receivers of ``receivers`` text."""
+    """(sensors, columns, 3) ``V``: sensor points (ASCII, ``-faf``) → the receivers of
+    ``receivers`` text."""
     rec = folder / "view_receivers.rad"
     write_text(rec, receivers)
-    cmd = ["rfluxmtx", "-I+", "-y", str(n_points), "-ff", "-n", str(nproc), *ambient, "-",
+    cmd = ["rfluxmtx", "-I+", "-y", str(n_points), "-faf", "-n", str(nproc), *ambient, "-",
            str(rec), "-i", str(octree)]
     return read_matrix(run(cmd, stdin=points.encode(), cwd=folder), "rfluxmtx (view)")
 
@@ -150,11 +156,21 @@ def multiply(view: Path, xml: Path, daylight: Path) -> np.ndarray:
     return read_matrix(run(cmd), "rmtxop")
 
 
+def _relabel(xml: Path, dest: Path, mapping: dict[str, str]) -> Path:
+    text = Path(xml).read_text()
+    pattern = re.compile(r"(<WavelengthDataDirection>)\s*(" + "|".join(mapping) + r")\s*(<)")
+    write_text(dest, pattern.sub(lambda m: m.group(1) + mapping[m.group(2)] + m.group(3), text))
+    return dest
+
+
 def turned_xml(xml: Path, dest: Path) -> Path:
     """``xml`` with its front and back data blocks swapped (the same layer, light crossing it
     the other way): for light leaving a closed crown from the inside."""
-    text = Path(xml).read_text()
-    pattern = re.compile(r"(<WavelengthDataDirection>)\s*(" + "|".join(_SWAP) + r")\s*(<)")
-    turned = pattern.sub(lambda m: m.group(1) + _SWAP[m.group(2)] + m.group(3), text)
-    write_text(dest, turned)
-    return dest
+    return _relabel(xml, dest, _SWAP)
+
+
+def room_reflection_xml(xml: Path, dest: Path) -> Path:
+    """``xml`` (front = away from the room, back = the room's side) relabelled so that its
+    "Transmission Front" block — what rmtxop/dctimestep read — holds its "Reflection Back":
+    the layer's reflection of light arriving from the room's side back into it."""
+    return _relabel(xml, dest, _REFLECT)
