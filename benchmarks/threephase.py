@@ -36,8 +36,9 @@ import pandas as pd
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
+from radtree.annual.methods import compute as compute_annual  # noqa: E402
 from radtree.annual.report import summarise  # noqa: E402
-from radtree.annual.run import AnnualOptions, AnnualResult, annual_tables, compute_annual  # noqa: E402
+from radtree.annual.run import AnnualOptions, AnnualResult, annual_tables  # noqa: E402
 from radtree.config import load_project  # noqa: E402
 
 COLUMNS = ["sda_300_50", "udi_below_100", "udi_100_300", "udi_300_3000", "udi_above_3000"]

@@ -84,7 +84,8 @@ def project_dir(tmp_path_factory) -> Path:
 @pytest.fixture(scope="module")
 def runs(project_dir):
     """The three-phase year, then again with another leaf schedule (all matrices cached)."""
-    from radtree.annual.run import AnnualOptions, compute_annual
+    from radtree.annual.methods import compute as compute_annual
+    from radtree.annual.run import AnnualOptions
     from radtree.annual.schedule import LeafSchedule
     from radtree.config import load_project
 
@@ -181,13 +182,13 @@ def test_turned_xml_swaps_front_and_back(runs, tmp_path):
 def test_facet_groups_face_the_sensors():
     """Free crowns: facets wound outwards (away from the crown centre, to the sensors);
     the 14 group directions; each facet within 55° of its group's normal."""
+    import trimesh
+
     from radtree.annual.threephase import facet_groups
     from radtree.optics import Bsdf
     from radtree.scene import Mesh
     from radtree.trees.bsdf_shell import BSDF_SHELL, inward
     from radtree.trees.model import TreeModel
-
-    import trimesh
 
     sphere = trimesh.creation.icosphere(subdivisions=2, radius=2.0)
     v = np.asarray(sphere.vertices) + [0.0, 5.0, 6.0]

@@ -287,10 +287,9 @@ def compute_annual(project: Project, options: AnnualOptions | None = None,
                    ) -> AnnualResult:
     """Trace the three scenes and assemble 8760 hours of illuminance per sensor."""
     options = options or AnnualOptions()
-    if options.method == "3phase":
-        from radtree.annual.threephase import compute_annual_3phase
-
-        return compute_annual_3phase(project, options, echo)
+    if options.method != "dc":
+        raise ConfigError(f"compute_annual is the 'dc' method; for {options.method!r} use "
+                          "radtree.annual.methods.compute")
     timing: dict[str, float] = {}
     t0 = time.perf_counter()
     with_sc, without_sc, notes = choose_scenarios(project, options)

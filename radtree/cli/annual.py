@@ -60,7 +60,8 @@ def annual_command(project: Path, leaf_on: str, leaf_off: str, mf: int, sun_mf: 
     Writes PROJECT/results/annual.csv, annual_summary.csv, annual_monthly.csv and
     results/annual/ (hourly arrays, coefficients, figures).
     """
-    from radtree.annual.run import AnnualOptions, run_annual
+    from radtree.annual.methods import run as run_annual
+    from radtree.annual.run import AnnualOptions
     from radtree.config import load_project
 
     proj = load_project(project)
