@@ -79,12 +79,60 @@ def second_weather(epw: Path, dest: Path) -> Path:
     return dest
 
 
+def same_crown(project_dir: Path, overrides: dict, r3: AnnualResult) -> AnnualResult:
+    """The 3-phase year with its sky part replaced by the default method's rcontrib sky
+    coefficients traced on the same BSDF-crown scenes (both leaf states; the sun terms are
+    the same runs in both): the matrices' own error, without the crown's representation."""
+    from dataclasses import replace
+
+    from radtree.annual.coefficients import CoefficientRunner
+    from radtree.annual.phenology import crown_year, phenology_of
+    from radtree.annual.skymatrix import sky_matrix
+    from radtree.annual.threephase import (
+        STATES,
+        ThreePhase,
+        _scene_with,
+        crown_models,
+        sky_lux,
+        state_xmls,
+    )
+    from radtree.pipeline.assemble import make_scene
+
+    project = load_project(project_dir, overrides=overrides)
+    sc = project.scenario(r3.scenarios["with"])
+    models, form = crown_models(project, sc, state_xmls(project, sc, print))
+    bare = make_scene(project, replace(sc, model="none"), dense_grid=False).scene
+    grids, rho, mf = list(r3.grids), r3.ground_reflectance, r3.options.mf
+    sky = sky_matrix(r3.wea, mf, rho)
+    work = project.results_dir / "annual" / "threephase"
+    tp = ThreePhase(work, bare, models, form, grids, rho, mf, r3.trace, print,
+                    r3.options.daylight_samples)
+    views, v_sky = tp.view()
+    total = {k: dict(v) for k, v in r3.total.items()}
+    direct = {k: dict(v) for k, v in r3.direct.items()}
+    for state in STATES:
+        runner = CoefficientRunner(_scene_with(bare, models[state]), grids,
+                                   work / f"sun_{state}", rho, echo=print)
+        diff = sky_lux(runner.sky(mf, r3.trace), sky) - sky_lux(
+            tp.coefficients(state, views, v_sky), sky)
+        start = 0
+        for g in grids:
+            n = len(r3.grids[g]["points"])
+            total[state][g] = (r3.total[state][g] + diff[start:start + n]).astype(np.float32)
+            start += n
+    crown_year(total, direct, grids, r3.wea, r3.options.leaf,
+               phenology_of(project, r3.options.species_phenology))
+    return replace(r3, total=total, direct=direct)
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--work", type=Path, default=Path("/tmp/threephase_bench"))
     ap.add_argument("--samples", type=int, default=200, help="tree.bsdf.samples")
     ap.add_argument("--daylight-samples", type=int, default=400, help="rfluxmtx -c of D")
     ap.add_argument("-j", "--processes", type=int, default=2)
+    ap.add_argument("--same-crown", action="store_true",
+                    help="also trace rcontrib sky coefficients on the 3-phase BSDF crowns")
     args = ap.parse_args()
     src = ROOT / "examples" / "office-block"
     args.work.mkdir(parents=True, exist_ok=True)
@@ -110,6 +158,11 @@ def main() -> None:
         again[m] = timed(dirs[m], opts, over)
 
     pd.set_option("display.width", 200)
+    if args.same_crown:
+        ref = same_crown(dirs["3phase"], over, runs["3phase"][0])
+        a, b = figures(ref), figures(runs["3phase"][0])
+        print("\nsame BSDF crown: rcontrib sky | 3-phase sky | difference (percentage points)")
+        print(pd.concat({"rcontrib": a, "3phase": b, "diff_pp": b - a}, axis=1).round(1))
     for label, pair in (("project weather", runs), ("second weather file", again)):
         a, b = figures(pair["dc"][0]), figures(pair["3phase"][0])
         print(f"\n{label}: dc | 3phase | 3phase − dc (percentage points)")
