@@ -133,37 +133,46 @@ def main() -> None:
     ap.add_argument("-j", "--processes", type=int, default=2)
     ap.add_argument("--same-crown", action="store_true",
                     help="also trace rcontrib sky coefficients on the 3-phase BSDF crowns")
+    ap.add_argument("--methods", default="dc,3phase", help="comma-separated: dc, 3phase")
     args = ap.parse_args()
+    methods = [m for m in ("dc", "3phase") if m in args.methods.split(",")]
     src = ROOT / "examples" / "office-block"
     args.work.mkdir(parents=True, exist_ok=True)
     dirs = {}
-    for m in ("dc", "3phase"):
+    for m in methods:
         dirs[m] = args.work / m
         if not dirs[m].exists():
             shutil.copytree(src, dirs[m], ignore=shutil.ignore_patterns("build", "results"))
     over = {"tree.bsdf.samples": args.samples}
     print(f"three-phase benchmark on {src} → {args.work}; load {os.getloadavg()}")
     runs: dict[str, tuple[AnnualResult, float, float]] = {}
-    for m in ("dc", "3phase"):
+    for m in methods:
         print(f"\n== {m}", flush=True)
         opts = AnnualOptions(nproc=args.processes, method=m,
                              daylight_samples=args.daylight_samples)
         runs[m] = timed(dirs[m], opts, over)
-    epw2 = second_weather(runs["dc"][0].weather.path, args.work / "second_weather.epw")
+    epw2 = second_weather(runs[methods[0]][0].weather.path, args.work / "second_weather.epw")
     again: dict[str, tuple[AnnualResult, float, float]] = {}
-    for m in ("dc", "3phase"):
+    for m in methods:
         print(f"\n== {m}, second weather file", flush=True)
         opts = AnnualOptions(nproc=args.processes, method=m, epw=epw2,
                              daylight_samples=args.daylight_samples)
         again[m] = timed(dirs[m], opts, over)
 
-    pd.set_option("display.width", 200)
-    if args.same_crown:
+    pd.set_option("display.width", 250)
+    pd.set_option("display.max_columns", None)
+    for label, pair in (("project weather", runs), ("second weather file", again)):
+        for m, (r, _, _) in pair.items():
+            print(f"\n{label}, {m}:")
+            print(figures(r).round(1))
+    if args.same_crown and "3phase" in runs:
         ref = same_crown(dirs["3phase"], over, runs["3phase"][0])
         a, b = figures(ref), figures(runs["3phase"][0])
         print("\nsame BSDF crown: rcontrib sky | 3-phase sky | difference (percentage points)")
         print(pd.concat({"rcontrib": a, "3phase": b, "diff_pp": b - a}, axis=1).round(1))
     for label, pair in (("project weather", runs), ("second weather file", again)):
+        if len(pair) < 2:
+            continue
         a, b = figures(pair["dc"][0]), figures(pair["3phase"][0])
         print(f"\n{label}: dc | 3phase | 3phase − dc (percentage points)")
         print(pd.concat({"dc": a, "3phase": b, "diff_pp": b - a}, axis=1).round(1))
@@ -176,13 +185,17 @@ def main() -> None:
             print(f"{label:20s} {m:7s} wall {wall:8.1f} s, CPU {cpu:8.1f} s")
             for k, v in r.timing.items():
                 print(f"    {k:32s} {v:8.1f} s")
-    t3 = runs["3phase"][0].timing
-    print("\nsecond leaf state: dc (rcontrib of the bare-branch scene) "
-          f"{runs['dc'][0].timing.get('leaf_off_s', float('nan')):.1f} s; 3-phase: daylight "
-          f"matrices {t3.get('3phase_daylight_leaf_off_s', 0.0):.1f} s + rmtxop "
-          f"{t3.get('3phase_rmtxop_leaf_off_s', 0.0):.1f} s + sky product "
-          f"{t3.get('leaf_off_sky_product_s', 0.0):.1f} s (+ its sun runs: leaf_off_s "
-          f"{t3.get('leaf_off_s', 0.0):.1f} s in all)")
+    if "dc" in runs:
+        print("\nsecond leaf state, dc: rcontrib of the bare-branch scene "
+              f"{runs['dc'][0].timing.get('leaf_off_s', float('nan')):.1f} s")
+    if "3phase" in runs:
+        t3 = runs["3phase"][0].timing
+        print("second leaf state, 3-phase: daylight matrices "
+              f"{t3.get('3phase_daylight_leaf_off_s', 0.0):.1f} s + room side "
+              f"{t3.get('3phase_daylight_room_leaf_off_s', 0.0):.1f} s + rmtxop "
+              f"{t3.get('3phase_rmtxop_leaf_off_s', 0.0):.1f} s + sky product "
+              f"{t3.get('leaf_off_sky_product_s', 0.0):.1f} s (with its sun runs "
+              f"{t3.get('leaf_off_s', 0.0):.1f} s)")
 
 
 if __name__ == "__main__":
