@@ -10,6 +10,8 @@
 * :mod:`~radtree.annual.branches` — the leaf-off crown (opaque branches at 40°);
 * :mod:`~radtree.annual.metrics` — UDI, DA, sDA, ASE;
 * :mod:`~radtree.annual.run` — the run (:func:`run_annual`) and its tables;
+* :mod:`~radtree.annual.threephase` — the three-phase method (view matrix · crown BSDF ·
+  daylight matrix · sky), ``--method 3phase``; :mod:`~radtree.annual.methods` picks the method;
 * :mod:`~radtree.annual.report` — figures and :func:`annual_section_data`.
 
 The command is :mod:`radtree.cli.annual`.

@@ -171,8 +171,11 @@ def _img(path: Path, alt: str) -> dict[str, str | None]:
 def grid_summary(project: Project) -> pd.DataFrame:
     """Per grid and tree: sDA, ASE and the mean UDI bins / DA over the sensors."""
     p = _paths(project)
-    annual = pd.read_csv(p["annual"])
-    summary = pd.read_csv(p["summary"])
+    return summarise(pd.read_csv(p["annual"]), pd.read_csv(p["summary"]))
+
+
+def summarise(annual: pd.DataFrame, summary: pd.DataFrame) -> pd.DataFrame:
+    """:func:`grid_summary` of the tables of :func:`radtree.annual.run.annual_tables`."""
     means = annual.groupby(["grid", "tree"], sort=False)[
         ["udi_below_100", "udi_100_300", "udi_300_3000", "udi_above_3000", "da_300",
          "ase_hours"]].mean().reset_index()

@@ -90,6 +90,7 @@ METHOD_NOTES = [
     "office work plane within ≈ 2–7 % of rcontrib with the exact sun (benchmarks/annual.py); "
     "the direct sun (ASE) is exact for every hour.",
 ]
+METHODS = ("dc", "3phase")
 MONTHLY_COLUMNS = ["grid", "tree", "month", "mean_lux", "mean_direct_lux", "leaf_on_days",
                    "days", "crown"]
 
@@ -116,8 +117,14 @@ class AnnualOptions:
     #: with ``[tree] species``: the crown of each hour from the species' phenology
     #: (:mod:`radtree.annual.phenology`) instead of the ``leaf`` dates (False: the dates)
     species_phenology: bool = True
+    #: "dc" (daylight coefficients, the default) or "3phase" (:mod:`radtree.annual.threephase`)
+    method: str = "dc"
+    #: 3phase: rays per Klems patch of each daylight matrix (rfluxmtx -c)
+    daylight_samples: int = 400
 
     def __post_init__(self) -> None:
+        if self.method not in METHODS:
+            raise ConfigError(f"unknown annual method {self.method!r} (have: {', '.join(METHODS)})")
         if self.mf < 1 or self.sun_mf < 1:
             raise ConfigError(f"sky subdivision must be ≥ 1 (got --mf {self.mf}, "
                               f"sun MF {self.sun_mf})")
@@ -280,6 +287,9 @@ def compute_annual(project: Project, options: AnnualOptions | None = None,
                    ) -> AnnualResult:
     """Trace the three scenes and assemble 8760 hours of illuminance per sensor."""
     options = options or AnnualOptions()
+    if options.method != "dc":
+        raise ConfigError(f"compute_annual is the 'dc' method; for {options.method!r} use "
+                          "radtree.annual.methods.compute")
     timing: dict[str, float] = {}
     t0 = time.perf_counter()
     with_sc, without_sc, notes = choose_scenarios(project, options)
@@ -455,7 +465,7 @@ def write_annual(result: AnnualResult, figures: bool = True) -> AnnualOutcome:
         "leaf_on": o.leaf.leaf_on, "leaf_off": o.leaf.leaf_off,
         "leaf_days": o.leaf.leaf_days(),
         "occupancy": list(o.occupancy), "occupied_hours": int(result.occupied.sum()),
-        "sky_mf": o.mf, "sun_mf": o.sun_mf,
+        "sky_mf": o.mf, "sun_mf": o.sun_mf, "method": o.method,
         "rcontrib": {"ab": result.trace.ab, "ad": result.trace.ad, "lw": result.trace.lw,
                      "sun_ad": result.sun_trace.ad, "sun_lw": result.sun_trace.lw,
                      "processes": result.trace.nproc},

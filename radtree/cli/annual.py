@@ -43,11 +43,14 @@ from radtree.cli.options import CONTEXT, writes
 @click.option("--dates", "use_dates", is_flag=True,
               help="With [tree] species: use the --leaf-on/--leaf-off switch instead of the "
                    "species' hourly phenology (leaf area ramps).")
+@click.option("--method", type=click.Choice(["dc", "3phase"]), default="dc", show_default=True,
+              help="dc: daylight coefficients of the explicit crown; 3phase: view matrix · "
+                   "crown BSDF (leaf-on/off) · daylight matrix · sky (rfluxmtx, dctimestep).")
 def annual_command(project: Path, leaf_on: str, leaf_off: str, mf: int, sun_mf: int,
                    occupancy: str, epw: Path | None, with_scenario: str | None,
                    without_scenario: str | None, ab: int | None, ad: int | None,
                    lw: float | None, processes: int, no_figures: bool,
-                   use_dates: bool = False) -> None:
+                   use_dates: bool = False, method: str = "dc") -> None:
     """Annual daylight (8760 h) with a deciduous tree: UDI, DA, sDA, ASE, monthly means.
 
     The crown is in leaf from --leaf-on to --leaf-off; with ``[tree] species`` each hour
@@ -57,7 +60,8 @@ def annual_command(project: Path, leaf_on: str, leaf_off: str, mf: int, sun_mf: 
     Writes PROJECT/results/annual.csv, annual_summary.csv, annual_monthly.csv and
     results/annual/ (hourly arrays, coefficients, figures).
     """
-    from radtree.annual.run import AnnualOptions, run_annual
+    from radtree.annual.methods import run as run_annual
+    from radtree.annual.run import AnnualOptions
     from radtree.config import load_project
 
     proj = load_project(project)
@@ -65,7 +69,7 @@ def annual_command(project: Path, leaf_on: str, leaf_off: str, mf: int, sun_mf: 
         leaf=LeafSchedule(leaf_on, leaf_off), mf=mf, sun_mf=sun_mf,
         occupancy=parse_occupancy(occupancy), ab=ab, ad=ad, lw=lw, nproc=processes,
         with_scenario=with_scenario, without_scenario=without_scenario, epw=epw,
-        species_phenology=not use_dates)
+        species_phenology=not use_dates, method=method)
     click.echo(f"annual: {proj.name}")
     out = run_annual(proj, options, echo=click.echo, progress=True,
                      figures=not no_figures)

@@ -1,0 +1,202 @@
+"""Three-phase annual against the default annual (daylight coefficients) on the office example.
+
+Copies ``examples/office-block`` twice into ``--work`` (kept, so a rerun reuses the crown BSDFs
+and every cached matrix: pass a fresh folder to time from scratch), runs
+
+1. ``radtree annual`` (``--method dc``: rcontrib daylight coefficients of the explicit slat
+   crown, leaf-on and bare-branch scenes);
+2. ``radtree annual --method 3phase`` (crown BSDFs leaf-on/off with ``tree.bsdf.samples``
+   rays per Klems patch, view matrix, daylight matrices, rmtxop; the sun as the default method
+   on the BSDF-crown scenes);
+3. both again with a second weather file (the project's EPW with its direct normal
+   irradiance × 0.6 and its diffuse × 1.4, written to ``--work``): what a second weather file
+   costs each method once its coefficients/matrices exist;
+
+and prints, per grid, sDA300/50 and the UDI bands of both methods (with the tree: leaf-on or
+bare by the schedule; and without), their differences in percentage points, the wall and CPU
+times and the cost of the second leaf state (3-phase: its daylight matrices, rmtxop and the
+sun runs on the bare BSDF crown; dc: the rcontrib runs of the bare-branch scene).
+
+Run: ``nice .venv/bin/python benchmarks/threephase.py [--work DIR] [--samples 200] [-j 2]``.
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import resource
+import shutil
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT))
+
+from radtree.annual.methods import compute as compute_annual  # noqa: E402
+from radtree.annual.report import summarise  # noqa: E402
+from radtree.annual.run import AnnualOptions, AnnualResult, annual_tables  # noqa: E402
+from radtree.config import load_project  # noqa: E402
+
+COLUMNS = ["sda_300_50", "udi_below_100", "udi_100_300", "udi_300_3000", "udi_above_3000"]
+
+
+def cpu_seconds() -> float:
+    """User + system CPU of this process and its finished children (Radiance programs)."""
+    own = resource.getrusage(resource.RUSAGE_SELF)
+    kids = resource.getrusage(resource.RUSAGE_CHILDREN)
+    return own.ru_utime + own.ru_stime + kids.ru_utime + kids.ru_stime
+
+
+def timed(project_dir: Path, options: AnnualOptions, overrides: dict | None = None
+          ) -> tuple[AnnualResult, float, float]:
+    project = load_project(project_dir, overrides=overrides)
+    t0, c0 = time.perf_counter(), cpu_seconds()
+    result = compute_annual(project, options, echo=lambda s: print(s, flush=True))
+    return result, time.perf_counter() - t0, cpu_seconds() - c0
+
+
+def figures(result: AnnualResult) -> pd.DataFrame:
+    annual, summary, _ = annual_tables(result)
+    return summarise(annual, summary).set_index(["grid", "tree"])[COLUMNS]
+
+
+def second_weather(epw: Path, dest: Path) -> Path:
+    """The EPW with DNI (field 15) × 0.6 and DHI (field 16) × 1.4 (epw2wea reads these two):
+    a cloudier year at the same site, so the same sun positions."""
+    lines = epw.read_text().splitlines()
+    out = lines[:8]
+    for line in lines[8:]:
+        f = line.split(",")
+        if len(f) > 16:
+            dni, dhi = float(f[14]) * 0.6, float(f[15]) * 1.4
+            f[14], f[15] = f"{dni:.0f}", f"{dhi:.0f}"
+        out.append(",".join(f))
+    dest.write_text("\n".join(out) + "\n")
+    return dest
+
+
+def same_crown(project_dir: Path, overrides: dict, r3: AnnualResult) -> AnnualResult:
+    """The 3-phase year with its sky part replaced by the default method's rcontrib sky
+    coefficients traced on the same BSDF-crown scenes (both leaf states; the sun terms are
+    the same runs in both): the matrices' own error, without the crown's representation."""
+    from dataclasses import replace
+
+    from radtree.annual.coefficients import CoefficientRunner
+    from radtree.annual.phenology import crown_year, phenology_of
+    from radtree.annual.skymatrix import sky_matrix
+    from radtree.annual.threephase import (
+        STATES,
+        ThreePhase,
+        _scene_with,
+        crown_models,
+        sky_lux,
+        state_xmls,
+    )
+    from radtree.pipeline.assemble import make_scene
+
+    project = load_project(project_dir, overrides=overrides)
+    sc = project.scenario(r3.scenarios["with"])
+    models, form = crown_models(project, sc, state_xmls(project, sc, print))
+    bare = make_scene(project, replace(sc, model="none"), dense_grid=False).scene
+    grids, rho, mf = list(r3.grids), r3.ground_reflectance, r3.options.mf
+    sky = sky_matrix(r3.wea, mf, rho)
+    work = project.results_dir / "annual" / "threephase"
+    tp = ThreePhase(work, bare, models, form, grids, rho, mf, r3.trace, print,
+                    r3.options.daylight_samples)
+    views, v_sky = tp.view()
+    total = {k: dict(v) for k, v in r3.total.items()}
+    direct = {k: dict(v) for k, v in r3.direct.items()}
+    for state in STATES:
+        runner = CoefficientRunner(_scene_with(bare, models[state]), grids,
+                                   work / f"sun_{state}", rho, echo=print)
+        diff = sky_lux(runner.sky(mf, r3.trace), sky) - sky_lux(
+            tp.coefficients(state, views, v_sky), sky)
+        start = 0
+        for g in grids:
+            n = len(r3.grids[g]["points"])
+            total[state][g] = (r3.total[state][g] + diff[start:start + n]).astype(np.float32)
+            start += n
+    crown_year(total, direct, grids, r3.wea, r3.options.leaf,
+               phenology_of(project, r3.options.species_phenology))
+    return replace(r3, total=total, direct=direct)
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("--work", type=Path, default=Path("/tmp/threephase_bench"))
+    ap.add_argument("--samples", type=int, default=200, help="tree.bsdf.samples")
+    ap.add_argument("--daylight-samples", type=int, default=400, help="rfluxmtx -c of D")
+    ap.add_argument("-j", "--processes", type=int, default=2)
+    ap.add_argument("--same-crown", action="store_true",
+                    help="also trace rcontrib sky coefficients on the 3-phase BSDF crowns")
+    ap.add_argument("--methods", default="dc,3phase", help="comma-separated: dc, 3phase")
+    args = ap.parse_args()
+    methods = [m for m in ("dc", "3phase") if m in args.methods.split(",")]
+    src = ROOT / "examples" / "office-block"
+    args.work.mkdir(parents=True, exist_ok=True)
+    dirs = {}
+    for m in methods:
+        dirs[m] = args.work / m
+        if not dirs[m].exists():
+            shutil.copytree(src, dirs[m], ignore=shutil.ignore_patterns("build", "results"))
+    over = {"tree.bsdf.samples": args.samples}
+    print(f"three-phase benchmark on {src} → {args.work}; load {os.getloadavg()}")
+    runs: dict[str, tuple[AnnualResult, float, float]] = {}
+    for m in methods:
+        print(f"\n== {m}", flush=True)
+        opts = AnnualOptions(nproc=args.processes, method=m,
+                             daylight_samples=args.daylight_samples)
+        runs[m] = timed(dirs[m], opts, over)
+    epw2 = second_weather(runs[methods[0]][0].weather.path, args.work / "second_weather.epw")
+    again: dict[str, tuple[AnnualResult, float, float]] = {}
+    for m in methods:
+        print(f"\n== {m}, second weather file", flush=True)
+        opts = AnnualOptions(nproc=args.processes, method=m, epw=epw2,
+                             daylight_samples=args.daylight_samples)
+        again[m] = timed(dirs[m], opts, over)
+
+    pd.set_option("display.width", 250)
+    pd.set_option("display.max_columns", None)
+    for label, pair in (("project weather", runs), ("second weather file", again)):
+        for m, (r, _, _) in pair.items():
+            print(f"\n{label}, {m}:")
+            print(figures(r).round(1))
+    if args.same_crown and "3phase" in runs:
+        ref = same_crown(dirs["3phase"], over, runs["3phase"][0])
+        a, b = figures(ref), figures(runs["3phase"][0])
+        print("\nsame BSDF crown: rcontrib sky | 3-phase sky | difference (percentage points)")
+        print(pd.concat({"rcontrib": a, "3phase": b, "diff_pp": b - a}, axis=1).round(1))
+    for label, pair in (("project weather", runs), ("second weather file", again)):
+        if len(pair) < 2:
+            continue
+        a, b = figures(pair["dc"][0]), figures(pair["3phase"][0])
+        print(f"\n{label}: dc | 3phase | 3phase − dc (percentage points)")
+        print(pd.concat({"dc": a, "3phase": b, "diff_pp": b - a}, axis=1).round(1))
+        print("largest |difference|: "
+              + ", ".join(f"{g}/{t} {float(np.abs((b - a).loc[(g, t)]).max()):.1f} pp"
+                          for g, t in a.index))
+    print(f"\nload now {os.getloadavg()}")
+    for label, pair in (("project weather", runs), ("second weather file", again)):
+        for m, (r, wall, cpu) in pair.items():
+            print(f"{label:20s} {m:7s} wall {wall:8.1f} s, CPU {cpu:8.1f} s")
+            for k, v in r.timing.items():
+                print(f"    {k:32s} {v:8.1f} s")
+    if "dc" in runs:
+        print("\nsecond leaf state, dc: rcontrib of the bare-branch scene "
+              f"{runs['dc'][0].timing.get('leaf_off_s', float('nan')):.1f} s")
+    if "3phase" in runs:
+        t3 = runs["3phase"][0].timing
+        print("second leaf state, 3-phase: daylight matrices "
+              f"{t3.get('3phase_daylight_leaf_off_s', 0.0):.1f} s + room side "
+              f"{t3.get('3phase_daylight_room_leaf_off_s', 0.0):.1f} s + rmtxop "
+              f"{t3.get('3phase_rmtxop_leaf_off_s', 0.0):.1f} s + sky product "
+              f"{t3.get('leaf_off_sky_product_s', 0.0):.1f} s (with its sun runs "
+              f"{t3.get('leaf_off_s', 0.0):.1f} s)")
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,417 @@
+"""``radtree annual --method 3phase``: the crown as a complex fenestration system.
+
+For every sensor and hour (lux, as :mod:`radtree.annual.run`)
+
+    E(h) = Σ_g V_g · T_g(state) · D_g(state) · s(h)    sky through the crown
+         + Σ_g V_g · R_g(state) · D'_g(state) · s(h)   sky reflected by the crown
+         + V_sky · s(h)                                sky that misses the crown (by-pass)
+         + sun(h, state)                               direct and reflected sun
+
+* the crown is the BSDF shell of ``[tree] representation = "bsdf"``
+  (:mod:`radtree.trees.bsdf_shell`): the sensor dome, or the free crowns' envelopes; its
+  facets are grouped by orientation (:func:`facet_groups`, one Klems hemisphere per group);
+* ``V`` — one ``rfluxmtx`` run, sensors → every group (Klems) and the sky (Reinhart): the
+  shell absorbs in this run, so ``V`` holds no crown optics and serves every leaf state;
+* ``T`` — the crown BSDF of ``radtree bsdf`` (:mod:`radtree.bsdf.run`), leaf-on and leaf-off
+  (the branch slab), per elevation band on the dome; for free crowns turned front ↔ back
+  (light leaves a crown from its inside, :func:`radtree.engines.radiance.threephase.turned_xml`);
+* ``D`` — one ``rfluxmtx`` run per group, the group → sky. The dome is crossed once: its
+  ``D`` holds no crown and serves both states. A free crown is crossed twice (in through the
+  far side of its envelope, out through the group): the far side is traced in ``D`` as the
+  state's ``BSDF`` material, so a free crown's ``D`` is computed per leaf state;
+* ``R``, ``D'`` — the crown reflects light arriving from the sensors' side (the sky, the
+  street, a façade lit through the crown) back to them: ``R`` is the XML's reflection on that
+  side (:func:`radtree.engines.radiance.threephase.room_reflection_xml`), ``D'`` the group →
+  sky seen from the sensors' side (the crown of the state in the scene), per leaf state;
+* ``s`` — ``gendaymtx -s`` (the Perez sky without its sun), as the default method;
+* ``Σ_g V_g·T_g·D_g`` — ``rmtxop V_g T.xml D_g`` per group (sensors × sky patches), once per
+  leaf state; times ``s`` for the 8760 hours in NumPy (``dctimestep``'s product).
+
+**Direct sun: as the existing annual does** (no fifth phase): ``rcontrib`` with a 0.533° sun
+exactly at each hour's position at ``-ab 0`` (the LM-83 direct sunlight, through the BSDF's
+undeviated "through" part) and the inter-reflected sun from unit suns at Reinhart patch
+centres (``-ab N`` minus ``-ab 0``), traced on the BSDF-crown scene of each leaf state
+(:class:`~radtree.annual.coefficients.CoefficientRunner`, cached by content). The scene without
+the tree is computed as the default method does (there is no crown to factor out).
+
+A second weather file reruns ``gendaymtx`` and the products only (the sun coefficients
+are reused when the sun positions are the same, i.e. the same site); a second leaf state
+reuses ``V`` (and the dome's ``D``). Not ray traced: light crossing the shell is turned
+by the Klems BSDF of its group, whose frame is the group's mean normal (facets within 55°
+of it); the BSDF of a planar periodic sample holds no lateral displacement.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import time
+from collections.abc import Callable
+from dataclasses import dataclass, replace
+from pathlib import Path
+
+import numpy as np
+
+from radtree.annual.coefficients import CoefficientRunner, TraceParams, points_text, scene_text
+from radtree.annual.phenology import crown_year, phenology_of
+from radtree.annual.run import (
+    LUX,
+    METHOD_NOTES,
+    AnnualOptions,
+    AnnualResult,
+    annual_ground_reflectance,
+    annual_scenes,
+    choose_scenarios,
+    combine,
+)
+from radtree.annual.schedule import occupied
+from radtree.annual.skymatrix import (
+    epw_to_wea,
+    patch_count,
+    reinhart_directions,
+    sky_matrix,
+    sun_patch_weights,
+    sun_positions,
+)
+from radtree.config import Project, Scenario, effective_project
+from radtree.engines.radiance import threephase as rad3
+from radtree.errors import ConfigError
+from radtree.light.weather import find_weather
+from radtree.optics import Bsdf
+from radtree.scene import Mesh, Scene
+from radtree.trees.bsdf_shell import BSDF_SHELL
+from radtree.trees.model import TreeModel
+
+STATES = ("leaf_on", "leaf_off")
+KLEMS = 145
+#: facet orientations: the 14 directions of a cube's faces and corners (a facet's normal is
+#: within 55° of its group's direction)
+_DIRS = np.array([(i, j, k) for i in (-1, 0, 1) for j in (-1, 0, 1) for k in (-1, 0, 1)
+                  if abs(i) + abs(j) + abs(k) in (1, 3)], float)
+_DIRS /= np.linalg.norm(_DIRS, axis=1)[:, None]
+#: the daylight matrices' ray weight limit (path tracing, -ad 2)
+D_LW_MIN = 1e-3
+
+
+@dataclass
+class FacetGroup:
+    """Shell facets of one material and orientation; ``triangles`` wound to the sensors."""
+
+    material: str
+    triangles: np.ndarray  # (k, 3, 3)
+    normal: np.ndarray     # unit mean normal, towards the sensors
+
+    @property
+    def key(self) -> str:
+        return f"{self.material}_{len(self.triangles)}"
+
+
+def facet_groups(model: TreeModel, sensors_inside: bool) -> list[FacetGroup]:
+    """The shell's facets grouped by BSDF material and by the nearest of 14 directions; each
+    triangle wound so that its normal points to the sensors (the shell's own normals point
+    inwards: to the sensors inside a dome, away from them for free crowns)."""
+    groups = []
+    for mesh in model.meshes:
+        if not mesh.material.startswith(BSDF_SHELL):
+            continue
+        tri = mesh.triangles if sensors_inside else mesh.triangles[:, ::-1]
+        n = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
+        area = np.linalg.norm(n, axis=1)
+        keep = area > 1e-12
+        tri, n = tri[keep], n[keep] / area[keep][:, None]
+        which = np.argmax(n @ _DIRS.T, axis=1)
+        for d in np.unique(which):
+            pick = which == d
+            mean = (n[pick] * area[keep][pick][:, None]).sum(axis=0)
+            groups.append(FacetGroup(mesh.material, tri[pick], mean / np.linalg.norm(mean)))
+    return groups
+
+
+def _without_shell(scene: Scene) -> Scene:
+    return Scene([m for m in scene.meshes if not m.material.startswith(BSDF_SHELL)],
+                 scene.materials, scene.grids, scene.notes, scene.ground_material)
+
+
+def state_xmls(project: Project, scenario: Scenario,
+               echo: Callable[[str], None]) -> dict[str, list[tuple[float, float, Path]]]:
+    """Leaf-on bands (``tree.bsdf.xml`` or computed) and the leaf-off branch-slab XML (for
+    every band), each cached under ``build/bsdf/<scenario>/``."""
+    from radtree.bsdf.run import leaf_off_sample
+    from radtree.pipeline.crown_bsdf import (
+        ensure_bsdf,
+        flux_settings,
+        leaf_on_sample,
+        scenario_tree,
+        scenario_xmls,
+    )
+
+    on = scenario_xmls(project, scenario, echo)
+    tree, form = scenario_tree(project, scenario)
+    off = ensure_bsdf(leaf_off_sample(project, scenario, leaf_on_sample(project, scenario)),
+                      flux_settings(tree, form), project.build_dir / "bsdf" / scenario.name /
+                      "leaf_off", "leaf_off", echo)
+    return {"leaf_on": on, "leaf_off": [(lo, hi, off.xml) for lo, hi, _ in on]}
+
+
+def crown_models(project: Project, scenario: Scenario,
+                 xmls: dict[str, list[tuple[float, float, Path]]]) -> tuple[dict, str]:
+    """The BSDF crown of each leaf state (:func:`radtree.trees.bsdf_shell.build_bsdf_crown`)."""
+    from radtree.pipeline.assemble import facade_frame
+    from radtree.pipeline.crown_bsdf import BSDF_SCENE_AB, scenario_tree
+    from radtree.trees.bsdf_shell import build_bsdf_crown
+
+    eff = effective_project(project, scenario)
+    tree, form = scenario_tree(project, scenario)
+    frame = facade_frame(eff)
+    models = {s: build_bsdf_crown(tree, eff.sensors, eff.street, frame, form, xmls[s],
+                                  BSDF_SCENE_AB, str(project.source)) for s in STATES}
+    return models, form
+
+
+def _scene_with(bare: Scene, model: TreeModel) -> Scene:
+    materials = dict(bare.materials)
+    materials.update(model.materials)
+    return Scene(bare.meshes + list(model.meshes), materials, bare.grids,
+                 bare.notes + list(model.notes), bare.ground_material)
+
+
+def _octree(folder: Path, name: str, scene: Scene, rho: float) -> Path:
+    return rad3.octree(folder, name, scene_text(scene, rho))
+
+
+class ThreePhase:
+    """The matrices of one crown (V once, D per group and, for free crowns, per state),
+    cached in ``folder`` by the text they were computed from."""
+
+    def __init__(self, folder: Path, bare: Scene, models: dict[str, TreeModel], form: str,
+                 grids: list[str], rho: float, mf: int, trace: TraceParams,
+                 echo: Callable[[str], None], samples: int = 400):
+        self.folder, self.samples = folder, samples
+        folder.mkdir(parents=True, exist_ok=True)
+        self.bare, self.models, self.grids, self.rho, self.mf = bare, models, grids, rho, mf
+        self.inside = form == "dome"
+        self.trace, self.echo = trace, echo
+        self.groups = facet_groups(models["leaf_on"], self.inside)
+        self.points = points_text(bare, grids)
+        self.n = sum(len(bare.grids[g]) for g in grids)
+        self.timing: dict[str, float] = {}
+
+    def _cached(self, name: str, key: str, compute: Callable[[], Path]) -> Path:
+        digest = hashlib.sha256(key.encode()).hexdigest()[:16]
+        path = self.folder / f"{name}_{digest}"
+        if not path.exists():
+            tmp = compute()
+            tmp.replace(path)
+        return path
+
+    def view(self) -> tuple[list[Path], np.ndarray]:
+        """The per-group view matrices (files) and V_sky (sensors, patches, 3)."""
+        receivers = (rad3.group_receivers_text([(g.triangles, g.normal) for g in self.groups])
+                     + "\n" + rad3.sky_receivers_text(self.mf))
+        scene = _without_shell(_scene_with(self.bare, self.models["leaf_on"]))  # trunks stay
+        octree_text = scene_text(scene, self.rho)
+        ambient = self.trace.ambient()
+        key = "|".join(["-I+ -faf", receivers, octree_text, self.points, " ".join(ambient)])
+
+        def compute() -> Path:
+            t0 = time.perf_counter()
+            self.echo(f"    rfluxmtx view matrix: {self.n} sensors → {len(self.groups)} shell "
+                      f"groups × {KLEMS} + {patch_count(self.mf)} sky patches")
+            octree = _octree(self.folder, "view", scene, self.rho)
+            m = rad3.view_matrix(self.folder, octree, self.points, self.n, receivers, ambient,
+                                 self.trace.nproc)
+            self.timing["view_s"] = time.perf_counter() - t0
+            return rad3.write_matrix(self.folder / "view.vmx.tmp", m)
+
+        path = self._cached("view", key, compute)
+        m = rad3.read_matrix(path.read_bytes(), str(path))
+        files = []
+        for k in range(len(self.groups)):
+            f = self.folder / f"view_g{k}.vmx"
+            rad3.write_matrix(f, m[:, k * KLEMS:(k + 1) * KLEMS])
+            files.append(f)
+        return files, m[:, len(self.groups) * KLEMS:]
+
+    def daylight(self, state: str, room_side: bool = False) -> list[Path]:
+        """The daylight matrix of every group: of the light it transmits into the room (the
+        dome's: one for both states), or (``room_side``) of the light arriving at it from
+        the room's side, which it reflects back."""
+        with_crown = _scene_with(self.bare, self.models[state])
+        own = self.inside and not room_side      # the dome's outward D meets no crown
+        scene = _without_shell(with_crown) if own else with_crown
+        text = scene_text(scene, self.rho) + ("" if own else "".join(
+            Path(m.xml).read_text() for m in self.models[state].materials.values()
+            if isinstance(m, Bsdf)))
+        # rays per Klems patch (-c) carry the sampling: path tracing, 2 rays per bounce
+        ambient = ["-ab", str(self.trace.ab), "-ad", "2", "-lw",
+                   f"{max(self.trace.lw, D_LW_MIN):g}", "-aa", "0"]
+        octree: list[Path] = []
+        out = []
+        t0 = time.perf_counter()
+        tag = "r" if room_side else "g"
+        for k, g in enumerate(self.groups):
+            sender = rad3.sender_text(g.triangles, g.normal, room_side)
+            key = "|".join([sender, text, " ".join(ambient), str(self.samples), str(self.mf)])
+
+            def compute(k: int = k, sender: str = sender) -> Path:
+                if not octree:
+                    octree.append(_octree(self.folder, f"daylight_{state}", scene, self.rho))
+                return rad3.daylight_matrix(self.folder, octree[0], f"{tag}{k}", sender,
+                                            self.mf, self.samples, ambient, self.trace.nproc)
+
+            out.append(self._cached(f"daylight_{tag}{k}", key, compute))
+        name = f"daylight_{'room_' if room_side else ''}{state}_s"
+        self.timing[name] = time.perf_counter() - t0
+        if octree:
+            self.echo(f"    rfluxmtx daylight matrices ({state}{', room side' if room_side else ''}"
+                      f"): {len(self.groups)} groups, -c {self.samples}, "
+                      f"{self.timing[name]:.0f} s")
+        return out
+
+    def transmission(self, state: str, reflection: bool = False) -> list[Path]:
+        """T of every group: its band's XML (turned for free crowns); ``reflection``: the
+        XML of its reflection back into the room."""
+        mats = self.models[state].materials
+        out = []
+        for g in self.groups:
+            mat = mats[g.material]
+            assert isinstance(mat, Bsdf)
+            xml = Path(mat.xml)
+            if not self.inside:
+                xml = rad3.turned_xml(xml, self.folder / f"{state}_{g.material}_turned.xml")
+            if reflection:
+                xml = rad3.room_reflection_xml(xml, self.folder /
+                                               f"{state}_{g.material}_room_reflection.xml")
+            out.append(xml)
+        return out
+
+    def coefficients(self, state: str, views: list[Path], v_sky: np.ndarray) -> np.ndarray:
+        """(sensors, patches, 3) daylight coefficients of the state: Σ_g V_g·T_g·D_g
+        + Σ_g V_g·R_g·D'_g (``rmtxop``) + V_sky."""
+        days, back = self.daylight(state), self.daylight(state, room_side=True)
+        t0 = time.perf_counter()
+        dc = v_sky.astype(np.float64)
+        for v, t, d in zip(views, self.transmission(state), days):
+            dc = dc + rad3.multiply(v, t, d)
+        for v, r, d in zip(views, self.transmission(state, reflection=True), back):
+            dc = dc + rad3.multiply(v, r, d)
+        self.timing[f"rmtxop_{state}_s"] = time.perf_counter() - t0
+        return dc.astype(np.float32)
+
+
+def sky_lux(dc: np.ndarray, sky: np.ndarray) -> np.ndarray:
+    """(sensors, hours) lux: the coefficients (sensors, patches, 3) times the sky matrix
+    (patches, hours, 3), channel by channel (as ``dctimestep DC sky`` does)."""
+    total = np.zeros((dc.shape[0], sky.shape[1]), np.float64)
+    for ch in range(3):
+        total += LUX[ch] * (dc[:, :, ch].astype(np.float64) @ sky[:, :, ch].astype(np.float64))
+    return total
+
+
+def compute_annual_3phase(project: Project, options: AnnualOptions,
+                          echo: Callable[[str], None] = print) -> AnnualResult:
+    """The annual run of :func:`radtree.annual.run.compute_annual` by the three-phase method
+    (module text); the same :class:`AnnualResult`, variants ``leaf_on``/``leaf_off`` from the
+    crown BSDFs, ``without`` as the default method."""
+    timing: dict[str, float] = {}
+    t0 = time.perf_counter()
+    with_sc, without_sc, notes = choose_scenarios(project, options)
+    if with_sc.model != "louvers":
+        raise ConfigError(f"--method 3phase needs a louvers crown (the BSDF is computed from "
+                          f"its slats); scenario '{with_sc.name}' is {with_sc.model!r}",
+                          source=str(project.source))
+    scenes, grids, rec_ab, _ = annual_scenes(project, with_sc, without_sc, options.branches,
+                                             options.grids)
+    eng = effective_project(project, with_sc).engine
+    ab = options.ab if options.ab is not None else (eng.ab if eng.ab is not None else rec_ab)
+    trace = TraceParams(ab=ab, ad=options.ad or eng.ad, lw=options.lw or eng.lw,
+                        nproc=options.nproc)
+    sun_trace = TraceParams(ab=ab, ad=options.sun_ad or max(128, trace.ad // 4),
+                            lw=options.sun_lw or max(trace.lw, 1e-3), nproc=options.nproc)
+    rho = annual_ground_reflectance(project)
+    t1 = time.perf_counter()
+    xmls = state_xmls(project, with_sc, echo)
+    models, form = crown_models(project, with_sc, xmls)
+    timing["bsdf_s"] = time.perf_counter() - t1
+    from radtree.pipeline.assemble import make_scene
+
+    bare = make_scene(project, replace(with_sc, model="none"), dense_grid=False).scene
+    timing["scenes_s"] = time.perf_counter() - t0
+
+    t1 = time.perf_counter()
+    weather = find_weather(project, options.epw, echo)
+    work = project.results_dir / "annual"
+    wea = epw_to_wea(weather.path, work / "weather" / "year.wea")
+    sky = sky_matrix(wea, options.mf, rho)
+    suns = sun_positions(wea, work / "weather")
+    verts, weights = sun_patch_weights(suns.direction, options.sun_mf)
+    need = np.unique(verts)
+    need = need[need > 0]
+    patch_dirs = reinhart_directions(options.sun_mf)
+    timing["weather_s"] = time.perf_counter() - t1
+
+    def dc(scene: Scene, folder: Path, with_sky: bool) -> tuple[np.ndarray, np.ndarray]:
+        runner = CoefficientRunner(scene, grids, folder, rho, echo=echo)
+        c_sky = runner.sky(options.mf, trace) if with_sky else np.zeros(
+            (runner.n_sensors, patch_count(options.mf), 3), np.float32)
+        c_dir = runner.suns("direct", suns.direction, 0, trace)
+        c_n = runner.suns(f"patch{options.sun_mf}_ab{trace.ab}", patch_dirs[need], trace.ab,
+                          sun_trace)
+        c_0 = runner.suns(f"patch{options.sun_mf}_ab0", patch_dirs[need], 0, sun_trace)
+        c_ind = np.zeros((runner.n_sensors, len(patch_dirs), 3), np.float32)
+        c_ind[:, need] = c_n - c_0
+        return combine(c_sky, sky, c_dir, suns, c_ind, verts, weights, wea.n_hours)
+
+    echo(f"  3-phase: {form} crown, BSDFs {', '.join(sorted({Path(b[2]).name for s in STATES for b in xmls[s]}))}")
+    tp = ThreePhase(work / "threephase", bare, models, form, grids, rho, options.mf, trace,
+                    echo, options.daylight_samples)
+    t1 = time.perf_counter()
+    views, v_sky = tp.view()
+    timing["view_s"] = time.perf_counter() - t1
+    per: dict[str, tuple[np.ndarray, np.ndarray]] = {}
+    dcs: dict[str, np.ndarray] = {}
+    tv = time.perf_counter()
+    per["without"] = dc(scenes["without"], work / "coefficients" / "without", True)
+    timing["without_s"] = time.perf_counter() - tv
+    for state in STATES:
+        tv = time.perf_counter()
+        scene = _scene_with(bare, models[state])
+        sun_tot, sun_dir = dc(scene, work / "threephase" / f"sun_{state}", False)
+        td = time.perf_counter()
+        dcs[state] = tp.coefficients(state, views, v_sky)
+        timing[f"{state}_matrices_s"] = time.perf_counter() - td
+        ts = time.perf_counter()
+        sky_tot = sky_lux(dcs[state], sky)
+        timing[f"{state}_sky_product_s"] = time.perf_counter() - ts
+        per[state] = ((sun_tot + sky_tot).astype(np.float32), sun_dir)
+        timing[f"{state}_s"] = time.perf_counter() - tv
+    timing.update({f"3phase_{k}": v for k, v in tp.timing.items()})
+
+    total: dict[str, dict[str, np.ndarray]] = {}
+    direct: dict[str, dict[str, np.ndarray]] = {}
+    for variant, (tot, dire) in per.items():
+        total[variant], direct[variant] = {}, {}
+        start = 0
+        for g in grids:
+            n = len(bare.grids[g])
+            total[variant][g], direct[variant][g] = tot[start:start + n], dire[start:start + n]
+            start += n
+    phen = phenology_of(project, options.species_phenology)
+    in_leaf, fraction, weight = crown_year(total, direct, grids, wea, options.leaf, phen)
+    grid_geo = {g: {"points": bare.grids[g].points, "normals": bare.grids[g].normals}
+                for g in grids}
+    notes.append(f"Crown {options.leaf.describe() if phen is None else phen.describe()}.")
+    notes.append(f"Method: three-phase (V·T·D·s with dctimestep; {len(tp.groups)} shell facet "
+                 "groups; the crown BSDFs leaf-on and leaf-off); direct and reflected sun as "
+                 "the default method, on the BSDF-crown scene of each leaf state.")
+    notes += METHOD_NOTES
+    timing["total_s"] = time.perf_counter() - t0
+    return AnnualResult(project=project, options=options, weather=weather, wea=wea,
+                        grids=grid_geo, total=total, direct=direct, in_leaf=in_leaf,
+                        occupied=occupied(wea.hour, options.occupancy),
+                        scenarios={"with": with_sc.name, "without": without_sc.name},
+                        trace=trace, sun_trace=sun_trace, ground_reflectance=rho, notes=notes,
+                        timing=timing, leaf_fraction=fraction, leaf_weight=weight,
+                        phenology=phen)
+
+
+__all__ = ["FacetGroup", "Mesh", "ThreePhase", "compute_annual_3phase", "facet_groups"]
