@@ -57,6 +57,8 @@ def main() -> None:
     ap.add_argument("--points", type=int, default=32)
     ap.add_argument("--rays", type=int, default=512)
     ap.add_argument("--ad", type=int, default=512)
+    ap.add_argument("--focus", type=float, default=0.5,
+                    help="forward: stratified launch, innermost ring radius m (0: uniform)")
     ap.add_argument("--pmap", type=int, default=0, help="photon map photons (0: not run)")
     ap.add_argument("--scenarios", nargs="+", default=["A", "B", "C", "D", "E", "F"])
     ap.add_argument("--hour", default="12:30")
@@ -75,8 +77,8 @@ def main() -> None:
         scene = built.scene
         print(f" scenario {name}: {scene.n_triangles} triangles, -ab {built.ab}", flush=True)
         t0 = time.perf_counter()
-        fw = trace_forward(scene, st, ForwardSettings(photons=a.photons, max_bounces=built.ab),
-                           ["facade"])
+        fw = trace_forward(scene, st, ForwardSettings(photons=a.photons, max_bounces=built.ab,
+                                                      focus_m=a.focus or None), ["facade"])
         dt = time.perf_counter() - t0
         f_mean, f_se = fw.grid_mean("facade")
         _line("forward", dt, fw.segments, "ray segments", f_mean, f_se)

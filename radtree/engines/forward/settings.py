@@ -8,8 +8,10 @@ false: one event per hit chosen ∝ its coefficient, Russian roulette below the 
 unbiased), ``beam_diameter_m`` (the sun as a collimated beam of that diameter aimed at the
 centre of the first sensor grid, and then the only source — no sky, no ground glow, as in the
 study; unset = sunlight, sky and ground glow over the whole scene), ``patch_m`` (side of
-the square detector around each sensor, m) and ``forward_batches`` (independent batches for the
-standard error).
+the square detector around each sensor, m), ``forward_batches`` (independent batches for the
+standard error) and ``forward_focus_m`` (a focused launch: start points drawn densest around
+the target grid's centre, innermost disc of that radius, m — unbiased, see
+:class:`radtree.engines.forward.sources.Focus`; unset = uniform over the launch disc).
 """
 
 from __future__ import annotations
@@ -41,6 +43,8 @@ class ForwardSettings:
     ``max_bounces``: diffuse scattering events per photon (``-ab``: a backward path with k
     diffuse segments is a photon path with k diffuse events). ``max_specular``: specular events
     per photon. ``chunk``: photons stepped at once (bounded memory). ``seed``: random seed.
+    ``focus_m``: innermost radius (m) of the focused launch around the target grid's centre
+    (None: start points uniform on the launch disc; ignored with a beam).
     """
 
     photons: int = 1_000_000
@@ -53,6 +57,7 @@ class ForwardSettings:
     max_specular: int = 32
     chunk: int = 1 << 17
     seed: int = 1
+    focus_m: float | None = None
 
     def __post_init__(self) -> None:
         if isinstance(self.photons, bool) or not isinstance(self.photons, int) or self.photons < 1:
@@ -74,6 +79,11 @@ class ForwardSettings:
             raise _bad("forward_batches", f"must be a whole number ≥ 2, got {self.batches!r}")
         if self.photons < self.batches:
             raise _bad("photons", f"{self.photons} photons cannot fill {self.batches} batches")
+        f = self.focus_m
+        if f is not None and (isinstance(f, bool) or not isinstance(f, int | float)
+                              or not math.isfinite(f) or f <= 0):
+            raise _bad("forward_focus_m", f"must be > 0 m (or unset for a uniform launch), "
+                       f"got {f!r}")
         if self.max_bounces < 0 or self.max_specular < 0 or self.chunk < 1:
             raise _bad("max_bounces", "bounce caps must be ≥ 0 and the chunk ≥ 1")
 
@@ -85,11 +95,13 @@ class ForwardSettings:
                    splitting=params.forward_splitting, beam_diameter_m=params.beam_diameter_m,
                    patch_m=params.patch_m, batches=params.forward_batches,
                    max_bounces=int(params.max_bounces if ab is None else ab),
-                   seed=int(params.seed))
+                   seed=int(params.seed), focus_m=params.forward_focus_m)
 
     def describe(self) -> str:
         source = ("sun over the whole scene" if self.beam_diameter_m is None
                   else f"sun beam {self.beam_diameter_m:g} m")
+        if self.beam_diameter_m is None and self.focus_m is not None:
+            source += f", focused launch from {self.focus_m:g} m"
         scatter = "ray splitting" if self.splitting else "Russian roulette"
         return (f"{self.photons} photons, {source}, {scatter}, threshold {self.threshold:g}, "
                 f"patches {self.patch_m:g} m, {self.batches} batches, seed {self.seed}")
