@@ -18,7 +18,7 @@ from radtree.engines.forward.detectors import PatchDetectors
 from radtree.engines.forward.settings import ForwardSettings
 from radtree.engines.forward.sources import EnvironmentSource, SunSource, bounding_sphere
 from radtree.engines.forward.strata import PILOT, Stratum, allocate, pilot, ring_edges, trace_strata
-from radtree.engines.forward.tracer import ForwardTracer, Ledger, Photons
+from radtree.engines.forward.tracer import ForwardTracer, Ledger, Photons, Splitting
 from radtree.engines.numpy.engine import Environment, scene_geometry, scene_optics
 from radtree.errors import ConfigError, EngineError
 from radtree.light.sky import SkyState
@@ -111,17 +111,20 @@ def trace_forward(scene: Scene, state: SkyState, settings: ForwardSettings,
     rng = np.random.default_rng(np.random.SeedSequence(
         [int(settings.seed) & 0xFFFFFFFF, zlib.crc32((label or state.label).encode())]))
     optics = scene_optics(scene, state, geo.material_names)
+    aim = target_grid(scene) if target_grid(scene) in names else names[0]
+    target = scene.grids[aim].points.mean(axis=0)
+    near = (Splitting(target, settings.split_radius_m, settings.split)
+            if settings.split > 1 else None)
 
     def new_tracer(batches: int) -> ForwardTracer:
         return ForwardTracer(geo, optics, det, batches, threshold=settings.threshold,
                              splitting=settings.splitting, max_bounces=settings.max_bounces,
-                             max_specular=settings.max_specular, chunk=settings.chunk, rng=rng)
+                             max_specular=settings.max_specular, chunk=settings.chunk, rng=rng,
+                             splitting_near=near)
 
     tracer = new_tracer(settings.batches)
     strata, n_pilot, pilot_segments = None, 0, 0
     if settings.focus_m is not None and settings.beam_diameter_m is None and sources:
-        aim = target_grid(scene) if target_grid(scene) in names else names[0]
-        target = scene.grids[aim].points.mean(axis=0)
         edges = ring_edges(float(settings.focus_m),
                            sphere.radius + float(np.linalg.norm(target - sphere.centre)))
         strata = [Stratum(i, a, b) for i in range(len(sources))

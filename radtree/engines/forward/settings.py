@@ -11,7 +11,9 @@ study; unset = sunlight, sky and ground glow over the whole scene), ``patch_m`` 
 the square detector around each sensor, m), ``forward_batches`` (independent batches for the
 standard error) and ``forward_focus_m`` (a focused launch: start points drawn densest around
 the target grid's centre, innermost disc of that radius, m — unbiased, see
-:class:`radtree.engines.forward.sources.Focus`; unset = uniform over the launch disc).
+:mod:`radtree.engines.forward.strata`; unset = uniform over the launch disc),
+``forward_split`` and ``forward_split_radius_m`` (diffuse events within that radius of the
+target grid's centre split into that many children, at most twice per photon; 1 = never).
 """
 
 from __future__ import annotations
@@ -44,7 +46,8 @@ class ForwardSettings:
     diffuse segments is a photon path with k diffuse events). ``max_specular``: specular events
     per photon. ``chunk``: photons stepped at once (bounded memory). ``seed``: random seed.
     ``focus_m``: innermost radius (m) of the focused launch around the target grid's centre
-    (None: start points uniform on the launch disc; ignored with a beam).
+    (None: start points uniform on the launch disc; ignored with a beam). ``split``: children
+    per diffuse event within ``split_radius_m`` (m) of the target grid's centre (1: none).
     """
 
     photons: int = 1_000_000
@@ -58,6 +61,8 @@ class ForwardSettings:
     chunk: int = 1 << 17
     seed: int = 1
     focus_m: float | None = None
+    split: int = 1
+    split_radius_m: float = 2.0
 
     def __post_init__(self) -> None:
         if isinstance(self.photons, bool) or not isinstance(self.photons, int) or self.photons < 1:
@@ -84,6 +89,11 @@ class ForwardSettings:
                               or not math.isfinite(f) or f <= 0):
             raise _bad("forward_focus_m", f"must be > 0 m (or unset for a uniform launch), "
                        f"got {f!r}")
+        if isinstance(self.split, bool) or not isinstance(self.split, int) or self.split < 1:
+            raise _bad("forward_split", f"must be a whole number ≥ 1, got {self.split!r}")
+        r = self.split_radius_m
+        if not isinstance(r, int | float) or not math.isfinite(r) or r <= 0:
+            raise _bad("forward_split_radius_m", f"must be > 0 m, got {r!r}")
         if self.max_bounces < 0 or self.max_specular < 0 or self.chunk < 1:
             raise _bad("max_bounces", "bounce caps must be ≥ 0 and the chunk ≥ 1")
 
@@ -95,7 +105,8 @@ class ForwardSettings:
                    splitting=params.forward_splitting, beam_diameter_m=params.beam_diameter_m,
                    patch_m=params.patch_m, batches=params.forward_batches,
                    max_bounces=int(params.max_bounces if ab is None else ab),
-                   seed=int(params.seed), focus_m=params.forward_focus_m)
+                   seed=int(params.seed), focus_m=params.forward_focus_m,
+                   split=params.forward_split, split_radius_m=params.forward_split_radius_m)
 
     def describe(self) -> str:
         source = ("sun over the whole scene" if self.beam_diameter_m is None
@@ -103,5 +114,7 @@ class ForwardSettings:
         if self.beam_diameter_m is None and self.focus_m is not None:
             source += f", focused launch from {self.focus_m:g} m"
         scatter = "ray splitting" if self.splitting else "Russian roulette"
+        if self.split > 1:
+            scatter += f", ×{self.split} within {self.split_radius_m:g} m of the target"
         return (f"{self.photons} photons, {source}, {scatter}, threshold {self.threshold:g}, "
                 f"patches {self.patch_m:g} m, {self.batches} batches, seed {self.seed}")

@@ -61,6 +61,8 @@ class Stratum:
     cost: float = 1.0      # photon segments per photon
     mean: float = 0.0      # the pilot's estimate of the ring's contribution (lux)
     photons: int = 0
+    got: float = 0.0       # the main run's estimate of the ring's contribution (lux) …
+    got_se: float = 0.0    # … and its standard error from the batches
 
 
 def _batches(k: int, batches: int, offset: int = 0) -> np.ndarray:
@@ -106,11 +108,16 @@ def allocate(strata: list[Stratum], photons: int, batches: int, floor: float = F
 def trace_strata(sources: list, strata: list[Stratum], target: np.ndarray,
                  tracer: ForwardTracer, chunk: int, batches: int,
                  rng: np.random.Generator) -> None:
-    """The main run: every stratum's photons, in chunks, assigned to the batches in turn."""
+    """The main run: every stratum's photons, in chunks, assigned to the batches in turn;
+    each stratum's ``got`` ± ``got_se``: its share of the traced detectors' mean (lux)."""
+    det = tracer.det
     for st in strata:
+        before = tracer.tally.sum(axis=1)
         src = sources[st.source]
         for c0 in range(0, st.photons, chunk):
             k = min(chunk, st.photons - c0)
             launch = src.ring_launch(k, st.a, st.b, target, rng)
             launch.flux *= k / st.photons  # the ring's flux shared by all its photons
             tracer.run(Photons.start(launch, _batches(k, batches, c0)))
+        part = (tracer.tally.sum(axis=1) - before) * batches / (det.count * det.area)
+        st.got, st.got_se = float(part.mean()), float(part.std(ddof=1) / math.sqrt(batches))
