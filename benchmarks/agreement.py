@@ -76,6 +76,9 @@ def main() -> None:
     ap.add_argument("--ad", type=int, default=512)
     ap.add_argument("--focus", type=float, default=0.5,
                     help="forward: stratified launch, innermost ring radius m (0: uniform)")
+    ap.add_argument("--guide", type=float, default=0.0,
+                    help="forward: share of diffuse directions aimed at the target (0: none)")
+    ap.add_argument("--guide-radius", type=float, default=1.0, help="its sphere's radius, m")
     ap.add_argument("--pmap", type=int, default=0, help="photon map photons (0: not run)")
     ap.add_argument("--scenarios", nargs="+", default=["A", "B", "C", "D", "E", "F"])
     ap.add_argument("--hour", default="12:30")
@@ -101,7 +104,8 @@ def main() -> None:
         if not a.skip_forward:
             t0, c0 = time.perf_counter(), time.process_time()
             fw = trace_forward(scene, st, ForwardSettings(
-                photons=a.photons, max_bounces=built.ab, focus_m=a.focus or None), ["facade"])
+                photons=a.photons, max_bounces=built.ab, focus_m=a.focus or None,
+                guide=a.guide, guide_radius_m=a.guide_radius), ["facade"])
             dt = time.perf_counter() - t0
             f_mean, f_se = fw.grid_mean("facade")
             _line("forward", dt, fw.segments, "ray segments", f_mean, f_se,

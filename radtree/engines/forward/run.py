@@ -15,6 +15,7 @@ import numpy as np
 
 from radtree.engines.base import GridResult
 from radtree.engines.forward.detectors import PatchDetectors
+from radtree.engines.forward.guide import Guide
 from radtree.engines.forward.settings import ForwardSettings
 from radtree.engines.forward.sources import EnvironmentSource, SunSource, bounding_sphere
 from radtree.engines.forward.strata import PILOT, Stratum, allocate, pilot, ring_edges, trace_strata
@@ -115,12 +116,14 @@ def trace_forward(scene: Scene, state: SkyState, settings: ForwardSettings,
     target = scene.grids[aim].points.mean(axis=0)
     near = (Splitting(target, settings.split_radius_m, settings.split)
             if settings.split > 1 else None)
+    guide = (Guide(target, settings.guide_radius_m, settings.guide)
+             if settings.guide > 0 else None)
 
     def new_tracer(batches: int) -> ForwardTracer:
         return ForwardTracer(geo, optics, det, batches, threshold=settings.threshold,
                              splitting=settings.splitting, max_bounces=settings.max_bounces,
                              max_specular=settings.max_specular, chunk=settings.chunk, rng=rng,
-                             splitting_near=near)
+                             splitting_near=near, guide=guide)
 
     tracer = new_tracer(settings.batches)
     strata, n_pilot, pilot_segments = None, 0, 0

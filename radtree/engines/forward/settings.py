@@ -13,7 +13,10 @@ standard error) and ``forward_focus_m`` (a focused launch: start points drawn de
 the target grid's centre, innermost disc of that radius, m — unbiased, see
 :mod:`radtree.engines.forward.strata`; unset = uniform over the launch disc),
 ``forward_split`` and ``forward_split_radius_m`` (diffuse events within that radius of the
-target grid's centre split into that many children, at most twice per photon; 1 = never).
+target grid's centre split into that many children, at most twice per photon; 1 = never),
+``forward_guide`` and ``forward_guide_radius_m`` (that share of every diffuse event outside a
+sphere of that radius around the target grid's centre aims its direction at the sphere, the
+flux corrected: :mod:`radtree.engines.forward.guide`; 0 = Lambertian scattering only).
 """
 
 from __future__ import annotations
@@ -48,6 +51,8 @@ class ForwardSettings:
     ``focus_m``: innermost radius (m) of the focused launch around the target grid's centre
     (None: start points uniform on the launch disc; ignored with a beam). ``split``: children
     per diffuse event within ``split_radius_m`` (m) of the target grid's centre (1: none).
+    ``guide``: share (0 ≤ q < 1) of diffuse directions aimed at the sphere of ``guide_radius_m``
+    (m) around the target grid's centre (0: none).
     """
 
     photons: int = 1_000_000
@@ -63,6 +68,8 @@ class ForwardSettings:
     focus_m: float | None = None
     split: int = 1
     split_radius_m: float = 2.0
+    guide: float = 0.0
+    guide_radius_m: float = 2.0
 
     def __post_init__(self) -> None:
         if isinstance(self.photons, bool) or not isinstance(self.photons, int) or self.photons < 1:
@@ -94,6 +101,13 @@ class ForwardSettings:
         r = self.split_radius_m
         if not isinstance(r, int | float) or not math.isfinite(r) or r <= 0:
             raise _bad("forward_split_radius_m", f"must be > 0 m, got {r!r}")
+        q = self.guide
+        if isinstance(q, bool) or not isinstance(q, int | float) or not 0.0 <= q < 1.0:
+            raise _bad("forward_guide", f"must be ≥ 0 and < 1 (a share of the diffuse "
+                       f"directions), got {q!r}")
+        r = self.guide_radius_m
+        if not isinstance(r, int | float) or not math.isfinite(r) or r <= 0:
+            raise _bad("forward_guide_radius_m", f"must be > 0 m, got {r!r}")
         if self.max_bounces < 0 or self.max_specular < 0 or self.chunk < 1:
             raise _bad("max_bounces", "bounce caps must be ≥ 0 and the chunk ≥ 1")
 
@@ -106,7 +120,8 @@ class ForwardSettings:
                    patch_m=params.patch_m, batches=params.forward_batches,
                    max_bounces=int(params.max_bounces if ab is None else ab),
                    seed=int(params.seed), focus_m=params.forward_focus_m,
-                   split=params.forward_split, split_radius_m=params.forward_split_radius_m)
+                   split=params.forward_split, split_radius_m=params.forward_split_radius_m,
+                   guide=params.forward_guide, guide_radius_m=params.forward_guide_radius_m)
 
     def describe(self) -> str:
         source = ("sun over the whole scene" if self.beam_diameter_m is None
@@ -116,5 +131,8 @@ class ForwardSettings:
         scatter = "ray splitting" if self.splitting else "Russian roulette"
         if self.split > 1:
             scatter += f", ×{self.split} within {self.split_radius_m:g} m of the target"
+        if self.guide > 0:
+            scatter += f", {self.guide:.0%} of diffuse directions aimed at the target " \
+                       f"({self.guide_radius_m:g} m)"
         return (f"{self.photons} photons, {source}, {scatter}, threshold {self.threshold:g}, "
                 f"patches {self.patch_m:g} m, {self.batches} batches, seed {self.seed}")

@@ -35,6 +35,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from radtree.engines.forward.detectors import PatchDetectors
+from radtree.engines.forward.guide import Guide
 from radtree.engines.forward.sources import Launch
 from radtree.engines.numpy.engine import Geometry, Optics, glass_coefficients
 from radtree.engines.numpy.sampling import cosine_hemisphere, mirror
@@ -123,9 +124,10 @@ class ForwardTracer:
 
     def __init__(self, geo: Geometry, optics: Optics, detectors: PatchDetectors, batches: int,
                  *, threshold: float, splitting: bool, max_bounces: int, max_specular: int,
-                 chunk: int, rng: np.random.Generator, splitting_near: Splitting | None = None):
+                 chunk: int, rng: np.random.Generator, splitting_near: Splitting | None = None,
+                 guide: Guide | None = None):
         self.geo, self.opt, self.det = geo, optics, detectors
-        self.near = splitting_near
+        self.near, self.guide = splitting_near, guide
         self.threshold, self.splitting = float(threshold), bool(splitting)
         self.max_bounces, self.max_specular = int(max_bounces), int(max_specular)
         self.chunk = int(chunk)
@@ -220,13 +222,23 @@ class ForwardTracer:
         diffuse = diff_r | diff_t
         if diffuse.any():
             axis = np.where(diff_r[diffuse, None], n[diffuse], -n[diffuse])
-            new_d[diffuse] = cosine_hemisphere(axis, self.rng)
+            if self.guide is None:
+                new_d[diffuse] = cosine_hemisphere(axis, self.rng)
+            else:
+                new_d[diffuse], factor = self.guide.directions(p[src][diffuse], axis, self.rng)
+                old = cw[diffuse]
+                new = old * factor
+                led.promoted += float(np.maximum(new - old, 0.0).sum())
+                led.killed += float(np.maximum(old - new, 0.0).sum())
+                cw = cw.copy()
+                cw[diffuse] = new
         if mir.any():
             new_d[mir] = mirror(d[mir], n[mir])
         side = np.where(diff_t | spec_t, -1.0, 1.0)
-        return Photons(p[src] + n * (self.eps * side)[:, None], new_d, cw, w0,
-                       ph.ndiff[src] + diffuse, ph.nspec[src] + (spec_t | mir), ph.batch[src],
-                       nsplit)
+        out = Photons(p[src] + n * (self.eps * side)[:, None], new_d, cw, w0,
+                      ph.ndiff[src] + diffuse, ph.nspec[src] + (spec_t | mir), ph.batch[src],
+                      nsplit)
+        return out if self.guide is None else out.take(out.w > 0)
 
     def _split(self, p: np.ndarray, src: np.ndarray, ev: np.ndarray, cw: np.ndarray,
                w0: np.ndarray, nsplit: np.ndarray) -> tuple[np.ndarray, ...]:
