@@ -11,7 +11,28 @@ error, against the 2 % target. The Radiance photon map (``mkpmap`` + ``rtrace -a
 and caustic photons) is the fourth estimator with ``--pmap N``.
 
 Run: ``.venv/bin/python benchmarks/agreement.py [--photons N] [--points N] [--rays N]
-[--ad N] [--pmap N] [--scenarios A B ...] [--hour HH:MM] [--backward numpy]``. No assertions.
+[--ad N] [--pmap N] [--scenarios A B ...] [--hour HH:MM] [--backward numpy]
+[--focus M] [--guide Q --guide-radius M] [--skip-forward]``. No assertions. ``--backward``
+with no engine runs the forward engine alone; ``--skip-forward`` the backward ones alone (run
+them as separate processes). Wall and CPU seconds are both printed: on a shared machine the CPU
+time is the comparable cost.
+
+Measured (session 5, 12:30, 2 cores shared by 6 sessions, load 16–23: a process got 5–8 % of
+a core, so CPU seconds are quoted). Forward with the stratified launch (``--focus 0.5``), 8 M
+photons: A 979.4 ± 18.7 lx (1.9 %, 27 CPU-s), B 1 372 ± 227 (17 %), C 3 636 ± 618 (17 %),
+D 2 575.5 ± 13.5 (0.52 %, 23 CPU-s), E 2 317 ± 84 (3.6 %), F 1 090 ± 103 (9.5 %);
++ guided scattering (``--guide 0.5 --guide-radius 1``), 4 M photons: B 1 182.5 ± 36.6 (3.1 %,
+14 CPU-s), C 3 107.0 ± 26.9 (0.87 %, 11 CPU-s), F 1 302 ± 84 (6.5 %), A 947.6 ± 15.0 (1.6 %),
+D 2 608.9 ± 14.5 (0.56 %), E 2 374.9 ± 35.6 (1.5 %). NumPy backward (32
+points × 256 paths; C, D 1 024 points × 32 paths): A 988.2 ± 6.0, B 1 281.3 ± 7.7,
+C 3 166.9 ± 57.4, D 2 716.4 ± 57.4, E 2 375.0 ± 8.3, F 1 408.3 ± 16.4. Radiance (32 points,
+-ad 256): A 987.6 ± 6.4 (90 CPU-s). The uniform launch (session 4) needed ≈ 2 000 s for 1 % on
+A; the rings need ≈ 100 CPU-s. Scenarios with traced street light (B, C, F) are heavy-tailed
+without the guide: one batch in 16 can hold 40× the others (a photon from a far ring, launched
+at low density, reaching the detectors through the dome); even with it the dome scenes' means
+rise with the photon count (A: 917 at 1 M, 927–940 at 2 M, 979 at 8 M) — a tail the 16-batch
+standard error does not see, so forward − backward within 2 % is shown only where the
+combined standard error is ≈ 2 %: C (−1.9 % ± 2.0 %), E (0.0 % ± 1.5 %), A (−0.9 % ± 2.0 %).
 
 Measured (session 4, 12:30, 2 cores shared by 8 sessions, load 12–16; 32 points per patch,
 NumPy 256 paths each): forward − NumPy façade patch mean, ± combined standard error —
