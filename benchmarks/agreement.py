@@ -23,10 +23,13 @@ photons: A 979.4 ± 18.7 lx (1.9 %, 27 CPU-s), B 1 372 ± 227 (17 %), C 3 636 ±
 D 2 575.5 ± 13.5 (0.52 %, 23 CPU-s), E 2 317 ± 84 (3.6 %), F 1 090 ± 103 (9.5 %);
 + guided scattering (``--guide 0.5 --guide-radius 1``), 4 M photons: B 1 182.5 ± 36.6 (3.1 %,
 14 CPU-s), C 3 107.0 ± 26.9 (0.87 %, 11 CPU-s), F 1 302 ± 84 (6.5 %), A 947.6 ± 15.0 (1.6 %),
-D 2 608.9 ± 14.5 (0.56 %), E 2 374.9 ± 35.6 (1.5 %). NumPy backward (32
+D 2 608.9 ± 14.5 (0.56 %), E 2 374.9 ± 35.6 (1.5 %); at 16 M: B 1 230.6 ± 16.2 (1.3 %, 56
+CPU-s), A 1 073 ± 115 (11 %: one tail event); rings alone at 16 M: D 2 574.4 ± 10.0 (0.39 %).
+NumPy backward (32
 points × 256 paths; C, D 1 024 points × 32 paths): A 988.2 ± 6.0, B 1 281.3 ± 7.7,
 C 3 166.9 ± 57.4, D 2 716.4 ± 57.4, E 2 375.0 ± 8.3, F 1 408.3 ± 16.4. Radiance (32 points,
--ad 256): A 987.6 ± 6.4 (90 CPU-s). The uniform launch (session 4) needed ≈ 2 000 s for 1 % on
+-ad 256): A 987.6 ± 6.4 (90 CPU-s), B 1 279.3 ± 6.2, C 3 290 ± 398, D 2 829 ± 397, E 2 362.2 ± 5.1
+(F not finished). The uniform launch (session 4) needed ≈ 2 000 s for 1 % on
 A; the rings need ≈ 100 CPU-s. Scenarios with traced street light (B, C, F) are heavy-tailed
 without the guide: one batch in 16 can hold 40× the others (a photon from a far ring, launched
 at low density, reaching the detectors through the dome); even with it the dome scenes' means
