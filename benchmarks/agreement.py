@@ -11,7 +11,31 @@ error, against the 2 % target. The Radiance photon map (``mkpmap`` + ``rtrace -a
 and caustic photons) is the fourth estimator with ``--pmap N``.
 
 Run: ``.venv/bin/python benchmarks/agreement.py [--photons N] [--points N] [--rays N]
-[--ad N] [--pmap N] [--scenarios A B ...] [--hour HH:MM] [--backward numpy]``. No assertions.
+[--ad N] [--pmap N] [--scenarios A B ...] [--hour HH:MM] [--backward numpy]
+[--focus M] [--guide Q --guide-radius M] [--skip-forward]``. No assertions. ``--backward``
+with no engine runs the forward engine alone; ``--skip-forward`` the backward ones alone (run
+them as separate processes). Wall and CPU seconds are both printed: on a shared machine the CPU
+time is the comparable cost.
+
+Measured (session 5, 12:30, 2 cores shared by 6 sessions, load 16–23: a process got 5–8 % of
+a core, so CPU seconds are quoted). Forward with the stratified launch (``--focus 0.5``), 8 M
+photons: A 979.4 ± 18.7 lx (1.9 %, 27 CPU-s), B 1 372 ± 227 (17 %), C 3 636 ± 618 (17 %),
+D 2 575.5 ± 13.5 (0.52 %, 23 CPU-s), E 2 317 ± 84 (3.6 %), F 1 090 ± 103 (9.5 %);
++ guided scattering (``--guide 0.5 --guide-radius 1``), 4 M photons: B 1 182.5 ± 36.6 (3.1 %,
+14 CPU-s), C 3 107.0 ± 26.9 (0.87 %, 11 CPU-s), F 1 302 ± 84 (6.5 %), A 947.6 ± 15.0 (1.6 %),
+D 2 608.9 ± 14.5 (0.56 %), E 2 374.9 ± 35.6 (1.5 %); at 16 M: B 1 230.6 ± 16.2 (1.3 %, 56
+CPU-s), A 1 073 ± 115 (11 %: one tail event); rings alone at 16 M: D 2 574.4 ± 10.0 (0.39 %).
+NumPy backward (32
+points × 256 paths; C, D 1 024 points × 32 paths): A 988.2 ± 6.0, B 1 281.3 ± 7.7,
+C 3 166.9 ± 57.4, D 2 716.4 ± 57.4, E 2 375.0 ± 8.3, F 1 408.3 ± 16.4. Radiance (32 points,
+-ad 256): A 987.6 ± 6.4 (90 CPU-s), B 1 279.3 ± 6.2, C 3 290 ± 398, D 2 829 ± 397, E 2 362.2 ± 5.1
+(F not finished). The uniform launch (session 4) needed ≈ 2 000 s for 1 % on
+A; the rings need ≈ 100 CPU-s. Scenarios with traced street light (B, C, F) are heavy-tailed
+without the guide: one batch in 16 can hold 40× the others (a photon from a far ring, launched
+at low density, reaching the detectors through the dome); even with it the dome scenes' means
+rise with the photon count (A: 917 at 1 M, 927–940 at 2 M, 979 at 8 M) — a tail the 16-batch
+standard error does not see, so forward − backward within 2 % is shown only where the
+combined standard error is ≈ 2 %: C (−1.9 % ± 2.0 %), E (0.0 % ± 1.5 %), A (−0.9 % ± 2.0 %).
 
 Measured (session 4, 12:30, 2 cores shared by 8 sessions, load 12–16; 32 points per patch,
 NumPy 256 paths each): forward − NumPy façade patch mean, ± combined standard error —
@@ -44,11 +68,28 @@ from radtree.light.hours import hour_states  # noqa: E402
 from radtree.pipeline.assemble import make_scene  # noqa: E402
 from radtree.verify.compare import MENDOZA, backward_patch_mean  # noqa: E402
 
+_CHILD = [0.0]
 
-def _line(engine: str, seconds: float, rays: float, unit: str, mean: float, se: float) -> None:
-    t1 = seconds * (se / (0.01 * mean)) ** 2 if mean > 0 else math.inf
-    print(f"   {engine:9s} {mean:9.1f} ± {se:6.1f} lx ({se / mean:5.2%})  {seconds:7.1f} s  "
-          f"{rays / seconds / 1e3:9.1f} k {unit}/s  → 1 % s.e. in {t1:8.3g} s", flush=True)
+
+def _children_cpu() -> float:
+    """CPU seconds of finished child processes (rtrace) since the last call."""
+    import resource
+
+    r = resource.getrusage(resource.RUSAGE_CHILDREN)
+    now = r.ru_utime + r.ru_stime
+    out, _CHILD[0] = now - _CHILD[0], now
+    return out
+
+
+def _line(engine: str, seconds: float, rays: float, unit: str, mean: float, se: float,
+          cpu: float) -> None:
+    """Wall and CPU seconds (the machine is shared: CPU time is the comparable figure), the
+    rates per wall and per CPU second, and the times to a 1 % standard error (t · (s.e./1 %)²)."""
+    k = (se / (0.01 * mean)) ** 2 if mean > 0 else math.inf
+    print(f"   {engine:9s} {mean:9.1f} ± {se:6.1f} lx ({se / mean:5.2%})  {seconds:7.1f} s wall "
+          f"{cpu:7.1f} s CPU  {rays / seconds / 1e3:8.1f} k {unit}/s ({rays / cpu / 1e3:8.1f} k "
+          f"per CPU s)  → 1 % s.e. in {seconds * k:8.3g} s wall, {cpu * k:8.3g} s CPU",
+          flush=True)
 
 
 def main() -> None:
@@ -57,14 +98,23 @@ def main() -> None:
     ap.add_argument("--points", type=int, default=32)
     ap.add_argument("--rays", type=int, default=512)
     ap.add_argument("--ad", type=int, default=512)
+    ap.add_argument("--focus", type=float, default=0.5,
+                    help="forward: stratified launch, innermost ring radius m (0: uniform)")
+    ap.add_argument("--guide", type=float, default=0.0,
+                    help="forward: share of diffuse directions aimed at the target (0: none)")
+    ap.add_argument("--guide-radius", type=float, default=1.0, help="its sphere's radius, m")
     ap.add_argument("--pmap", type=int, default=0, help="photon map photons (0: not run)")
     ap.add_argument("--scenarios", nargs="+", default=["A", "B", "C", "D", "E", "F"])
     ap.add_argument("--hour", default="12:30")
-    ap.add_argument("--backward", nargs="+", default=None,
-                    help="backward engines compared (default: every available one)")
+    ap.add_argument("--skip-forward", action="store_true",
+                    help="backward engines only (run the estimators in separate processes)")
+    ap.add_argument("--backward", nargs="*", default=None,
+                    help="backward engines compared (default: every available one; none: "
+                         "forward only)")
     a = ap.parse_args()
     proj = load_project(MENDOZA, overrides={"site.hours": [a.hour], "sensors.dense_grid": False})
-    backward = a.backward or [e.name for e in available_engines() if e.name != "forward"]
+    backward = a.backward if a.backward is not None else [
+        e.name for e in available_engines() if e.name != "forward"]
     print(f"Mendoza example, {a.hour}: forward {a.photons} photons; backward {a.points} points "
           f"per 0.5 m patch (NumPy {a.rays} paths each, Radiance -ad {a.ad})")
     summary = []
@@ -74,30 +124,34 @@ def main() -> None:
         st = hour_states(proj, sc, [a.hour])[0]
         scene = built.scene
         print(f" scenario {name}: {scene.n_triangles} triangles, -ab {built.ab}", flush=True)
-        t0 = time.perf_counter()
-        fw = trace_forward(scene, st, ForwardSettings(photons=a.photons, max_bounces=built.ab),
-                           ["facade"])
-        dt = time.perf_counter() - t0
-        f_mean, f_se = fw.grid_mean("facade")
-        _line("forward", dt, fw.segments, "ray segments", f_mean, f_se)
+        f_mean = f_se = math.nan
+        if not a.skip_forward:
+            t0, c0 = time.perf_counter(), time.process_time()
+            fw = trace_forward(scene, st, ForwardSettings(
+                photons=a.photons, max_bounces=built.ab, focus_m=a.focus or None,
+                guide=a.guide, guide_radius_m=a.guide_radius), ["facade"])
+            dt = time.perf_counter() - t0
+            f_mean, f_se = fw.grid_mean("facade")
+            _line("forward", dt, fw.segments, "ray segments", f_mean, f_se,
+                  time.process_time() - c0)
         runs = [(e, replace(proj.engine, ad=a.ad)) for e in backward]
         if a.pmap:
             runs.append(("radiance", replace(proj.engine, ad=a.ad, pmap_photons=a.pmap,
                                              pmap_caustic_photons=a.pmap)))
         for e, params in runs:
             label = "pmap" if params.pmap_photons else e
-            t0 = time.perf_counter()
+            t0, c0 = time.perf_counter(), time.process_time()
             bw = backward_patch_mean(e, scene, st, "facade", 0.5, ab=built.ab,
                                      points=a.points, rays=a.rays, params=params)
             dt = time.perf_counter() - t0
             n = len(scene.grids["facade"]) * a.points * (a.rays if e == "numpy" else a.ad)
             _line(label, dt, n, "paths" if e == "numpy" else "first-bounce rays", bw.lux,
-                  bw.stderr)
+                  bw.stderr, time.process_time() - c0 + _children_cpu())
             diff = (f_mean - bw.lux) / bw.lux
             comb = math.hypot(f_se, bw.stderr) / bw.lux
             summary.append((name, label, bw.lux, f_mean, diff, comb))
     print("\nforward − backward (façade patch mean), target within 2 %")
-    for name, label, b, f, d, c in summary:
+    for name, label, b, f, d, c in summary if not a.skip_forward else []:
         ok = "ok" if abs(d) <= max(0.02, 3 * c) else "MISS"
         print(f"  {name:2s} vs {label:9s} {b:9.1f} / {f:9.1f} lx  {d:+6.2%} ± {c:5.2%}  {ok}")
 

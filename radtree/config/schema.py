@@ -331,6 +331,15 @@ class EngineParams(Checked):
     beam_diameter_m: float | None = field(default=None, metadata=meta(0.0, lo_open=True))
     patch_m: float = field(default=0.5, metadata=meta(0.0, lo_open=True))
     forward_batches: int = field(default=16, metadata=meta(2))
+    # forward engine: focused launch, innermost disc radius (m) around the target grid (None =
+    # start points uniform over the launch disc)
+    forward_focus_m: float | None = field(default=None, metadata=meta(0.0, lo_open=True))
+    # forward engine: children per diffuse event near the target grid (1 = none), and how near
+    forward_split: int = field(default=1, metadata=meta(1))
+    forward_split_radius_m: float = field(default=2.0, metadata=meta(0.0, lo_open=True))
+    # forward engine: share of diffuse directions aimed at the target grid (0 = none), sphere
+    forward_guide: float = field(default=0.0, metadata=meta(0.0, 1.0, hi_open=True))
+    forward_guide_radius_m: float = field(default=2.0, metadata=meta(0.0, lo_open=True))
     # Radiance photon map (radtree.engines.radiance.pmap): global photons per hour (None = no
     # photon map, plain rtrace -I), caustic photons (None = none), photons per density estimate
     pmap_photons: int | None = field(default=None, metadata=meta(1))
@@ -342,7 +351,8 @@ class EngineParams(Checked):
 PMAP_KEYS = ("pmap_photons", "pmap_caustic_photons", "pmap_bandwidth")
 #: the :class:`EngineParams` fields only the forward engine reads
 FORWARD_KEYS = ("photons", "forward_threshold", "forward_splitting", "beam_diameter_m",
-                "patch_m", "forward_batches")
+                "patch_m", "forward_batches", "forward_focus_m", "forward_split",
+                "forward_split_radius_m", "forward_guide", "forward_guide_radius_m")
 
 
 @dataclass(frozen=True)

@@ -15,9 +15,11 @@ import numpy as np
 
 from radtree.engines.base import GridResult
 from radtree.engines.forward.detectors import PatchDetectors
+from radtree.engines.forward.guide import Guide
 from radtree.engines.forward.settings import ForwardSettings
 from radtree.engines.forward.sources import EnvironmentSource, SunSource, bounding_sphere
-from radtree.engines.forward.tracer import ForwardTracer, Ledger, Photons
+from radtree.engines.forward.strata import PILOT, Stratum, allocate, pilot, ring_edges, trace_strata
+from radtree.engines.forward.tracer import ForwardTracer, Ledger, Photons, Splitting
 from radtree.engines.numpy.engine import Environment, scene_geometry, scene_optics
 from radtree.errors import ConfigError, EngineError
 from radtree.light.sky import SkyState
@@ -35,6 +37,9 @@ class ForwardResult:
     segments: int
     seconds: float
     batches: dict[str, np.ndarray]
+    #: the stratified launch's rings (None: uniform launch) and the pilot's photons
+    strata: list[Stratum] | None = None
+    pilot_photons: int = 0
 
     def grid_mean(self, grid: str) -> tuple[float, float]:
         """Mean lux over the grid's sensors and its standard error from the batches (patches
@@ -106,25 +111,51 @@ def trace_forward(scene: Scene, state: SkyState, settings: ForwardSettings,
             sources.append(env)
     rng = np.random.default_rng(np.random.SeedSequence(
         [int(settings.seed) & 0xFFFFFFFF, zlib.crc32((label or state.label).encode())]))
-    tracer = ForwardTracer(geo, scene_optics(scene, state, geo.material_names), det,
-                           settings.batches, threshold=settings.threshold,
-                           splitting=settings.splitting, max_bounces=settings.max_bounces,
-                           max_specular=settings.max_specular, chunk=settings.chunk, rng=rng)
-    counts = _allot(settings.photons, [s.flux for s in sources], settings.batches)
-    for src, n_src in zip(sources, counts):
-        per_photon = src.flux / n_src
-        for c0 in range(0, n_src, settings.chunk):
-            k = min(settings.chunk, n_src - c0)
-            batch = (c0 + np.arange(k)) % settings.batches
-            tracer.run(Photons.start(src.launch(k, per_photon, rng), batch))
+    optics = scene_optics(scene, state, geo.material_names)
+    aim = target_grid(scene) if target_grid(scene) in names else names[0]
+    target = scene.grids[aim].points.mean(axis=0)
+    near = (Splitting(target, settings.split_radius_m, settings.split)
+            if settings.split > 1 else None)
+    guide = (Guide(target, settings.guide_radius_m, settings.guide)
+             if settings.guide > 0 else None)
+
+    def new_tracer(batches: int) -> ForwardTracer:
+        return ForwardTracer(geo, optics, det, batches, threshold=settings.threshold,
+                             splitting=settings.splitting, max_bounces=settings.max_bounces,
+                             max_specular=settings.max_specular, chunk=settings.chunk, rng=rng,
+                             splitting_near=near, guide=guide)
+
+    tracer = new_tracer(settings.batches)
+    strata, n_pilot, pilot_segments = None, 0, 0
+    if settings.focus_m is not None and settings.beam_diameter_m is None and sources:
+        edges = ring_edges(float(settings.focus_m),
+                           sphere.radius + float(np.linalg.norm(target - sphere.centre)))
+        strata = [Stratum(i, a, b) for i in range(len(sources))
+                  for a, b in zip(edges[:-1], edges[1:])]
+        per_ring = max(64, int(PILOT * settings.photons / len(strata)))
+        scout = new_tracer(1)
+        pilot(sources, strata, target, scout, per_ring, rng)
+        n_pilot, pilot_segments = per_ring * len(strata), scout.segments
+        allocate(strata, max(settings.photons - n_pilot, settings.batches * len(strata)),
+                 settings.batches)
+        trace_strata(sources, strata, target, tracer, settings.chunk, settings.batches, rng)
+        counts = [sum(st.photons for st in strata)]
+    else:
+        counts = _allot(settings.photons, [s.flux for s in sources], settings.batches)
+        for src, n_src in zip(sources, counts):
+            per_photon = src.flux / n_src
+            for c0 in range(0, n_src, settings.chunk):
+                k = min(settings.chunk, n_src - c0)
+                batch = (c0 + np.arange(k)) % settings.batches
+                tracer.run(Photons.start(src.launch(k, per_photon, rng), batch))
     out, per = {}, {}
     b = settings.batches
     for name in names:
         per[name] = tracer.tally[:, det.slices[name]] * b / det.area
         mean = tracer.tally[:, det.slices[name]].sum(axis=0) / det.area
         out[name] = GridResult(mean, per[name].std(axis=0, ddof=1) / np.sqrt(b))
-    return ForwardResult(out, tracer.ledger, int(sum(counts)), tracer.segments,
-                         time.perf_counter() - t0, per)
+    return ForwardResult(out, tracer.ledger, int(sum(counts)), tracer.segments + pilot_segments,
+                         time.perf_counter() - t0, per, strata, n_pilot)
 
 
 def _allot(photons: int, fluxes: list[float], batches: int) -> list[int]:

@@ -8,8 +8,15 @@ false: one event per hit chosen ∝ its coefficient, Russian roulette below the 
 unbiased), ``beam_diameter_m`` (the sun as a collimated beam of that diameter aimed at the
 centre of the first sensor grid, and then the only source — no sky, no ground glow, as in the
 study; unset = sunlight, sky and ground glow over the whole scene), ``patch_m`` (side of
-the square detector around each sensor, m) and ``forward_batches`` (independent batches for the
-standard error).
+the square detector around each sensor, m), ``forward_batches`` (independent batches for the
+standard error) and ``forward_focus_m`` (a focused launch: start points drawn densest around
+the target grid's centre, innermost disc of that radius, m — unbiased, see
+:mod:`radtree.engines.forward.strata`; unset = uniform over the launch disc),
+``forward_split`` and ``forward_split_radius_m`` (diffuse events within that radius of the
+target grid's centre split into that many children, at most twice per photon; 1 = never),
+``forward_guide`` and ``forward_guide_radius_m`` (that share of every diffuse event outside a
+sphere of that radius around the target grid's centre aims its direction at the sphere, the
+flux corrected: :mod:`radtree.engines.forward.guide`; 0 = Lambertian scattering only).
 """
 
 from __future__ import annotations
@@ -41,6 +48,11 @@ class ForwardSettings:
     ``max_bounces``: diffuse scattering events per photon (``-ab``: a backward path with k
     diffuse segments is a photon path with k diffuse events). ``max_specular``: specular events
     per photon. ``chunk``: photons stepped at once (bounded memory). ``seed``: random seed.
+    ``focus_m``: innermost radius (m) of the focused launch around the target grid's centre
+    (None: start points uniform on the launch disc; ignored with a beam). ``split``: children
+    per diffuse event within ``split_radius_m`` (m) of the target grid's centre (1: none).
+    ``guide``: share (0 ≤ q < 1) of diffuse directions aimed at the sphere of ``guide_radius_m``
+    (m) around the target grid's centre (0: none).
     """
 
     photons: int = 1_000_000
@@ -53,6 +65,11 @@ class ForwardSettings:
     max_specular: int = 32
     chunk: int = 1 << 17
     seed: int = 1
+    focus_m: float | None = None
+    split: int = 1
+    split_radius_m: float = 2.0
+    guide: float = 0.0
+    guide_radius_m: float = 2.0
 
     def __post_init__(self) -> None:
         if isinstance(self.photons, bool) or not isinstance(self.photons, int) or self.photons < 1:
@@ -74,6 +91,23 @@ class ForwardSettings:
             raise _bad("forward_batches", f"must be a whole number ≥ 2, got {self.batches!r}")
         if self.photons < self.batches:
             raise _bad("photons", f"{self.photons} photons cannot fill {self.batches} batches")
+        f = self.focus_m
+        if f is not None and (isinstance(f, bool) or not isinstance(f, int | float)
+                              or not math.isfinite(f) or f <= 0):
+            raise _bad("forward_focus_m", f"must be > 0 m (or unset for a uniform launch), "
+                       f"got {f!r}")
+        if isinstance(self.split, bool) or not isinstance(self.split, int) or self.split < 1:
+            raise _bad("forward_split", f"must be a whole number ≥ 1, got {self.split!r}")
+        r = self.split_radius_m
+        if not isinstance(r, int | float) or not math.isfinite(r) or r <= 0:
+            raise _bad("forward_split_radius_m", f"must be > 0 m, got {r!r}")
+        q = self.guide
+        if isinstance(q, bool) or not isinstance(q, int | float) or not 0.0 <= q < 1.0:
+            raise _bad("forward_guide", f"must be ≥ 0 and < 1 (a share of the diffuse "
+                       f"directions), got {q!r}")
+        r = self.guide_radius_m
+        if not isinstance(r, int | float) or not math.isfinite(r) or r <= 0:
+            raise _bad("forward_guide_radius_m", f"must be > 0 m, got {r!r}")
         if self.max_bounces < 0 or self.max_specular < 0 or self.chunk < 1:
             raise _bad("max_bounces", "bounce caps must be ≥ 0 and the chunk ≥ 1")
 
@@ -85,11 +119,20 @@ class ForwardSettings:
                    splitting=params.forward_splitting, beam_diameter_m=params.beam_diameter_m,
                    patch_m=params.patch_m, batches=params.forward_batches,
                    max_bounces=int(params.max_bounces if ab is None else ab),
-                   seed=int(params.seed))
+                   seed=int(params.seed), focus_m=params.forward_focus_m,
+                   split=params.forward_split, split_radius_m=params.forward_split_radius_m,
+                   guide=params.forward_guide, guide_radius_m=params.forward_guide_radius_m)
 
     def describe(self) -> str:
         source = ("sun over the whole scene" if self.beam_diameter_m is None
                   else f"sun beam {self.beam_diameter_m:g} m")
+        if self.beam_diameter_m is None and self.focus_m is not None:
+            source += f", focused launch from {self.focus_m:g} m"
         scatter = "ray splitting" if self.splitting else "Russian roulette"
+        if self.split > 1:
+            scatter += f", ×{self.split} within {self.split_radius_m:g} m of the target"
+        if self.guide > 0:
+            scatter += f", {self.guide:.0%} of diffuse directions aimed at the target " \
+                       f"({self.guide_radius_m:g} m)"
         return (f"{self.photons} photons, {source}, {scatter}, threshold {self.threshold:g}, "
                 f"patches {self.patch_m:g} m, {self.batches} batches, seed {self.seed}")

@@ -11,6 +11,11 @@ scene or as a beam aimed at a target), and the sky and distant ground glow.
   cells, ∝ L·Ω) and a photon starts on the disc of radius R perpendicular to ω outside the
   bounding sphere, travelling along −ω; flux through the disc from dω is L(ω) dω · π R², so
   the total is π R² ∫ L dω and a photon's flux is corrected by L(ω) / L(cell).
+* **Rings** (the stratified launch of :mod:`radtree.engines.forward.strata`): start points
+  uniform in an annulus a ≤ ρ < b of the launch plane around the *focus*, where the line
+  through a target point along the photon's direction crosses that plane; flux per photon
+  = (flux per m² of launch plane) × π (b² − a²) / photons. Rings out to R + |target − centre|
+  cover the whole launch disc.
 """
 
 from __future__ import annotations
@@ -59,6 +64,23 @@ def _disc_points(centres: np.ndarray, normals: np.ndarray, radius: float,
     return centres + t * (r * np.cos(phi))[:, None] + b * (r * np.sin(phi))[:, None]
 
 
+def _ring_points(foci: np.ndarray, normals: np.ndarray, a: float, b: float,
+                 rng: np.random.Generator) -> np.ndarray:
+    """Points uniform in the annuli a ≤ ρ < b (m) around ``foci`` in the planes of unit
+    ``normals``."""
+    k = len(foci)
+    r = np.sqrt(a * a + rng.random(k) * (b * b - a * a))
+    phi = 2.0 * math.pi * rng.random(k)
+    t, bb = orthonormal_basis(normals)
+    return foci + t * (r * np.cos(phi))[:, None] + bb * (r * np.sin(phi))[:, None]
+
+
+def _foci(target: np.ndarray, centres: np.ndarray, normals: np.ndarray) -> np.ndarray:
+    """Where the lines through ``target`` along ``normals`` cross the planes through
+    ``centres`` perpendicular to them."""
+    return target + normals * np.einsum("ij,ij->i", centres - target, normals)[:, None]
+
+
 class SunSource:
     """The collimated sun: direction ``sun`` (unit, towards the sun), direct normal
     illuminance ``dni`` (lux), a disc of ``radius`` (m) whose axis passes through ``axis_point``,
@@ -70,12 +92,23 @@ class SunSource:
         self.axis_point = np.asarray(axis_point, float)
         self.radius = float(radius)
         self.centre = self.axis_point + self.sun * float(distance)
-        self.flux = float(dni) * math.pi * self.radius ** 2
+        self.density = float(dni)  # lm per m² of launch plane
+        self.flux = self.density * math.pi * self.radius ** 2
 
     def launch(self, k: int, photon_flux: float, rng: np.random.Generator) -> Launch:
         normals = np.broadcast_to(self.sun, (k, 3))
         o = _disc_points(np.broadcast_to(self.centre, (k, 3)), normals, self.radius, rng)
         return Launch(o, np.broadcast_to(-self.sun, (k, 3)).copy(), np.full(k, photon_flux))
+
+    def ring_launch(self, k: int, a: float, b: float, target: np.ndarray,
+                    rng: np.random.Generator) -> Launch:
+        """``k`` photons starting uniformly in the ring a ≤ ρ < b (m) around ``target``'s
+        focus, each carrying an equal share of the ring's flux (lm)."""
+        normals = np.broadcast_to(self.sun, (k, 3))
+        foci = _foci(target, np.broadcast_to(self.centre, (k, 3)), normals)
+        o = _ring_points(foci, normals, a, b, rng)
+        share = self.density * math.pi * (b * b - a * a) / k
+        return Launch(o, np.broadcast_to(-self.sun, (k, 3)).copy(), np.full(k, share))
 
     def distance_to_axis(self, points: np.ndarray) -> np.ndarray:
         """Perpendicular distance (m) of ``points`` from the beam axis."""
@@ -101,10 +134,13 @@ class EnvironmentSource:
         self.omega = 4.0 * math.pi / (nz * nphi)
         total = float(self.cell_l.sum())
         self.area = math.pi * sphere.radius ** 2
-        self.flux = self.area * total * self.omega
+        self.density = total * self.omega  # lm per m² of launch plane, all directions
+        self.flux = self.area * self.density
         self.cdf = np.cumsum(self.cell_l) / total if total > 0 else None
 
-    def launch(self, k: int, photon_flux: float, rng: np.random.Generator) -> Launch:
+    def _directions(self, k: int, rng: np.random.Generator) -> tuple[np.ndarray, np.ndarray]:
+        """``k`` unit directions towards the source drawn ∝ L·Ω, and each one's flux
+        correction L(ω) / L(cell)."""
         assert self.cdf is not None
         cell = np.minimum(np.searchsorted(self.cdf, rng.random(k), side="right"),
                           len(self.cdf) - 1)
@@ -113,7 +149,19 @@ class EnvironmentSource:
         phi = (ip + rng.random(k)) * 2.0 * math.pi / self.nphi
         s = np.sqrt(np.maximum(0.0, 1.0 - z * z))
         w = np.column_stack([s * np.cos(phi), s * np.sin(phi), z])
-        ratio = np.asarray(self.luminance(w), float) / self.cell_l[cell]
+        return w, np.asarray(self.luminance(w), float) / self.cell_l[cell]
+
+    def launch(self, k: int, photon_flux: float, rng: np.random.Generator) -> Launch:
+        w, ratio = self._directions(k, rng)
         centres = self.sphere.centre + w * (self.sphere.radius + 1.0)
         o = _disc_points(centres, w, self.sphere.radius, rng)
         return Launch(o, -w, photon_flux * ratio)
+
+    def ring_launch(self, k: int, a: float, b: float, target: np.ndarray,
+                    rng: np.random.Generator) -> Launch:
+        """As :meth:`SunSource.ring_launch`, each photon's direction drawn from the sky."""
+        w, ratio = self._directions(k, rng)
+        centres = self.sphere.centre + w * (self.sphere.radius + 1.0)
+        o = _ring_points(_foci(target, centres, w), w, a, b, rng)
+        share = self.density * math.pi * (b * b - a * a) / k
+        return Launch(o, -w, share * ratio)

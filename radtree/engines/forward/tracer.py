@@ -16,6 +16,12 @@ At every hit a photon of flux w either
   threshold it plays Russian roulette (survives with probability w / (threshold · w₀), then
   carries threshold · w₀): unbiased.
 
+**Splitting near the detectors** (:class:`Splitting`): a diffuse event within ``radius`` of
+the target point splits its child into ``factor`` children, each drawing its own direction and
+carrying 1/``factor`` of the flux (and of the threshold's reference flux, so roulette does not
+undo the split), at most ``levels`` times per lineage: more photons where the detectors can see
+them, the expected tally unchanged.
+
 Diffuse events per photon are capped at ``max_bounces`` (``-ab``: the diffuse part of a hit
 beyond the cap is dropped, like a backward path that may not bounce again) and specular events
 at ``max_specular``. Every lumen is accounted for in a :class:`Ledger`: launched = escaped +
@@ -29,6 +35,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from radtree.engines.forward.detectors import PatchDetectors
+from radtree.engines.forward.guide import Guide
 from radtree.engines.forward.sources import Launch
 from radtree.engines.numpy.engine import Geometry, Optics, glass_coefficients
 from radtree.engines.numpy.sampling import cosine_hemisphere, mirror
@@ -67,6 +74,17 @@ class Ledger:
                                 + self.killed - self.promoted)
 
 
+@dataclass(frozen=True)
+class Splitting:
+    """Split diffuse children within ``radius`` (m) of ``target`` into ``factor`` (≥ 2), at
+    most ``levels`` times per photon lineage."""
+
+    target: np.ndarray
+    radius: float
+    factor: int
+    levels: int = 2
+
+
 @dataclass
 class Photons:
     """A set of photons in flight (struct of arrays)."""
@@ -78,25 +96,27 @@ class Photons:
     ndiff: np.ndarray    # diffuse events so far
     nspec: np.ndarray    # specular events so far
     batch: np.ndarray    # batch of the photon (standard errors)
+    nsplit: np.ndarray   # splits in its lineage so far
 
     def __len__(self) -> int:
         return len(self.w)
 
     def take(self, m: np.ndarray | slice) -> Photons:
         return Photons(self.o[m], self.d[m], self.w[m], self.w0[m], self.ndiff[m],
-                       self.nspec[m], self.batch[m])
+                       self.nspec[m], self.batch[m], self.nsplit[m])
 
     @staticmethod
     def join(parts: list[Photons]) -> Photons:
         return Photons(*(np.concatenate([getattr(p, f) for p in parts])
-                         for f in ("o", "d", "w", "w0", "ndiff", "nspec", "batch")))
+                         for f in ("o", "d", "w", "w0", "ndiff", "nspec", "batch",
+                                   "nsplit")))
 
     @staticmethod
     def start(launch: Launch, batch: np.ndarray) -> Photons:
         k = len(launch.flux)
         z = np.zeros(k, np.int64)
         return Photons(launch.origins, launch.dirs, launch.flux.copy(), launch.flux.copy(),
-                       z, z.copy(), batch)
+                       z, z.copy(), batch, z.copy())
 
 
 class ForwardTracer:
@@ -104,8 +124,10 @@ class ForwardTracer:
 
     def __init__(self, geo: Geometry, optics: Optics, detectors: PatchDetectors, batches: int,
                  *, threshold: float, splitting: bool, max_bounces: int, max_specular: int,
-                 chunk: int, rng: np.random.Generator):
+                 chunk: int, rng: np.random.Generator, splitting_near: Splitting | None = None,
+                 guide: Guide | None = None):
         self.geo, self.opt, self.det = geo, optics, detectors
+        self.near, self.guide = splitting_near, guide
         self.threshold, self.splitting = float(threshold), bool(splitting)
         self.max_bounces, self.max_specular = int(max_bounces), int(max_specular)
         self.chunk = int(chunk)
@@ -191,15 +213,44 @@ class ForwardTracer:
             ev, cw = ev[live], cw[live]
         if len(src) == 0:
             return ph.take(np.zeros(0, np.int64))
+        w0, nsplit = ph.w0[src], ph.nsplit[src]
+        if self.near is not None:
+            src, ev, cw, w0, nsplit = self._split(p, src, ev, cw, w0, nsplit)
         d, n = ph.d[src], nf[src]
         new_d = d.copy()
         diff_r, diff_t, spec_t, mir = ev == 0, ev == 1, ev == 2, ev == 3
         diffuse = diff_r | diff_t
         if diffuse.any():
             axis = np.where(diff_r[diffuse, None], n[diffuse], -n[diffuse])
-            new_d[diffuse] = cosine_hemisphere(axis, self.rng)
+            if self.guide is None:
+                new_d[diffuse] = cosine_hemisphere(axis, self.rng)
+            else:
+                new_d[diffuse], factor = self.guide.directions(p[src][diffuse], axis, self.rng)
+                old = cw[diffuse]
+                new = old * factor
+                led.promoted += float(np.maximum(new - old, 0.0).sum())
+                led.killed += float(np.maximum(old - new, 0.0).sum())
+                cw = cw.copy()
+                cw[diffuse] = new
         if mir.any():
             new_d[mir] = mirror(d[mir], n[mir])
         side = np.where(diff_t | spec_t, -1.0, 1.0)
-        return Photons(p[src] + n * (self.eps * side)[:, None], new_d, cw, ph.w0[src],
-                       ph.ndiff[src] + diffuse, ph.nspec[src] + (spec_t | mir), ph.batch[src])
+        out = Photons(p[src] + n * (self.eps * side)[:, None], new_d, cw, w0,
+                      ph.ndiff[src] + diffuse, ph.nspec[src] + (spec_t | mir), ph.batch[src],
+                      nsplit)
+        return out if self.guide is None else out.take(out.w > 0)
+
+    def _split(self, p: np.ndarray, src: np.ndarray, ev: np.ndarray, cw: np.ndarray,
+               w0: np.ndarray, nsplit: np.ndarray) -> tuple[np.ndarray, ...]:
+        """Children of diffuse events near the target, ``factor`` times each (flux and
+        reference flux divided: the expected tally is unchanged)."""
+        near = self.near
+        assert near is not None
+        close = np.linalg.norm(p[src] - near.target, axis=1) <= near.radius
+        go = close & (ev <= 1) & (nsplit < near.levels)
+        if not go.any():
+            return src, ev, cw, w0, nsplit
+        reps = np.where(go, near.factor, 1)
+        f = np.where(go, 1.0 / near.factor, 1.0)
+        return (np.repeat(src, reps), np.repeat(ev, reps), np.repeat(cw * f, reps),
+                np.repeat(w0 * f, reps), np.repeat(nsplit + go, reps))

@@ -1,0 +1,123 @@
+"""The stratified, importance-allocated launch: photons where their light can reach the
+detectors, with the flux weighting that keeps the estimate unbiased.
+
+A whole-scene sun (or sky) launches photons uniformly over a disc the size of the scene, most of
+them far from the few square metres of detectors. Here each source's launch plane is cut into
+**rings** around the *focus* — where the line through the target (the centre of the target
+grid's sensors) along the photon's direction crosses the plane — with edges 0, r, 2r, 3r, 4r,
+6r, 8r, 12r, … out to R + |target − scene centre| (R the bounding sphere's radius: the rings
+cover every start point of the uniform launch). Every ring is a stratum; its photons start
+uniformly in it and share its flux equally (flux per m² × ring area / photons, lm).
+
+1. **Pilot**: ``pilot`` × the photons, spread equally over every ring of every source, traced
+   with one tally row per photon: each photon's estimate y of its ring's contribution to the
+   mean illuminance of the traced detectors (lux), the standard deviation σ_h of y per ring
+   and the photon segments per photon c_h (its cost).
+2. **Allocation** (Neyman, with cost): the remaining photons go ∝ σ_h / √c_h, the optimum for a
+   stratified mean at a given tracing cost; a **defensive** share ``floor`` of them is spread
+   equally over every ring, so rings the pilot saw no light from (rare paths: a far bright
+   façade, a long ground bounce) keep photons and the estimate stays unbiased whatever the
+   pilot found. Each ring's count is a multiple of the batches.
+3. **Main run**: the rings' photons, assigned to the batches in turn: every batch is an
+   independent stratified estimate (its tally × batches), so the batch standard error stands.
+
+The pilot's photons only steer the allocation; they are not counted in the result (its
+randomness would otherwise correlate with the allocation). Photons still start at the source
+and travel along its direction: this is a forward tracer with a non-uniform launch.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from radtree.engines.forward.tracer import ForwardTracer, Photons
+
+PILOT = 0.1   # share of the photons spent on the pilot
+FLOOR = 0.1   # share of the remaining photons spread equally over every ring (defensive)
+
+
+def ring_edges(inner: float, outer: float) -> np.ndarray:
+    """Ring edges (m): 0, r, 2r, 3r, 4r, 6r, 8r, 12r, … (ratios alternating 3/2 and 4/3
+    from 2r on, ≈ √2 per ring) up to and including the first ≥ ``outer``."""
+    edges = [0.0, inner, 2.0 * inner]
+    k = 0
+    while edges[-1] < outer:
+        edges.append(edges[-1] * (1.5 if k % 2 == 0 else 4.0 / 3.0))
+        k += 1
+    return np.array(edges)
+
+
+@dataclass
+class Stratum:
+    """One ring of one source: edges (m), pilot figures, photons allotted."""
+
+    source: int
+    a: float
+    b: float
+    sigma: float = 0.0     # s.d. of one photon's estimate of the ring's contribution (lux)
+    cost: float = 1.0      # photon segments per photon
+    mean: float = 0.0      # the pilot's estimate of the ring's contribution (lux)
+    photons: int = 0
+    got: float = 0.0       # the main run's estimate of the ring's contribution (lux) …
+    got_se: float = 0.0    # … and its standard error from the batches
+
+
+def _batches(k: int, batches: int, offset: int = 0) -> np.ndarray:
+    return (offset + np.arange(k)) % batches
+
+
+def pilot(sources: list, strata: list[Stratum], target: np.ndarray, tracer: ForwardTracer,
+          per_ring: int, rng: np.random.Generator) -> None:
+    """Trace ``per_ring`` photons in every stratum with a tally row per photon (``tracer``: a
+    throw-away tracer on the same scene) and set each stratum's ``sigma``, ``cost``, ``mean``.
+    The figure of merit is the mean over every traced detector (lux)."""
+    det = tracer.det
+    for st in strata:
+        tracer.tally = np.zeros((per_ring, det.count))
+        before = tracer.segments
+        launch = sources[st.source].ring_launch(per_ring, st.a, st.b, target, rng)
+        tracer.run(Photons.start(launch, np.arange(per_ring)))
+        y = tracer.tally.sum(axis=1) / (det.count * det.area) * per_ring
+        st.sigma = float(y.std(ddof=1))
+        st.mean = float(y.mean())
+        st.cost = max(1.0, (tracer.segments - before) / per_ring)
+
+
+def allocate(strata: list[Stratum], photons: int, batches: int, floor: float = FLOOR) -> None:
+    """Set each stratum's ``photons``: ``floor`` × ``photons`` equally, the rest ∝ σ / √cost
+    — each ring's weight at least half its neighbours' (same source), so a ring whose rare
+    light the pilot missed between two lit ones is not starved — (all equally when the pilot
+    saw nothing), each rounded up to a multiple of ``batches``."""
+    n = len(strata)
+    raw = np.array([s.sigma / math.sqrt(s.cost) for s in strata])
+    weight = raw.copy()
+    for i in range(n):
+        for j in (i - 1, i + 1):
+            if 0 <= j < n and strata[j].source == strata[i].source:
+                weight[i] = max(weight[i], 0.5 * raw[j])
+    if weight.sum() <= 0:
+        weight = np.ones(n)
+    share = floor / n + (1.0 - floor) * weight / weight.sum()
+    for s, f in zip(strata, share):
+        s.photons = batches * max(1, math.ceil(photons * f / batches))
+
+
+def trace_strata(sources: list, strata: list[Stratum], target: np.ndarray,
+                 tracer: ForwardTracer, chunk: int, batches: int,
+                 rng: np.random.Generator) -> None:
+    """The main run: every stratum's photons, in chunks, assigned to the batches in turn;
+    each stratum's ``got`` ± ``got_se``: its share of the traced detectors' mean (lux)."""
+    det = tracer.det
+    for st in strata:
+        before = tracer.tally.sum(axis=1)
+        src = sources[st.source]
+        for c0 in range(0, st.photons, chunk):
+            k = min(chunk, st.photons - c0)
+            launch = src.ring_launch(k, st.a, st.b, target, rng)
+            launch.flux *= k / st.photons  # the ring's flux shared by all its photons
+            tracer.run(Photons.start(launch, _batches(k, batches, c0)))
+        part = (tracer.tally.sum(axis=1) - before) * batches / (det.count * det.area)
+        st.got, st.got_se = float(part.mean()), float(part.std(ddof=1) / math.sqrt(batches))
