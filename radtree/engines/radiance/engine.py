@@ -34,15 +34,16 @@ def run_hour(plan: BuildPlan, hour: str, dry_run: bool = False,
     folder = plan.folder
     oct_rel = f"octrees/{hour}.oct"
     commands: list[tuple[list[str], str | None, str]] = [
-        (argv, None, oct_) for argv, oct_ in plan.prototype_commands()
-        if dry_run or not (folder / oct_).exists()]
+        (argv, None, out) for argv, out in [*plan.mesh_commands(), *plan.prototype_commands()]
+        if dry_run or not (folder / out).exists()]
     commands.append((plan.oconv_command(hour), None, oct_rel))
     mkpmap = plan.mkpmap_command(hour)
     if mkpmap is not None:
         commands.append((mkpmap, None, f"pmaps/{hour}.log"))
     use = [g for g in plan.grids if grids is None or g in grids]
     for g in use:
-        commands.append((plan.rtrace_command(hour), f"grids/{g}.pts", f"results/{hour}_{g}.rgb"))
+        commands.append((plan.rtrace_command(hour, g), f"grids/{g}.pts",
+                         f"results/{hour}_{g}.rgb"))
     if dry_run:
         for argv, stdin, stdout in commands:
             line = " ".join(argv) + (f" < {stdin}" if stdin else "") + f" > {stdout}"
