@@ -33,9 +33,11 @@ def run_hour(plan: BuildPlan, hour: str, dry_run: bool = False,
     """
     folder = plan.folder
     oct_rel = f"octrees/{hour}.oct"
+    # the hours' shared inputs (compiled meshes, prototype octrees), made once
+    shared = [(argv, out) for argv, out in [*plan.mesh_commands(), *plan.prototype_commands()]
+              if dry_run or not (folder / out).exists()]
     commands: list[tuple[list[str], str | None, str]] = [
-        (argv, None, out) for argv, out in [*plan.mesh_commands(), *plan.prototype_commands()]
-        if dry_run or not (folder / out).exists()]
+        (argv, None, out) for argv, out in shared] if dry_run else []
     commands.append((plan.oconv_command(hour), None, oct_rel))
     mkpmap = plan.mkpmap_command(hour)
     if mkpmap is not None:
@@ -55,16 +57,12 @@ def run_hour(plan: BuildPlan, hour: str, dry_run: bool = False,
     if mkpmap is not None:
         (folder / "pmaps").mkdir(exist_ok=True)
     results: dict[str, GridResult] = {}
+    for argv, stdout in shared:
+        with _lock_for(folder / stdout):   # two hours of one folder in two threads: once
+            if not (folder / stdout).exists():
+                _produce(folder, argv, None, stdout)
     for argv, stdin, stdout in commands:
-        out = folder / stdout
-        tmp = out.with_name(f"{out.name}.{os.getpid()}.{threading.get_ident()}.tmp")
-        data = (folder / stdin).read_bytes() if stdin else None
-        try:
-            run(argv, stdin=data, cwd=folder, stdout_path=tmp)
-            os.replace(tmp, out)
-        finally:
-            if tmp.exists():
-                tmp.unlink()
+        _produce(folder, argv, stdin, stdout)
     for g in use:
         rgb_path = folder / f"results/{hour}_{g}.rgb"
         lux = read_rgb_as_lux(rgb_path, expected=None)
@@ -74,6 +72,28 @@ def run_hour(plan: BuildPlan, hour: str, dry_run: bool = False,
         os.replace(tmp, lux_path)
         results[g] = GridResult(lux, None)
     return results
+
+
+_LOCKS: dict[Path, threading.Lock] = {}
+_LOCKS_GUARD = threading.Lock()
+
+
+def _lock_for(path: Path) -> threading.Lock:
+    with _LOCKS_GUARD:
+        return _LOCKS.setdefault(path, threading.Lock())
+
+
+def _produce(folder: Path, argv: list[str], stdin: str | None, stdout: str) -> None:
+    """Run ``argv`` in ``folder`` (stdin from a file), its output to a temporary name first."""
+    out = folder / stdout
+    tmp = out.with_name(f"{out.name}.{os.getpid()}.{threading.get_ident()}.tmp")
+    data = (folder / stdin).read_bytes() if stdin else None
+    try:
+        run(argv, stdin=data, cwd=folder, stdout_path=tmp)
+        os.replace(tmp, out)
+    finally:
+        if tmp.exists():
+            tmp.unlink()
 
 
 def read_rgb_as_lux(path: Path, expected: int | None) -> np.ndarray:
