@@ -33,11 +33,11 @@ def run_hour(plan: BuildPlan, hour: str, dry_run: bool = False,
     """
     folder = plan.folder
     oct_rel = f"octrees/{hour}.oct"
-    # the hours' shared inputs (compiled meshes, prototype octrees), made once
-    shared = [(argv, out) for argv, out in [*plan.mesh_commands(), *plan.prototype_commands()]
-              if dry_run or not (folder / out).exists()]
+    # the hours' shared inputs (compiled meshes, prototype octrees): listed by a dry run,
+    # else made once by ensure_shared_inputs
     commands: list[tuple[list[str], str | None, str]] = [
-        (argv, None, out) for argv, out in shared] if dry_run else []
+        (argv, None, out) for argv, out in [*plan.mesh_commands(), *plan.prototype_commands()]
+    ] if dry_run else []
     commands.append((plan.oconv_command(hour), None, oct_rel))
     mkpmap = plan.mkpmap_command(hour)
     if mkpmap is not None:
@@ -57,10 +57,7 @@ def run_hour(plan: BuildPlan, hour: str, dry_run: bool = False,
     if mkpmap is not None:
         (folder / "pmaps").mkdir(exist_ok=True)
     results: dict[str, GridResult] = {}
-    for argv, stdout in shared:
-        with _lock_for(folder / stdout):   # two hours of one folder in two threads: once
-            if not (folder / stdout).exists():
-                _produce(folder, argv, None, stdout)
+    ensure_shared_inputs(plan)
     for argv, stdin, stdout in commands:
         _produce(folder, argv, stdin, stdout)
     for g in use:
@@ -72,6 +69,20 @@ def run_hour(plan: BuildPlan, hour: str, dry_run: bool = False,
         os.replace(tmp, lux_path)
         results[g] = GridResult(lux, None)
     return results
+
+
+def ensure_shared_inputs(plan: BuildPlan) -> None:
+    """Make the folder's missing compiled meshes (``obj2mesh``) and prototype octrees, each
+    once even when two hours of the folder run in two threads."""
+    folder = plan.folder
+    for argv, stdout in [*plan.mesh_commands(), *plan.prototype_commands()]:
+        target = folder / stdout
+        if target.exists():
+            continue
+        target.parent.mkdir(parents=True, exist_ok=True)
+        with _lock_for(target):
+            if not target.exists():
+                _produce(folder, argv, None, stdout)
 
 
 _LOCKS: dict[Path, threading.Lock] = {}
