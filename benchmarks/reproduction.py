@@ -1,7 +1,7 @@
 """Wall time of the full reference reproduction (scenarios A–E × 7 hours) with Radiance.
 
 Prints build and tracing times (wall and CPU, rtrace children included), peak memory (this
-process and its largest child), the machine load, the façade means and the statistics against
+process), the machine load, the façade means and the statistics against
 the measured data.
 Run: .venv/bin/python benchmarks/reproduction.py  (target, issue 22: ≤ 10 s on 2 idle cores)
 """
@@ -48,9 +48,8 @@ def main() -> None:
               f"for {len(scenarios)} scenarios × {len(project.site.hours)} hours (Radiance, "
               "2 workers, façade sensors only)")
         own = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
-        child = resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss / 1024
         print(f"CPU {_cpu() - c0:.1f} s (user + system, rtrace included); peak RSS "
-              f"{own:.0f} MiB (Python), {child:.0f} MiB (largest Radiance process); "
+              f"{own:.0f} MiB (Python; each rtrace is a few tens of MiB); "
               f"load average at the start {load:.2f} on {os.cpu_count()} cores")
         pd.set_option("display.width", 120)
         print(cmp.stats[["scenario", "model", "reflection", "rmse", "rmse_low", "rmse_high",
