@@ -9,6 +9,7 @@ change per step.
 from __future__ import annotations
 
 from collections.abc import Callable
+from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 
 import pandas as pd
@@ -26,35 +27,76 @@ AB_LADDER = (1, 2, 3, 4, 6, 8)
 
 def convergence_table(project: Project, scenarios: list[str] | None = None,
                       hours: list[str] | None = None, ab_values: tuple[int, ...] = AB_LADDER,
-                      echo: Callable[[str], None] = print, engine: str | Engine = "auto"
+                      echo: Callable[[str], None] = print, engine: str | Engine = "auto",
+                      previous: pd.DataFrame | None = None, workers: int | None = None
                       ) -> pd.DataFrame:
     """One row per scenario × hour × -ab: façade mean lux and relative change from the step before.
     A scenario with several crown realisations is checked on its first one. ``engine``: as
     ``simulate`` (``auto`` → the project's ``engine.name``); the scenario's ``engine.*`` switches
-    apply."""
+    apply.
+
+    ``previous`` (an earlier table, e.g. ``results/convergence.csv``): its rows with the same
+    scenario, hour, ``-ab``, ``-ad``, engine and parameter hash are reused, not traced again.
+    The remaining runs go ``workers`` at a time (default ``engine.workers``) for an engine that
+    runs external programs (Radiance), one at a time for an in-process engine."""
     eng = resolve_engine(project, engine)
-    rows = []
+    done = _known(previous)
+    jobs: list[tuple] = []       # (scenario, name, built, hour, ab, ad, phash)
     for sc in selected(project, scenarios):
         if is_later_realisation(sc.name):
             continue
-        name = parent_name(sc.name)
         built = make_scene(project, sc, dense_grid=False)
         ad = effective_project(project, sc).engine.ad
+        phash = project.params_hash(sc)
         for hour in hours or [project.site.hours[0]]:
-            prev = None
             for ab in sorted(set(ab_values) | {built.ab}):   # always the -ab simulate uses
-                traced = trace_hours(project, sc, eng, [hour], ["facade"], ab=ab, built=built)
-                st, lux = traced.states[0], traced.results[0]["facade"].lux
-                mean = float(lux.mean())
-                change = (mean - prev) / prev if prev else float("nan")
-                rows.append({"scenario": name, "model": sc.model, "time": st.time, "ab": ab,
-                             "ad": ad, "facade_mean_lux": round(mean, 1),
-                             "change": round(change, 4) if prev else None,
-                             "model_recommended_ab": built.ab})
-                echo(f"  {name} {st.time} -ab {ab}: {mean:.0f} lx"
-                     + (f" ({change:+.1%})" if prev else ""))
-                prev = mean
+                jobs.append((sc, parent_name(sc.name), built, hour, ab, ad, phash))
+
+    def run(job: tuple) -> tuple[str, float]:
+        sc, name, built, hour, ab, ad, phash = job
+        hit = done.get((name, hour, ab, ad, eng.name, phash))
+        if hit is not None:
+            return hit
+        traced = trace_hours(project, sc, eng, [hour], ["facade"], ab=ab, built=built)
+        return traced.states[0].time, float(traced.results[0]["facade"].lux.mean())
+
+    n = max(1, workers or project.engine.workers) if eng.uses_build_folder else 1
+    with ThreadPoolExecutor(max_workers=n) as pool:
+        means = list(pool.map(run, jobs))
+    rows = []
+    prev: dict[tuple[str, str], float] = {}
+    for (sc, name, built, hour, ab, ad, phash), (time_, mean) in zip(jobs, means):
+        before = prev.get((name, hour))
+        change = (mean - before) / before if before else float("nan")
+        rows.append({"scenario": name, "model": sc.model, "time": time_, "ab": ab,
+                     "ad": ad, "facade_mean_lux": round(mean, 1),
+                     "change": round(change, 4) if before else None,
+                     "model_recommended_ab": built.ab, "engine": eng.name,
+                     "params_hash": phash})
+        echo(f"  {name} {time_} -ab {ab}: {mean:.0f} lx"
+             + (f" ({change:+.1%})" if before else ""))
+        prev[(name, hour)] = mean
     return pd.DataFrame(rows)
+
+
+def read_convergence(project: Project) -> pd.DataFrame | None:
+    """``results/convergence.csv`` as written by :func:`write_convergence`, or None."""
+    path = project.results_dir / "convergence.csv"
+    try:
+        return pd.read_csv(path, dtype={"scenario": str, "time": str, "params_hash": str})
+    except (OSError, ValueError):
+        return None
+
+
+def _known(previous: pd.DataFrame | None) -> dict[tuple, tuple[str, float]]:
+    """(scenario, hour, ab, ad, engine, params_hash) → (time, façade mean) of an earlier
+    table (rows without engine or parameter hash — older tables — are not reused)."""
+    cols = {"scenario", "time", "ab", "ad", "engine", "params_hash", "facade_mean_lux"}
+    if previous is None or not cols <= set(previous.columns):
+        return {}
+    return {(str(r.scenario), str(r.time), int(r.ab), int(r.ad), str(r.engine),
+             str(r.params_hash)): (str(r.time), float(r.facade_mean_lux))
+            for r in previous.dropna(subset=sorted(cols)).itertuples()}
 
 
 def write_convergence(project: Project, table: pd.DataFrame) -> Path:

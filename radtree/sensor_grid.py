@@ -38,7 +38,11 @@ def facade_circle(sensors: Sensors, frame: FacadeFrame, name: str = "facade") ->
     return SensorGrid(name, frame.to_world(local), normals, rows)
 
 
-def facade_dense_grid(sensors: Sensors, frame: FacadeFrame, name: str = "facade_map") -> SensorGrid:
+#: the dense façade map grid (a figure: ``engine.dense_lw`` may trace it with fewer paths)
+DENSE_GRID = "facade_map"
+
+
+def facade_dense_grid(sensors: Sensors, frame: FacadeFrame, name: str = DENSE_GRID) -> SensorGrid:
     """A square grid of side ``dense_size_m`` and spacing ``dense_spacing_m`` centred on the
     sensors, for false-colour façade maps. Row labels are the sensor-row names by height."""
     half = sensors.dense_size_m / 2.0

@@ -1,6 +1,7 @@
 """Real Radiance runs (no mocks): analytic skies, build folder, Makefile, CLI."""
 
 import math
+import re
 import subprocess
 
 import numpy as np
@@ -76,6 +77,66 @@ def test_polygon_text():
     assert text.count("polygon") == 2
 
 
+def test_compiled_mesh_text():
+    """A large mesh: Wavefront OBJ (1-based faces, 5 decimals), one `mesh` primitive with the
+    mesh's material as modifier, and the obj2mesh command of the Makefile and the runner."""
+    from radtree.engines.radiance.meshes import (
+        MESH_MIN_TRIANGLES,
+        as_compiled_mesh,
+        mesh_primitive_text,
+        obj2mesh_command,
+        obj_text,
+    )
+    from radtree.scene import Mesh
+
+    m = Mesh("crown", "leaf", [[0, 0, 0], [1, 0, 0], [1.25, 0.5, 2]], [[0, 1, 2], [2, 1, 0]])
+    assert obj_text(m) == ("# crown: 2 triangles, material leaf\n"
+                           "v 0.00000 0.00000 0.00000\nv 1.00000 0.00000 0.00000\n"
+                           "v 1.25000 0.50000 2.00000\nf 1 2 3\nf 3 2 1\n")
+    assert mesh_primitive_text(m, "geometry/crown.rtm") == (
+        "# crown: 2 triangles, material leaf, compiled by obj2mesh\n"
+        "leaf mesh crown\n1 geometry/crown.rtm\n0\n0\n")
+    assert obj2mesh_command("geometry/crown.obj") == ["obj2mesh", "-n", "4",
+                                                      "geometry/crown.obj"]
+    assert not as_compiled_mesh(m)
+    big = Mesh("c", "leaf", np.zeros((3 * MESH_MIN_TRIANGLES, 3)),
+               np.arange(3 * MESH_MIN_TRIANGLES).reshape(-1, 3))
+    assert as_compiled_mesh(big)
+
+
+def test_compiled_mesh_is_the_polygons_geometry(tmp_path):
+    """The same 400 random opaque triangles as polygon text and as an obj2mesh mesh: under a
+    sun alone (-ab 0: no Monte Carlo, each sensor lit or shadowed) every sensor of a 15 × 15
+    grid gets the same lux to the last digit."""
+    from radtree.engines.radiance.binaries import run
+    from radtree.engines.radiance.meshes import mesh_primitive_text, obj2mesh_command, obj_text
+    from radtree.scene import Mesh
+
+    rng = np.random.default_rng(7)
+    centres = rng.uniform([-3, -3, 1], [3, 3, 3], (400, 1, 3))
+    tri = centres + rng.normal(0, 0.25, (400, 3, 3))
+    crown = Mesh("crown", "slat", tri.reshape(-1, 3), np.arange(1200).reshape(-1, 3))
+    common = ("void plastic slat\n0\n0\n5 0.2 0.2 0.2 0 0\n"
+              "void light solar\n0\n0\n3 1e6 1e6 1e6\n"
+              "solar source sun\n0\n0\n4 0.3 0.2 0.93 0.533\n")
+    (tmp_path / "common.rad").write_text(common)
+    (tmp_path / "poly.rad").write_text(mesh_to_radiance(crown))
+    (tmp_path / "crown.obj").write_text(obj_text(crown))
+    run(obj2mesh_command("crown.obj"), cwd=tmp_path, stdout_path=tmp_path / "crown.rtm")
+    (tmp_path / "mesh.rad").write_text(mesh_primitive_text(crown, "crown.rtm"))
+    g = np.linspace(-3, 3, 15)
+    pts = "".join(f"{x:g} {y:g} 0 0 0 1\n" for x in g for y in g).encode()
+    lux = {}
+    for kind in ("poly", "mesh"):
+        run(["oconv", "common.rad", f"{kind}.rad"], cwd=tmp_path,
+            stdout_path=tmp_path / f"{kind}.oct")
+        out = run(["rtrace", "-h", "-I", "-ab", "0", f"{kind}.oct"], stdin=pts, cwd=tmp_path)
+        lux[kind] = np.loadtxt(out.decode().splitlines())[:, 0]
+    shadowed = lux["poly"] < 0.5 * lux["poly"].max()
+    assert 20 < shadowed.sum() < 205           # the crown shades part of the grid, not all
+    np.testing.assert_array_equal(lux["mesh"], lux["poly"])
+
+
 def test_radiance_failure_carries_command_and_stderr(tmp_path):
     from radtree.engines.radiance.binaries import run
 
@@ -96,6 +157,12 @@ def test_build_simulate_and_makefile(open_street):
     # scenario A (calculated) has a black ground; B the per-hour concrete reflectance 0.151
     assert "5 0 0 0 0 0" in (b / "skies/1030_ground.rad").read_text()
     assert "5 0.151 0.151 0.151" in (open_street / "build/B/skies/1030_ground.rad").read_text()
+    # the example's engine.dense_lw = 0.001: the dense map alone with -lw 0.001
+    make = (b / "Makefile").read_text()
+    opts = re.search(r"^RTRACE_OPTS := (.*)$", make, re.M).group(1)
+    assert f"RTRACE_OPTS_facade_map := {opts.replace('-lw 0.0001', '-lw 0.001')}\n" in make
+    assert "rtrace $(RTRACE_OPTS_facade_map) octrees/1330.oct < grids/facade_map.pts" in make
+    assert "rtrace $(RTRACE_OPTS) octrees/1330.oct < grids/facade.pts" in make
     # the generated Makefile runs without Python
     subprocess.run(["make", "-s", "-j2", "-C", str(open_street / "build" / "B"), "1330"],
                    check=True, capture_output=True)
@@ -125,6 +192,30 @@ def test_build_simulate_and_makefile(open_street):
     # a rerun reuses every finished hour
     r = CliRunner().invoke(main, ["simulate", str(open_street)])
     assert "0 hours traced, 14 reused" in r.output
+
+
+def test_crown_build_folder_holds_compiled_meshes(tmp_path):
+    """Scenario A's louvers dome (7 718 slat triangles): geometry/tree_leaves.obj, a `mesh`
+    primitive, and the Makefile's obj2mesh rule before the octrees; the façade stays polygons."""
+    from .conftest import copy_project
+
+    p = copy_project(tmp_path / "proj", hours=["13:30"])
+    r = CliRunner().invoke(main, ["build", str(p), "-s", "A", "--no-pictures"])
+    assert r.exit_code == 0, r.output
+    b = p / "build" / "A"
+    assert (b / "geometry/tree_leaves.rad").read_text() == (
+        "# tree_leaves: 7718 triangles, material leaf, compiled by obj2mesh\n"
+        "leaf mesh tree_leaves\n1 geometry/tree_leaves.rtm\n0\n0\n")
+    assert (b / "geometry/tree_leaves.obj").read_text().count("\nf ") == 7718
+    assert "facade_paint polygon facade.0" in (b / "geometry/facade.rad").read_text()
+    make = (b / "Makefile").read_text()
+    assert ("geometry/tree_leaves.rtm: geometry/tree_leaves.obj\n"
+            "\tobj2mesh -n 4 geometry/tree_leaves.obj > $@.tmp && mv $@.tmp $@\n") in make
+    assert "geometry/tree_leaves.rad skies/1330.sky $(MESHES)\n" in make
+    # the Makefile alone compiles the mesh and the octree
+    subprocess.run(["make", "-s", "-C", str(b), "octrees/1330.oct"], check=True,
+                   capture_output=True)
+    assert (b / "geometry/tree_leaves.rtm").stat().st_size > 100_000
 
 
 def test_dry_run_prints_commands(open_street):

@@ -39,10 +39,11 @@ def simulate_command(project: str, scenarios: tuple[str, ...], engine: str,
 
     p = load_project(project)
     if convergence:
-        from radtree.convergence import convergence_table, write_convergence
+        from radtree.convergence import convergence_table, read_convergence, write_convergence
 
         table = convergence_table(p, list(scenarios) or None, list(hours) or None,
-                                  echo=click.echo)
+                                  echo=click.echo, engine=engine, workers=workers,
+                                  previous=None if fresh else read_convergence(p))
         click.echo(table.to_string(index=False))
         click.echo(f"convergence table → {write_convergence(p, table)}")
         return

@@ -345,6 +345,8 @@ class EngineParams(Checked):
     pmap_photons: int | None = field(default=None, metadata=meta(1))
     pmap_caustic_photons: int | None = field(default=None, metadata=meta(1))
     pmap_bandwidth: int = field(default=50, metadata=meta(1))
+    # Radiance: -lw of the dense façade map grid only (None = lw); the map is a figure
+    dense_lw: float | None = field(default=None, metadata=meta(0.0, 1.0))
 
 
 #: the :class:`EngineParams` fields only the Radiance photon map reads

@@ -7,6 +7,7 @@ from north (compass). Vectors in the scene frame: x east, y north, z up.
 
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import dataclass
 from datetime import datetime, timedelta, timezone
@@ -63,6 +64,7 @@ def local_datetime(date: str, time: str, utc_offset_hours: float) -> datetime:
     return datetime.fromisoformat(f"{date}T{time}").replace(tzinfo=tz)
 
 
+@functools.lru_cache(maxsize=4096)   # every scenario and crown realisation asks for the same hours
 def sun_position(
     when: datetime, latitude: float, longitude: float, elevation_m: float = 0.0
 ) -> SunPosition:

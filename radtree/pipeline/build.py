@@ -1,7 +1,8 @@
 """Build folders: ``PROJECT/build/<scenario>/`` (or ``<scenario>@k`` per crown realisation).
 
 Each holds the scene as the folder engine (Radiance) writes it — ``materials.rad``,
-``geometry/``, ``skies/``, ``grids/*.pts``, a Makefile per hour — plus ``model.png`` and a
+``geometry/``, ``skies/``, ``grids/*.pts``, a Makefile per hour — plus ``model.png`` (in the
+first crown realisation only: the one the report shows) and a
 ``manifest.json`` carrying the scenario's parameter hash, by which a stale folder is detected;
 ``build/Makefile`` runs them all.
 """
@@ -62,7 +63,8 @@ def build_project(project: Project, scenarios: list[str] | None = None,
             at = {st.label: hour_grids(project, st.time, names, None, sc) for st in states}
             engine.write_folder(built.scene, states, effective_project(project, sc).engine,
                                 built.ab, tmp, sc.name, at)
-            if pictures and built.tree is not None and project.district is None:
+            if pictures and built.tree is not None and project.district is None \
+                    and not is_later_realisation(sc.name):   # the report shows F@1's
                 from radtree.trees.picture import render_model_png
 
                 render_model_png(built.tree, built.scene, tmp / "model.png")

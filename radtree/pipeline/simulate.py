@@ -195,6 +195,9 @@ def simulate_project(project: Project, engine: str | Engine = "auto",
             timing[job.scenario.name]["tracing_s"] += time.perf_counter() - t
         return df
 
+    # most sensors first (the dense map's hour, the crowns' realisations after), so the
+    # workers do not end on one long task; the table's order does not depend on it
+    todo.sort(key=lambda j: -sum(len(g.points) for g in j.scene.grids.values()))
     if todo:
         bar = progress_bar(None, f"simulate ({eng.name})", progress, total=len(todo))
         try:

@@ -134,19 +134,18 @@ def clip_polygon(poly: np.ndarray, normal: np.ndarray, offset: float) -> np.ndar
 
 
 def polygons_to_mesh(polygons: list[np.ndarray]) -> tuple[np.ndarray, np.ndarray]:
-    """Convex planar polygons → vertices and fan-triangulated faces."""
-    verts, faces, offset = [], [], 0
-    for p in polygons:
-        k = len(p)
-        if k < 3:
-            continue
-        verts.append(p)
-        idx = np.arange(1, k - 1)
-        faces.append(np.column_stack([np.zeros(k - 2, np.int64), idx, idx + 1]) + offset)
-        offset += k
-    if not verts:
+    """Convex planar polygons → vertices and fan-triangulated faces (polygons of fewer than 3
+    corners dropped; triangle ``(0, i, i + 1)`` of each polygon in order)."""
+    kept = [p for p in polygons if len(p) >= 3]
+    if not kept:
         return np.zeros((0, 3)), np.zeros((0, 3), np.int64)
-    return np.vstack(verts), np.vstack(faces)
+    k = np.fromiter((len(p) for p in kept), np.int64, len(kept))
+    offset = np.concatenate([[0], np.cumsum(k)[:-1]])
+    n_tri = k - 2
+    first = np.repeat(offset, n_tri)
+    local = np.arange(int(n_tri.sum())) - np.repeat(np.cumsum(n_tri) - n_tri, n_tri) + 1
+    faces = np.column_stack([first, first + local, first + local + 1])
+    return np.vstack(kept), faces
 
 
 def quads_to_mesh(quads: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

@@ -21,6 +21,9 @@ from radtree.scene import Mesh, Scene
 from radtree.site.frame import FacadeFrame
 from radtree.trees.model import LEAF, TRUNK, TreeModel
 
+#: meshes below this many triangles are drawn whole when the crown is subsampled
+SMALL_MESH = 2000
+
 VIEWS = (("Elevation from the street", 0, 2, "u along the façade (m)", "z (m)"),
          ("Section (façade at n = 0)", 1, 2, "n from the façade (m)", "z (m)"),
          ("Plan", 0, 1, "u along the façade (m)", "n from the façade (m)"))
@@ -41,14 +44,15 @@ def _colour(name: str, material: object) -> tuple[float, float, float]:
 def render_model_png(model: TreeModel, scene: Scene | None, path: str | Path,
                      frame: FacadeFrame | None = None, *, extra_meshes: Sequence[Mesh] = (),
                      sensor_points: np.ndarray | None = None, title: str | None = None,
-                     max_triangles: int = 60_000, dpi: int = 110, seed: int = 0) -> Path:
+                     max_triangles: int = 15_000, dpi: int = 110, seed: int = 0) -> Path:
     """Write a PNG with three orthographic views of ``model``.
 
     ``scene`` (optional): its other meshes (street, façades) are drawn faintly and its
     ``facade`` grid (else its first grid) marked in red. ``extra_meshes`` and
     ``sensor_points`` (k, 3 world coordinates) add to / replace those. ``frame`` defaults to
     the frame the model was built in (``model.frame``), else one inferred from the sensors'
-    normals. At most ``max_triangles`` crown triangles are drawn (a random subset beyond that).
+    normals. At most about ``max_triangles`` crown triangles are drawn: beyond that a random
+    subset of the large meshes (leaves, slats; small ones such as trunks are drawn whole).
     """
     extra = list(extra_meshes)
     if scene is not None:
@@ -80,11 +84,12 @@ def _render(model: TreeModel, path: Path, frame: FacadeFrame, extra_meshes: Sequ
     crown = [m for m in model.meshes if m.n_triangles
              and not isinstance(model.materials.get(m.material), Hole)]
     total = sum(m.n_triangles for m in crown)
-    keep_share = min(1.0, max_triangles / total) if total else 1.0
+    small = sum(m.n_triangles for m in crown if m.n_triangles < SMALL_MESH)
+    keep_share = min(1.0, max(max_triangles - small, 1) / max(total - small, 1)) if total else 1.0
     local_tris = []
     for m in crown:
         tri = frame.to_local(m.vertices)[m.faces]
-        if keep_share < 1.0:
+        if keep_share < 1.0 and m.n_triangles >= SMALL_MESH:
             tri = tri[rng.random(len(tri)) < keep_share]
         local_tris.append((tri, _colour(m.material, model.materials.get(m.material))))
     extras = [frame.to_local(m.vertices)[m.faces] for m in extra_meshes if m.n_triangles]
@@ -96,7 +101,8 @@ def _render(model: TreeModel, path: Path, frame: FacadeFrame, extra_meshes: Sequ
     lo, hi = allpts.min(axis=0), allpts.max(axis=0)
     lo = np.minimum(lo, [lo[0], -0.5, 0.0]) - 1.0
     hi = np.maximum(hi, [hi[0], 1.0, 1.0]) + 1.0
-    alpha = float(np.clip(60.0 / max(1.0, np.sqrt(total)), 0.08, 0.9))
+    drawn = sum(len(t) for t, _ in local_tris)
+    alpha = float(np.clip(60.0 / max(1.0, np.sqrt(drawn)), 0.08, 0.9))
     for ax, (name, i, j, xl, yl) in zip(axes, VIEWS):
         for tri in extras:
             ax.add_collection(PolyCollection(tri[:, :, [i, j]], facecolors=(0.85, 0.85, 0.85),
@@ -124,7 +130,7 @@ def _render(model: TreeModel, path: Path, frame: FacadeFrame, extra_meshes: Sequ
     head = title or f"{model.model} crown, {model.form} form"
     sub = f"{model.triangles} triangles, built in {model.build_seconds:.2f} s"
     if keep_share < 1.0:
-        sub += f" (about {100 * keep_share:.0f} % of them drawn)"
+        sub += f" ({drawn} of them drawn)"
     for key in ("tau_crown_direct", "hole_fraction", "crown_transmission"):
         if key in model.info:
             sub += f"; {key.replace('_', ' ')} {model.info[key]:.4f}"

@@ -17,7 +17,7 @@ from pathlib import Path
 
 from radtree.errors import EngineError
 
-REQUIRED = ("oconv", "rtrace", "gendaylit", "rcalc")
+REQUIRED = ("oconv", "rtrace", "gendaylit", "rcalc", "obj2mesh")   # obj2mesh: crowns (meshes.py)
 
 
 @dataclass(frozen=True)

@@ -33,16 +33,19 @@ def run_hour(plan: BuildPlan, hour: str, dry_run: bool = False,
     """
     folder = plan.folder
     oct_rel = f"octrees/{hour}.oct"
+    # the hours' shared inputs (compiled meshes, prototype octrees): listed by a dry run,
+    # else made once by ensure_shared_inputs
     commands: list[tuple[list[str], str | None, str]] = [
-        (argv, None, oct_) for argv, oct_ in plan.prototype_commands()
-        if dry_run or not (folder / oct_).exists()]
+        (argv, None, out) for argv, out in [*plan.mesh_commands(), *plan.prototype_commands()]
+    ] if dry_run else []
     commands.append((plan.oconv_command(hour), None, oct_rel))
     mkpmap = plan.mkpmap_command(hour)
     if mkpmap is not None:
         commands.append((mkpmap, None, f"pmaps/{hour}.log"))
     use = [g for g in plan.grids if grids is None or g in grids]
     for g in use:
-        commands.append((plan.rtrace_command(hour), f"grids/{g}.pts", f"results/{hour}_{g}.rgb"))
+        commands.append((plan.rtrace_command(hour, g), f"grids/{g}.pts",
+                         f"results/{hour}_{g}.rgb"))
     if dry_run:
         for argv, stdin, stdout in commands:
             line = " ".join(argv) + (f" < {stdin}" if stdin else "") + f" > {stdout}"
@@ -54,16 +57,9 @@ def run_hour(plan: BuildPlan, hour: str, dry_run: bool = False,
     if mkpmap is not None:
         (folder / "pmaps").mkdir(exist_ok=True)
     results: dict[str, GridResult] = {}
+    ensure_shared_inputs(plan)
     for argv, stdin, stdout in commands:
-        out = folder / stdout
-        tmp = out.with_name(f"{out.name}.{os.getpid()}.{threading.get_ident()}.tmp")
-        data = (folder / stdin).read_bytes() if stdin else None
-        try:
-            run(argv, stdin=data, cwd=folder, stdout_path=tmp)
-            os.replace(tmp, out)
-        finally:
-            if tmp.exists():
-                tmp.unlink()
+        _produce(folder, argv, stdin, stdout)
     for g in use:
         rgb_path = folder / f"results/{hour}_{g}.rgb"
         lux = read_rgb_as_lux(rgb_path, expected=None)
@@ -73,6 +69,42 @@ def run_hour(plan: BuildPlan, hour: str, dry_run: bool = False,
         os.replace(tmp, lux_path)
         results[g] = GridResult(lux, None)
     return results
+
+
+def ensure_shared_inputs(plan: BuildPlan) -> None:
+    """Make the folder's missing compiled meshes (``obj2mesh``) and prototype octrees, each
+    once even when two hours of the folder run in two threads."""
+    folder = plan.folder
+    for argv, stdout in [*plan.mesh_commands(), *plan.prototype_commands()]:
+        target = folder / stdout
+        if target.exists():
+            continue
+        target.parent.mkdir(parents=True, exist_ok=True)
+        with _lock_for(target):
+            if not target.exists():
+                _produce(folder, argv, None, stdout)
+
+
+_LOCKS: dict[Path, threading.Lock] = {}
+_LOCKS_GUARD = threading.Lock()
+
+
+def _lock_for(path: Path) -> threading.Lock:
+    with _LOCKS_GUARD:
+        return _LOCKS.setdefault(path, threading.Lock())
+
+
+def _produce(folder: Path, argv: list[str], stdin: str | None, stdout: str) -> None:
+    """Run ``argv`` in ``folder`` (stdin from a file), its output to a temporary name first."""
+    out = folder / stdout
+    tmp = out.with_name(f"{out.name}.{os.getpid()}.{threading.get_ident()}.tmp")
+    data = (folder / stdin).read_bytes() if stdin else None
+    try:
+        run(argv, stdin=data, cwd=folder, stdout_path=tmp)
+        os.replace(tmp, out)
+    finally:
+        if tmp.exists():
+            tmp.unlink()
 
 
 def read_rgb_as_lux(path: Path, expected: int | None) -> np.ndarray:

@@ -12,6 +12,7 @@ from radtree.engines.radiance.engine import run_hour
 from radtree.engines.radiance.pmap import PhotonMap
 from radtree.engines.radiance.writer import (
     BuildPlan,
+    grid_rtrace_options,
     prototype_octree,
     rtrace_options,
     write_build,
@@ -73,8 +74,11 @@ class RadianceEngine(Engine):
                          scene_files=["materials.rad"], hour_files={},
                          rtrace_opts=rtrace_options(params, ab),
                          states={s.label: s for s in states},
-                         photon_map=PhotonMap.from_params(params))
+                         photon_map=PhotonMap.from_params(params),
+                         grid_opts=grid_rtrace_options(params, ab, list(scene.grids)))
         geometry = sorted(str(p.relative_to(folder)) for p in (folder / "geometry").glob("*.rad"))
+        plan.meshes = {str(p.with_suffix(".rtm").relative_to(folder)): str(p.relative_to(folder))
+                       for p in sorted((folder / "geometry").glob("*.obj"))}
         plan.prototypes = {prototype_octree(p.stem): str(p.relative_to(folder))
                            for p in sorted((folder / "geometry" / "prototypes").glob("*.rad"))}
         for st in states:

@@ -15,6 +15,7 @@ from pathlib import Path
 import numpy as np
 
 from radtree.engines.radiance.binaries import run
+from radtree.engines.radiance.engine import ensure_shared_inputs
 from radtree.engines.radiance.writer import BuildPlan
 
 
@@ -35,6 +36,7 @@ def fisheye_picture(plan: BuildPlan, hour: str, viewpoint: np.ndarray, direction
     """Render ``out``.hdr and ``out``.bmp (tone-mapped) of the plan's hour (label HHMM)."""
     folder = plan.folder
     (folder / "octrees").mkdir(exist_ok=True)
+    ensure_shared_inputs(plan)   # compiled meshes, prototype octrees
     octree = f"octrees/{hour}.oct"
     steps = [(plan.oconv_command(hour), folder / octree),
              (fisheye_command(octree, viewpoint, direction, up, size, ab, ad),

@@ -8,6 +8,7 @@ radiance = luminance / ``WHITE_EFFICACY`` (:mod:`radtree.light.units`).
 
 from __future__ import annotations
 
+import functools
 import re
 
 from radtree.engines.radiance.binaries import RadianceInstall, run
@@ -97,6 +98,13 @@ def gendaylit_command(state: SkyState) -> list[str]:
     return cmd
 
 
+@functools.lru_cache(maxsize=512)
+def _gendaylit(bin_dir: str, cmd: tuple[str, ...]) -> str:
+    """``gendaylit``'s output for an argument list, run once per process and Radiance
+    installation ``bin_dir`` (the crown realisations and scenarios of one sky share hours)."""
+    return run(list(cmd)).decode()
+
+
 def sky_text(state: SkyState, install: RadianceInstall | None) -> str:
     """The hour's light in Radiance: sun (if on), sky (if any) and distant ground glow."""
     header = (f"# {state.time} local ({state.datetime.isoformat()}): sun altitude "
@@ -107,7 +115,7 @@ def sky_text(state: SkyState, install: RadianceInstall | None) -> str:
         if install is None:
             raise RuntimeError("a Perez sky needs gendaylit (Radiance)")
         cmd = gendaylit_command(state)
-        text = run(cmd).decode()
+        text = _gendaylit(str(install.bin_dir), tuple(cmd))
         return header + f"# {' '.join(cmd)}\n" + text + "\n" + perez_sky_suffix(state.ground_glow)
     parts = [header]
     if state.sun_on:

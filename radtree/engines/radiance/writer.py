@@ -3,7 +3,8 @@
 ```
 build/<scenario>/
   materials.rad            all materials (the ground's default reflectance)
-  geometry/<mesh>.rad      one file per mesh, triangles as polygons
+  geometry/<mesh>.rad      one file per mesh: triangles as polygons, or for a large mesh one
+                           `mesh` primitive reading geometry/<mesh>.rtm (obj2mesh of <mesh>.obj)
   grids/<grid>.pts         rtrace input: x y z dx dy dz per sensor
   skies/<HHMM>.sky         sun (and sky, ground glow) of each hour
   skies/<HHMM>_ground.rad  the hour's ground material (reflectance from the sun altitude)
@@ -15,7 +16,7 @@ build/<scenario>/
 from __future__ import annotations
 
 from collections.abc import Mapping
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 import numpy as np
@@ -23,6 +24,12 @@ import numpy as np
 import radtree
 from radtree.config import EngineParams
 from radtree.engines.radiance.binaries import RadianceInstall
+from radtree.engines.radiance.meshes import (
+    as_compiled_mesh,
+    mesh_primitive_text,
+    obj2mesh_command,
+    obj_text,
+)
 from radtree.engines.radiance.pmap import FINAL_GATHER_AB, PhotonMap
 from radtree.engines.radiance.sky import ANALYTIC_SKY_CAL, sky_text
 from radtree.fileio import write_text
@@ -31,6 +38,7 @@ from radtree.light.units import PHOTOPIC_RGB, WHITE_EFFICACY
 from radtree.optics import Hole, Material, Plastic, with_reflectance
 from radtree.resources import template_environment
 from radtree.scene import Mesh, Scene
+from radtree.sensor_grid import DENSE_GRID
 
 
 def mesh_to_radiance(mesh: Mesh) -> str:
@@ -80,6 +88,14 @@ def rtrace_options(params: EngineParams, ab: int) -> list[str]:
     ]
 
 
+def grid_rtrace_options(params: EngineParams, ab: int, grids: list[str]) -> dict[str, list[str]]:
+    """rtrace options of the grids traced differently: the dense façade map with
+    ``-lw engine.dense_lw`` (when set and the map is in ``grids``)."""
+    if params.dense_lw is None or DENSE_GRID not in grids:
+        return {}
+    return {DENSE_GRID: rtrace_options(replace(params, lw=params.dense_lw), ab)}
+
+
 @dataclass
 class BuildPlan:
     """What a build folder holds, for the Python runner and the Makefile alike."""
@@ -94,6 +110,12 @@ class BuildPlan:
     hour_grids: dict[str, list[str]] = field(default_factory=dict)   # default: every grid
     photon_map: PhotonMap | None = None                               # mkpmap before rtrace
     prototypes: dict[str, str] = field(default_factory=dict)   # octree → its geometry file
+    meshes: dict[str, str] = field(default_factory=dict)       # .rtm → its .obj (obj2mesh)
+    grid_opts: dict[str, list[str]] = field(default_factory=dict)  # grid → its own rtrace_opts
+
+    def mesh_commands(self) -> list[tuple[list[str], str]]:
+        """``obj2mesh`` of each compiled mesh (stdout → the ``.rtm``)."""
+        return [(obj2mesh_command(obj), rtm) for rtm, obj in self.meshes.items()]
 
     def prototype_commands(self) -> list[tuple[list[str], str]]:
         """``oconv -f`` of each prototype (frozen: instances need their octree whole)."""
@@ -107,9 +129,10 @@ class BuildPlan:
     def oconv_command(self, hour: str) -> list[str]:
         return ["oconv", *self.scene_files, *self.hour_files[hour]]
 
-    def rtrace_command(self, hour: str) -> list[str]:
+    def rtrace_command(self, hour: str, grid: str | None = None) -> list[str]:
         pm = self.photon_map.rtrace_args(hour) if self.photon_map else []
-        return ["rtrace", *self.rtrace_opts, *pm, f"octrees/{hour}.oct"]
+        opts = self.grid_opts.get(grid, self.rtrace_opts) if grid else self.rtrace_opts
+        return ["rtrace", *opts, *pm, f"octrees/{hour}.oct"]
 
     def mkpmap_command(self, hour: str) -> list[str] | None:
         """The hour's ``mkpmap`` (None without a photon map)."""
@@ -131,16 +154,23 @@ def write_build(scene: Scene, states: list[SkyState], params: EngineParams, ab: 
     write_text(folder / "materials.rad", materials_text(scene.materials, scene.ground_material))
     scene_files = ["materials.rad"]
     geometry_files = []
+    meshes: dict[str, str] = {}
     for mesh in scene.own_solid_meshes():
         rel = f"geometry/{mesh.name}.rad"
-        write_text(folder / rel, mesh_to_radiance(mesh))
+        if as_compiled_mesh(mesh):
+            obj, rtm = f"geometry/{mesh.name}.obj", f"geometry/{mesh.name}.rtm"
+            write_text(folder / obj, obj_text(mesh))
+            write_text(folder / rel, mesh_primitive_text(mesh, rtm))
+            meshes[rtm] = obj   # compiled by the runner / the Makefile (like the octrees)
+        else:
+            write_text(folder / rel, mesh_to_radiance(mesh))
         geometry_files.append(rel)
     prototypes: dict[str, str] = {}
     if scene.instances:
         (folder / "geometry" / "prototypes").mkdir(exist_ok=True)
-        for name, meshes in scene.prototypes.items():
+        for name, proto in scene.prototypes.items():
             rel = f"geometry/prototypes/{name}.rad"
-            write_text(folder / rel, "\n".join(mesh_to_radiance(m) for m in meshes))
+            write_text(folder / rel, "\n".join(mesh_to_radiance(m) for m in proto))
             prototypes[prototype_octree(name)] = rel
         write_text(folder / "geometry" / "instances.rad", instances_text(scene))
         geometry_files.append("geometry/instances.rad")
@@ -170,7 +200,8 @@ def write_build(scene: Scene, states: list[SkyState], params: EngineParams, ab: 
                      rtrace_opts=rtrace_options(params, ab),
                      states={s.label: s for s in states},
                      hour_grids=dict(hour_grids or {}), prototypes=prototypes,
-                     photon_map=PhotonMap.from_params(params))
+                     meshes=meshes, photon_map=PhotonMap.from_params(params),
+                     grid_opts=grid_rtrace_options(params, ab, list(scene.grids)))
     write_makefile(plan, install, scenario)
     return plan
 
@@ -182,6 +213,7 @@ def write_makefile(plan: BuildPlan, install: RadianceInstall | None, scenario: s
         hour_grids={h: plan.grids_at(h) for h in plan.hours},
         scene_files=plan.scene_files, hour_files=plan.hour_files,
         rtrace_opts=" ".join(plan.rtrace_opts),
+        grid_opts={g: " ".join(o) for g, o in plan.grid_opts.items()},
         efficacy=f"{WHITE_EFFICACY:g}", weights=[f"{w:.3f}" for w in PHOTOPIC_RGB],
         bin_dir=str(install.bin_dir) if install else "/usr/local/bin",
         raypath=install.raypath if install else ".:/usr/local/lib/ray",
@@ -190,7 +222,8 @@ def write_makefile(plan: BuildPlan, install: RadianceInstall | None, scenario: s
                for h in plan.hours},
         rtrace_pmap={h: " ".join(plan.photon_map.rtrace_args(h)) if plan.photon_map else ""
                      for h in plan.hours},
-        prototypes=plan.prototypes,
+        prototypes=plan.prototypes, meshes=plan.meshes,
+        mesh_cmds={rtm: " ".join(argv) for argv, rtm in plan.mesh_commands()},
     )
     write_text(plan.folder / "Makefile", text)
 
