@@ -123,3 +123,28 @@ def test_step_identifiability_names_the_partners_and_brackets_the_strength() -> 
         "named sky_diffuse, but sky_diffuse and unfiltered_ground are not separable")
     assert iv["sky_diffuse"].covers(15000.0) and iv["sky_diffuse"].hi - iv["sky_diffuse"].lo < 2000
     assert iv["unfiltered_ground"].lo > 0.1   # alone, ground would need > its reference
+
+
+def test_unique_snr_is_the_signal_beyond_the_others_span() -> None:
+    from radtree.diagnose.identify import unique_snr
+
+    a = np.array([1.0, 0.0, 0.0, 1.0]) * 30.0
+    b = np.array([0.0, 1.0, 0.0, 1.0]) * 30.0
+    c = np.array([0.0, 0.0, 1.0, 0.0]) * 30.0
+    # orthogonal to the others: all of its signal (√2 · 30 / 10)
+    assert unique_snr(c, np.column_stack([a, b]), 10.0) == pytest.approx(3.0)
+    assert unique_snr(c, None, 10.0) == pytest.approx(3.0)
+    # identical to another: nothing left
+    assert unique_snr(a, 2.0 * a[:, None], 10.0) == pytest.approx(0.0, abs=1e-12)
+    # one other at correlation ρ = 1/2: SNR · √(1 − ρ²)
+    rho = a @ b / (np.linalg.norm(a) * np.linalg.norm(b))
+    assert rho == pytest.approx(0.5)
+    assert unique_snr(a, b[:, None], 10.0) == pytest.approx(np.sqrt(18.0) * np.sqrt(0.75))
+    # the sum of two others correlates only 0.87 with each, yet the pair reproduces it
+    s = a + b
+    assert max(s @ a / np.linalg.norm(s) / np.linalg.norm(a),
+               s @ b / np.linalg.norm(s) / np.linalg.norm(b)) < 0.9
+    assert unique_snr(s, np.column_stack([a, b]), 10.0) == pytest.approx(0.0, abs=1e-12)
+    # per-observation noise: the same vectors, the loud observation counts less
+    sig = np.array([10.0, 10.0, 10.0, 1000.0])
+    assert unique_snr(a, b[:, None], sig) == pytest.approx(3.0, rel=1e-3)

@@ -9,11 +9,23 @@ For each effect X of the catalogue (or of ``effects``) that applies to the scena
    per-row daily means likewise from the hourly row means) — written to
    ``PROJECT/diagnose/selftest/<X>.csv`` and read back through
    :func:`radtree.measurements.load_measured`;
-3. **before any loop runs**, X is declared *distinguishable* when its signature's RMS over the
-   hours is ≥ ``SNR_MIN`` × the noise RMS and its signature's (uncentred) correlation with every
-   other candidate's is below ``TIE_CORR``. Noise RMS = √mean_h((noise·E_h)² + 2·se_h²), E_h the
-   expected truth and se_h the Monte Carlo standard error of the hourly mean (the truth's and
-   the model's own noise);
+3. **before any loop runs**, X is declared *distinguishable* when both hold:
+
+   * **beyond the others**: the part of X's signature that no linear combination of the
+     other candidates' signatures (every strength each was simulated at) can reproduce is at
+     least ``SNR_MIN`` (3) noise units over all the measured values —
+     z = ‖(I − P) s/σ‖ ≥ 3 (:func:`~radtree.diagnose.identify.unique_snr`: the z-score of X's
+     amplitude in a joint fit with every other candidate free; z² is the χ² the residual
+     signature adds over the noise). It replaces a per-value SNR and a pairwise correlation
+     cut: many readings each below the noise add up, and a correlation decides nothing
+     without the signal's size;
+   * **within the loop's reach**: fitting X is expected to lower the loop's RMSE by more than
+     its margin — the signature's RMS over the values ≥ √((1 − margin)⁻² − 1) × the noise RMS
+     (0.33 × for the default 5 %).
+
+   σ_i = √((noise·E_i)² + noise_lux² + 2·se_i²), E_i the expected truth and se_i the Monte
+   Carlo standard error (the truth's and the model's own noise); in a campaign the values
+   are noise-weighted (:meth:`~.campaign_sim.CampaignSimulator.set_weights`);
 4. the diagnosis loop runs from the base against the synthetic measurement.
 
 The test passes when every distinguishable X is named by the first step; the table also shows
@@ -34,14 +46,14 @@ import pandas as pd
 from radtree.config import Project, Scenario
 from radtree.diagnose.attribution import (
     DEFAULT_MARGIN,
-    TIE_CORR,
+    Signature,
     compute_signatures,
     cosine,
 )
 from radtree.diagnose.campaign import Campaign
 from radtree.diagnose.campaign_sim import CampaignSimulator, campaign_synthetic
 from radtree.diagnose.effects import EFFECTS, Effect, EffectContext, candidates
-from radtree.diagnose.identify import DEFAULT_NOISE, noise_sigma
+from radtree.diagnose.identify import DEFAULT_NOISE, noise_sigma, unique_snr
 from radtree.diagnose.loop import (
     DEFAULT_MAX_STEPS,
     Measured,
@@ -56,7 +68,7 @@ from radtree.diagnose.outcome import (
     pick_scenario,
     resolve_project,
 )
-from radtree.diagnose.simulate import Simulator
+from radtree.diagnose.simulate import Run, Simulator
 from radtree.errors import RadtreeError
 from radtree.fileio import atomic_path, write_text
 
@@ -64,7 +76,8 @@ TRUTH_SEED_OFFSET = 7919
 
 
 def _decide(sim: Simulator, ctx: EffectContext, effect: Effect, start: Scenario, noise: float,
-            echo: Echo | None, noise_lux: float | np.ndarray = 0.0) -> HiddenCase:
+            echo: Echo | None, noise_lux: float | np.ndarray = 0.0,
+            margin: float = DEFAULT_MARGIN) -> HiddenCase:
     base = effect.switch_off(ctx, start) if effect.is_on(ctx, start) else start
     if base is not start:
         base = Scenario(f"{start.name}-no-{effect.name}", base.model, base.reflection, base.sky,
@@ -77,26 +90,48 @@ def _decide(sim: Simulator, ctx: EffectContext, effect: Effect, start: Scenario,
         raise RadtreeError(f"self-test: {effect.name} is still on after switching it off "
                            "(catalogue bug)")
     sigs = compute_signatures(sim, ctx, base, base_run, cands, echo)
+    return _verdict(effect, ctx, base, truth, ref, sigs, base_run, noise, noise_lux, margin)
+
+
+def _verdict(effect: Effect, ctx: EffectContext, base: Scenario, truth: Scenario,
+             ref: float | None, sigs: dict[str, Signature], base_run: Run, noise: float,
+             noise_lux: float | np.ndarray, margin: float) -> HiddenCase:
+    """The module doc's rule on the signatures of ``base``'s candidates."""
     sx = sigs[effect.name].reference_hourly()
     expected = base_run.lux + sx
     se = np.nan_to_num(base_run.stderr, nan=0.0)
-    noise_rms = float(np.sqrt(np.mean(noise_sigma(expected, se, noise, noise_lux) ** 2)))
+    sigma = np.maximum(noise_sigma(expected, se, noise, noise_lux), 1e-9)
+    noise_rms = float(np.sqrt(np.mean(sigma ** 2)))
     rms = float(np.sqrt(np.mean(sx ** 2)))
+    others = [s.hourly for n, s in sigs.items() if n != effect.name]
+    span = np.vstack(others).T if others else None
+    z = unique_snr(sx, span, sigma)
+    combined = unique_snr(sx, None, sigma)
     corr = {n: cosine(sx, s.reference_hourly()) for n, s in sigs.items() if n != effect.name}
     corr = {k: v for k, v in corr.items() if math.isfinite(v)}
     most = max(corr, key=lambda k: corr[k]) if corr else ""
     cmax = corr[most] if most else math.nan
+    need = margin_snr(margin)
     reasons = []
-    if not rms >= SNR_MIN * noise_rms:
-        reasons.append(f"signature RMS {rms:.0f} lx < {SNR_MIN:g} × noise RMS {noise_rms:.0f} lx")
-    if most and cmax >= TIE_CORR:
-        reasons.append(f"correlates {cmax:.2f} with {most}")
+    if not z >= SNR_MIN:
+        reasons.append(f"beyond the span of the other candidates only {z:.1f} σ of its "
+                       f"{combined:.1f} σ remain (< {SNR_MIN:g})")
+    if not rms >= need * noise_rms:
+        reasons.append(f"signature RMS {rms:.0f} lx < {need:.2f} × noise RMS {noise_rms:.0f} lx "
+                       f"(the loop's {margin:.0%} margin)")
     st = effect.strength(ctx, base)
     stext = "on" if st is None or ref is None else st.text(ref)
     return HiddenCase(effect.name, base, truth, ref, stext, rms, noise_rms, cmax, most,
                       not reasons, "; ".join(reasons) or
-                      f"signature RMS {rms:.0f} lx = {rms / noise_rms:.1f} × noise, max "
-                      f"correlation {cmax:.2f} ({most or 'no other candidate'})")
+                      f"{z:.1f} σ beyond the span of the other candidates (of {combined:.1f} σ"
+                      f"), signature RMS {rms / noise_rms:.2f} × noise; max correlation "
+                      f"{cmax:.2f} ({most or 'no other candidate'})", z, combined)
+
+
+def margin_snr(margin: float) -> float:
+    """The per-value signal-to-noise ratio (RMS over the values) at which fitting the effect is
+    expected to lower the loop's RMSE by the relative ``margin``: 1 − 1/√(1 + q²) = margin."""
+    return math.sqrt((1.0 - margin) ** -2 - 1.0)
 
 
 def _synthetic(truth_sim: Simulator, case: HiddenCase, noise: float, seed: int, index: int,
@@ -136,8 +171,13 @@ def selftest(project: str | os.PathLike | Project, scenario: str | None = None,
              margin: float = DEFAULT_MARGIN, max_steps: int = DEFAULT_MAX_STEPS,
              out_dir: str | os.PathLike | None = None, write: bool = True,
              echo: Echo | None = print, campaign: Campaign | None = None,
-             noise_lux: float = 0.0) -> SelftestResult:
+             noise_lux: float = 0.0, resimulate: bool = False) -> SelftestResult:
     """Hide each effect in synthetic measurements and check the loop names it.
+
+    ``resimulate``: re-simulate every candidate's signature at every step of each loop
+    (default: after the first step the loop ranks with the first step's signatures,
+    :func:`~radtree.diagnose.loop.run_loop`'s ``first_step_signatures`` — the first step, the
+    one the test judges, is exact either way, and every winner is re-simulated).
 
     ``campaign``: measure what the campaign measures (its days, hours, sensor groups; its
     noise unless ``noise`` is given); default the project's façade grid mean at its hours."""
@@ -181,7 +221,7 @@ def selftest(project: str | os.PathLike | Project, scenario: str | None = None,
             continue
         case = _decide(sim, ctx, e, start, noise, None,
                        noise_lux * sim.weights if isinstance(sim, CampaignSimulator)
-                       and sim.weights is not None else noise_lux)
+                       and sim.weights is not None else noise_lux, margin)
         cases.append(case)
         say(f"  {e.name:26s} {'distinguishable' if case.distinguishable else 'not distinguishable'}"
             f": {case.reason}")
@@ -191,7 +231,7 @@ def selftest(project: str | os.PathLike | Project, scenario: str | None = None,
                           out / "selftest" if write else None, proj, noise_lux)
         case.measured = meas
         case.loop = run_loop(sim, ctx, case.base, meas, margin, max_steps, EFFECTS,
-                             echo=None)
+                             echo=None, first_step_signatures=not resimulate)
         lp = case.loop
         verdict = ("correct" if case.correct else
                    ("MISNAMED" if case.distinguishable else "not distinguishable"))

@@ -15,7 +15,8 @@ from radtree.config import Project, Scenario, load_project
 from radtree.diagnose.attribution import DEFAULT_MARGIN
 from radtree.diagnose.loop import LoopResult, Measured
 
-#: a hidden effect is distinguishable when its signature is this many times the noise (rms)
+#: a hidden effect is distinguishable when its signature beyond the span of the other
+#: candidates' is at least this many noise units over all values (radtree.diagnose.hidden)
 SNR_MIN = 3.0
 SELFTEST_COLUMNS = ["hidden_effect", "distinguishable", "named_effect", "rmse_before",
                     "rmse_after"]
@@ -71,6 +72,9 @@ class HiddenCase:
     most_correlated_with: str
     distinguishable: bool
     reason: str
+    #: noise units of the signature beyond the span of the other candidates, and in all
+    unique_snr: float = math.nan
+    combined_snr: float = math.nan
     loop: LoopResult | None = None
     measured: Measured | None = None
 
@@ -107,6 +111,7 @@ class HiddenCase:
             "signature_rms_lux": self.signature_rms_lux, "noise_rms_lux": self.noise_rms_lux,
             "snr": self.signature_rms_lux / self.noise_rms_lux if self.noise_rms_lux > 0
             else math.nan,
+            "unique_snr": self.unique_snr, "combined_snr": self.combined_snr,
             "max_correlation": self.max_correlation,
             "most_correlated_with": self.most_correlated_with, "reason": self.reason,
             "base": self.base.name if not self.base.switches else
