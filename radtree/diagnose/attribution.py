@@ -162,11 +162,8 @@ def compute_signatures(sim: Simulator, ctx: EffectContext, base: Scenario, base_
     base_rows = base_run.row_daily().to_numpy(float)
     for e in effects:
         st = e.strength(ctx, base)
-        pts: list[float | None]
-        if st is None:
-            kind, pts = "binary", [None]
-        else:
-            kind, pts = st.mode, list(st.search_points())
+        kind = "binary" if st is None else st.mode
+        pts = _points(st)
         hourly, rows, scs = [], [], []
         for p in pts:
             sc = e.switch_on(ctx, base, p)
@@ -181,6 +178,16 @@ def compute_signatures(sim: Simulator, ctx: EffectContext, base: Scenario, base_
         out[e.name] = Signature(e, kind, st, strengths, np.array(hourly), np.array(rows),
                                 row_names, scs, None if st is None else st.reference)
     return out
+
+
+def _points(st: Strength | None) -> list[float | None]:
+    return [None] if st is None else list(st.search_points())
+
+
+def signature_scenarios(ctx: EffectContext, base: Scenario, effects: Iterable[Effect]
+                        ) -> list[Scenario]:
+    """The switched scenarios :func:`compute_signatures` simulates (to trace them ahead)."""
+    return [e.switch_on(ctx, base, p) for e in effects for p in _points(e.strength(ctx, base))]
 
 
 # --------------------------------------------------------------------------- fitting

@@ -104,6 +104,21 @@ def unique_snr(target: np.ndarray, others: np.ndarray | None,
     return float(np.linalg.norm(w - u @ (u.T @ w)))
 
 
+def nearest_snr(target: np.ndarray, alternatives: np.ndarray,
+                sigma: np.ndarray | float | None = None) -> float:
+    """How far ``target`` (lux per observation) lies from the nearest of ``alternatives``
+    (k × observations, lux: what another explanation can predict), in noise units over all the
+    observations: min_k ‖(target − alternative_k) / σ‖ (∞ without alternatives). Fitting the
+    target's cause instead of the nearest alternative lowers the noise-weighted sum of squares
+    by about this squared (a χ² with that non-centrality)."""
+    a = np.atleast_2d(np.asarray(alternatives, float))
+    if a.size == 0:
+        return math.inf
+    t = np.asarray(target, float)
+    d = whiten((t[None, :] - a).T, sigma)
+    return float(np.min(np.linalg.norm(d, axis=0)))
+
+
 def condition_number(signatures: np.ndarray, sigma: np.ndarray | float | None = None) -> float:
     """2-norm condition number of the whitened, column-normalised signature matrix (zero
     columns left out; ∞ when the matrix has fewer observations than effects)."""
