@@ -278,14 +278,14 @@ def test_selftest_names_hidden_effects(reduced):
     # one layer more darkens every hour: nothing else in the catalogue does in B
     assert flags["more_stages"] and t.loc["more_stages", "separation_snr"] >= 3
     # sky and unfiltered ground light both brighten every hour (signatures correlate > 0.9):
-    # the sky at 12 klx lies within 3 σ (over the 7 hours) of the best unfiltered-ground fit
-    assert t.loc["sky_diffuse", "max_correlation"] > 0.9
-    assert not flags["sky_diffuse"] and t.loc["sky_diffuse", "separation_snr"] < 3
-    assert t.loc["sky_diffuse", "nearest_candidate"] == "unfiltered_ground"
-    # ... but the unfiltered share 0.1 is a larger signal: at the same correlation more of it
-    # is left beyond the sky's best fit — distinguishable, and named (res.passed)
+    # the sky at 12 klx lies within 3 σ (over the 7 hours) of another candidate's best fit
+    sky = t.loc["sky_diffuse"]
+    assert sky["max_correlation"] > 0.9
+    assert not sky["distinguishable"] and sky["separation_snr"] < 3
+    assert sky["nearest_candidate"] in {"unfiltered_ground", "fewer_stages"}
+    # the unfiltered share 0.1: the verdict is its separation's (a larger signal than the
+    # sky's, so at a like correlation more of it is left beyond the others' best fits)
     ug = t.loc["unfiltered_ground"]
-    assert ug["most_correlated_with"] == "sky_diffuse" and ug["max_correlation"] > 0.9
     assert flags["unfiltered_ground"] == (ug["separation_snr"] >= 3 and ug["snr"] >= 0.33)
     assert ug["combined_snr"] > t.loc["sky_diffuse", "combined_snr"]
     # 7 values cannot separate anything from the span of all the other candidates together
