@@ -63,4 +63,7 @@ def main(argv: list[str] | None = None) -> int:
 
 
 if __name__ == "__main__":
+    from _common import print_resources_at_exit  # benchmarks/_common.py
+
+    print_resources_at_exit()
     sys.exit(main())

@@ -8,7 +8,13 @@ Prints (no timing assertions):
    inclined 30°, random azimuth, in a 4 m sensor dome on the façade of the Mendoza canyon;
    Perez sky + sun of 11:30) at the default budget, and on the Mendoza project's own louvers
    crown (``radtree.pipeline.assemble.make_scene``) when that builds;
-3. when Radiance is available, the per-row relative difference NumPy − Radiance on the slat
+3. the NumPy engine's ray throughput against raw Embree on the very same rays: every
+   Embree query of one traced hour is recorded, then replayed through embreex's
+   ``EmbreeScene.run`` (float32 rays already in trimesh's Embree frame, chunks of 65 536 over
+   the same number of threads) and through the engine's ``EmbreeCaster.first_hit`` in one call
+   (conversions and float64 distances included); the engine's rays/s over raw Embree's is the
+   throughput ratio (Mendoza scenarios B and F, 12:30, 1 and 2 threads);
+4. when Radiance is available, the per-row relative difference NumPy − Radiance on the slat
    scene, with Radiance at ``-ab 8 -ad 8192 -as 0 -aa 0`` and with ambient super-sampling
    (``-as 4096``, biased low here); ``--with-defaults`` adds the project's ``-as 512 -aa 0.1``.
 
@@ -20,7 +26,10 @@ from __future__ import annotations
 import argparse
 import os
 import sys
+import threading
 import time
+from concurrent.futures import ThreadPoolExecutor
+from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
@@ -148,6 +157,89 @@ def engine_hour(quick: bool) -> Scene:
     return sc
 
 
+def _replay_raw(caster: EmbreeCaster, o: np.ndarray, d: np.ndarray, workers: int) -> float:
+    """Wall time of raw ``EmbreeScene.run`` on the rays (prepared beforehand, not timed)."""
+    wrap = caster._embree
+    o32 = ((np.asarray(o, np.float32).astype(np.float64) - wrap.origin) * wrap.scale
+           ).astype(np.float32)
+    d32 = np.asarray(d, np.float32)
+    step = 1 << 16
+    starts = range(0, len(o32), step)
+    with ThreadPoolExecutor(workers) as pool:
+        list(pool.map(lambda i: wrap.scene.run(o32[i:i + 1000], d32[i:i + 1000]), starts[:2]))
+        t = time.perf_counter()
+        list(pool.map(lambda i: wrap.scene.run(o32[i:i + step], d32[i:i + step]), starts))
+        return time.perf_counter() - t
+
+
+def _recorded_queries(caster: EmbreeCaster, work: Any, *args: Any
+                      ) -> tuple[np.ndarray, np.ndarray, int]:
+    """Every ray ``work(*args)`` sends to Embree through ``caster`` (origins, directions,
+    queries): recorded at the caster's one Embree call, whichever caster method made it."""
+    casts: list[tuple[np.ndarray, np.ndarray]] = []
+    lock = threading.Lock()
+    original = caster._query
+
+    def recording(o: np.ndarray, d: np.ndarray) -> np.ndarray:
+        with lock:
+            casts.append((np.array(o), np.array(d)))
+        return original(o, d)
+
+    caster._query = recording  # type: ignore[method-assign]
+    try:
+        work(*args)
+    finally:
+        caster._query = original  # type: ignore[method-assign]
+    return (np.concatenate([c[0] for c in casts]), np.concatenate([c[1] for c in casts]),
+            len(casts))
+
+
+def engine_vs_embree(quick: bool) -> None:
+    print("\n== NumPy engine vs raw Embree on the same rays ==")
+    from radtree.config import load_project
+    from radtree.engines.numpy import trace_hour
+    from radtree.light.hours import hour_states
+    from radtree.pipeline.assemble import make_scene
+
+    for name in ("B", "F"):
+        for workers in (1, 2):
+            project = load_project(ROOT / "examples" / "mendoza-street", overrides={
+                "site.hours": ["12:30"], "sensors.dense_grid": False, "engine.workers": workers})
+            sc = project.scenario(name)
+            built = make_scene(project, sc, dense_grid=False)
+            state = hour_states(project, sc, ["12:30"])[0]
+            p = replace(project.engine, rays=1024 if quick else 4096, max_bounces=built.ab)
+            geo = scene_geometry(built.scene, DEFAULT_OPTIONS.backend, workers)
+            caster = geo.caster
+            if not isinstance(caster, EmbreeCaster):
+                print("  embreex not installed: skipped")
+                return
+            trace_hour(built.scene, state, replace(p, rays=16), ["facade"])
+            o, d, calls = _recorded_queries(caster, trace_hour, built.scene, state, p,
+                                            ["facade"])
+            best = []
+            for _ in range(2):  # best of 2 of each, measured back to back
+                c0, t0 = time.process_time(), time.perf_counter()
+                trace_hour(built.scene, state, p, ["facade"])
+                engine, engine_cpu = time.perf_counter() - t0, time.process_time() - c0
+                c0 = time.process_time()
+                raw = _replay_raw(caster, o, d, workers)
+                raw_cpu = time.process_time() - c0
+                t0 = time.perf_counter()
+                caster.first_hit(o, d)
+                first_hit = time.perf_counter() - t0
+                best.append((engine, raw, first_hit, engine_cpu, raw_cpu))
+            engine, raw, first_hit, engine_cpu, raw_cpu = min(best)
+            n = len(o)
+            print(f"  scenario {name}: {built.triangles} triangles, {workers} thread(s), "
+                  f"{n / 1e6:.2f} M queries in {calls} calls: engine {n / engine / 1e6:.2f} "
+                  f"M rays/s ({engine:.2f} s, {engine_cpu:.2f} s CPU), raw Embree "
+                  f"{n / raw / 1e6:.2f} M/s ({raw_cpu:.2f} s CPU), EmbreeCaster.first_hit "
+                  f"{n / first_hit / 1e6:.2f} M/s → engine / raw Embree {raw / engine:.0%} "
+                  f"(CPU {raw_cpu / engine_cpu:.0%}), engine / first_hit "
+                  f"{first_hit / engine:.0%}; load {os.getloadavg()[0]:.1f}", flush=True)
+
+
 def engines_differ(sc: Scene, quick: bool, with_defaults: bool) -> None:
     print("\n== NumPy vs Radiance (per sensor row) ==")
     if find_radiance() is None:
@@ -191,8 +283,12 @@ def main() -> None:
     print(f"cpus: {os.cpu_count()}, load average {load[0]:.2f}")
     rays_per_second(args.quick)
     sc = engine_hour(args.quick)
+    engine_vs_embree(args.quick)
     engines_differ(sc, args.quick, args.with_defaults)
 
 
 if __name__ == "__main__":
+    from _common import print_resources_at_exit  # benchmarks/_common.py
+
+    print_resources_at_exit()
     main()

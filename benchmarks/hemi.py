@@ -62,4 +62,7 @@ def main() -> int:
 
 
 if __name__ == "__main__":
+    from _common import print_resources_at_exit  # benchmarks/_common.py
+
+    print_resources_at_exit()
     sys.exit(main())

@@ -93,4 +93,7 @@ def run(work: Path, size: int) -> None:
 
 
 if __name__ == "__main__":
+    from _common import print_resources_at_exit  # benchmarks/_common.py
+
+    print_resources_at_exit()
     main()

@@ -73,4 +73,7 @@ def main(project_path: Path) -> None:
 
 
 if __name__ == "__main__":
+    from _common import print_resources_at_exit  # benchmarks/_common.py
+
+    print_resources_at_exit()
     main(Path(sys.argv[1]) if len(sys.argv) > 1 else ROOT / "examples" / "mendoza-street")

@@ -37,15 +37,17 @@ Light sources and physics, chosen to behave like Radiance:
   reflectance + transmittance and Russian roulette starts below ``roulette_weight`` (0.05).
 
 Rays are processed in batches of at most ``batch_paths`` paths (arrays of that length, one
-first-hit query per bounce plus the shadow queries), never a Python loop per ray.
+first-hit query per bounce plus the shadow queries), never a Python loop per ray. With
+``engine.workers`` > 1 a batch is split into that many contiguous parts (of at least
+``min_part_paths``) traced in parallel threads, each running its own NumPy work and
+single-threaded Embree queries; the parts draw exactly the random numbers of the one-thread
+trace (:mod:`radtree.engines.numpy.lockstep`), so the numbers do not depend on ``workers``.
 """
 
 from __future__ import annotations
 
-import hashlib
 import math
 import threading
-import weakref
 import zlib
 from dataclasses import dataclass
 
@@ -53,16 +55,28 @@ import numpy as np
 
 from radtree.config import EngineParams
 from radtree.engines.base import GridResult
-from radtree.engines.numpy.raycast import RayCaster, embree_available, make_caster
+from radtree.engines.numpy.geometry import (
+    GLASS_INDEX,
+    Environment,
+    Geometry,
+    Optics,
+    glass_coefficients,
+    scene_geometry,
+    scene_optics,
+)
+from radtree.engines.numpy.lockstep import Draws, LockstepRandom, SerialDraws
+from radtree.engines.numpy.raycast import embree_available, first_hits
 from radtree.engines.numpy.sampling import cosine_hemisphere, mirror, uniform_cone
 from radtree.errors import EngineError
-from radtree.light.sky import SkyState, sky_luminance
+from radtree.light.sky import SkyState
 from radtree.light.sun import SUN_HALF_ANGLE_DEG
-from radtree.optics import Glass, Hole, Plastic, Trans
 from radtree.scene import Scene, SensorGrid
 
+__all__ = ["DEFAULT_OPTIONS", "ENGINE_NAME", "GLASS_INDEX", "Environment", "Geometry", "Optics",
+           "TraceOptions", "describe", "glass_coefficients", "scene_geometry", "scene_optics",
+           "trace", "trace_hour"]
+
 ENGINE_NAME = "numpy"
-GLASS_INDEX = 1.52  # Radiance's refractive index of glass
 SHADOW_ROULETTE = 0.02  # shadow-ray transmittance below which Russian roulette starts
 
 
@@ -74,6 +88,7 @@ class TraceOptions:
     sun_disc: bool = False  # sample the 0.533° sun disc (penumbrae) instead of a point sun
     roulette_weight: float = 0.05  # Russian roulette below this path weight
     batch_paths: int = 1 << 18  # paths per batch (bounded memory)
+    min_part_paths: int = 4096  # a batch is split over the worker threads in parts ≥ this
     max_specular: int = 32  # specular events per path
     max_shadow_layers: int = 64  # transmissive surfaces a shadow ray may cross
     epsilon: float | None = None  # origin offset (m); None = 2e-6 × scene size, ≥ 1e-5
@@ -96,158 +111,17 @@ def describe(backend: str = "auto") -> str:
     return "numpy Monte Carlo engine, ray backend numpy-bvh (vectorised NumPy BVH)"
 
 
-# --------------------------------------------------------------------------- geometry + optics
-
-
-class Geometry:
-    """All light-interacting triangles of a scene, with their material index and ray caster."""
-
-    def __init__(self, scene: Scene, backend: str, workers: int):
-        meshes = scene.solid_meshes()
-        self.material_names = sorted({m.material for m in meshes})
-        mat_index = {n: i for i, n in enumerate(self.material_names)}
-        verts, faces, tri_mat, offset = [], [], [], 0
-        for m in meshes:
-            if m.n_triangles == 0:
-                continue
-            verts.append(m.vertices)
-            faces.append(m.faces + offset)
-            tri_mat.append(np.full(m.n_triangles, mat_index[m.material], np.int64))
-            offset += len(m.vertices)
-        self.vertices = np.vstack(verts) if verts else np.zeros((0, 3))
-        self.faces = np.vstack(faces) if faces else np.zeros((0, 3), np.int64)
-        self.tri_material = np.concatenate(tri_mat) if tri_mat else np.zeros(0, np.int64)
-        tris = self.vertices[self.faces]
-        n = np.cross(tris[:, 1] - tris[:, 0], tris[:, 2] - tris[:, 0]) if len(tris) else \
-            np.zeros((0, 3))
-        length = np.linalg.norm(n, axis=1)
-        bad = length < 1e-300
-        n[bad] = (0.0, 0.0, 1.0)
-        length[bad] = 1.0
-        self.normals = n / length[:, None]
-        pts = [self.vertices] + [g.points for g in scene.grids.values()]
-        allp = np.vstack(pts)
-        self.size = float(np.ptp(allp, axis=0).max()) if len(allp) else 1.0
-        self.caster: RayCaster = make_caster(self.vertices, self.faces, backend, workers)
-
-
-_GEOMETRY_CACHE: dict[int, tuple[weakref.ref, str, Geometry]] = {}
-_GEOMETRY_LOCK = threading.Lock()
-
-
-def _fingerprint(scene: Scene, backend: str, workers: int) -> str:
-    h = hashlib.blake2b(digest_size=16)
-    h.update(f"{backend}|{workers}".encode())
-    for m in scene.solid_meshes():
-        h.update(f"{m.name}|{m.material}|{m.vertices.shape}|{m.faces.shape}".encode())
-        h.update(np.ascontiguousarray(m.vertices).tobytes())
-        h.update(np.ascontiguousarray(m.faces).tobytes())
-    for g in scene.grids.values():
-        h.update(np.ascontiguousarray(g.points).tobytes())
-    return h.hexdigest()
-
-
-def scene_geometry(scene: Scene, backend: str, workers: int) -> Geometry:
-    """The scene's triangles and ray caster, cached across hours of the same scene.
-
-    Thread-safe: the scenario runner traces several hours of one scene in parallel threads
-    (they then share one ray caster; Embree queries are thread-safe).
-    """
-    key = id(scene)
-    fp = _fingerprint(scene, backend, workers)
-    with _GEOMETRY_LOCK:
-        hit = _GEOMETRY_CACHE.get(key)
-        if hit is not None and hit[0]() is scene and hit[1] == fp:
-            return hit[2]
-        geo = Geometry(scene, backend, workers)
-        for k in [k for k, v in _GEOMETRY_CACHE.items() if v[0]() is None]:
-            del _GEOMETRY_CACHE[k]
-        _GEOMETRY_CACHE[key] = (weakref.ref(scene), fp, geo)
-        return geo
-
-
-@dataclass
-class Optics:
-    """Per-material coefficients (arrays indexed by material index)."""
-
-    rd: np.ndarray  # diffuse reflectance
-    td: np.ndarray  # diffuse transmittance
-    ts: np.ndarray  # specular (undeviated) transmittance
-    rm: np.ndarray  # mirror reflectance (plastic specularity)
-    glass_tn: np.ndarray  # glass transmissivity (NaN = not glass)
-
-    @property
-    def any_specular_pass(self) -> bool:
-        return bool(np.any(self.ts > 0) or np.any(np.isfinite(self.glass_tn)))
-
-
-def scene_optics(scene: Scene, state: SkyState, names: list[str]) -> Optics:
-    k = len(names)
-    rd, td, ts, rm = np.zeros(k), np.zeros(k), np.zeros(k), np.zeros(k)
-    tn = np.full(k, np.nan)
-    for i, name in enumerate(names):
-        m = scene.materials[name]
-        if isinstance(m, Plastic):
-            rho = state.ground_reflectance if name == scene.ground_material else m.reflectance
-            rd[i] = rho * (1.0 - m.specularity)
-            rm[i] = m.specularity
-        elif isinstance(m, Trans):
-            rd[i], td[i], ts[i] = m.reflectance, m.diffuse_transmittance, m.specular_transmittance
-        elif isinstance(m, Glass):
-            tn[i] = m.transmissivity
-        elif isinstance(m, Hole):  # pragma: no cover - holes are removed with solid_meshes()
-            ts[i] = 1.0
-        else:  # pragma: no cover
-            raise EngineError(f"material '{name}' of type {type(m).__name__} is not supported "
-                              "by the in-process engines (a BSDF crown, [tree] representation"
-                              " = \"bsdf\", is Radiance only: use --engine radiance)")
-    return Optics(rd, td, ts, rm, tn)
-
-
-def glass_coefficients(cos_i: np.ndarray, transmissivity: np.ndarray
-                       ) -> tuple[np.ndarray, np.ndarray]:
-    """Transmittance and reflectance of Radiance ``glass`` at incidence cosines ``cos_i``.
-
-    Fresnel reflection (both polarisations, n = 1.52), the transmissivity applied along the
-    refracted path (tn^(1/cos θ_t)) and the infinite series of internal reflections — the
-    formulas of Radiance's ``m_glass``.
-    """
-    c = np.clip(np.abs(cos_i), 1e-6, 1.0)
-    n = GLASS_INDEX
-    cos2 = np.sqrt((1.0 - 1.0 / (n * n)) + c * c / (n * n))
-    d = np.power(transmissivity, 1.0 / cos2)
-    r1e = ((c - n * cos2) / (c + n * cos2)) ** 2
-    r1m = ((1.0 / c - n / cos2) / (1.0 / c + n / cos2)) ** 2
-    t = (0.5 * (1 - r1e) ** 2 * d / (1 - r1e * r1e * d * d)
-         + 0.5 * (1 - r1m) ** 2 * d / (1 - r1m * r1m * d * d))
-    d2 = d * d
-    r = (0.5 * r1e * (1 + (1 - 2 * r1e) * d2) / (1 - r1e * r1e * d2)
-         + 0.5 * r1m * (1 + (1 - 2 * r1m) * d2) / (1 - r1m * r1m * d2))
-    return t, r
-
-
-class Environment:
-    """Luminance (cd/m²) of whatever an escaping ray sees: sky above, distant ground below."""
-
-    def __init__(self, state: SkyState):
-        self.state = state
-        self.perez = None
-        if state.sky_model == "perez":
-            from radtree.light.perez import perez_sky
-
-            self.perez = perez_sky(state)
-        self.ground = state.ground_luminance
-
-    def __call__(self, d: np.ndarray) -> np.ndarray:
-        dz = d[:, 2]
-        up = dz > 0.0
-        if self.perez is not None:
-            L = self.perez.luminance(d)
-            return np.where(up | self.state.ground_glow, L, 0.0)
-        return np.where(up, sky_luminance(self.state, dz), self.ground)
-
-
 # --------------------------------------------------------------------------- the tracer
+
+
+def _rows(d: np.ndarray, sel: np.ndarray | None) -> np.ndarray:
+    """``d[sel]`` (``sel``: indices or a mask; None: all rows, copied) — except that a
+    broadcast row (stride 0, the point sun's direction) stays a broadcast row."""
+    if d.ndim == 2 and d.strides[0] == 0:
+        k = len(d) if sel is None else (int(np.count_nonzero(sel)) if sel.dtype == bool
+                                        else len(sel))
+        return np.broadcast_to(d[0], (k, d.shape[1]))
+    return np.array(d) if sel is None else d[sel]
 
 
 class _Tracer:
@@ -260,61 +134,74 @@ class _Tracer:
         self.state = state
         self.max_bounces = int(params.max_bounces)
         self.opts = opts
+        self.workers = max(1, int(getattr(params, "workers", 2) or 1))
         self.eps = opts.epsilon if opts.epsilon is not None else max(1e-5, 2e-6 * geo.size)
         self.sun_on = state.sun_on
         self.dni = float(state.direct_normal_lux)
         self.sun = np.asarray(state.sun.vector, float)
         self.sun = self.sun / np.linalg.norm(self.sun)
+        # per-triangle optics (one gather per query instead of material index + coefficients)
+        mat = geo.tri_material
+        self.tri_coef = np.stack([optics.rd, optics.td, optics.ts, optics.rm], axis=1)[mat]
+        self.tri_glass_tn = optics.glass_tn[mat]
+        self.tri_glass = np.isfinite(self.tri_glass_tn)
+        self.glass_any = bool(self.tri_glass.any())
 
     # -- sun
-    def sun_directions(self, k: int, rng: np.random.Generator) -> np.ndarray:
+    def sun_directions(self, k: int, rng: Draws | np.random.Generator) -> np.ndarray:
         if self.opts.sun_disc:
             return uniform_cone(self.sun, math.radians(SUN_HALF_ANGLE_DEG), k, rng)
         return np.broadcast_to(self.sun, (k, 3))
 
     def shadow(self, origins: np.ndarray, dirs: np.ndarray,
-               rng: np.random.Generator | None = None) -> np.ndarray:
+               rng: Draws | np.random.Generator | None = None, tag: tuple[int, ...] = (),
+               parallel: bool = True) -> np.ndarray:
         """Transmittance towards the sun: 1 if free, product of specular passes, else 0.
 
         With ``rng``, faint shadow rays are continued by Russian roulette (unbiased); without,
-        the product is exact (the sensors' own direct sun).
+        the product is exact (the sensors' own direct sun). ``tag``: the program-order label
+        of the roulette draws when ``rng`` is a :class:`Draws` (layer appended); ``parallel``:
+        whether the ray caster may split its queries over threads (not inside a part thread).
         """
         k = len(origins)
         vis = np.ones(k)
         idx = np.arange(k)
         o = np.array(origins, float)
-        d = np.array(dirs, float)
+        d = _rows(np.asarray(dirs, float), None)  # a point sun stays one broadcast row
         passes = self.opt.any_specular_pass
-        for _ in range(self.opts.max_shadow_layers):
-            tri, t = self.caster.first_hit(o, d)
-            hit = tri >= 0
-            if not hit.any():
+        normals, ts = self.geo.normals, self.tri_coef[:, 2]
+        for layer in range(self.opts.max_shadow_layers):
+            h = first_hits(self.caster, o, d, normals, parallel)
+            if len(h.sel) == 0:
                 return vis
-            idx, o, d, tri, t = idx[hit], o[hit], d[hit], tri[hit], t[hit]
+            tri, t, ng, cosd = h.tri, h.t, h.normal, h.cos
+            if len(h.sel) < len(o):
+                idx, o, d = idx[h.sel], o[h.sel], _rows(d, h.sel)
             if not passes:
                 vis[idx] = 0.0
                 return vis
-            mat = self.geo.tri_material[tri]
-            ng = self.geo.normals[tri]
-            cosd = np.einsum("ij,ij->i", d, ng)
-            f = self.opt.ts[mat].copy()
-            glass = np.isfinite(self.opt.glass_tn[mat])
-            if glass.any():
-                f[glass] = glass_coefficients(cosd[glass], self.opt.glass_tn[mat][glass])[0]
-            vis[idx] *= f
+            f = ts[tri]
+            if self.glass_any:
+                glass = self.tri_glass[tri]
+                if glass.any():
+                    f[glass] = glass_coefficients(cosd[glass], self.tri_glass_tn[tri][glass])[0]
+            v = vis[idx] * f
+            vis[idx] = v
             # Russian roulette on faint shadow rays (unbiased: survivors are promoted)
-            v = vis[idx]
             faint = (v > 0) & (v < SHADOW_ROULETTE)
             if rng is not None and faint.any():
+                if tag:
+                    rng.at(*tag, layer)  # type: ignore[union-attr]
                 keep = rng.random(int(faint.sum())) * SHADOW_ROULETTE < v[faint]
                 v[faint] = np.where(keep, SHADOW_ROULETTE, 0.0)
                 vis[idx] = v
-            go = v > 0
-            nf = np.where((cosd < 0)[:, None], ng, -ng)
-            o = (o + t[:, None] * d - nf * self.eps)[go]
-            idx, d = idx[go], d[go]
-            if len(idx) == 0:
+            go = np.flatnonzero(v > 0)
+            if len(go) == 0:
                 return vis
+            if len(go) < len(v):
+                idx, o, d, t, ng, cosd = idx[go], o[go], _rows(d, go), t[go], ng[go], cosd[go]
+            nf = np.where((cosd < 0)[:, None], ng, -ng)
+            o = o + t[:, None] * d - nf * self.eps
         vis[idx] = 0.0
         return vis
 
@@ -330,25 +217,33 @@ class _Tracer:
         cos = np.einsum("ij,ij->i", normals, dirs)
         need = cos > 0
         if need.any():
-            out[need] = self.dni * cos[need] * self.shadow(points[need], dirs[need], rng)
+            out[need] = self.dni * cos[need] * self.shadow(points[need],
+                                                               _rows(dirs, need), rng)
         return out
 
     # -- paths
-    def paths(self, points: np.ndarray, normals: np.ndarray, rng: np.random.Generator
-              ) -> np.ndarray:
-        """Radiance (cd/m²) seen along one cosine-sampled direction from each sensor sample."""
+    def paths(self, points: np.ndarray, normals: np.ndarray, rng: Draws,
+              parallel: bool = True) -> np.ndarray:
+        """Radiance (cd/m²) seen along one cosine-sampled direction from each sensor sample.
+
+        Every draw is labelled (``rng.at``) with its place in the program — (bounce, site) —
+        so that parts of a batch traced in separate threads (:meth:`paths_split`) draw the
+        numbers this method draws for them when it traces the whole batch."""
         k = len(points)
         acc = np.zeros(k)
         alive = np.arange(k)
         o = np.array(points, float)
+        rng.at(0, 4)
         d = cosine_hemisphere(np.asarray(normals, float), rng)
         beta = np.ones(k)
         depth = np.ones(k, np.int64)
         nspec = np.zeros(k, np.int64)
-        geo, opt, eps = self.geo, self.opt, self.eps
+        geo, eps = self.geo, self.eps
         thr = self.opts.roulette_weight
+        bounce = 0
         while len(alive):
-            tri, t = self.caster.first_hit(o, d)
+            bounce += 1
+            tri, t = self.caster.first_hit(o, d, parallel)
             miss = tri < 0
             if miss.any():
                 acc[alive[miss]] += beta[miss] * self.env(d[miss])
@@ -363,36 +258,39 @@ class _Tracer:
             cosd = np.einsum("ij,ij->i", d, ng)
             front = cosd < 0
             nf = np.where(front[:, None], ng, -ng)  # normal on the side the ray came from
-            mat = geo.tri_material[tri]
-            rd, td = opt.rd[mat], opt.td[mat]
+            coef = self.tri_coef[tri]  # diffuse R, diffuse T, specular T, mirror (a copy)
+            rd, td = coef[:, 0], coef[:, 1]
 
             # next-event estimation towards the sun
             if self.sun_on:
+                rng.at(bounce, 0)
                 sd = self.sun_directions(len(alive), rng)
                 cs = np.einsum("ij,ij->i", nf, sd)
                 f = np.where(cs > 0, rd * cs, -td * cs) / math.pi
                 need = f > 0
                 if need.any():
                     so = p[need] + nf[need] * (eps * np.sign(cs[need]))[:, None]
-                    vis = self.shadow(so, sd[need], rng)
+                    vis = self.shadow(so, _rows(sd, need), rng, (bounce, 1), parallel)
                     acc[alive[need]] += beta[need] * self.dni * f[need] * vis
 
             # scattering events: diffuse reflect, diffuse transmit, specular transmit, mirror
-            coef = np.stack([rd, td, opt.ts[mat], opt.rm[mat]], axis=1)
-            glass = np.isfinite(opt.glass_tn[mat])
-            if glass.any():
-                tg, rg = glass_coefficients(cosd[glass], opt.glass_tn[mat][glass])
-                coef[glass, 2] = tg
-                coef[glass, 3] = rg
+            if self.glass_any:
+                glass = self.tri_glass[tri]
+                if glass.any():
+                    tg, rg = glass_coefficients(cosd[glass], self.tri_glass_tn[tri][glass])
+                    coef[glass, 2] = tg
+                    coef[glass, 3] = rg
             coef[:, :2] *= (depth < self.max_bounces)[:, None]
             coef[:, 2:] *= (nspec < self.opts.max_specular)[:, None]
             total = coef.sum(axis=1)
             beta = beta * total
+            rng.at(bounce, 2)
             u = rng.random(len(alive))
             low = beta < thr
             survive = (total > 0) & (~low | (u * thr < beta))
             beta = np.where(low, thr, beta)
             cum = np.cumsum(coef, axis=1)
+            rng.at(bounce, 3)
             pick = rng.random(len(alive)) * total
             ev = np.minimum((pick[:, None] >= cum).sum(axis=1), 3)
 
@@ -407,6 +305,7 @@ class _Tracer:
             diffuse = diff_r | diff_t
             if diffuse.any():
                 axis = np.where(diff_r[diffuse, None], nf[diffuse], -nf[diffuse])
+                rng.at(bounce, 4)
                 new_d[diffuse] = cosine_hemisphere(axis, rng)
             spec_t, mir = ev == 2, ev == 3
             if mir.any():
@@ -417,6 +316,40 @@ class _Tracer:
             depth = depth + diffuse
             nspec = nspec + (spec_t | mir)
         return acc
+
+
+    def paths_split(self, points: np.ndarray, normals: np.ndarray, rng: np.random.Generator
+                    ) -> np.ndarray:
+        """:meth:`paths` of a batch, split into ``workers`` contiguous parts traced in parallel
+        threads (each part's NumPy work and Embree queries on its own core) drawing the very
+        numbers of the serial trace (:class:`~radtree.engines.numpy.lockstep.LockstepRandom`):
+        the results are identical to ``paths(points, normals, SerialDraws(rng))``."""
+        k = len(points)
+        parts = min(self.workers, k // self.opts.min_part_paths)
+        if parts <= 1:
+            return self.paths(points, normals, SerialDraws(rng))
+        bounds = np.linspace(0, k, parts + 1).astype(int)
+        shared = LockstepRandom(rng, parts)
+        out: list[np.ndarray | None] = [None] * parts
+        errors: list[BaseException] = []
+
+        def run(i: int) -> None:
+            try:
+                s = slice(bounds[i], bounds[i + 1])
+                out[i] = self.paths(points[s], normals[s], shared.part(i), parallel=False)
+            except BaseException as exc:  # re-raised in the calling thread
+                errors.append(exc)
+            finally:
+                shared.finish(i)
+
+        threads = [threading.Thread(target=run, args=(i,), daemon=True) for i in range(parts)]
+        for th in threads:
+            th.start()
+        for th in threads:
+            th.join()
+        if errors:
+            raise errors[0]
+        return np.concatenate([o for o in out if o is not None])
 
 
 # --------------------------------------------------------------------------- public API
@@ -446,7 +379,7 @@ def _trace_grid(tracer: _Tracer, grid: SensorGrid, n_paths: int, rng: np.random.
         sensor = pid // n_paths
         x = np.zeros(len(pid))
         if tracer.max_bounces > 0:
-            x += math.pi * tracer.paths(pts[sensor], nrm[sensor], rng)
+            x += math.pi * tracer.paths_split(pts[sensor], nrm[sensor], rng)
         if disc:
             x += tracer.sensor_sun(pts[sensor], nrm[sensor],
                                    tracer.sun_directions(len(pid), rng), rng)

@@ -14,7 +14,9 @@ work). Select a backend with :func:`make_caster` or the environment variable
 from __future__ import annotations
 
 import os
+import threading
 from concurrent.futures import ThreadPoolExecutor
+from dataclasses import dataclass
 from typing import Protocol
 
 import numpy as np
@@ -26,9 +28,12 @@ class RayCaster(Protocol):
     name: str
     rays_cast: int  # rays queried so far (statistics)
 
-    def first_hit(self, origins: np.ndarray, directions: np.ndarray
+    def first_hit(self, origins: np.ndarray, directions: np.ndarray, parallel: bool = True
                   ) -> tuple[np.ndarray, np.ndarray]:
-        """(triangle index or -1, distance or inf) per ray; directions must be unit vectors."""
+        """(triangle index or -1, distance or inf) per ray; directions must be unit vectors.
+
+        ``parallel=False``: answer in the calling thread (a caller that is itself one of
+        several worker threads)."""
         ...
 
 
@@ -42,20 +47,38 @@ def embree_available() -> bool:
 
 
 def _plane_distance(tris_v0: np.ndarray, normals: np.ndarray, centroids: np.ndarray,
-                    origins: np.ndarray, directions: np.ndarray, idx: np.ndarray) -> np.ndarray:
-    """Distance along each ray to the plane of its hit triangle (float64)."""
-    n = normals[idx]
-    denom = np.einsum("ij,ij->i", directions, n)
+                    origins: np.ndarray, directions: np.ndarray, idx: np.ndarray,
+                    n: np.ndarray | None = None, denom: np.ndarray | None = None) -> np.ndarray:
+    """Distance along each ray to the plane of its hit triangle (float64; a ray parallel to
+    the plane gets the distance of the triangle's centroid along it). ``n``, ``denom``: the
+    hit triangles' normals and direction · normal when already at hand (not modified)."""
+    if n is None:
+        n = normals[idx]
+    if denom is None:
+        denom = np.einsum("ij,ij->i", directions, n)
     num = np.einsum("ij,ij->i", tris_v0[idx] - origins, n)
-    grazing = np.abs(denom) < 1e-12
+    grazing = np.flatnonzero(np.abs(denom) < 1e-12)
+    if len(grazing):
+        denom = denom.copy()
     with np.errstate(divide="ignore", invalid="ignore"):
-        t = np.where(grazing, np.einsum("ij,ij->i", centroids[idx] - origins, directions),
-                     num / np.where(grazing, 1.0, denom))
-    return np.maximum(t, 0.0)
+        if len(grazing):
+            denom[grazing] = 1.0
+        t = num / denom
+    if len(grazing):
+        g = idx[grazing]
+        t[grazing] = np.einsum("ij,ij->i", centroids[g] - origins[grazing],
+                               directions[grazing])
+    return np.maximum(t, 0.0, out=t)
 
 
 class EmbreeCaster:
-    """trimesh's ``RayMeshIntersector`` (embreex) with the batch split over worker threads."""
+    """trimesh's ``RayMeshIntersector`` (embreex) with the batch split over worker threads.
+
+    Each thread converts its chunk of rays exactly as ``RayMeshIntersector.intersects_first``
+    does (float32, directions re-unitised, shifted and scaled into trimesh's Embree frame),
+    queries Embree (which releases the GIL) and computes the float64 plane distances of its
+    hits, so that only the result arrays are assembled in the calling thread.
+    """
 
     name = "embree"
 
@@ -75,31 +98,104 @@ class EmbreeCaster:
         self.chunk = chunk
         self._pool = ThreadPoolExecutor(self.workers) if self.workers > 1 else None
         self.rays_cast = 0
+        self._count_lock = threading.Lock()
         # build the Embree scene now (trimesh builds it lazily on first query)
         self._intersector.intersects_first(np.zeros((1, 3)), np.array([[0.0, 0.0, 1.0]]))
+        self._embree = self._intersector._scene  # trimesh's scaled Embree scene
 
     def _query(self, o: np.ndarray, d: np.ndarray) -> np.ndarray:
-        return np.asarray(self._intersector.intersects_first(o, d), dtype=np.int64)
+        """Triangle index per ray: the arithmetic of ``RayMeshIntersector.intersects_first``
+        (identical float32 inputs to Embree) without its per-call overhead."""
+        from trimesh.util import unitize
 
-    def first_hit(self, origins: np.ndarray, directions: np.ndarray
+        wrap = self._embree
+        o32 = np.array(o, dtype=np.float32)
+        if d.ndim == 2 and d.strides[0] == 0 and len(d):  # one direction (a point sun)
+            d32 = np.tile(unitize(np.array(d[:1], dtype=np.float32)).astype(np.float32),
+                          (len(d), 1))
+        else:
+            d32 = unitize(np.array(d, dtype=np.float32)).astype(np.float32)
+        scaled = np.subtract(o32, wrap.origin, dtype=np.float64)  # float32 → float64 exactly
+        scaled *= wrap.scale
+        return np.asarray(wrap.scene.run(scaled.astype(np.float32), d32), dtype=np.int64)
+
+    def _chunk(self, o: np.ndarray, d: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        idx = self._query(o, d)
+        t = np.full(len(o), np.inf)
+        hit = idx >= 0
+        if hit.any():
+            dh = d[hit] if d.strides[0] else np.broadcast_to(d[0], (int(hit.sum()), 3))
+            t[hit] = _plane_distance(self._v0, self._normals, self._centroids, o[hit], dh,
+                                     idx[hit])
+        return idx, t
+
+    def _parts(self, n: int, parallel: bool) -> list[slice] | None:
+        with self._count_lock:
+            self.rays_cast += n
+        if parallel and self._pool is not None and n >= 2048:
+            step = min(self.chunk, -(-n // self.workers))
+            return [slice(i, min(i + step, n)) for i in range(0, n, step)]
+        return None
+
+    def first_hit(self, origins: np.ndarray, directions: np.ndarray, parallel: bool = True
                   ) -> tuple[np.ndarray, np.ndarray]:
         n = len(origins)
         if n == 0:
             return np.zeros(0, np.int64), np.zeros(0)
-        self.rays_cast += n
-        if self._pool is not None and n >= 4096:
-            step = min(self.chunk, -(-n // self.workers))
-            parts = [slice(i, min(i + step, n)) for i in range(0, n, step)]
-            idx = np.concatenate(list(self._pool.map(
-                lambda s: self._query(origins[s], directions[s]), parts)))
-        else:
-            idx = self._query(origins, directions)
-        t = np.full(n, np.inf)
-        hit = idx >= 0
-        if hit.any():
-            t[hit] = _plane_distance(self._v0, self._normals, self._centroids, origins[hit],
-                                     directions[hit], idx[hit])
-        return idx, t
+        parts = self._parts(n, parallel)
+        if parts is not None and self._pool is not None:
+            res = list(self._pool.map(lambda s: self._chunk(origins[s], directions[s]), parts))
+            return np.concatenate([r[0] for r in res]), np.concatenate([r[1] for r in res])
+        return self._chunk(origins, directions)
+
+    def _chunk_hits(self, o: np.ndarray, d: np.ndarray, start: int = 0) -> Hits:
+        idx = self._query(o, d)
+        sel = np.flatnonzero(idx >= 0)
+        tri = idx[sel]
+        n = self._normals[tri]
+        oh = o[sel]
+        dh = d[sel] if d.strides[0] else np.broadcast_to(d[0], (len(sel), 3))
+        cos = np.einsum("ij,ij->i", dh, n)
+        t = _plane_distance(self._v0, self._normals, self._centroids, oh, dh, tri, n, cos)
+        return Hits(sel + start, tri, t, n, cos)
+
+    def hits(self, origins: np.ndarray, directions: np.ndarray, parallel: bool = True) -> Hits:
+        """The rays that hit: see :func:`first_hits`."""
+        n = len(origins)
+        parts = self._parts(n, parallel)
+        if parts is not None and self._pool is not None:
+            res = list(self._pool.map(
+                lambda s: self._chunk_hits(origins[s], directions[s], s.start), parts))
+            return Hits(*(np.concatenate([getattr(r, f) for r in res])
+                          for f in ("sel", "tri", "t", "normal", "cos")))
+        return self._chunk_hits(origins, directions)
+
+
+@dataclass
+class Hits:
+    """The rays of a query that hit something: their indices in the query (ascending), the
+    triangle, the distance (float64), the triangle's unit normal and direction · normal."""
+
+    sel: np.ndarray
+    tri: np.ndarray
+    t: np.ndarray
+    normal: np.ndarray
+    cos: np.ndarray
+
+
+def first_hits(caster: RayCaster, origins: np.ndarray, directions: np.ndarray,
+               normals: np.ndarray, parallel: bool = True) -> Hits:
+    """First hits of the rays that hit anything (``normals``: the unit normal per triangle of
+    the caster's mesh). Embree answers in its worker threads, others via ``first_hit``."""
+    if isinstance(caster, EmbreeCaster):
+        return caster.hits(origins, directions, parallel)
+    tri, t = caster.first_hit(origins, directions, parallel)
+    sel = np.flatnonzero(tri >= 0)
+    tri, t = tri[sel], t[sel]
+    n = normals[tri]
+    d = directions[sel] if directions.strides[0] else \
+        np.broadcast_to(directions[0], (len(sel), 3))
+    return Hits(sel, tri, t, n, np.einsum("ij,ij->i", d, n))
 
 
 def _unit_normals(tris: np.ndarray) -> np.ndarray:
@@ -210,7 +306,7 @@ class BVHCaster:
         tmax = np.maximum(t1, t2).min(axis=1)
         return tmin, tmax >= tmin
 
-    def first_hit(self, origins: np.ndarray, directions: np.ndarray
+    def first_hit(self, origins: np.ndarray, directions: np.ndarray, parallel: bool = True
                   ) -> tuple[np.ndarray, np.ndarray]:
         n = len(origins)
         self.rays_cast += n
@@ -288,7 +384,7 @@ class NullCaster:
     name = "none"
     rays_cast = 0
 
-    def first_hit(self, origins: np.ndarray, directions: np.ndarray
+    def first_hit(self, origins: np.ndarray, directions: np.ndarray, parallel: bool = True
                   ) -> tuple[np.ndarray, np.ndarray]:
         n = len(origins)
         self.rays_cast += n

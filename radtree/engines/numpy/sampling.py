@@ -3,8 +3,15 @@
 from __future__ import annotations
 
 import math
+from typing import Protocol
 
 import numpy as np
+
+
+class Uniform(Protocol):
+    """Anything with ``random(k)`` → k uniform doubles in [0, 1) (a NumPy ``Generator``)."""
+
+    def random(self, size: int) -> np.ndarray: ...
 
 
 def orthonormal_basis(n: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -21,7 +28,7 @@ def orthonormal_basis(n: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return t, bb
 
 
-def cosine_hemisphere(normals: np.ndarray, rng: np.random.Generator) -> np.ndarray:
+def cosine_hemisphere(normals: np.ndarray, rng: Uniform) -> np.ndarray:
     """Directions distributed ∝ cos θ about each normal (pdf cos θ / π)."""
     k = len(normals)
     u1 = rng.random(k)
@@ -36,7 +43,7 @@ def cosine_hemisphere(normals: np.ndarray, rng: np.random.Generator) -> np.ndarr
 
 
 def uniform_cone(axis: np.ndarray, half_angle_rad: float, k: int,
-                 rng: np.random.Generator) -> np.ndarray:
+                 rng: Uniform) -> np.ndarray:
     """``k`` directions uniform in solid angle within a cone about one unit ``axis`` (3,)."""
     axis = np.asarray(axis, float) / np.linalg.norm(axis)
     cos_max = math.cos(half_angle_rad)
