@@ -179,6 +179,11 @@ class CampaignSimulator(Simulator):
     def traced_cache(self) -> dict[str, Any]:
         return self._ctraced
 
+    def key_project(self) -> Project:
+        # the day projects point at DNI tables in this simulator's own temporary folder: hash
+        # the project the simulator was made from (its campaign fixes the days and hours)
+        return self._origin
+
     def has_traced(self, sc: Scenario) -> bool:
         return self._traced_key(sc) in self._ctraced
 

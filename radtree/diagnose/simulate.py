@@ -131,7 +131,11 @@ class Simulator:
         return self._engine.seeded
 
     def key(self, sc: Scenario) -> str:
-        return scenario_key(self.project, sc)
+        return scenario_key(self.key_project(), sc)
+
+    def key_project(self) -> Project:
+        """The project the cache keys hash (the same in every process: :mod:`.parallel`)."""
+        return self.project
 
     def grid(self, sc: Scenario | None = None):
         """The façade sensor grid (points, normals, row labels)."""
@@ -179,7 +183,7 @@ class Simulator:
             # the traced hours then see no ground light (radtree.light.hours: reflectance 0,
             # no ground glow): the street's reflectance enters the ground terms only
             keep.pop(GROUND_RHO, None)
-        return scenario_key(self.project, replace(sc, switches=keep))
+        return scenario_key(self.key_project(), replace(sc, switches=keep))
 
     def spec(self) -> tuple[type, tuple[Any, ...], dict[str, Any]]:
         """How to make this simulator again in another process (:mod:`.parallel`): class,
