@@ -6,9 +6,13 @@ For every effect of the catalogue that applies to the scenario: its signature on
 campaign's observations (effects off in the scenario: switched on at the reference strength
 minus the scenario; effects on: the scenario minus the scenario with the effect off), the
 noise of every observation (the campaign's noise and twice the Monte Carlo variance, as the
-self-test), then the self-test's rule on noise-weighted values — signature RMS ≥ SNR_MIN ×
-noise RMS and (signed, uncentred) correlation with every other effect < TIE_CORR — and the
-joint-fit groups at |corr| ≥ 0.95 (radtree.diagnose.identify). Prints one line per effect and the count.
+self-test), then on noise-weighted values: the signal in noise units over all observations
+(‖s/σ‖), the part of it outside the span of every other effect's signature (``joint``,
+radtree.diagnose.identify.unique_snr) and the per-value RMS; "distinguishable" here is
+joint ≥ SNR_MIN and RMS ≥ the loop's margin (radtree.diagnose.hidden.margin_snr) — stricter
+than the self-test's rule (≥ SNR_MIN from each other effect's best fit, which this
+signatures-only check does not fit), so a sufficient condition. Also the joint-fit groups at
+|corr| ≥ 0.95. Prints one line per effect and the count.
 """
 
 from __future__ import annotations
@@ -19,11 +23,12 @@ import time
 import numpy as np
 
 from radtree.config import load_project
-from radtree.diagnose.attribution import TIE_CORR
+from radtree.diagnose.attribution import DEFAULT_MARGIN
 from radtree.diagnose.campaign import load_campaign
 from radtree.diagnose.campaign_sim import CampaignSimulator
 from radtree.diagnose.effects import EFFECTS, EffectContext
-from radtree.diagnose.identify import identifiability, noise_sigma
+from radtree.diagnose.hidden import margin_snr
+from radtree.diagnose.identify import identifiability, noise_sigma, unique_snr
 from radtree.diagnose.outcome import SNR_MIN
 
 
@@ -63,9 +68,11 @@ def main() -> None:
         corr = ident.correlation[j].copy()
         corr[j] = np.nan
         k = int(np.nanargmax(corr))
-        ok = snr >= SNR_MIN and corr[k] < TIE_CORR
+        joint = unique_snr(S[:, j], np.delete(S, j, axis=1), sigma)
+        ok = joint >= SNR_MIN and snr >= margin_snr(DEFAULT_MARGIN)
         n_ok += ok
-        print(f"  {n:26s} SNR {snr:6.2f}  max corr {corr[k]:+.2f} ({names[k]})  "
+        print(f"  {n:26s} {np.linalg.norm(w[:, j]):7.1f} σ, joint {joint:6.1f} σ, RMS "
+              f"{snr:5.2f} σ, max corr {corr[k]:+.2f} ({names[k]})  "
               f"{'distinguishable' if ok else 'not distinguishable'}")
     print(f"distinguishable: {n_ok} of {len(names)}; groups at |corr| ≥ 0.95: "
           + ("; ".join(" ~ ".join(g) for g in ident.confounded) or "none")

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -126,3 +127,19 @@ def test_rich_readings_load_in_observation_order(mendoza) -> None:
         encoding="utf-8").splitlines()[-1]
     assert sim.labels[-1] == "2025-03-20 16:30 street_open:0"
     assert values[-1] == pytest.approx(float(open_last.split(",")[2]))
+
+
+def test_simulator_made_again_elsewhere_has_the_same_cache_keys(mendoza) -> None:
+    """The self-test's worker processes make the campaign simulator again from its spec; the
+    traced parts the parent sends must be found under the same keys (the day projects' DNI
+    tables live in each simulator's own temporary folder)."""
+    from radtree.diagnose.campaign_sim import CampaignSimulator
+
+    camp = load_campaign(MENDOZA / "campaign-rich.toml", mendoza)
+    a = CampaignSimulator(mendoza, (), None, None, None, campaign=camp)
+    cls, args, kwargs = a.spec()
+    b = cls(*args, **kwargs)
+    assert a.project.light.direct_normal_table != b.project.light.direct_normal_table
+    sc = mendoza.scenario("A")
+    assert a._traced_key(sc) == b._traced_key(sc) and a.key(sc) == b.key(sc)
+    assert a._traced_key(sc) != a._traced_key(replace(sc, model="perforated"))

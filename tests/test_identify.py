@@ -123,3 +123,73 @@ def test_step_identifiability_names_the_partners_and_brackets_the_strength() -> 
         "named sky_diffuse, but sky_diffuse and unfiltered_ground are not separable")
     assert iv["sky_diffuse"].covers(15000.0) and iv["sky_diffuse"].hi - iv["sky_diffuse"].lo < 2000
     assert iv["unfiltered_ground"].lo > 0.1   # alone, ground would need > its reference
+
+
+def test_unique_snr_is_the_signal_beyond_the_others_span() -> None:
+    from radtree.diagnose.identify import unique_snr
+
+    a = np.array([1.0, 0.0, 0.0, 1.0]) * 30.0
+    b = np.array([0.0, 1.0, 0.0, 1.0]) * 30.0
+    c = np.array([0.0, 0.0, 1.0, 0.0]) * 30.0
+    # orthogonal to the others: all of its signal (√2 · 30 / 10)
+    assert unique_snr(c, np.column_stack([a, b]), 10.0) == pytest.approx(3.0)
+    assert unique_snr(c, None, 10.0) == pytest.approx(3.0)
+    # identical to another: nothing left
+    assert unique_snr(a, 2.0 * a[:, None], 10.0) == pytest.approx(0.0, abs=1e-12)
+    # one other at correlation ρ = 1/2: SNR · √(1 − ρ²)
+    rho = a @ b / (np.linalg.norm(a) * np.linalg.norm(b))
+    assert rho == pytest.approx(0.5)
+    assert unique_snr(a, b[:, None], 10.0) == pytest.approx(np.sqrt(18.0) * np.sqrt(0.75))
+    # the sum of two others correlates only 0.87 with each, yet the pair reproduces it
+    s = a + b
+    assert max(s @ a / np.linalg.norm(s) / np.linalg.norm(a),
+               s @ b / np.linalg.norm(s) / np.linalg.norm(b)) < 0.9
+    assert unique_snr(s, np.column_stack([a, b]), 10.0) == pytest.approx(0.0, abs=1e-12)
+    # per-observation noise: the same vectors, the loud observation counts less
+    sig = np.array([10.0, 10.0, 10.0, 1000.0])
+    assert unique_snr(a, b[:, None], sig) == pytest.approx(3.0, rel=1e-3)
+
+
+def test_nearest_snr_counts_every_value_and_the_alternatives_reach() -> None:
+    from radtree.diagnose.identify import nearest_snr
+
+    # 100 values each at 0.5 σ: per value below the noise, together 5 σ from no change
+    s = np.full(100, 0.5)
+    assert nearest_snr(s, np.zeros((1, 100)), 1.0) == pytest.approx(5.0)
+    # an alternative that can scale to the same shape leaves nothing; a fixed one at half
+    # the size leaves half
+    assert nearest_snr(s, np.vstack([0.5 * s, s]), 1.0) == pytest.approx(0.0)
+    assert nearest_snr(s, 0.5 * s[None, :], 1.0) == pytest.approx(2.5)
+    assert nearest_snr(s, np.zeros((0, 100)), 1.0) == np.inf
+
+
+def test_selftest_rule_separation_against_linear_search_and_binary() -> None:
+    """The self-test's alternatives: a linear candidate fits its non-negative amplitude (so an
+    opposite-signed signature cannot stand in), a searched one any scanned strength."""
+    from radtree.diagnose.attribution import Signature
+    from radtree.diagnose.effects import Strength, get_effect
+    from radtree.diagnose.hidden import alternatives, margin_snr
+    from radtree.diagnose.identify import nearest_snr
+
+    n = 50
+    x = np.linspace(1.0, 2.0, n)
+    sigma = np.full(n, 0.1)
+
+    def lin(v: np.ndarray) -> Signature:
+        st = Strength("s", "", 0.0, 1.0, 0.1, "linear")
+        return Signature(get_effect("unfiltered_ground"), "linear", st, np.array([0.1]),
+                         v[None, :], np.zeros((1, 1)), ["all"], [], 0.1)
+
+    assert nearest_snr(x, alternatives(lin(3.0 * x), x, sigma), sigma) == pytest.approx(0.0)
+    # anticorrelated: amplitude clipped at 0, the whole signal remains
+    far = nearest_snr(x, alternatives(lin(-x), x, sigma), sigma)
+    assert far == pytest.approx(np.linalg.norm(x / sigma))
+    st = Strength("layers", "", 1.0, 2.0, 1.0, "search", grid=(1.0, 2.0), integer=True)
+    search = Signature(get_effect("fewer_stages"), "search", st, np.array([1.0, 2.0]),
+                       np.vstack([0.5 * x, 2.0 * x]), np.zeros((2, 1)), ["all"], [], 1.0)
+    # integer strengths: 0, 0.5 x or 2 x — the nearest is 0.5 x, 0.5 ‖x/σ‖ away
+    assert nearest_snr(x, alternatives(search, x, sigma), sigma) == pytest.approx(
+        0.5 * np.linalg.norm(x / sigma))
+    # the loop's 5 % margin: 1 − 1/√(1 + q²) = 0.05
+    q = margin_snr(0.05)
+    assert 1.0 - 1.0 / np.sqrt(1.0 + q * q) == pytest.approx(0.05)

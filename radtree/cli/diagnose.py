@@ -55,6 +55,9 @@ from radtree.engines.registry import ENGINES
 @click.option("--candidates", type=click.Path(dir_okay=False, exists=True),
               help="With --next-measurement: a campaign TOML whose groups/hours/days are the "
                    "candidates (default: generated).")
+@click.option("--workers", type=click.IntRange(min=1), default=None,
+              help="Self-test: processes tracing ahead and diagnosing the hidden effects "
+                   "(same numbers as 1) [default: the usable cores, at most 4].")
 @click.option("--out", type=click.Path(file_okay=False),
               help="Output folder. Default: PROJECT/diagnose.")
 @click.option("--list-effects", is_flag=True, help="Print the effect catalogue and exit.")
@@ -62,7 +65,8 @@ def diagnose_command(project: str | None, measured: str | None, units: str | Non
                      scenario: str | None, engine: str | None, rays: int | None, seed: int | None,
                      margin: float, max_steps: int, effects: str | None, selftest: bool,
                      noise: float | None, campaign: str | None, next_measurement: bool,
-                     candidates: str | None, out: str | None, list_effects: bool) -> None:
+                     candidates: str | None, out: str | None, list_effects: bool,
+                     workers: int | None = None) -> None:
     """Find where simulation and measurement disagree, name the missing effect, add it.
 
     \b
@@ -112,7 +116,8 @@ def diagnose_command(project: str | None, measured: str | None, units: str | Non
         from radtree.diagnose.hidden import selftest as run_selftest
 
         res = run_selftest(project, scenario, chosen, noise, engine, rays, seed, margin,
-                           max_steps, out, echo=click.echo, campaign=camp)
+                           max_steps, out, echo=click.echo, campaign=camp,
+                           workers=workers)
         table = res.table()
         click.echo("")
         cols = ["hidden_effect", "distinguishable", "named_effect", "rmse_before", "rmse_after",

@@ -162,11 +162,8 @@ def compute_signatures(sim: Simulator, ctx: EffectContext, base: Scenario, base_
     base_rows = base_run.row_daily().to_numpy(float)
     for e in effects:
         st = e.strength(ctx, base)
-        pts: list[float | None]
-        if st is None:
-            kind, pts = "binary", [None]
-        else:
-            kind, pts = st.mode, list(st.search_points())
+        kind = "binary" if st is None else st.mode
+        pts = _points(st)
         hourly, rows, scs = [], [], []
         for p in pts:
             sc = e.switch_on(ctx, base, p)
@@ -181,6 +178,16 @@ def compute_signatures(sim: Simulator, ctx: EffectContext, base: Scenario, base_
         out[e.name] = Signature(e, kind, st, strengths, np.array(hourly), np.array(rows),
                                 row_names, scs, None if st is None else st.reference)
     return out
+
+
+def _points(st: Strength | None) -> list[float | None]:
+    return [None] if st is None else list(st.search_points())
+
+
+def signature_scenarios(ctx: EffectContext, base: Scenario, effects: Iterable[Effect]
+                        ) -> list[Scenario]:
+    """The switched scenarios :func:`compute_signatures` simulates (to trace them ahead)."""
+    return [e.switch_on(ctx, base, p) for e in effects for p in _points(e.strength(ctx, base))]
 
 
 # --------------------------------------------------------------------------- fitting
@@ -240,15 +247,24 @@ def fit_candidate(sig: Signature, r: np.ndarray, ctx: EffectContext, base: Scena
 def attribute(sim: Simulator, ctx: EffectContext, base: Scenario, base_run: Run, measured: np.ndarray,
               row_residual: np.ndarray | None = None, catalogue: Iterable[Effect] = EFFECTS,
               margin: float = DEFAULT_MARGIN, echo: Callable[[str], None] | None = None,
-              exclude: Iterable[str] = ()) -> Attribution:
-    """Rank the candidate effects of ``base`` against the residual measured − base."""
+              exclude: Iterable[str] = (), reuse: dict[str, Signature] | None = None
+              ) -> Attribution:
+    """Rank the candidate effects of ``base`` against the residual measured − base.
+
+    ``reuse``: signatures kept from an earlier step (by effect name) are taken from it instead
+    of being simulated on ``base``, and the ones simulated are added to it."""
     r = np.asarray(measured, float) - base_run.lux
     cands, why = candidates(ctx, base, catalogue)
     skip = set(exclude)
     for e in [c for c in cands if c.name in skip]:
         why[e.name] = "left out (tried at this step and rejected)"
     cands = [c for c in cands if c.name not in skip]
-    sigs = compute_signatures(sim, ctx, base, base_run, cands, echo)
+    if reuse is None:
+        sigs = compute_signatures(sim, ctx, base, base_run, cands, echo)
+    else:
+        reuse.update(compute_signatures(sim, ctx, base, base_run,
+                                        [c for c in cands if c.name not in reuse], echo))
+        sigs = {c.name: reuse[c.name] for c in cands}
     fits = [fit_candidate(sigs[c.name], r, ctx, base, row_residual) for c in cands]
     baseline = float(np.sqrt(np.mean(r ** 2)))
     for f in fits:

@@ -96,6 +96,8 @@ class CampaignSimulator(Simulator):
     _ctraced: dict[str, dict[str, np.ndarray]] = field(default_factory=dict,
                                                                 repr=False)
     _tmp: Any = field(default=None, repr=False)
+    _origin: Any = field(default=None, repr=False)
+    _grids: dict[str, dict[str, SensorGrid]] = field(default_factory=dict, repr=False)
     layout: Layout | None = field(default=None, repr=False)
     #: per-observation factors applied to every run (:meth:`set_weights`); None: plain lux
     weights: np.ndarray | None = field(default=None, repr=False)
@@ -104,6 +106,7 @@ class CampaignSimulator(Simulator):
         if self.campaign is None:
             raise ValueError("CampaignSimulator needs a campaign")
         c = self.campaign
+        self._origin = self.project
         if self.rays is None and c.rays is not None:
             self.rays = c.rays
         self._tmp = tempfile.TemporaryDirectory(prefix="radtree-campaign-")
@@ -169,6 +172,43 @@ class CampaignSimulator(Simulator):
                 built.scene.grids[name] = group_grid(self.project, g, name)
         return built
 
+    def spec(self) -> tuple[type, tuple[Any, ...], dict[str, Any]]:
+        return type(self), (self._origin, (), self.engine, self.rays, self.seed), {
+            "campaign": self.campaign}
+
+    def traced_cache(self) -> dict[str, Any]:
+        return self._ctraced
+
+    def key_project(self) -> Project:
+        # the day projects point at DNI tables in this simulator's own temporary folder: hash
+        # the project the simulator was made from (its campaign fixes the days and hours)
+        return self._origin
+
+    def has_traced(self, sc: Scenario) -> bool:
+        return self._traced_key(sc) in self._ctraced
+
+    def trace_payload(self, sc: Scenario) -> Any:
+        assert self.campaign is not None
+        names = list(dict.fromkeys(self._grid_names.values()))
+        traced = {}
+        built = self._scene(sc)
+        for day, proj in self._days.items():
+            out = trace_hours(proj, sc, self._engine, list(self.hours), names,
+                              rays=int(self.rays or 1), seed=int(self.seed or 0),
+                              built=built)
+            for name in names:
+                got = [res[name] for res in out.results]
+                traced[f"{day}|{name}|lux"] = np.array([x.lux for x in got])
+                traced[f"{day}|{name}|se"] = np.array(
+                    [x.stderr if x.stderr is not None else np.full(len(x.lux), np.nan)
+                     for x in got])
+        return traced
+
+    def store_traced(self, sc: Scenario, payload: Any, seconds: float) -> None:
+        self._ctraced[self._traced_key(sc)] = payload
+        self.traced_runs += 1
+        self.trace_seconds += seconds
+
     def _traced_run(self, sc: Scenario) -> Run:
         assert self.campaign is not None and self.layout is not None
         tkey = self._traced_key(sc)
@@ -178,22 +218,12 @@ class CampaignSimulator(Simulator):
             self.cache_hits += 1
         else:
             t0 = time.perf_counter()
-            traced = {}
-            built = self._scene(sc)
-            for day, proj in self._days.items():
-                out = trace_hours(proj, sc, self._engine, list(self.hours), names,
-                                  rays=int(self.rays or 1), seed=int(self.seed or 0),
-                                  built=built)
-                for name in names:
-                    got = [res[name] for res in out.results]
-                    traced[f"{day}|{name}|lux"] = np.array([x.lux for x in got])
-                    traced[f"{day}|{name}|se"] = np.array(
-                        [x.stderr if x.stderr is not None else np.full(len(x.lux), np.nan)
-                         for x in got])
-            self._ctraced[tkey] = traced
-            self.traced_runs += 1
-            self.trace_seconds += time.perf_counter() - t0
-        grids = self._scene(sc).scene.grids
+            traced = self.trace_payload(sc)
+            self.store_traced(sc, traced, time.perf_counter() - t0)
+        gkey = repr(sorted((k, v) for k, v in sc.switches.items() if k.startswith("sensors.")))
+        grids = self._grids.get(gkey)
+        if grids is None:   # the sensor grids do not depend on the crown: one scene's will do
+            grids = self._grids[gkey] = dict(self._scene(sc).scene.grids)
         values: dict[tuple[str, str], np.ndarray] = {}
         errors: dict[tuple[str, str], np.ndarray] = {}
         for day, proj in self._days.items():

@@ -82,6 +82,43 @@ def correlation_matrix(signatures: np.ndarray, sigma: np.ndarray | float | None 
     return np.clip(c, -1.0, 1.0)
 
 
+def unique_snr(target: np.ndarray, others: np.ndarray | None,
+               sigma: np.ndarray | float | None = None) -> float:
+    """The part of ``target`` (one signature, lux per observation) that no combination of the
+    columns of ``others`` (observations × k, lux) can reproduce, in noise units over all the
+    observations: ‖(I − P) w‖ with w = target / σ and P the least-squares projection on the
+    span of the whitened ``others``. Equivalently SNR · √(1 − R²), R² the squared multiple
+    correlation of w with the others (1 / the variance inflation factor), and the z-score —
+    amplitude ÷ its standard error, noise known — of the target's amplitude in a joint,
+    unconstrained fit with every other column free; its square is the χ² that the residual
+    signature adds over the noise. No others (or all zero): the plain whitened norm."""
+    w = whiten(np.asarray(target, float)[:, None], sigma)[:, 0]
+    if others is None or np.size(others) == 0:
+        return float(np.linalg.norm(w))
+    o = whiten(np.asarray(others, float).reshape(len(w), -1), sigma)
+    o = o[:, np.linalg.norm(o, axis=0) > 0]
+    if o.shape[1] == 0:
+        return float(np.linalg.norm(w))
+    u, sv, _ = np.linalg.svd(o, full_matrices=False)
+    u = u[:, sv > 1e-10 * sv[0]]
+    return float(np.linalg.norm(w - u @ (u.T @ w)))
+
+
+def nearest_snr(target: np.ndarray, alternatives: np.ndarray,
+                sigma: np.ndarray | float | None = None) -> float:
+    """How far ``target`` (lux per observation) lies from the nearest of ``alternatives``
+    (k × observations, lux: what another explanation can predict), in noise units over all the
+    observations: min_k ‖(target − alternative_k) / σ‖ (∞ without alternatives). Fitting the
+    target's cause instead of the nearest alternative lowers the noise-weighted sum of squares
+    by about this squared (a χ² with that non-centrality)."""
+    a = np.atleast_2d(np.asarray(alternatives, float))
+    if a.size == 0:
+        return math.inf
+    t = np.asarray(target, float)
+    d = whiten((t[None, :] - a).T, sigma)
+    return float(np.min(np.linalg.norm(d, axis=0)))
+
+
 def condition_number(signatures: np.ndarray, sigma: np.ndarray | float | None = None) -> float:
     """2-norm condition number of the whitened, column-normalised signature matrix (zero
     columns left out; ∞ when the matrix has fewer observations than effects)."""

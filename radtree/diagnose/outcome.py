@@ -15,7 +15,8 @@ from radtree.config import Project, Scenario, load_project
 from radtree.diagnose.attribution import DEFAULT_MARGIN
 from radtree.diagnose.loop import LoopResult, Measured
 
-#: a hidden effect is distinguishable when its signature is this many times the noise (rms)
+#: a hidden effect is distinguishable when its signature lies at least this many noise units
+#: (over all values) from every other candidate's best fit (radtree.diagnose.hidden)
 SNR_MIN = 3.0
 SELFTEST_COLUMNS = ["hidden_effect", "distinguishable", "named_effect", "rmse_before",
                     "rmse_after"]
@@ -71,6 +72,12 @@ class HiddenCase:
     most_correlated_with: str
     distinguishable: bool
     reason: str
+    #: noise units (over all values) from the nearest other candidate's best fit (or from no
+    #: change, if nearer), from no change, and beyond the span of every other candidate
+    separation_snr: float = math.nan
+    combined_snr: float = math.nan
+    joint_snr: float = math.nan
+    nearest: str = ""
     loop: LoopResult | None = None
     measured: Measured | None = None
 
@@ -107,6 +114,8 @@ class HiddenCase:
             "signature_rms_lux": self.signature_rms_lux, "noise_rms_lux": self.noise_rms_lux,
             "snr": self.signature_rms_lux / self.noise_rms_lux if self.noise_rms_lux > 0
             else math.nan,
+            "separation_snr": self.separation_snr, "nearest_candidate": self.nearest,
+            "combined_snr": self.combined_snr, "joint_snr": self.joint_snr,
             "max_correlation": self.max_correlation,
             "most_correlated_with": self.most_correlated_with, "reason": self.reason,
             "base": self.base.name if not self.base.switches else
@@ -130,6 +139,7 @@ class SelftestResult:
     rays: int | None = None
     seed: int | None = None
     campaign: str = ""   # the campaign's summary ("" : the project's façade grid mean)
+    margin: float = DEFAULT_MARGIN
 
     @property
     def passed(self) -> bool:

@@ -10,7 +10,8 @@ Caching inside a run: the traced part is keyed by everything that changes the tr
 project, model, form, sky, reflection mode and the switches other than ``reflection.*``), the
 crown geometry by what changes the scene; the analytic ground terms (``reflection = calculated``
 and the ``reflection.unfiltered`` switch, :mod:`radtree.light.ground`) are added afresh each time, so
-fitting those costs no tracing. Any registered engine may trace (default: the seeded engine,
+fitting those costs no tracing (nor does the street's reflectance when reflection is calculated:
+the traced hours then see no ground light). Any registered engine may trace (default: the seeded engine,
 whose fixed seed gives common random numbers); tracing goes through
 :func:`radtree.pipeline.trace.trace_hours`, exactly as ``simulate`` traces.
 """
@@ -40,6 +41,7 @@ from radtree.stats import mean_stderr
 #: mean of 8 sensors; common random numbers make signatures less noisy still).
 DEFAULT_RAYS = 1024
 FACADE = "facade"
+GROUND_RHO = "street.ground_reflectance"
 
 
 @dataclass
@@ -129,7 +131,11 @@ class Simulator:
         return self._engine.seeded
 
     def key(self, sc: Scenario) -> str:
-        return scenario_key(self.project, sc)
+        return scenario_key(self.key_project(), sc)
+
+    def key_project(self) -> Project:
+        """The project the cache keys hash (the same in every process: :mod:`.parallel`)."""
+        return self.project
 
     def grid(self, sc: Scenario | None = None):
         """The façade sensor grid (points, normals, row labels)."""
@@ -173,7 +179,46 @@ class Simulator:
 
     def _traced_key(self, sc: Scenario) -> str:
         keep = {k: v for k, v in sc.switches.items() if not k.startswith("reflection.")}
-        return scenario_key(self.project, replace(sc, switches=keep))
+        if sc.reflection == "calculated":
+            # the traced hours then see no ground light (radtree.light.hours: reflectance 0,
+            # no ground glow): the street's reflectance enters the ground terms only
+            keep.pop(GROUND_RHO, None)
+        return scenario_key(self.key_project(), replace(sc, switches=keep))
+
+    def spec(self) -> tuple[type, tuple[Any, ...], dict[str, Any]]:
+        """How to make this simulator again in another process (:mod:`.parallel`): class,
+        positional and keyword arguments (picklable)."""
+        return type(self), (self.project, self.hours, self.engine, self.rays, self.seed), {}
+
+    def traced_cache(self) -> dict[str, Any]:
+        """The traced parts kept so far, by traced key (what :meth:`store_traced` fills)."""
+        return self._traced
+
+    def has_traced(self, sc: Scenario) -> bool:
+        """True when the traced part of ``sc`` is cached (only ground terms left to add)."""
+        return self._traced_key(sc) in self._traced
+
+    def trace_payload(self, sc: Scenario) -> Any:
+        """Trace ``sc`` (no cache): what :meth:`store_traced` keeps."""
+        t0 = time.perf_counter()
+        # as radtree simulate: the scene's -ab rule and engine switches (the scene is cached
+        # without them; trace_hours takes -ab afresh from the switched project)
+        out = trace_hours(self.project, sc, self._engine, list(self.hours), [FACADE],
+                          rays=int(self.rays or 1), seed=int(self.seed or 0),
+                          built=self._scene(sc))
+        lux, se = [], []
+        for res in out.results:
+            g = res[FACADE]
+            lux.append(g.lux)
+            se.append(g.stderr if g.stderr is not None else np.full(len(g.lux), np.nan))
+        return _Traced(np.array(lux), np.array(se), time.perf_counter() - t0,
+                       out.built.scene.grids[FACADE])
+
+    def store_traced(self, sc: Scenario, payload: Any, seconds: float) -> None:
+        """Keep the traced part of ``sc`` (from :meth:`trace_payload`, here or elsewhere)."""
+        self._traced[self._traced_key(sc)] = payload
+        self.traced_runs += 1
+        self.trace_seconds += seconds
 
     def _traced_run(self, sc: Scenario) -> Run:
         states = hour_states(self.project, sc, list(self.hours))
@@ -182,22 +227,8 @@ class Simulator:
         if traced is not None:
             self.cache_hits += 1  # only the analytic ground terms differ
         else:
-            t0 = time.perf_counter()
-            # as radtree simulate: the scene's -ab rule and engine switches (the scene is cached
-            # without them; trace_hours takes -ab afresh from the switched project)
-            out = trace_hours(self.project, sc, self._engine, list(self.hours), [FACADE],
-                              rays=int(self.rays or 1), seed=int(self.seed or 0),
-                              built=self._scene(sc))
-            lux, se = [], []
-            for res in out.results:
-                g = res[FACADE]
-                lux.append(g.lux)
-                se.append(g.stderr if g.stderr is not None else np.full(len(g.lux), np.nan))
-            traced = _Traced(np.array(lux), np.array(se), time.perf_counter() - t0,
-                             out.built.scene.grids[FACADE])
-            self._traced[tkey] = traced
-            self.traced_runs += 1
-            self.trace_seconds += traced.seconds
+            traced = self.trace_payload(sc)
+            self.store_traced(sc, traced, traced.seconds)
         grid = traced.grid
         extra = np.zeros_like(traced.lux)
         for i, st in enumerate(states):

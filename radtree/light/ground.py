@@ -21,6 +21,8 @@ Only sensors whose normal is horizontal (|n_z| < 0.1) receive the term.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import lru_cache
+from pathlib import Path
 
 import numpy as np
 
@@ -37,11 +39,25 @@ def ground_reflectance_at(project: Project, altitude_deg: float) -> float:
     table = project.street.ground_reflectance_table
     if table is None:
         return project.street.ground_reflectance
-    df = ground_reflectance_table(table)
-    df = df.sort_values("angle_deg")
+    path = Path(table)
+    try:
+        version = path.stat().st_mtime_ns
+    except OSError:
+        version = -1      # the reader says what is wrong
+    angles, values = _reflectance_curve(str(path), version)
+    return float(np.interp(altitude_deg, angles, values))
+
+
+@lru_cache(maxsize=64)
+def _reflectance_curve(path: str, mtime_ns: int) -> tuple[np.ndarray, np.ndarray]:
+    """The table's (angle, reflectance) sorted by angle, read once per file version."""
+    df = ground_reflectance_table(Path(path)).sort_values("angle_deg")
     if (df["reflectance"] > 1).any():
-        raise ConfigError(f"ground reflectance table {table}: reflectance above 1")
-    return float(np.interp(altitude_deg, df["angle_deg"], df["reflectance"]))
+        raise ConfigError(f"ground reflectance table {path}: reflectance above 1")
+    angles, values = df["angle_deg"].to_numpy(float), df["reflectance"].to_numpy(float)
+    angles.setflags(write=False)
+    values.setflags(write=False)
+    return angles, values
 
 
 @dataclass(frozen=True)

@@ -11,6 +11,7 @@ import functools
 import math
 from dataclasses import dataclass
 from datetime import datetime, timedelta, timezone
+from functools import lru_cache
 
 import numpy as np
 
@@ -70,13 +71,19 @@ def sun_position(
 ) -> SunPosition:
     """Sun position (NREL SPA via pvlib) for a timezone-aware datetime.
 
-    ``longitude`` in degrees east (west negative), ``latitude`` north positive.
+    ``longitude`` in degrees east (west negative), ``latitude`` north positive. Remembered
+    per instant and place (a diagnosis asks for the same hours hundreds of times).
     """
+    if when.tzinfo is None:
+        raise ValueError("sun_position needs a timezone-aware datetime")
+    return _spa(when, float(latitude), float(longitude), float(elevation_m))
+
+
+@lru_cache(maxsize=4096)
+def _spa(when: datetime, latitude: float, longitude: float, elevation_m: float) -> SunPosition:
     import pandas as pd
     import pvlib
 
-    if when.tzinfo is None:
-        raise ValueError("sun_position needs a timezone-aware datetime")
     times = pd.DatetimeIndex([pd.Timestamp(when)])
     sp = pvlib.solarposition.spa_python(times, latitude, longitude, altitude=elevation_m)
     return SunPosition(
