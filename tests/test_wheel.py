@@ -33,7 +33,8 @@ PROBE = textwrap.dedent("""
         hour_grids={"1200": ["facade"]}, scene_files=["materials.rad"],
         hour_files={"1200": ["skies/1200.sky"]}, rtrace_opts="-h -I -ab 2",
         efficacy="179", weights=["0.265", "0.670", "0.065"], bin_dir="/usr/local/bin", raypath=".",
-        prototypes={}, mkpmap={"1200": ""}, pmaps={"1200": []}, rtrace_pmap={"1200": ""})
+        prototypes={}, mkpmap={"1200": ""}, pmaps={"1200": []}, rtrace_pmap={"1200": ""},
+    grid_opts={}, meshes={}, mesh_cmds={})
     print(json.dumps({"radtree": radtree.__file__, "templates": str(resources.folder("templates")),
                       "makefile": make, "leaf": resources.material_text("leaf"),
                       "materials": resources.material_files(),
