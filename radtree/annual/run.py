@@ -62,17 +62,13 @@ from radtree.annual.schedule import (
 from radtree.annual.skymatrix import (
     Suns,
     Wea,
-    epw_to_wea,
-    reinhart_directions,
-    sky_matrix,
-    sun_patch_weights,
-    sun_positions,
 )
+from radtree.annual.weather_year import annual_weather
 from radtree.config import Project, Scenario, effective_project
 from radtree.errors import ConfigError
 from radtree.fileio import atomic_path, write_text
 from radtree.light.units import PHOTOPIC_RGB, WHITE_EFFICACY
-from radtree.light.weather import WeatherSource, find_weather
+from radtree.light.weather import WeatherSource
 from radtree.scene import Scene
 
 LUX = WHITE_EFFICACY * np.array(PHOTOPIC_RGB)  # lux per Radiance R, G, B
@@ -282,6 +278,8 @@ def combine(c_sky: np.ndarray, sky: np.ndarray, c_dir: np.ndarray, suns: Suns,
 
 
 # ---------------------------------------------------------------- the run
+
+
 def compute_annual(project: Project, options: AnnualOptions | None = None,
                    echo: Callable[[str], None] = print, progress: bool = False
                    ) -> AnnualResult:
@@ -306,19 +304,9 @@ def compute_annual(project: Project, options: AnnualOptions | None = None,
     timing["scenes_s"] = time.perf_counter() - t0
 
     t1 = time.perf_counter()
-    weather = find_weather(project, options.epw, echo)
     work = project.results_dir / "annual"
-    wea = epw_to_wea(weather.path, work / "weather" / "year.wea")
-    site = project.site
-    if abs(wea.latitude - site.latitude) > 0.5 or abs(-wea.longitude_west - site.longitude) > 0.5:
-        raise ConfigError(f"weather {weather.path} is for {wea.latitude}, {-wea.longitude_west} "
-                          f"but the site is at {site.latitude}, {site.longitude}")
-    sky = sky_matrix(wea, options.mf, rho)
-    suns = sun_positions(wea, work / "weather")
-    verts, weights = sun_patch_weights(suns.direction, options.sun_mf)
-    need = np.unique(verts)
-    need = need[need > 0]
-    patch_dirs = reinhart_directions(options.sun_mf)
+    weather, wea, sky, suns, verts, weights, need, patch_dirs = annual_weather(
+        project, options.epw, options.mf, options.sun_mf, rho, echo)
     timing["weather_s"] = time.perf_counter() - t1
     echo(f"  weather: {weather.description}; {int((wea.dni + wea.dhi > 0).sum())} daylight "
          f"hours, {len(suns)} sun positions, {len(need)} sun patches (MF {options.sun_mf})")

@@ -65,17 +65,12 @@ from radtree.annual.run import (
 )
 from radtree.annual.schedule import occupied
 from radtree.annual.skymatrix import (
-    epw_to_wea,
     patch_count,
-    reinhart_directions,
-    sky_matrix,
-    sun_patch_weights,
-    sun_positions,
 )
+from radtree.annual.weather_year import annual_weather
 from radtree.config import Project, Scenario, effective_project
 from radtree.engines.radiance import threephase as rad3
 from radtree.errors import ConfigError
-from radtree.light.weather import find_weather
 from radtree.optics import Bsdf
 from radtree.scene import Mesh, Scene
 from radtree.trees.bsdf_shell import BSDF_SHELL
@@ -338,15 +333,9 @@ def compute_annual_3phase(project: Project, options: AnnualOptions,
     timing["scenes_s"] = time.perf_counter() - t0
 
     t1 = time.perf_counter()
-    weather = find_weather(project, options.epw, echo)
     work = project.results_dir / "annual"
-    wea = epw_to_wea(weather.path, work / "weather" / "year.wea")
-    sky = sky_matrix(wea, options.mf, rho)
-    suns = sun_positions(wea, work / "weather")
-    verts, weights = sun_patch_weights(suns.direction, options.sun_mf)
-    need = np.unique(verts)
-    need = need[need > 0]
-    patch_dirs = reinhart_directions(options.sun_mf)
+    weather, wea, sky, suns, verts, weights, need, patch_dirs = annual_weather(
+        project, options.epw, options.mf, options.sun_mf, rho, echo)
     timing["weather_s"] = time.perf_counter() - t1
 
     def dc(scene: Scene, folder: Path, with_sky: bool) -> tuple[np.ndarray, np.ndarray]:
