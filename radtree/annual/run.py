@@ -59,11 +59,8 @@ from radtree.annual.schedule import (
     occupied,
     parse_occupancy,
 )
-from radtree.annual.skymatrix import (
-    Suns,
-    Wea,
-)
-from radtree.annual.weather_year import annual_weather
+from radtree.annual.skymatrix import Suns, Wea, patch_count
+from radtree.annual.weather_year import YearInputs, annual_weather
 from radtree.config import Project, Scenario, effective_project
 from radtree.errors import ConfigError
 from radtree.fileio import atomic_path, write_text
@@ -280,6 +277,22 @@ def combine(c_sky: np.ndarray, sky: np.ndarray, c_dir: np.ndarray, suns: Suns,
 # ---------------------------------------------------------------- the run
 
 
+def scene_year_lux(runner: CoefficientRunner, year: YearInputs, mf: int, sun_mf: int,
+                   trace: TraceParams, sun_trace: TraceParams, with_sky: bool = True
+                   ) -> tuple[np.ndarray, np.ndarray]:
+    """(total, direct) lux, each (sensors, hours), of one scene over ``year``: sky coefficients
+    (zero unless ``with_sky``), exact suns at ``-ab 0`` and the sun patches' reflected part."""
+    _, wea, sky, suns, verts, weights, need, patch_dirs = year
+    c_sky = runner.sky(mf, trace) if with_sky else np.zeros(
+        (runner.n_sensors, patch_count(mf), 3), np.float32)
+    c_dir = runner.suns("direct", suns.direction, 0, trace)
+    c_n = runner.suns(f"patch{sun_mf}_ab{trace.ab}", patch_dirs[need], trace.ab, sun_trace)
+    c_0 = runner.suns(f"patch{sun_mf}_ab0", patch_dirs[need], 0, sun_trace)
+    c_ind = np.zeros((runner.n_sensors, len(patch_dirs), 3), np.float32)
+    c_ind[:, need] = c_n - c_0
+    return combine(c_sky, sky, c_dir, suns, c_ind, verts, weights, wea.n_hours)
+
+
 def compute_annual(project: Project, options: AnnualOptions | None = None,
                    echo: Callable[[str], None] = print, progress: bool = False
                    ) -> AnnualResult:
@@ -305,8 +318,8 @@ def compute_annual(project: Project, options: AnnualOptions | None = None,
 
     t1 = time.perf_counter()
     work = project.results_dir / "annual"
-    weather, wea, sky, suns, verts, weights, need, patch_dirs = annual_weather(
-        project, options.epw, options.mf, options.sun_mf, rho, echo)
+    year = annual_weather(project, options.epw, options.mf, options.sun_mf, rho, echo)
+    weather, wea, sky, suns, verts, weights, need, patch_dirs = year
     timing["weather_s"] = time.perf_counter() - t1
     echo(f"  weather: {weather.description}; {int((wea.dni + wea.dhi > 0).sum())} daylight "
          f"hours, {len(suns)} sun positions, {len(need)} sun patches (MF {options.sun_mf})")
@@ -330,14 +343,8 @@ def compute_annual(project: Project, options: AnnualOptions | None = None,
                  f"{sum(len(scene.grids[g]) for g in grids)} sensors")
             runner = CoefficientRunner(scene, grids, work / "coefficients" / variant, rho,
                                        echo=echo)
-            c_sky = runner.sky(options.mf, trace)
-            c_dir = runner.suns("direct", suns.direction, 0, trace)
-            c_n = runner.suns(f"patch{options.sun_mf}_ab{trace.ab}", patch_dirs[need],
-                              trace.ab, sun_trace)
-            c_0 = runner.suns(f"patch{options.sun_mf}_ab0", patch_dirs[need], 0, sun_trace)
-            c_ind = np.zeros((runner.n_sensors, len(patch_dirs), 3), np.float32)
-            c_ind[:, need] = c_n - c_0
-            tot, dire = combine(c_sky, sky, c_dir, suns, c_ind, verts, weights, wea.n_hours)
+            tot, dire = scene_year_lux(runner, year, options.mf, options.sun_mf, trace,
+                                       sun_trace)
             total[variant], direct[variant] = {}, {}
             start = 0
             for g in grids:

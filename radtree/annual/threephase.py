@@ -61,7 +61,7 @@ from radtree.annual.run import (
     annual_ground_reflectance,
     annual_scenes,
     choose_scenarios,
-    combine,
+    scene_year_lux,
 )
 from radtree.annual.schedule import occupied
 from radtree.annual.skymatrix import (
@@ -334,21 +334,14 @@ def compute_annual_3phase(project: Project, options: AnnualOptions,
 
     t1 = time.perf_counter()
     work = project.results_dir / "annual"
-    weather, wea, sky, suns, verts, weights, need, patch_dirs = annual_weather(
-        project, options.epw, options.mf, options.sun_mf, rho, echo)
+    year = annual_weather(project, options.epw, options.mf, options.sun_mf, rho, echo)
+    weather, wea, sky, suns, verts, weights, need, patch_dirs = year
     timing["weather_s"] = time.perf_counter() - t1
 
     def dc(scene: Scene, folder: Path, with_sky: bool) -> tuple[np.ndarray, np.ndarray]:
         runner = CoefficientRunner(scene, grids, folder, rho, echo=echo)
-        c_sky = runner.sky(options.mf, trace) if with_sky else np.zeros(
-            (runner.n_sensors, patch_count(options.mf), 3), np.float32)
-        c_dir = runner.suns("direct", suns.direction, 0, trace)
-        c_n = runner.suns(f"patch{options.sun_mf}_ab{trace.ab}", patch_dirs[need], trace.ab,
-                          sun_trace)
-        c_0 = runner.suns(f"patch{options.sun_mf}_ab0", patch_dirs[need], 0, sun_trace)
-        c_ind = np.zeros((runner.n_sensors, len(patch_dirs), 3), np.float32)
-        c_ind[:, need] = c_n - c_0
-        return combine(c_sky, sky, c_dir, suns, c_ind, verts, weights, wea.n_hours)
+        return scene_year_lux(runner, year, options.mf, options.sun_mf, trace, sun_trace,
+                              with_sky)
 
     echo(f"  3-phase: {form} crown, BSDFs {', '.join(sorted({Path(b[2]).name for s in STATES for b in xmls[s]}))}")
     tp = ThreePhase(work / "threephase", bare, models, form, grids, rho, options.mf, trace,
