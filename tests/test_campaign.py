@@ -35,7 +35,7 @@ def test_mendoza_data_is_a_campaign(mendoza) -> None:
 
 def test_rich_campaign_layout(mendoza) -> None:
     c = load_campaign(MENDOZA / "campaign-rich.toml", mendoza)
-    assert c.synthetic and c.rays == 1024 and len(c.days) == 2
+    assert c.synthetic and c.rays == 512 and len(c.days) == 2
     sizes = {g.geometry: (8 if g.grid else 1) for g in c.groups}
     lay = Layout(c, sizes)
     assert len(lay.observations) == 2 * 7 * (8 + 1 + 1)
@@ -143,3 +143,21 @@ def test_simulator_made_again_elsewhere_has_the_same_cache_keys(mendoza) -> None
     sc = mendoza.scenario("A")
     assert a._traced_key(sc) == b._traced_key(sc) and a.key(sc) == b.key(sc)
     assert a._traced_key(sc) != a._traced_key(replace(sc, model="perforated"))
+
+
+def test_worker_simulators_trace_single_threaded_with_the_same_keys(mendoza) -> None:
+    """The self-test's worker processes share the cores out (engine.workers = cores ÷
+    processes): the spec they rebuild from differs only in engine.workers, which no cache key
+    or number depends on — and the traced numbers are identical."""
+    from radtree.diagnose.campaign_sim import CampaignSimulator
+    from radtree.diagnose.parallel import threaded
+
+    camp = load_campaign(MENDOZA / "campaign.toml", mendoza)
+    two = replace(mendoza, engine=replace(mendoza.engine, workers=2))
+    a = CampaignSimulator(two, (), None, 32, None, campaign=camp)
+    cls, args, kwargs = threaded(a.spec(), 1)
+    assert args[0].engine.workers == 1 and a.project.engine.workers == 2
+    b = cls(*args, **kwargs)
+    sc = mendoza.scenario("A")
+    assert a._traced_key(sc) == b._traced_key(sc) and a.key(sc) == b.key(sc)
+    assert np.array_equal(a.run(sc).lux, b.run(sc).lux)

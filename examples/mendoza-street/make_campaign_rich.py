@@ -3,8 +3,8 @@
     python examples/mendoza-street/make_campaign_rich.py
 
 Truth: scenario A plus a clear Perez sky of 15 000 lx diffuse horizontal (what `radtree
-diagnose` fits on the real data), traced with the NumPy engine (seed 101, the campaign's
-rays) on every day, hour and sensor of the campaign; each reading × (1 + noise · N(0, 1)),
+diagnose` fits on the real data), traced with the NumPy engine (seed 101, 1024
+rays per sensor) on every day, hour and sensor of the campaign; each reading × (1 + noise · N(0, 1)),
 noise from the campaign, numpy seed 2024. Writes data/campaign-rich/<group>_<day>.csv in the
 `time,sensor,lux` shape of radtree.measurements.load_measured.
 """
@@ -24,13 +24,14 @@ from radtree.fileio import write_text
 HERE = Path(__file__).resolve().parent
 TRUTH_SKY_LUX = 15000.0
 TRACE_SEED = 101
+TRACE_RAYS = 1024   # the readings' rays (the campaign's own `rays` sets how it is diagnosed)
 NOISE_SEED = 2024
 
 
 def main() -> None:
     project = load_project(HERE)
     campaign = load_campaign(HERE / "campaign-rich.toml", project)
-    sim = CampaignSimulator(project, (), None, None, TRACE_SEED, campaign=campaign)
+    sim = CampaignSimulator(project, (), None, TRACE_RAYS, TRACE_SEED, campaign=campaign)
     ctx = EffectContext(project)
     truth = get_effect("sky_diffuse").switch_on(ctx, project.scenario("A"), TRUTH_SKY_LUX)
     run = sim.run(truth)

@@ -7,7 +7,12 @@ so no ray-tracer thread state is forked) and hands the traced parts back to the
 :class:`~radtree.diagnose.simulate.Simulator`, whose cache then serves every later
 ``run`` — the numbers are those of the same simulator in this process (same engine, rays,
 seed, scene), only computed elsewhere. Each worker makes each simulator once (from
-:meth:`~radtree.diagnose.simulate.Simulator.spec`) and keeps its scenes between tasks.
+:meth:`~radtree.diagnose.simulate.Simulator.spec`) and keeps its scenes between tasks. The
+workers trace with ``engine.workers`` = the cores ÷ the processes (at least 1): the NumPy
+engine's threads would otherwise compete with the other processes for the same cores (the
+numbers do not depend on it, :mod:`radtree.engines.numpy.lockstep`; measured on the rich
+campaign's runs: 2 threads in one process take 1.35 × the CPU time of 1 for the same wall
+time — a diagnosis's grids are too small for threads to pay).
 :meth:`TracePool.loops` runs whole diagnosis loops in the workers (the self-test's hidden
 effects are independent), each starting from everything traced so far.
 """
@@ -20,6 +25,7 @@ import time
 import uuid
 from collections.abc import Iterable
 from concurrent.futures import Future, ProcessPoolExecutor
+from dataclasses import replace
 from typing import Any
 
 from radtree.config import Project, Scenario
@@ -30,16 +36,28 @@ from radtree.diagnose.simulate import Simulator
 _SIMULATORS: dict[str, Simulator] = {}   # per worker process: token → simulator
 
 
+def _cores() -> int:
+    try:
+        return len(os.sched_getaffinity(0))
+    except AttributeError:  # pragma: no cover - not Linux
+        return os.cpu_count() or 1
+
+
 def default_workers() -> int:
     """Worker processes by default: the usable CPU cores, at most 4."""
-    try:
-        n = len(os.sched_getaffinity(0))
-    except AttributeError:  # pragma: no cover - not Linux
-        n = os.cpu_count() or 1
-    return max(1, min(4, n))
+    return max(1, min(4, _cores()))
 
 
 Spec = tuple[type, tuple[Any, ...], dict[str, Any]]
+
+
+def threaded(spec: Spec, threads: int) -> Spec:
+    """``spec`` with its project's ``engine.workers`` set to ``threads`` (not hashed: same
+    cache keys, same numbers)."""
+    cls, args, kwargs = spec
+    project = args[0]
+    project = replace(project, engine=replace(project.engine, workers=max(1, int(threads))))
+    return cls, (project, *args[1:]), kwargs
 
 
 def _simulator(token: str, spec: Spec) -> Simulator:
@@ -63,6 +81,8 @@ class TracePool:
 
     def __init__(self, workers: int | None = None):
         self.workers = default_workers() if workers is None else max(1, int(workers))
+        #: engine threads in each worker process: the usable cores shared out
+        self.threads = max(1, _cores() // self.workers)
         self._pool: ProcessPoolExecutor | None = None
         self._tokens: dict[int, str] = {}
         self.tasks = 0
@@ -84,7 +104,7 @@ class TracePool:
         if self._pool is None:
             return 0
         token = self._tokens.setdefault(id(sim), uuid.uuid4().hex)
-        spec = sim.spec()
+        spec = threaded(sim.spec(), self.threads)
         todo: dict[str, Scenario] = {}
         for sc in scenarios:
             key = sim._traced_key(sc)
@@ -112,7 +132,8 @@ class TracePool:
         token = self._tokens.setdefault(id(sim), uuid.uuid4().hex)
         traced = dict(sim.traced_cache())
         weights = getattr(sim, "weights", None)
-        futures = [self._pool.submit(_loop, token, sim.spec(), weights, traced, project, start,
+        spec = threaded(sim.spec(), self.threads)
+        futures = [self._pool.submit(_loop, token, spec, weights, traced, project, start,
                                      meas, margin, max_steps, first_step_signatures)
                    for start, meas in jobs]
         out = []
