@@ -155,11 +155,13 @@ def test_a_bug_is_1_and_not_disguised_as_bad_input(proj, monkeypatch):
     assert "Traceback" in r.output and "an internal invariant broke" in r.output
 
 
-def test_python_m_radtree_cli():
-    done = subprocess.run([sys.executable, "-m", "radtree.cli", "--help"], capture_output=True,
+@pytest.mark.parametrize("module", ["radtree", "radtree.cli"])
+def test_python_m_radtree(module):
+    done = subprocess.run([sys.executable, "-m", module, "--help"], capture_output=True,
                           timeout=120)
     assert done.returncode == OK, done.stderr.decode()
     assert b"Exit codes" in done.stdout and b"simulate" in done.stdout
+    assert f"python -m {module}".encode() in done.stdout
 
 
 @needs_radiance
