@@ -103,6 +103,8 @@ def main() -> None:
     ap.add_argument("--guide", type=float, default=0.0,
                     help="forward: share of diffuse directions aimed at the target (0: none)")
     ap.add_argument("--guide-radius", type=float, default=1.0, help="its sphere's radius, m")
+    ap.add_argument("--guide-scenarios", nargs="*", default=None,
+                    help="the scenarios the guide applies to (default: all)")
     ap.add_argument("--pmap", type=int, default=0, help="photon map photons (0: not run)")
     ap.add_argument("--scenarios", nargs="+", default=["A", "B", "C", "D", "E", "F"])
     ap.add_argument("--hour", default="12:30")
@@ -127,9 +129,12 @@ def main() -> None:
         f_mean = f_se = math.nan
         if not a.skip_forward:
             t0, c0 = time.perf_counter(), time.process_time()
+            guide = a.guide if a.guide_scenarios is None or name in a.guide_scenarios else 0.0
+            if guide != a.guide:
+                print(f"   (forward without the guide for {name})")
             fw = trace_forward(scene, st, ForwardSettings(
                 photons=a.photons, max_bounces=built.ab, focus_m=a.focus or None,
-                guide=a.guide, guide_radius_m=a.guide_radius), ["facade"])
+                guide=guide, guide_radius_m=a.guide_radius), ["facade"])
             dt = time.perf_counter() - t0
             f_mean, f_se = fw.grid_mean("facade")
             _line("forward", dt, fw.segments, "ray segments", f_mean, f_se,
