@@ -64,7 +64,6 @@ def main(argv: list[str] | None = None) -> int:
                                          src.is_relative_to(MENDOZA) else src)
             rays = args.selftest_rays or (campaign.rays if campaign is not None and
                                           campaign.rays else 512)
-            args.selftest_rays = rays
             t0 = time.perf_counter()
             st = selftest(proj, scenario=args.scenario, rays=rays, echo=None, campaign=campaign)
             wall = time.perf_counter() - t0
@@ -72,7 +71,7 @@ def main(argv: list[str] | None = None) -> int:
                     "rmse_after", "gap_shrinks"]
             print(f"\nself-test, whole catalogue, scenario {args.scenario}, "
                   + (f"campaign {campaign.summary()}, " if campaign is not None else
-                     "noise 3 %, ") + f"{args.selftest_rays} rays/sensor:")
+                     "noise 3 %, ") + f"{rays} rays/sensor:")
             print(st.table()[cols].to_string(index=False, float_format="%.3f"))
             print(f"passed: {st.passed} ({st.simulations} simulations), wall time: {wall:.1f} s")
             ok = st.passed

@@ -98,13 +98,18 @@ class TracePool:
             self._pool.shutdown(wait=True, cancel_futures=True)
             self._pool = None
 
+    def _worker(self, sim: Simulator) -> tuple[str, Spec]:
+        """The token and the (single-threaded where the cores are shared) spec by which the
+        workers make ``sim`` again."""
+        return (self._tokens.setdefault(id(sim), uuid.uuid4().hex),
+                threaded(sim.spec(), self.threads))
+
     def prefetch(self, sim: Simulator, scenarios: Iterable[Scenario]) -> int:
         """Trace the scenarios whose traced part ``sim`` lacks (one per traced key) in the
         workers and store them in ``sim``; returns how many were traced."""
         if self._pool is None:
             return 0
-        token = self._tokens.setdefault(id(sim), uuid.uuid4().hex)
-        spec = threaded(sim.spec(), self.threads)
+        token, spec = self._worker(sim)
         todo: dict[str, Scenario] = {}
         for sc in scenarios:
             key = sim._traced_key(sc)
@@ -129,10 +134,9 @@ class TracePool:
             return [run_loop(sim, ctx, start, meas, margin, max_steps, EFFECTS, echo=None,
                              first_step_signatures=first_step_signatures)
                     for start, meas in jobs]
-        token = self._tokens.setdefault(id(sim), uuid.uuid4().hex)
+        token, spec = self._worker(sim)
         traced = dict(sim.traced_cache())
         weights = getattr(sim, "weights", None)
-        spec = threaded(sim.spec(), self.threads)
         futures = [self._pool.submit(_loop, token, spec, weights, traced, project, start,
                                      meas, margin, max_steps, first_step_signatures)
                    for start, meas in jobs]
