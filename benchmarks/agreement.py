@@ -17,6 +17,15 @@ with no engine runs the forward engine alone; ``--skip-forward`` the backward on
 them as separate processes). Wall and CPU seconds are both printed: on a shared machine the CPU
 time is the comparable cost.
 
+Measured (session 6, 12:30, idle 2 cores; ``--photons 64000000 --guide 0.5 --guide-radius 1
+--guide-scenarios B C D F --backward numpy --points 8192 --rays 16``, 612 s wall): forward −
+NumPy A −0.11 ± 1.04 %, B −1.69 ± 1.11 %, C +0.75 ± 0.67 %, D +0.90 ± 0.79 %, E −1.04 ±
+0.67 %, F −0.20 ± 1.97 % — every scenario within 2 %. NumPy A 990.2, B 1 280.6, C 3 042.3,
+D 2 583.4, E 2 374.4, F 1 433.8 lx; Radiance (separate runs) A 986.9, B 1 278.1, E 2 373.5
+(32 points, -ad 256), C 3 027.4, D 2 573.5 (2 048 points, -ad 64). Forward time to 1 %: A 98,
+B 137, C 1.9, D 3.1, E 34, F 445 CPU-s. Session 5's D "−5.2 %" was the NumPy side: 1 024
+points per patch under-sample D's sun flecks (2 716 ± 57 there, 2 583 ± 20 at 8 192).
+
 Measured (session 5, 12:30, 2 cores shared by 6 sessions, load 16–23: a process got 5–8 % of
 a core, so CPU seconds are quoted). Forward with the stratified launch (``--focus 0.5``), 8 M
 photons: A 979.4 ± 18.7 lx (1.9 %, 27 CPU-s), B 1 372 ± 227 (17 %), C 3 636 ± 618 (17 %),

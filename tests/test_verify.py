@@ -115,3 +115,23 @@ def test_verify_command_writes_the_table_and_fails_on_a_failure(monkeypatch, tmp
     assert list(t.columns) == ["check", "engine", "expected", "got", "tolerance", "passed"]
     assert bool(t["passed"][0]) is (code == 0)
     assert ("FAIL" in res.output) is (code == 1)
+
+
+def test_agreement_check_forward_vs_numpy_on_the_reduced_dome():
+    from radtree.verify.checks import BackwardPlan, agreement_checks
+
+    plans = {"numpy": BackwardPlan(points=8, rays=64)}
+    checks = agreement_checks(photons=1_000_000, backward=["numpy"], plans=plans)
+    assert len(checks) == 1
+    c = checks[0]
+    assert "louvers dome A 12:30" in c.check and c.check.endswith("forward vs numpy")
+    assert 850.0 < c.expected < 1050.0          # ≈ 945 lx converged (verify's quick table)
+    assert c.passed, c
+    assert c.tolerance >= 0.02 * c.expected
+
+
+def test_agreement_plan_hours_skip_the_engine_and_the_forward_trace():
+    from radtree.verify.checks import BackwardPlan, agreement_checks
+
+    plans = {"numpy": BackwardPlan(points=2, rays=4, hours=("10:30",))}
+    assert agreement_checks(hours=("12:30",), photons=0, backward=["numpy"], plans=plans) == []

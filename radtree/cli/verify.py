@@ -14,8 +14,9 @@ from radtree.cli.options import CONTEXT
 @click.command("verify", context_settings=CONTEXT)
 @click.option("--full", is_flag=True,
               help="The long version: more photons and leaf layers, scenarios A and B of the "
-                   "reduced dome and the free volume crown at 10:30, 12:30 and 14:30.")
-@click.option("--out", type=click.Path(dir_okay=False, path_type=Path),
+                   "reduced dome and the free volume crown at 10:30, 12:30 and 14:30 against "
+                   "NumPy, at 12:30 against Radiance.")
+@click.option("--out", "-o", type=click.Path(dir_okay=False, path_type=Path),
               default=Path("verify.csv"), show_default=True, help="Where to write the table.")
 @click.option("--backward", multiple=True,
               help="Backward engine(s) to compare the forward engine with (default: every "
