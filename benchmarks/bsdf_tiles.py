@@ -56,4 +56,7 @@ def main() -> None:
 
 
 if __name__ == "__main__":
+    from _common import print_resources_at_exit  # benchmarks/_common.py
+
+    print_resources_at_exit()
     main()
