@@ -255,3 +255,20 @@ def test_old_perforated_photo_field_still_works(mendoza):
     assert old.info["hole_fraction"] == new.info["hole_fraction"] > 0.03
     assert old.tree.photo["field"] == "tree.perforated.photo"
     shutil.rmtree(mendoza.build_dir, ignore_errors=True)
+
+
+def test_canopy_rectangles_cover_exactly_the_canopy_cells():
+    from radtree.trees.photo_cut import _runs
+
+    rng = np.random.default_rng(5)
+    for share in (0.05, 0.5, 0.95):
+        grid = rng.random((23, 17)) > share
+        grid[4:9, 3:12] = True                  # a block the rows must merge into one
+        r0, r1, a, b = _runs(grid)
+        cover = np.zeros(grid.shape, int)
+        for i0, i1, j0, j1 in zip(r0, r1, a, b):
+            cover[i0:i1 + 1, j0:j1] += 1
+        assert np.array_equal(cover, grid.astype(int))   # every canopy cell once, no sky cell
+        rows = sum(len(np.flatnonzero(np.diff(np.r_[0, row.astype(int), 0]) == 1))
+                   for row in grid)
+        assert len(r0) < rows                      # fewer pieces than one per row run

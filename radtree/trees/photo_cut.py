@@ -11,8 +11,8 @@ face centre, finer towards its edges) is sky when the photo shows sky at the cel
 direction, and the part of every slat inside a sky cell is removed. So a direction through a
 sky cell passes every layer and a direction through a canopy cell meets every layer's slat —
 the layers' gaps line up along the lines from the photo point, as in the photo, up to one
-cell. The pieces kept are (rows of consecutive canopy cells) ∩ slat: convex polygons
-(shapely), mapped back onto the slat's plane.
+cell. The pieces kept are (rectangles of canopy cells: runs along a row, merged with the same
+runs in the rows above) ∩ slat: convex polygons (shapely), mapped back onto the slat's plane.
 """
 
 from __future__ import annotations
@@ -59,14 +59,22 @@ def _face_rasters(is_sky, cell: float = CELL) -> list[tuple[np.ndarray, np.ndarr
     return out
 
 
-def _runs(grid: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Runs of consecutive True cells along each row: (row, start, stop) index arrays."""
+def _runs(grid: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """The True cells of ``grid`` as rectangles: runs of consecutive True cells along each row,
+    runs with the same columns in consecutive rows merged into one — (first row, last row,
+    start column, stop column) index arrays. They cover exactly the True cells."""
     pad = np.zeros((grid.shape[0], grid.shape[1] + 2), np.int8)
     pad[:, 1:-1] = grid
     d = np.diff(pad, axis=1)
-    r0, a = np.nonzero(d == 1)
+    r, a = np.nonzero(d == 1)
     _, b = np.nonzero(d == -1)
-    return r0, a, b
+    order = np.lexsort((r, b, a))
+    r, a, b = r[order], a[order], b[order]
+    new = np.ones(len(r), bool)
+    new[1:] = (a[1:] != a[:-1]) | (b[1:] != b[:-1]) | (r[1:] != r[:-1] + 1)
+    first = np.flatnonzero(new)
+    last = np.append(first[1:], len(r)) - 1
+    return r[first], r[last], a[first], b[first]
 
 
 def cut_slats(quads: np.ndarray, centre: np.ndarray, is_sky, cell: float = CELL
@@ -105,11 +113,11 @@ def cut_slats(quads: np.ndarray, centre: np.ndarray, is_sky, cell: float = CELL
             if not sub.any():
                 removed += 1
                 continue
-            r, a, b = _runs(sub)
-            bx.append(np.column_stack([edges[ix0[k] + a], edges[iy0[k] + r],
-                                       edges[ix0[k] + b], edges[iy0[k] + r] + cell]))
-            owner.extend([int(q)] * len(r))
-            slat_of.extend([k] * len(r))
+            r0, r1, a, b = _runs(sub)
+            bx.append(np.column_stack([edges[ix0[k] + a], edges[iy0[k] + r0],
+                                       edges[ix0[k] + b], edges[iy0[k] + r1] + cell]))
+            owner.extend([int(q)] * len(r0))
+            slat_of.extend([k] * len(r0))
         if not bx:
             continue
         b4 = np.concatenate(bx)
