@@ -247,38 +247,35 @@ class BackwardPlan:
 
 
 def agreement_checks(hours: tuple[str, ...] = ("12:30",), scenarios: tuple[str, ...] = ("A",),
-                     photons: int = 16_000_000, points: int = 16, rays: int = 192,
-                     ad: int | None = 256, backward: list[str] | None = None,
+                     photons: int = 16_000_000, backward: list[str] | None = None,
                      crown: str = "louvers dome", plans: dict[str, BackwardPlan] | None = None,
                      progress: Callable[[str], None] | None = None) -> list[Check]:
     """Forward vs backward engines on the reduced Mendoza louvers dome (or another ``crown``
     of :data:`radtree.verify.compare.REDUCED`): the 8 sensors' 0.5 m
     patch mean per scenario and hour (expected = the backward engine's value). Each backward
-    engine is sampled by its entry of ``plans``, else by ``points`` random points per patch,
-    ``rays`` paths per point (NumPy) and ``-ad ad`` (Radiance; None = the project's)."""
+    engine is sampled by its entry of ``plans`` (default :class:`BackwardPlan`)."""
     from radtree.engines.registry import available_engines
     from radtree.light.hours import hour_states
     from radtree.pipeline.assemble import make_scene
 
     names = backward if backward is not None else [
         e.name for e in available_engines() if e.name != FORWARD]
-    default = BackwardPlan(points=points, rays=rays, ad=ad)
+    plan_of = {e: (plans or {}).get(e, BackwardPlan()) for e in names}
     out = []
     for hour in hours:
+        active = [e for e in names if hour in (plan_of[e].hours or (hour,))]
+        if not active:
+            continue
         proj = reduced_dome_project(hour, crown=crown)
         for name in scenarios:
             sc = proj.scenario(name)
             built = make_scene(proj, sc, dense_grid=False)
             st = hour_states(proj, sc, [hour])[0]
-            fw = None
-            for e in names:
-                plan = (plans or {}).get(e, default)
-                if plan.hours is not None and hour not in plan.hours:
-                    continue
-                if fw is None:
-                    fw = trace_forward(built.scene, st, ForwardSettings(
-                        photons=photons, max_bounces=built.ab, seed=7), ["facade"])
-                got, se = fw.grid_mean("facade")
+            fw = trace_forward(built.scene, st, ForwardSettings(
+                photons=photons, max_bounces=built.ab, seed=7), ["facade"])
+            got, se = fw.grid_mean("facade")
+            for e in active:
+                plan = plan_of[e]
                 params = proj.engine if plan.ad is None else replace(proj.engine,
                                                                      ad=int(plan.ad))
                 bw = backward_patch_mean(e, built.scene, st, "facade", 0.5, ab=built.ab,

@@ -23,8 +23,8 @@ from radtree.verify.checks import (
 )
 
 # Radiance at -ad 2048 over 64 points per patch took 206 s per scenario and hour on the reduced
-# dome (2 cores); at -ad 1024 over 32 points about a quarter of that, so it is compared at noon
-# only, while NumPy (≈1 s a case) is compared at every hour.
+# dome (2 cores); at -ad 1024 over 32 points ≈ 75 s, so it is compared at noon only, while NumPy
+# (≈ 1 s a case) is compared at every hour.
 FULL_PLANS = {"numpy": BackwardPlan(points=64, rays=128),
               "radiance": BackwardPlan(points=32, ad=1024, hours=("12:30",))}
 
