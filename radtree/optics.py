@@ -201,6 +201,14 @@ class Bsdf:
                 "0\n0\n")
 
 
+#: The Klems full basis (LBNL/WINDOW "LBNL/Klems Full"): per θ ring (lower, upper, centre
+#: polar angle in degrees, number of azimuth patches); 145 patches in this order.
+KLEMS_FULL_RINGS: tuple[tuple[float, float, float, int], ...] = (
+    (0.0, 5.0, 0.0, 1), (5.0, 15.0, 10.0, 8), (15.0, 25.0, 20.0, 16), (25.0, 35.0, 30.0, 20),
+    (35.0, 45.0, 40.0, 24), (45.0, 55.0, 50.0, 24), (55.0, 65.0, 60.0, 24),
+    (65.0, 75.0, 70.0, 16), (75.0, 90.0, 82.5, 12))
+
+
 Material = Plastic | Trans | Glass | Hole | Bsdf
 
 

@@ -44,6 +44,7 @@ of it); the BSDF of a planar periodic sample holds no lateral displacement.
 from __future__ import annotations
 
 import hashlib
+import os
 import time
 from collections.abc import Callable
 from dataclasses import dataclass, replace
@@ -128,8 +129,9 @@ def _without_shell(scene: Scene) -> Scene:
 
 def state_xmls(project: Project, scenario: Scenario,
                echo: Callable[[str], None]) -> dict[str, list[tuple[float, float, Path]]]:
-    """Leaf-on bands (``tree.bsdf.xml`` or computed) and the leaf-off branch-slab XML (for
-    every band), each cached under ``build/bsdf/<scenario>/``."""
+    """Leaf-on bands (``tree.bsdf.xml`` or computed; a free crown's wall cap too) and the
+    leaf-off branch-slab XML (for every band and the wall cap), each cached under
+    ``build/bsdf/<scenario>/``."""
     from radtree.bsdf.run import leaf_off_sample
     from radtree.pipeline.crown_bsdf import (
         ensure_bsdf,
@@ -142,8 +144,8 @@ def state_xmls(project: Project, scenario: Scenario,
     on = scenario_xmls(project, scenario, echo)
     tree, form = scenario_tree(project, scenario)
     off = ensure_bsdf(leaf_off_sample(project, scenario, leaf_on_sample(project, scenario)),
-                      flux_settings(tree, form), project.build_dir / "bsdf" / scenario.name /
-                      "leaf_off", "leaf_off", echo)
+                      flux_settings(tree, form, os.cpu_count() or 1),
+                      project.build_dir / "bsdf" / scenario.name / "leaf_off", "leaf_off", echo)
     return {"leaf_on": on, "leaf_off": [(lo, hi, off.xml) for lo, hi, _ in on]}
 
 

@@ -28,13 +28,14 @@ from radtree.engines.radiance.bsdf import BsdfRun
 from radtree.fileio import atomic_path, write_text
 from radtree.pipeline.assemble import facade_frame
 from radtree.pipeline.crown_bsdf import (
+    CHORD_MIN_SLATS,
     ensure_bsdf,
     flux_settings,
     leaf_on_sample,
     scenario_tree,
     slab_depth,
 )
-from radtree.trees.slab import SlabSample, branch_slab
+from radtree.trees.slab import RingSamples, SlabSample, branch_slab, chord_samples
 
 STATES = ("leaf_on", "leaf_off")
 SUMMARY_COLUMNS = ["state", "xml", "thickness_m", "t_front_normal", "r_front_normal",
@@ -44,8 +45,11 @@ SUMMARY_COLUMNS = ["state", "xml", "thickness_m", "t_front_normal", "r_front_nor
                    "reciprocity_t", "seconds"]
 
 
-def leaf_off_sample(project: Project, scenario: Scenario, leaf_on: SlabSample) -> SlabSample:
-    """The bare-crown slab matching ``leaf_on`` (see the module text)."""
+def leaf_off_sample(project: Project, scenario: Scenario, leaf_on: SlabSample | RingSamples
+                    ) -> SlabSample | RingSamples:
+    """The bare-crown slab matching ``leaf_on`` (see the module text; a free crown's chord
+    envelope: per Klems ring the plan cover of the optical depth −ln(1 − C₁) · cos² θ, C₁ the
+    cover of one crossing)."""
     tree, form = scenario_tree(project, scenario)
     params = BranchParams()
     bare = build_leaf_off(project, scenario, facade_frame(project), params)
@@ -54,10 +58,22 @@ def leaf_off_sample(project: Project, scenario: Scenario, leaf_on: SlabSample) -
     depth = leaf_on.thickness if form == "dome" else slab_depth(tree)
     last = params.base_diameter_m / math.sqrt(params.fork) ** (params.orders - 1)
     diameter = math.sqrt(params.base_diameter_m * last)
+    cell = max(leaf_on.width, leaf_on.height)
+    note = (f"Bare crown cover {100 * cover:.1f} % "
+            f"({'one crossing' if form == 'dome' else 'two crossings'}).")
+    if isinstance(leaf_on, RingSamples):
+        tau = -math.log(1.0 - per_slab)
+
+        def ring(d: float, c: float) -> SlabSample:
+            return branch_slab(1.0 - math.exp(-tau * c * d / depth), d, params.inclination_deg,
+                               diameter, params.seed, cell_m=cell, min_sticks=12)
+
+        first = ring(depth, 1.0)
+        return chord_samples(ring, depth, CHORD_MIN_SLATS * tree.louvers.slat_size_m,
+                             "leaf_off", [*first.notes, note])
     sample = branch_slab(per_slab, depth, params.inclination_deg, diameter, params.seed,
-                         cell_m=max(leaf_on.width, leaf_on.height))
-    sample.notes.append(f"Bare crown cover {100 * cover:.1f} % "
-                        f"({'one crossing' if form == 'dome' else 'two crossings'}).")
+                         cell_m=cell)
+    sample.notes.append(note)
     return sample
 
 

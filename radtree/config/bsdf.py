@@ -9,9 +9,15 @@ recommendation), ``ad``, ``lw``; ``tiles`` × ``tiles`` periodic copies of the s
 ``bands``: the sensor dome's shell is cut into this many elevation bands of equal width
 (|elevation| 0–90°, the lower half mirrored), each with the BSDF of the slats as tilted at the
 band's middle elevation (the dome's slats turn with elevation); ``bands = 1``: one BSDF, the
-slats as tilted where the shell is seen ``elevation_deg`` above the horizon. ``depth_m`` (free crowns): slab depth per crossing
-of the envelope (0: the crown's vertical semi-axis, so the two crossings of a vertical line
-through the centre add up to the crown's height). ``tensor_tree``: 0, or the log2 resolution
+slats as tilted where the shell is seen ``elevation_deg`` above the horizon.
+
+Free crowns: ``depth_m`` is the crown depth one crossing of the envelope carries at normal
+incidence (0: the crown's vertical semi-axis, so the two crossings of a vertical line through
+the centre add up to the crown's height). ``crossing = "chord"`` (default): at incidence θ a
+crossing carries the half chord ``depth_m`` · cos θ of a sphere (one planar sample per Klems
+ring, :func:`radtree.trees.slab.chord_samples`); ``"slab"``: one slab ``depth_m`` deep,
+crossed along ``depth_m`` / cos θ — grazing light, which passes the rim of a real crown
+through a short chord, then crosses the thickest layer. ``tensor_tree``: 0, or the log2 resolution
 of an extra rank-4 tensor-tree XML. ``xml``: use this leaf-on XML instead of computing it
 (computed XMLs are cached under ``build/bsdf/<scenario>/``).
 """
@@ -25,6 +31,7 @@ from typing import ClassVar
 from radtree.config.spec import Checked, SchemaError, meta
 
 REPRESENTATIONS = ("explicit", "bsdf")
+CROSSINGS = ("chord", "slab")
 
 
 @dataclass(frozen=True)
@@ -40,6 +47,7 @@ class CrownBsdf(Checked):
     elevation_deg: float = field(default=30.0, metadata=meta(0.0, 90.0))
     bands: int = field(default=3, metadata=meta(1, 9))
     depth_m: float = field(default=0.0, metadata=meta(0.0, 50.0))
+    crossing: str = field(default="chord", metadata=meta(choices=CROSSINGS))
     tensor_tree: int = field(default=0, metadata=meta(0, 6))
     xml: Path | None = None
 

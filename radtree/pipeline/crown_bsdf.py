@@ -2,9 +2,11 @@
 and cached, and the BSDF crown (``[tree] representation = "bsdf"``) that carries it.
 
 Leaf-on sample (:mod:`radtree.trees.slab`): the sensor dome's slat shells as a planar stack,
-or a slab of the free volume crown at its fitted density, ``tree.bsdf.depth_m`` deep (0: the
-crown's vertical semi-axis — two crossings of a vertical line through the centre add up to
-the crown's height). The XML is cached in ``build/bsdf/<scenario>/leaf_on/`` under a key of
+or, for a free volume crown, slabs at its fitted density whose optical depth at incidence θ is
+the half chord ``tree.bsdf.depth_m`` · cos θ of a sphere (one sample per Klems ring;
+``tree.bsdf.crossing = "slab"``: one slab ``depth_m`` deep; ``depth_m`` 0: the crown's
+vertical semi-axis — two crossings of a vertical line through the centre add up to the
+crown's height). The XML is cached in ``build/bsdf/<scenario>/leaf_on/`` under a key of
 the sample's polygons, optics and rfluxmtx settings, so changing any of them recomputes it.
 """
 
@@ -12,7 +14,9 @@ from __future__ import annotations
 
 import hashlib
 import json
+import os
 from collections.abc import Callable
+from dataclasses import replace
 from pathlib import Path
 
 from radtree.config import Project, Scenario
@@ -22,16 +26,18 @@ from radtree.engines.radiance.bsdf import (
     FluxSettings,
     check_bsdf,
     klems_bsdf,
+    klems_bsdf_rings,
     tensor_tree_bsdf,
     write_system,
 )
 from radtree.errors import ConfigError
 from radtree.fileio import write_text
 from radtree.site.frame import FacadeFrame
-from radtree.trees.bsdf_shell import build_bsdf_crown
+from radtree.trees.bsdf_shell import WALL_BAND, build_bsdf_crown
 from radtree.trees.build import apply_switches
+from radtree.trees.envelope import crown_row_spec
 from radtree.trees.model import TreeModel
-from radtree.trees.slab import SlabSample, dome_slab, volume_slab
+from radtree.trees.slab import RingSamples, SlabSample, chord_samples, dome_slab, volume_slab
 from radtree.trees.volume import recommended_volume_ab
 
 #: -ab of a scene with a BSDF crown: every pass through the shell's Klems BSDF is an ambient
@@ -39,6 +45,8 @@ from radtree.trees.volume import recommended_volume_ab
 #: read 1162 / 1169 lx at -ab 6 and 1148 / 1160 lx at -ab 8; -ab 4 (-ad 2048) read 1060 lx
 #: at 14:30, ≈ 9 % low
 BSDF_SCENE_AB = 6
+#: thinnest chord-ring slab, in slat sizes (a thinner slab is no random medium of slats)
+CHORD_MIN_SLATS = 2.0
 
 
 def scenario_tree(project: Project, scenario: Scenario) -> tuple[Tree, str]:
@@ -55,20 +63,41 @@ def slab_depth(tree: Tree) -> float:
 
 
 def band_elevations(tree: Tree, form: str) -> list[tuple[float, float, float]]:
-    """(lowest, highest, sample) |elevation| of each band of the BSDF shell, degrees: the
-    dome's ``tree.bsdf.bands`` equal bands sampled at their middles (one band: sampled at
-    ``tree.bsdf.elevation_deg``); a free crown has one band."""
-    n = tree.bsdf.bands if form == "dome" else 1
+    """(lowest, highest, sample) |elevation| of each band of the BSDF shell, degrees:
+    ``tree.bsdf.bands`` equal bands sampled at their middles (one band: sampled at
+    ``tree.bsdf.elevation_deg``). The dome's elevation is that of the shell seen from the
+    dome centre (its slats turn with it); a free crown's that of the facet's outward normal
+    (its slats keep their inclination from the vertical, so a side facet sees them turned).
+    A free crown with ``tree.bsdf.crossing = "slab"`` has one band, its slats inclined from
+    the facet normal (the representation before the chord envelope)."""
+    n = 1 if form != "dome" and tree.bsdf.crossing == "slab" else tree.bsdf.bands
     if n == 1:
-        return [(0.0, 90.0, tree.bsdf.elevation_deg)]
+        el = 90.0 if form != "dome" and tree.bsdf.crossing == "slab" else tree.bsdf.elevation_deg
+        return [(0.0, 90.0, el)]
     step = 90.0 / n
     return [(k * step, (k + 1) * step, (k + 0.5) * step) for k in range(n)]
 
 
+def wall_half_chord(tree: Tree, sensors, street, source: str | None = None) -> float:
+    """Half chord (m) of a free crown's wall cap — the distance from the crown centre to the
+    wall-side clip plane — or 0 when the crowns do not reach it.
+
+    A line from a point S on the cap to the envelope point P runs b + R cos θ_P inside the
+    crown, b = (C − S)·u: for S at the cap's foot point b = h cos ψ (h the centre's distance,
+    ψ the angle from the cap normal) — a chord crossing of half chord h."""
+    spec = crown_row_spec(tree, sensors, street, source)
+    h = float(spec.centres[0][1] - spec.n_clip)
+    return h if h < spec.a else 0.0
+
+
 def leaf_on_sample(project: Project, scenario: Scenario,
-                   elevation_deg: float | None = None) -> SlabSample:
-    """The planar sample of the scenario's (louvers) crown layer (the dome's slats tilted as
-    at ``elevation_deg``, default ``tree.bsdf.elevation_deg``)."""
+                   elevation_deg: float | None = None, half_chord_m: float | None = None
+                   ) -> SlabSample | RingSamples:
+    """The planar sample of the scenario's (louvers) crown layer: the dome's slats tilted as
+    at ``elevation_deg`` (default ``tree.bsdf.elevation_deg``); a free crown's for an envelope
+    facet whose outward normal is ``elevation_deg`` above the horizon (default: the first
+    band's, :func:`band_elevations`), crossed along the half chord ``half_chord_m`` · cos θ
+    (default :func:`slab_depth`)."""
     tree, form = scenario_tree(project, scenario)
     source = str(project.source)
     if scenario.model != "louvers":
@@ -82,7 +111,15 @@ def leaf_on_sample(project: Project, scenario: Scenario,
         raise ConfigError("free crowns need louvers.arrangement = 'volume' for a BSDF (the "
                           "layered lens crowns are no planar slab)", source=source,
                           field="tree.louvers.arrangement")
-    return volume_slab(tree.louvers, tree.crown.vertical_radius_m, slab_depth(tree), source)
+    lv, semi = tree.louvers, tree.crown.vertical_radius_m
+    if tree.bsdf.crossing == "slab":
+        return volume_slab(lv, semi, slab_depth(tree), source)
+    el = band_elevations(tree, form)[0][2] if elevation_deg is None else elevation_deg
+    half = slab_depth(tree) if half_chord_m is None else half_chord_m
+    on_normal = volume_slab(lv, semi, half, source, normal_elevation_deg=el)
+    return chord_samples(lambda d, c: volume_slab(lv, semi, d, source, c, el), half,
+                         CHORD_MIN_SLATS * lv.slat_size_m, "volume_leaf_on",
+                         on_normal.notes[:1])
 
 
 def sample_ab(tree: Tree, form: str) -> int:
@@ -98,30 +135,50 @@ def flux_settings(tree: Tree, form: str, nproc: int = 1) -> FluxSettings:
                         tiles=b.tiles, nproc=nproc, tensor_tree=b.tensor_tree)
 
 
-def sample_key(sample: SlabSample, settings: FluxSettings) -> str:
+def sample_key(sample: SlabSample | RingSamples, settings: FluxSettings) -> str:
     h = hashlib.sha256()
-    for name in sorted(sample.polygons):
-        h.update(name.encode())
-        h.update(sample.polygons[name].round(7).tobytes())
-        h.update(sample.materials[name].to_radiance().encode())
-    h.update(json.dumps([sample.width, sample.height, sample.thickness, repr(settings)]).encode())
+    slabs = sample.rings if isinstance(sample, RingSamples) else [sample]
+    for slab in slabs:
+        for name in sorted(slab.polygons):
+            h.update(name.encode())
+            h.update(slab.polygons[name].round(7).tobytes())
+            h.update(slab.materials[name].to_radiance().encode())
+        h.update(json.dumps([slab.width, slab.height, slab.thickness]).encode())
+    # rfluxmtx -n only splits the work: not part of the key
+    h.update(json.dumps([sample.thickness, repr(replace(settings, nproc=1))]).encode())
     return h.hexdigest()[:16]
 
 
-def ensure_bsdf(sample: SlabSample, settings: FluxSettings, folder: Path, name: str,
-                progress: Callable[[str], None] | None = None) -> BsdfRun:
+def ensure_bsdf(sample: SlabSample | RingSamples, settings: FluxSettings, folder: Path,
+                name: str, progress: Callable[[str], None] | None = None) -> BsdfRun:
     """The XML of ``sample`` in ``folder`` (``<name>.xml``): reused when its key matches,
-    else computed (rfluxmtx, wrapBSDF, checkBSDF)."""
+    else computed (rfluxmtx, wrapBSDF, checkBSDF; an envelope sample: one system per Klems
+    ring in ``folder/ring<k>/``)."""
     key = sample_key(sample, settings)
     xml, key_file = folder / f"{name}.xml", folder / "key.txt"
     if xml.exists() and key_file.exists() and key_file.read_text().strip() == key:
         tt = folder / f"{name}_t4.xml"
         return BsdfRun(xml, check_bsdf(xml), 0.0, tt if tt.exists() else None)
+    comment = (f"radtree crown BSDF: {sample.name}; " + " ".join(sample.notes))[:900]
+    if isinstance(sample, RingSamples):
+        if settings.tensor_tree:
+            raise ConfigError("tree.bsdf.tensor_tree needs tree.bsdf.crossing = 'slab' (the "
+                              "chord envelope is assembled ring by ring in the Klems basis)",
+                              field="tree.bsdf.tensor_tree")
+        subs = []
+        for k, slab in enumerate(sample.rings):
+            sub = folder / f"ring{k}"
+            write_system(sub, slab.polygons, slab.materials, slab.width, slab.height,
+                         slab.thickness, settings.tiles)
+            subs.append(sub)
+        result = klems_bsdf_rings(folder, subs, settings, name, sample.thickness,
+                                  sample.width, sample.height, comment, progress)
+        write_text(key_file, key + "\n")
+        return result
     write_system(folder, sample.polygons, sample.materials, sample.width, sample.height,
                  sample.thickness, settings.tiles)
-    comment = f"radtree crown BSDF: {sample.name}; " + " ".join(sample.notes)
     result = klems_bsdf(folder, settings, name, sample.thickness, sample.width, sample.height,
-                        comment=comment[:900], progress=progress)
+                        comment=comment, progress=progress)
     if settings.tensor_tree:
         result.tensor_xml = tensor_tree_bsdf(folder, settings, name, sample.thickness,
                                              sample.width, sample.height)
@@ -134,18 +191,26 @@ def scenario_xmls(project: Project, scenario: Scenario,
                   ) -> list[tuple[float, float, Path]]:
     """The leaf-on XML of each band of ``scenario``'s BSDF shell, (lowest, highest |elevation|,
     XML): ``tree.bsdf.xml`` for every band when given, else computed and cached in
-    ``build/bsdf/<scenario>/leaf_on[_b<k>]/``."""
+    ``build/bsdf/<scenario>/leaf_on[_b<k>]/``. A free crown with the chord crossing that
+    reaches the wall adds its wall cap as a last entry :data:`WALL_BAND` (its own half chord,
+    :func:`wall_half_chord`; ``leaf_on_wall/``)."""
     tree, form = scenario_tree(project, scenario)
     bands = band_elevations(tree, form)
     if tree.bsdf.xml is not None:
         check_bsdf(Path(tree.bsdf.xml))
         return [(lo, hi, Path(tree.bsdf.xml)) for lo, hi, _ in bands]
+    settings = flux_settings(tree, form, os.cpu_count() or 1)
+    jobs = [("leaf_on" if len(bands) == 1 else f"leaf_on_b{k}", lo, hi, el, None)
+            for k, (lo, hi, el) in enumerate(bands)]
+    if form != "dome" and tree.bsdf.crossing == "chord":
+        h = wall_half_chord(tree, project.sensors, project.street, str(project.source))
+        if h > 0:
+            jobs.append(("leaf_on_wall", *WALL_BAND, 0.0, h))
     out = []
-    for k, (lo, hi, el) in enumerate(bands):
-        name = "leaf_on" if len(bands) == 1 else f"leaf_on_b{k}"
+    for name, lo, hi, el, half in jobs:
         folder = project.build_dir / "bsdf" / scenario.name / name
-        run = ensure_bsdf(leaf_on_sample(project, scenario, el), flux_settings(tree, form),
-                          folder, name, progress)
+        run = ensure_bsdf(leaf_on_sample(project, scenario, el, half), settings, folder, name,
+                          progress)
         out.append((lo, hi, run.xml))
     return out
 

@@ -11,8 +11,10 @@ the same XMLs with up −z. The XML is computed by :mod:`radtree.pipeline.crown_
 given as ``tree.bsdf.xml``); this module only builds the geometry.
 
 Free crowns: the envelope is closed, so light reaching the façade through a crown crosses the
-shell twice (in and out); the slab behind the XML is one crossing's depth
-(``tree.bsdf.depth_m``, default the vertical semi-axis).
+shell twice (in and out); the XML holds one crossing (the half chord of the crown at each
+incidence, :func:`radtree.trees.slab.chord_samples`). The crown's slats keep their
+inclination from the vertical, so the envelope is cut into bands by the elevation of its
+facets' outward normals, each with the slats as a facet of that orientation sees them.
 """
 
 from __future__ import annotations
@@ -29,6 +31,8 @@ from radtree.trees.envelope import crown_row_spec, dome_notes, dome_spec, icosph
 from radtree.trees.model import BARK_REFLECTANCE, TRUNK, TreeModel
 
 BSDF_SHELL = "crown_bsdf"
+#: (lowest, highest) of a band entry that is a free crown's wall cap, not an elevation band
+WALL_BAND = (-1.0, -1.0)
 
 
 def inward(verts: np.ndarray, faces: np.ndarray, centre: np.ndarray) -> np.ndarray:
@@ -41,15 +45,13 @@ def inward(verts: np.ndarray, faces: np.ndarray, centre: np.ndarray) -> np.ndarr
     return faces
 
 
-def dome_bands(verts: np.ndarray, faces: np.ndarray, centre: np.ndarray,
-               bands: list[tuple[float, float, Path]]
-               ) -> list[tuple[str, Bsdf, np.ndarray]]:
+def elevation_bands(el: np.ndarray, faces: np.ndarray, bands: list[tuple[float, float, Path]]
+                    ) -> list[tuple[str, Bsdf, np.ndarray]]:
     """(material name, material, faces) per elevation band and half: a triangle belongs to
-    the band of its centroid's |elevation| seen from ``centre``; the upper half carries the
-    XML with up +z, the lower half the same XML with up −z (the dome's slats are mirrored
-    there: tilted towards lower elevations)."""
-    c = verts[faces].mean(axis=1) - centre
-    el = np.degrees(np.arctan2(c[:, 2], np.hypot(c[:, 0], c[:, 1])))
+    the band of its |elevation| ``el`` (degrees, one per face); the upper half carries the
+    XML with up +z, the lower half the same XML with up −z (mirrored: the dome's slats are
+    tilted towards lower elevations there; a free crown's lower facets see the vertical as
+    the upper ones do, up to sign)."""
     out = []
     for k, (lo, hi, xml) in enumerate(bands):
         last = k == len(bands) - 1
@@ -63,12 +65,35 @@ def dome_bands(verts: np.ndarray, faces: np.ndarray, centre: np.ndarray,
     return out
 
 
+def dome_bands(verts: np.ndarray, faces: np.ndarray, centre: np.ndarray,
+               bands: list[tuple[float, float, Path]]
+               ) -> list[tuple[str, Bsdf, np.ndarray]]:
+    """:func:`elevation_bands` by the elevation of each triangle's centroid seen from
+    ``centre``."""
+    c = verts[faces].mean(axis=1) - centre
+    return elevation_bands(np.degrees(np.arctan2(c[:, 2], np.hypot(c[:, 0], c[:, 1]))),
+                           faces, bands)
+
+
+def normal_bands(verts: np.ndarray, faces: np.ndarray, bands: list[tuple[float, float, Path]]
+                 ) -> list[tuple[str, Bsdf, np.ndarray]]:
+    """:func:`elevation_bands` by the elevation of each (inward-wound) triangle's outward
+    normal."""
+    t = verts[faces]
+    n = -np.cross(t[:, 1] - t[:, 0], t[:, 2] - t[:, 0])
+    return elevation_bands(np.degrees(np.arctan2(n[:, 2], np.hypot(n[:, 0], n[:, 1]))),
+                           faces, bands)
+
+
 def build_bsdf_crown(tree: Tree, sensors: Sensors, street: Street, frame: FacadeFrame,
                      form: str, bands: list[tuple[float, float, Path]], recommended_ab: int,
                      source: str | None = None) -> TreeModel:
     """The crown of ``form`` as a BSDF shell; ``bands``: (lowest, highest |elevation| in
-    degrees, XML) — the dome's elevation bands, one band for free crowns."""
-    xml = bands[0][2]
+    degrees, XML) — the elevation bands (the dome's seen from its centre, a free crown's by
+    its facets' normals); an entry (:data:`WALL_BAND`, XML) gives free crowns' wall caps
+    (the envelope's faces on the wall-side clip plane) their own XML."""
+    wall = [b[2] for b in bands if (b[0], b[1]) == WALL_BAND]
+    bands = [b for b in bands if (b[0], b[1]) != WALL_BAND]
     materials: dict = {}
     meshes: list[Mesh] = []
     notes: list[str] = []
@@ -83,16 +108,26 @@ def build_bsdf_crown(tree: Tree, sensors: Sensors, street: Street, frame: Facade
         notes.extend(dome_notes(spec))
         info = {"dome_radius_m": spec.radius, "bsdf_bands": float(len(bands))}
     else:
-        materials[BSDF_SHELL] = Bsdf(BSDF_SHELL, str(Path(xml).resolve()))
         spec_r = crown_row_spec(tree, sensors, street, source)
         level = icosphere_level(360.0 / tree.crown.segments)
-        parts = []
+        verts_all, faces_all, walls, base = [], [], [], 0
         for i in range(spec_r.count):
-            v, f, _ = spec_r.envelope(i, level)
+            v, f, on_wall = spec_r.envelope(i, level)
             v = frame.to_world(v)
             inner = frame.to_world(spec_r.hull_point(i)[None, :])[0]
-            parts.append(Mesh(f"{BSDF_SHELL}_{i}", BSDF_SHELL, v, inward(v, f, inner)))
-        meshes.append(Mesh.merge(BSDF_SHELL, BSDF_SHELL, parts))
+            verts_all.append(v)
+            faces_all.append(inward(v, f, inner) + base)
+            walls.append(on_wall)
+            base += len(v)
+        verts, faces = np.concatenate(verts_all), np.concatenate(faces_all)
+        on_wall = np.concatenate(walls) if wall else np.zeros(len(faces), bool)
+        parts = normal_bands(verts, faces[~on_wall], bands)
+        if np.any(on_wall):
+            name = f"{BSDF_SHELL}_wall"
+            parts.append((name, Bsdf(name, str(Path(wall[0]).resolve())), faces[on_wall]))
+        for name, mat, fs in parts:
+            materials[name] = mat
+            meshes.append(Mesh(name, name, verts, fs))
         tv, tf = spec_r.trunks()
         materials[TRUNK] = Plastic(TRUNK, BARK_REFLECTANCE)
         meshes.append(Mesh("tree_trunks", TRUNK, frame.to_world(tv), tf))

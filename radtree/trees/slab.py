@@ -22,13 +22,14 @@ the centre cell, so light may wander sideways up to the tiled margin.
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass, field
 
 import numpy as np
 
 from radtree.config import Louvers, Sensors, Street, Tree
 from radtree.errors import ConfigError
-from radtree.optics import Material, Plastic
+from radtree.optics import KLEMS_FULL_RINGS, Material, Plastic
 from radtree.trees.envelope import dome_spec
 from radtree.trees.louvers import LouverOptics
 from radtree.trees.louvers_dome import dome_layer_radii, slat_normals
@@ -143,13 +144,19 @@ def dome_slab(tree: Tree, sensors: Sensors, street: Street, elevation_deg: float
 
 
 def volume_slab(lv: Louvers, vertical_semi_axis_m: float, depth_m: float,
-                source: str | None = None) -> SlabSample:
-    """Slats at random through a slab of ``depth_m`` at the fitted crown density ρ."""
+                source: str | None = None, density_scale: float = 1.0,
+                normal_elevation_deg: float = 90.0) -> SlabSample:
+    """Slats at random through a slab of ``depth_m`` at the fitted crown density ρ (times
+    ``density_scale``: the chord samples of :func:`chord_samples`), their normals inclined
+    α from the world vertical at random azimuths, for an envelope facet whose outward normal
+    is ``normal_elevation_deg`` above the horizon (90: the top of the crown, slab normal =
+    vertical). In the sample's frame (z the inward normal, y the facet's upward tangent, as
+    the Radiance BSDF material with up = world +z) the vertical is (0, cos e, −sin e)."""
     if not depth_m > 0:
         raise ConfigError(f"got {depth_m}, expected a positive slab depth", source=source,
                           field="tree.bsdf.depth_m")
     s = lv.slat_size_m
-    rho = volume_density(lv, vertical_semi_axis_m)
+    rho = volume_density(lv, vertical_semi_axis_m) * density_scale
     width = height = CELL_SLATS * s
     n = int(round(rho * width * height * depth_m))
     if n < 1:
@@ -159,17 +166,26 @@ def volume_slab(lv: Louvers, vertical_semi_axis_m: float, depth_m: float,
     centres = rng.random((n, 3)) * [width, height, depth_m] - [0.0, 0.0, depth_m]
     phi = rng.uniform(0.0, 2.0 * math.pi, n)
     quads = _slat_corners(centres, phi, s, math.radians(lv.inclination_deg))
-    # the slab lies in the horizontal crown: its normal (z here) is the crown's vertical,
-    # so slat normals inclined α from vertical are inclined α from the slab normal
+    # drawn about z, then turned about x by γ = 90° − e: z → (0, −sin γ, cos γ), the
+    # facet's vertical up to sign (slats are two-sided)
+    g = math.radians(90.0 - normal_elevation_deg)
+    if g:
+        rel = quads - centres[:, None, :]
+        y, z = rel[..., 1].copy(), rel[..., 2].copy()
+        rel[..., 1], rel[..., 2] = y * math.cos(g) - z * math.sin(g), y * math.sin(g) + z * math.cos(g)
+        quads = centres[:, None, :] + rel
     polys, thickness = _to_back({LEAF: quads})
     optics = LouverOptics.of(lv)
     lam = rho * s * s * math.cos(math.radians(lv.inclination_deg)) * depth_m
     notes = [f"Planar slab of the volume crown: {n} slats of {s:g} m at the fitted density "
-             f"{rho:.2f} m⁻³ through {depth_m:.2f} m (normal line crosses {lam:.2f} slats on "
-             f"average), normals {lv.inclination_deg:g}° from the slab normal at random "
-             f"azimuths; periodic cell {width:.2f} × {height:.2f} m. "
+             f"{rho:.2f} m⁻³ through {depth_m:.2f} m, normals {lv.inclination_deg:g}° from the "
+             f"vertical at random azimuths, the facet's outward normal "
+             f"{normal_elevation_deg:g}° above the horizon (a line along the slab normal "
+             f"crosses {lam:.2f} slats on average at the top, e = 90°); periodic cell "
+             f"{width:.2f} × {height:.2f} m. "
              + optics.describe_slat() + "."]
     info = {"density_per_m3": rho, "depth_m": depth_m, "slats": float(n),
+            "normal_elevation_deg": normal_elevation_deg,
             "normal_crossings": lam,
             "tau_normal_direct": math.exp(-lam * (1.0 - optics.t_specular))}
     return SlabSample("volume_leaf_on", polys, {LEAF: optics.material()}, width, height,
@@ -177,16 +193,27 @@ def volume_slab(lv: Louvers, vertical_semi_axis_m: float, depth_m: float,
 
 
 def branch_slab(cover: float, depth_m: float, inclination_deg: float, diameter_m: float,
-                seed: int = 1, cell_m: float = 2.4) -> SlabSample:
-    """Leaf-off: opaque square-section bark sticks (length one cell) at ``inclination_deg``
-    from the slab plane, random azimuths, with plan-view cover ``cover`` (0 < cover < 1)."""
+                seed: int = 1, cell_m: float = 2.4, min_sticks: int = 1) -> SlabSample:
+    """Leaf-off: opaque square-section bark sticks (length ≤ one cell) at ``inclination_deg``
+    from the slab plane, random azimuths, with plan-view cover ``cover`` (0 < cover < 1). The
+    cell grows (up to 16-fold in side) until it holds ``min_sticks``: a sparse cover would
+    otherwise be rounded to one stick."""
     if not 0.0 < cover < 1.0:
         raise ConfigError(f"got branch cover {cover}, expected between 0 and 1",
                           field="tree.bsdf.leaf_off")
     beta = math.radians(inclination_deg)
-    length = min(cell_m, depth_m / max(math.sin(beta), 1e-3))
-    per_stick = length * math.cos(beta) * diameter_m
-    n = max(1, int(round(-math.log(1.0 - cover) * cell_m * cell_m / per_stick)))
+
+    def expected(cell: float) -> tuple[float, float]:
+        length = min(cell, depth_m / max(math.sin(beta), 1e-3))
+        return -math.log(1.0 - cover) * cell * cell / (length * math.cos(beta) * diameter_m), \
+            length
+
+    grown = cell_m
+    while expected(grown)[0] < min_sticks and grown < 16.0 * cell_m:
+        grown = min(16.0 * cell_m, grown * 1.25)
+    cell_m = grown
+    sticks, length = expected(cell_m)
+    n = max(1, int(round(sticks)))
     rng = np.random.default_rng(np.random.SeedSequence(seed))
     z0 = depth_m * rng.random(n) * (1.0 - length * math.sin(beta) / depth_m) - depth_m
     start = np.stack([rng.random(n) * cell_m, rng.random(n) * cell_m, z0], axis=1)
@@ -208,3 +235,66 @@ def branch_slab(cover: float, depth_m: float, inclination_deg: float, diameter_m
              f"{depth_m:.2f} m, plan-view cover {100 * cover:.1f} % (the bare crown's)."]
     return SlabSample("leaf_off", polys, {TRUNK: Plastic(TRUNK, BARK_REFLECTANCE)}, cell_m,
                       cell_m, thickness, notes, {"branch_cover": cover, "sticks": float(n)})
+
+
+@dataclass
+class RingSamples:
+    """A crown *envelope* sample: one planar sample per Klems θ ring of incidence
+    (:data:`radtree.optics.KLEMS_FULL_RINGS`); ring k's sample supplies the BSDF columns of the
+    incident patches of ring k. ``thickness``: the half chord at normal incidence (m)."""
+
+    name: str
+    rings: list[SlabSample]
+    thickness: float
+    notes: list[str] = field(default_factory=list)
+    info: dict[str, float] = field(default_factory=dict)
+
+    def __post_init__(self) -> None:
+        if len(self.rings) != len(KLEMS_FULL_RINGS):
+            raise ValueError(f"envelope sample '{self.name}': {len(self.rings)} ring samples, "
+                             f"expected {len(KLEMS_FULL_RINGS)}")
+
+    @property
+    def width(self) -> float:
+        return self.rings[0].width
+
+    @property
+    def height(self) -> float:
+        return self.rings[0].height
+
+    @property
+    def count(self) -> int:
+        return sum(r.count for r in self.rings)
+
+
+def chord_rings(half_chord_m: float, min_depth_m: float) -> list[tuple[float, float]]:
+    """(slab depth m, optical-depth scale) per Klems ring for a crossing of a crown envelope.
+
+    A straight line entering a sphere of radius R at incidence θ (from the surface normal)
+    runs a chord 2 R cos θ inside: each of its two crossings of the envelope carries the half
+    chord R cos θ. A planar slab of depth D at density scale c is crossed along c D / cos θ,
+    so ring k (centre θ_k) takes c_k D_k = R cos² θ_k, with D_k = max(R cos² θ_k,
+    ``min_depth_m``) (a slab thinner than a few slats is no random medium) and c_k ≤ 1."""
+    out = []
+    for _, _, centre, _ in KLEMS_FULL_RINGS:
+        target = half_chord_m * math.cos(math.radians(centre)) ** 2
+        depth = min(half_chord_m, max(target, min_depth_m))
+        out.append((depth, target / depth))
+    return out
+
+
+def chord_samples(make: Callable[[float, float], SlabSample], half_chord_m: float,
+                  min_depth_m: float, name: str, notes: list[str]) -> RingSamples:
+    """The :class:`RingSamples` of ``make(depth, scale)`` over :func:`chord_rings`."""
+    rings = chord_rings(half_chord_m, min_depth_m)
+    samples = [make(d, c) for d, c in rings]
+    text = ", ".join(f"{ring[2]:g}°: {c * d:.2f} m" for ring, (d, c) in
+                     zip(KLEMS_FULL_RINGS, rings))
+    notes = [*notes, f"Envelope crossing (chord): each Klems ring of incidence θ has its own "
+             f"planar sample whose optical depth is that of the half chord R cos θ of a crown of "
+             f"R = {half_chord_m:.2f} m (a line entering a sphere at θ runs 2 R cos θ inside), "
+             f"as slab depth at full density — {text}; ring-to-ring exchanges made reciprocal "
+             f"(Helmholtz) by averaging each pair."]
+    info = {"half_chord_m": half_chord_m, **{f"ring{k}_depth_m": d * c
+                                               for k, (d, c) in enumerate(rings)}}
+    return RingSamples(name, samples, half_chord_m, notes, info)

@@ -24,10 +24,12 @@ The optional tensor tree (``h=-sc<2^N>``, ``rttree_reduce``) follows genBSDF's `
 
 from __future__ import annotations
 
+import math
 import os
 import time
 from collections.abc import Callable
-from dataclasses import dataclass
+from concurrent.futures import ThreadPoolExecutor
+from dataclasses import dataclass, replace
 from pathlib import Path
 
 import numpy as np
@@ -35,7 +37,7 @@ import numpy as np
 from radtree.engines.radiance.binaries import run
 from radtree.errors import EngineError
 from radtree.fileio import write_text
-from radtree.optics import Material
+from radtree.optics import KLEMS_FULL_RINGS, Material
 
 EPS = 1e-5
 #: photopic Y of Radiance RGB (the weights genBSDF passes to rmtxop -c)
@@ -152,21 +154,26 @@ def flux_commands(settings: FluxSettings) -> list[list[str]]:
              "system.oct"] for sender in ("fsender.rad", "bsender.rad")]
 
 
-def klems_bsdf(folder: Path, settings: FluxSettings, name: str, thickness: float,
-               width: float, height: float, comment: str = "",
-               progress: Callable[[str], None] | None = None) -> BsdfRun:
-    """Run both rfluxmtx passes in ``folder`` (after :func:`write_system`) and wrap the four
-    Klems matrices into ``folder/<name>.xml``; checkBSDF must accept it."""
-    t0 = time.perf_counter()
-    parts: list[str] = []
-    for cmd, (trans, refl, tkey, rkey) in zip(flux_commands(settings), (
-            ("face.dat", "behind.dat", "tf", "rf"), ("behind.dat", "face.dat", "tb", "rb"))):
+PASSES = (("face.dat", "behind.dat", "tf", "rf"), ("behind.dat", "face.dat", "tb", "rb"))
+KEYS = ("tf", "rf", "tb", "rb")
+
+
+def flux_passes(folder: Path, settings: FluxSettings,
+                progress: Callable[[str], None] | None = None) -> None:
+    """Both rfluxmtx passes in ``folder`` (after :func:`write_system`): ``tf.dat``,
+    ``rf.dat``, ``tb.dat``, ``rb.dat``, photopic flux factors F[out, in]."""
+    for cmd, (trans, refl, tkey, rkey) in zip(flux_commands(settings), PASSES):
         if progress:
             progress(" ".join(cmd))
         run(cmd, cwd=folder)
         _to_y(folder, trans, f"{tkey}.dat")
         _to_y(folder, refl, f"{rkey}.dat")
-        parts += [f"-{tkey}", f"{tkey}.dat", f"-{rkey}", f"{rkey}.dat"]
+
+
+def wrap_klems(folder: Path, name: str, thickness: float, width: float, height: float,
+               comment: str = "") -> Path:
+    """wrapBSDF of the four ``*.dat`` flux matrices in ``folder`` → ``folder/<name>.xml``."""
+    parts = [arg for key in KEYS for arg in (f"-{key}", f"{key}.dat")]
     fields = f"t={thickness:.6g};w={width:.6g};h={height:.6g};n={name};m=radtree"
     argv = ["wrapBSDF", "-a", "kf", "-c", "-u", "meter", "-f", fields, *parts]
     if comment:
@@ -175,6 +182,88 @@ def klems_bsdf(folder: Path, settings: FluxSettings, name: str, thickness: float
     tmp = xml.with_name(xml.name + ".tmp")
     run(argv, cwd=folder, stdout_path=tmp)
     os.replace(tmp, xml)
+    return xml
+
+
+def klems_bsdf(folder: Path, settings: FluxSettings, name: str, thickness: float,
+               width: float, height: float, comment: str = "",
+               progress: Callable[[str], None] | None = None) -> BsdfRun:
+    """Run both rfluxmtx passes in ``folder`` (after :func:`write_system`) and wrap the four
+    Klems matrices into ``folder/<name>.xml``; checkBSDF must accept it."""
+    t0 = time.perf_counter()
+    flux_passes(folder, settings, progress)
+    xml = wrap_klems(folder, name, thickness, width, height, comment)
+    return BsdfRun(xml, check_bsdf(xml), time.perf_counter() - t0)
+
+
+def klems_patch_rings() -> tuple[np.ndarray, np.ndarray]:
+    """(ring index, projected solid angle Λ in sr) of each of the 145 Klems patches."""
+    ring, lam = [], []
+    for k, (lo, hi, _, n) in enumerate(KLEMS_FULL_RINGS):
+        a = math.pi * (math.sin(math.radians(hi)) ** 2 - math.sin(math.radians(lo)) ** 2) / n
+        ring += [k] * n
+        lam += [a] * n
+    return np.array(ring), np.array(lam)
+
+
+def reciprocal_rings(flux: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
+    """Flux matrices F[out, in] (``tf rf tb rb``) rescaled block by block (ring of out × ring
+    of in) so that their ring exchanges W = Σ F[o, i] Λ_i obey Helmholtz reciprocity exactly:
+    W_rf and W_rb symmetric, W_tf = W_tbᵀ. Needed when the columns of different incident
+    rings come from different samples (:func:`klems_bsdf_rings`): a pair of blocks (light
+    scattered from ring i into ring o, and back) comes from the two rings' samples and is
+    set to the smaller of the two, so that every factor is ≤ 1 and no incident patch gains
+    energy (the thin grazing samples transmit nearly everything undeviated: the mean would
+    push their T + R above 1). The azimuthal structure inside a block is kept. Inside one
+    ring the pair is one sample seen from both sides and differs by Monte Carlo noise only."""
+    ring, lam = klems_patch_rings()
+    onehot = np.eye(ring.max() + 1)[ring]
+
+    def exchange(f: np.ndarray) -> np.ndarray:
+        return onehot.T @ (f * lam[None, :]) @ onehot
+
+    def scaled(f: np.ndarray, w: np.ndarray, target: np.ndarray) -> np.ndarray:
+        full = w > 0
+        factor = np.where(full, target / np.where(full, w, 1.0), 1.0)
+        return f * factor[np.ix_(ring, ring)]
+
+    out = dict(flux)
+    for a, b in (("tf", "tb"), ("rf", "rf"), ("rb", "rb")):
+        wa, wb = exchange(flux[a]), exchange(flux[b])
+        target = np.minimum(wa, wb.T)
+        out[a] = scaled(flux[a], wa, target)
+        if b != a:
+            out[b] = scaled(flux[b], wb, target.T)
+    return out
+
+
+def klems_bsdf_rings(folder: Path, ring_folders: list[Path], settings: FluxSettings,
+                     name: str, thickness: float, width: float, height: float,
+                     comment: str = "", progress: Callable[[str], None] | None = None
+                     ) -> BsdfRun:
+    """One Klems XML from one sample per incident θ ring: both rfluxmtx passes in each of
+    ``ring_folders`` (after :func:`write_system`), the columns of ring k's incident patches
+    taken from ring k's run, made reciprocal (:func:`reciprocal_rings`), wrapped into
+    ``folder/<name>.xml``. The rings run ``settings.nproc`` at a time, each as one process
+    (the same matrices for any ``nproc``)."""
+    t0 = time.perf_counter()
+    ring, _ = klems_patch_rings()
+    flux = {key: np.zeros((ring.size, ring.size)) for key in KEYS}
+    single = replace(settings, nproc=1)
+    with ThreadPoolExecutor(max_workers=max(1, min(settings.nproc, len(ring_folders)))) as pool:
+        list(pool.map(lambda sub: flux_passes(sub, single, progress), ring_folders))
+    for k, sub in enumerate(ring_folders):
+        cols = ring == k
+        for key in KEYS:
+            m = np.loadtxt(sub / f"{key}.dat", ndmin=2)
+            if m.shape != flux[key].shape:
+                raise EngineError(f"{sub / key}.dat: {m.shape} values, expected 145 × 145",
+                                  command=["rfluxmtx"], stderr="")
+            flux[key][:, cols] = m[:, cols]
+    folder.mkdir(parents=True, exist_ok=True)
+    for key, m in reciprocal_rings(flux).items():
+        np.savetxt(folder / f"{key}.dat", m, fmt="%.7e", delimiter="\t")
+    xml = wrap_klems(folder, name, thickness, width, height, comment)
     return BsdfRun(xml, check_bsdf(xml), time.perf_counter() - t0)
 
 
