@@ -54,6 +54,7 @@ slat_size_m = 0.6
 [tree.bsdf]
 samples = 10
 tiles = 5
+bands = 1
 
 [sensors]
 dense_grid = false
