@@ -161,7 +161,11 @@ def test_second_leaf_schedule_reuses_every_matrix(runs):
     july = (wea.month == 7) & (wea.hour == 12.5)
     np.testing.assert_allclose(first.total["with"][g][:, july],
                                first.total["leaf_off"][g][:, july])
-    assert first.total["leaf_off"][g][:, july].mean() > first.total["leaf_on"][g][:, july].mean()
+    # the bare crown lets more light through over July (one hour depends on the one Klems
+    # patch holding the sun, sampled by 10 rays here)
+    winter = wea.month == 7
+    assert first.total["leaf_off"][g][:, winter].mean() > 1.2 * first.total["leaf_on"][g][
+        :, winter].mean()
     assert any("three-phase" in n for n in first.notes)
 
 

@@ -83,7 +83,7 @@ class CrownBsdfs:
 
     runs: dict[str, BsdfRun]
     matrices: dict[str, KlemsBsdf]
-    samples: dict[str, SlabSample]
+    samples: dict[str, SlabSample | RingSamples]
     summary: pd.DataFrame
 
 

@@ -200,8 +200,9 @@ def scenario_xmls(project: Project, scenario: Scenario,
         check_bsdf(Path(tree.bsdf.xml))
         return [(lo, hi, Path(tree.bsdf.xml)) for lo, hi, _ in bands]
     settings = flux_settings(tree, form, os.cpu_count() or 1)
-    jobs = [("leaf_on" if len(bands) == 1 else f"leaf_on_b{k}", lo, hi, el, None)
-            for k, (lo, hi, el) in enumerate(bands)]
+    jobs: list[tuple[str, float, float, float, float | None]] = [
+        ("leaf_on" if len(bands) == 1 else f"leaf_on_b{k}", lo, hi, el, None)
+        for k, (lo, hi, el) in enumerate(bands)]
     if form != "dome" and tree.bsdf.crossing == "chord":
         h = wall_half_chord(tree, project.sensors, project.street, str(project.source))
         if h > 0:
