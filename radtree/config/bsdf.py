@@ -17,7 +17,11 @@ the centre add up to the crown's height). ``crossing = "chord"`` (default): at i
 crossing carries the half chord ``depth_m`` · cos θ of a sphere (one planar sample per Klems
 ring, :func:`radtree.trees.slab.chord_samples`); ``"slab"``: one slab ``depth_m`` deep,
 crossed along ``depth_m`` / cos θ — grazing light, which passes the rim of a real crown
-through a short chord, then crosses the thickest layer. ``tensor_tree``: 0, or the log2 resolution
+through a short chord, then crosses the thickest layer. ``curvature`` (sensor dome):
+``"traced"`` (default) replaces the planar sample's view from the dome's centre (the row of
+the normal outgoing patch, ring by ring) by the one traced through the curved dome's own
+slats (:mod:`radtree.pipeline.dome_curvature`); ``"planar"`` keeps the flat stack's.
+``tensor_tree``: 0, or the log2 resolution
 of an extra rank-4 tensor-tree XML. ``xml``: use this leaf-on XML instead of computing it
 (computed XMLs are cached under ``build/bsdf/<scenario>/``).
 """
@@ -32,6 +36,7 @@ from radtree.config.spec import Checked, SchemaError, meta
 
 REPRESENTATIONS = ("explicit", "bsdf")
 CROSSINGS = ("chord", "slab")
+CURVATURES = ("traced", "planar")
 
 
 @dataclass(frozen=True)
@@ -48,6 +53,7 @@ class CrownBsdf(Checked):
     bands: int = field(default=3, metadata=meta(1, 9))
     depth_m: float = field(default=0.0, metadata=meta(0.0, 50.0))
     crossing: str = field(default="chord", metadata=meta(choices=CROSSINGS))
+    curvature: str = field(default="traced", metadata=meta(choices=CURVATURES))
     tensor_tree: int = field(default=0, metadata=meta(0, 6))
     xml: Path | None = None
 

@@ -210,9 +210,41 @@ def scenario_xmls(project: Project, scenario: Scenario,
     out = []
     for name, lo, hi, el, half in jobs:
         folder = project.build_dir / "bsdf" / scenario.name / name
-        run = ensure_bsdf(leaf_on_sample(project, scenario, el, half), settings, folder, name,
-                          progress)
-        out.append((lo, hi, run.xml))
+        sample = leaf_on_sample(project, scenario, el, half)
+        run = ensure_bsdf(sample, settings, folder, name, progress)
+        xml = run.xml
+        if form == "dome" and tree.bsdf.curvature == "traced":
+            xml = ensure_curved(project, scenario, tree, sample, settings, folder, name, lo, hi,
+                                progress)
+        out.append((lo, hi, xml))
+    return out
+
+
+def ensure_curved(project: Project, scenario: Scenario, tree: Tree,
+                  sample: SlabSample | RingSamples, settings: FluxSettings, folder: Path,
+                  name: str, lo: float, hi: float,
+                  progress: Callable[[str], None] | None = None) -> Path:
+    """The dome band's XML with the view from the centre traced through the curved slats
+    (:mod:`radtree.pipeline.dome_curvature`), in ``folder/curved/``; reused when the planar
+    sample's key and the trace's settings match."""
+    from radtree.pipeline.dome_curvature import CURVATURE_PATHS, curved_ring_row, write_curved_xml
+
+    key = (f"{sample_key(sample, settings)}|{lo:g}|{hi:g}|{CURVATURE_PATHS}|"
+           f"{tree.louvers.seed}|{tree.dome.radius_m:g}|{project.sensors.radius_m:g}|"
+           f"{project.sensors.offset_m:g}|{project.street.facade_azimuth_deg:g}")
+    sub = folder / "curved"
+    xml, key_file = sub / f"{name}_curved.xml", sub / "key.txt"
+    if xml.exists() and key_file.exists() and key_file.read_text().strip() == key:
+        return xml
+    row = curved_ring_row(project, scenario, tree, lo, hi, CURVATURE_PATHS,
+                          workers=os.cpu_count() or 1)
+    comment = (f"radtree crown BSDF: {sample.name}, curved dome |elevation| {lo:g}–{hi:g}°: "
+               f"the normal-outgoing row traced through the dome's slats ({row.paths} paths); "
+               + " ".join(sample.notes))[:900]
+    out, _ = write_curved_xml(folder, sub, f"{name}_curved", row, sample.thickness,
+                              sample.width, sample.height, comment, progress)
+    check_bsdf(out)
+    write_text(key_file, key + "\n")
     return out
 
 

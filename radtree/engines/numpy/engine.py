@@ -49,6 +49,7 @@ from __future__ import annotations
 import math
 import threading
 import zlib
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
@@ -223,18 +224,24 @@ class _Tracer:
 
     # -- paths
     def paths(self, points: np.ndarray, normals: np.ndarray, rng: Draws,
-              parallel: bool = True) -> np.ndarray:
+              parallel: bool = True, *, dirs: np.ndarray | None = None,
+              escapes: Callable[[np.ndarray, np.ndarray, np.ndarray], None] | None = None
+              ) -> np.ndarray:
         """Radiance (cd/m²) seen along one cosine-sampled direction from each sensor sample.
 
         Every draw is labelled (``rng.at``) with its place in the program — (bounce, site) —
         so that parts of a batch traced in separate threads (:meth:`paths_split`) draw the
-        numbers this method draws for them when it traces the whole batch."""
+        numbers this method draws for them when it traces the whole batch. ``dirs``: the
+        first directions instead of the cosine samples about ``normals``; ``escapes(path,
+        direction, throughput)`` is told of every path leaving the scene (the transfer of a
+        layer, :mod:`radtree.engines.numpy.transfer`)."""
         k = len(points)
         acc = np.zeros(k)
         alive = np.arange(k)
         o = np.array(points, float)
         rng.at(0, 4)
-        d = cosine_hemisphere(np.asarray(normals, float), rng)
+        d = (cosine_hemisphere(np.asarray(normals, float), rng) if dirs is None
+             else np.array(dirs, float))
         beta = np.ones(k)
         depth = np.ones(k, np.int64)
         nspec = np.zeros(k, np.int64)
@@ -246,6 +253,8 @@ class _Tracer:
             tri, t = self.caster.first_hit(o, d, parallel)
             miss = tri < 0
             if miss.any():
+                if escapes is not None:
+                    escapes(alive[miss], d[miss], beta[miss])
                 acc[alive[miss]] += beta[miss] * self.env(d[miss])
                 hit = ~miss
                 alive, o, d, beta, depth, nspec, tri, t = (

@@ -1,0 +1,160 @@
+"""The sensor dome's curvature in its crown BSDF (``tree.bsdf.curvature = "traced"``).
+
+The dome's BSDF is computed on a planar stack of its slat shells (:mod:`radtree.trees.slab`):
+same slats and spacing, but flat. In the dome the shells are concentric spheres (radii
+1.6–3.82 m for the Mendoza example): light scattered in a shell and travelling outwards meets
+the next shell more nearly along its normal than the flat stack's next layer, and light
+travelling inwards meets the inner, smaller shells ever more obliquely or misses them, so
+the curved stack passes more scattered light than the flat one.
+
+A sensor at the dome's centre sees each point of the BSDF shell along its normal: the light it
+receives is the XML's row of the normal outgoing patch, f[0, j] (transmission front → back,
+Klems patch 0 of the back side). This module traces that row through the explicit slats of
+the curved dome from its centre (:func:`radtree.engines.numpy.transfer.trace_escapes`: paths
+start on a black sphere just inside the innermost shell, along directions d of the band,
+cosine-weighted about the façade normal as a façade sensor sees them; a path returning into
+that sphere is light the stack reflects back, not part of the row) and bins each escape by its
+angle to d. Per Klems ring r of incident angle the traced P_r = Σ_{j ∈ r} f[0, j] Λ_j (the
+weight of that ring of the sky in the radiance the centre receives) replaces the planar
+sample's, by scaling the row's patches in r (their azimuthal shape is kept), and the
+reciprocal column tb[j, 0] with them (Helmholtz: T_f[o, i] = T_b[i, o]). The other rows
+(light seen obliquely from off-centre points, the wall's view of the shell) stay planar.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+import trimesh
+
+from radtree.config import Project, Scenario, effective_project
+from radtree.config.schema import Tree
+from radtree.engines.numpy.transfer import trace_escapes
+from radtree.engines.radiance.bsdf import KEYS, klems_patch_rings, wrap_klems
+from radtree.errors import EngineError
+from radtree.optics import KLEMS_FULL_RINGS, Plastic
+from radtree.scene import Mesh, Scene
+from radtree.site.frame import FacadeFrame
+from radtree.trees.build import build_tree
+from radtree.trees.envelope import dome_spec
+from radtree.trees.louvers_dome import dome_layer_radii
+from radtree.trees.model import TRUNK
+
+#: the sphere inside the innermost shell that ends paths coming back (reflected by the stack)
+SINK = "curvature_sink"
+#: paths traced per band: the row's sum to ≈ 0.3 % (1 σ), ≈ 2 s a band on 2 cores
+CURVATURE_PATHS = 400_000
+RING_EDGES = np.array([lo for lo, _, _, _ in KLEMS_FULL_RINGS] + [90.0])
+
+
+@dataclass(frozen=True)
+class RingRow:
+    """The normal-outgoing row of a dome band, per Klems θ ring of incidence: ``weight``
+    P_r = Σ_{j ∈ r} f[0, j] Λ_j (dimensionless: the share of a uniform sky's radiance in
+    ring r that reaches the centre), its Monte Carlo standard error, the share of the launched
+    throughput the stack sent back inwards, and the paths traced."""
+
+    weight: np.ndarray
+    stderr: np.ndarray
+    reflected: float
+    paths: int
+
+
+def band_directions(n_world: np.ndarray, lo_deg: float, hi_deg: float, count: int,
+                    rng: np.random.Generator) -> np.ndarray:
+    """``count`` directions cosine-distributed about the façade normal ``n_world`` (horizontal)
+    whose |elevation| lies in [lo, hi] degrees (rejection sampling)."""
+    n = np.asarray(n_world, float) / np.linalg.norm(n_world)
+    u = np.cross([0.0, 0.0, 1.0], n)
+    out: list[np.ndarray] = []
+    have = 0
+    while have < count:
+        k = max(1024, 2 * (count - have))
+        a, b = rng.random(k), rng.random(k)
+        r, phi = np.sqrt(a), 2 * math.pi * b
+        local = np.column_stack([r * np.cos(phi), r * np.sin(phi), np.sqrt(1.0 - a)])
+        d = local[:, :1] * u + local[:, 1:2] * np.array([0.0, 0.0, 1.0]) + local[:, 2:] * n
+        el = np.degrees(np.arcsin(np.clip(np.abs(d[:, 2]), 0.0, 1.0)))
+        keep = d[(el >= lo_deg) & (el <= hi_deg)]
+        out.append(keep)
+        have += len(keep)
+    return np.vstack(out)[:count]
+
+
+def curved_ring_row(project: Project, scenario: Scenario, tree: Tree, lo_deg: float,
+                    hi_deg: float, paths: int = 200_000, seed: int = 1, workers: int = 2
+                    ) -> RingRow:
+    """Trace the normal-outgoing row of the band |elevation| ∈ [lo, hi]° through the explicit
+    slats of ``scenario``'s sensor dome (``tree``: its tree, switches applied; see the module
+    docstring)."""
+    project = effective_project(project, scenario)
+    frame = FacadeFrame(azimuth_deg=project.street.facade_azimuth_deg)
+    model = build_tree(project, scenario, frame)
+    spec = dome_spec(tree, project.sensors, project.street)
+    radii = dome_layer_radii(spec, tree.louvers, project.sensors)
+    centre = frame.to_world(spec.centre)
+    sink_r = float(radii[0] - 0.75 * tree.louvers.slat_size_m)
+    if not sink_r > 0.05:
+        raise EngineError(f"the dome's innermost shell (radius {radii[0]:.2f} m) leaves no room "
+                          "for the curvature trace's sink inside it")
+    ball = trimesh.creation.icosphere(subdivisions=4, radius=sink_r)
+    meshes = [m for m in model.meshes if m.material != TRUNK]
+    meshes.append(Mesh(SINK, SINK, np.asarray(ball.vertices) + centre, np.asarray(ball.faces)))
+    materials = {**model.materials, SINK: Plastic(SINK, 0.0)}
+    scene = Scene(meshes, materials, {}, [])
+    rng = np.random.default_rng(seed)
+    d = band_directions(frame.normal, lo_deg, hi_deg, paths, rng)
+    # start just outside the sink (its facets lie inside the sphere by < 0.3 %)
+    origins = centre + (sink_r + 1e-3) * d
+    esc = trace_escapes(scene, origins, d, seed=seed + 1, workers=workers)
+    cos = np.einsum("ij,ij->i", esc.direction, d[esc.path])
+    theta = np.degrees(np.arccos(np.clip(cos, -1.0, 1.0)))
+    front = cos > 0
+    ring = np.clip(np.searchsorted(RING_EDGES, theta[front], side="right") - 1, 0,
+                   len(KLEMS_FULL_RINGS) - 1)
+    per_path = np.zeros((len(KLEMS_FULL_RINGS), paths))
+    np.add.at(per_path, (ring, esc.path[front]), esc.weight[front])
+    weight = per_path.mean(axis=1)
+    stderr = per_path.std(axis=1, ddof=1) / math.sqrt(paths)
+    reflected = float(esc.weight[~front].sum() / paths)
+    return RingRow(weight, stderr, reflected, paths)
+
+
+def planar_ring_row(flux_tf: np.ndarray) -> np.ndarray:
+    """P_r of a planar sample's T_f flux matrix F[o, i] = f[o, i] Λ_o: Σ_{j ∈ r} f[0, j] Λ_j."""
+    ring, lam = klems_patch_rings()
+    f_row = flux_tf[0] / lam[0]
+    return np.bincount(ring, f_row * lam, minlength=len(KLEMS_FULL_RINGS))
+
+
+def curved_flux(flux: dict[str, np.ndarray], row: RingRow) -> tuple[dict[str, np.ndarray],
+                                                                    np.ndarray]:
+    """The planar flux matrices with the normal-outgoing row of T_f (and the reciprocal column
+    of T_b) scaled ring by ring to the traced ``row``; returns them and the factors per ring
+    (1 where the planar ring is empty)."""
+    ring, _ = klems_patch_rings()
+    planar = planar_ring_row(flux["tf"])
+    factor = np.where(planar > 0, row.weight / np.where(planar > 0, planar, 1.0), 1.0)
+    out = {k: np.array(v, float) for k, v in flux.items()}
+    out["tf"][0, :] *= factor[ring]
+    out["tb"][:, 0] *= factor[ring]
+    return out, factor
+
+
+def write_curved_xml(planar_folder: Path, folder: Path, name: str, row: RingRow,
+                     thickness: float, width: float, height: float, comment: str = "",
+                     progress: Callable[[str], None] | None = None) -> tuple[Path, np.ndarray]:
+    """The planar sample's four flux matrices (``planar_folder/*.dat``) with the traced row
+    (:func:`curved_flux`), wrapped into ``folder/<name>.xml``; returns it and the factors."""
+    flux = {k: np.loadtxt(planar_folder / f"{k}.dat", ndmin=2) for k in KEYS}
+    curved, factor = curved_flux(flux, row)
+    folder.mkdir(parents=True, exist_ok=True)
+    for k, m in curved.items():
+        np.savetxt(folder / f"{k}.dat", m, fmt="%.7e", delimiter="\t")
+    if progress:
+        progress(f"curvature: ring factors {np.array2string(factor, precision=3)}")
+    return wrap_klems(folder, name, thickness, width, height, comment), factor
