@@ -4,7 +4,8 @@
 
 Traces scenario B (explicit slats, Radiance) and the same scenario with
 ``tree.representation = "bsdf"`` (the dome as a shell of the crown layer's Klems BSDF) at the
-project's hours and prints the façade means per hour, their ratio and the 7-hour mean; then
+project's hours and prints the façade means per hour, their ratio and the 7-hour mean
+(``--curvature planar``: the flat stack's BSDF without the traced view from the centre); then
 what the BSDF cannot represent: the lateral displacement of light inside the 2.2 m thick slat
 stack (see :func:`lateral_displacement`).
 """
@@ -58,6 +59,9 @@ def main() -> None:
     ap.add_argument("--scenario", default="B")
     ap.add_argument("--bands", type=int, default=3, help="elevation bands of the dome shell")
     ap.add_argument("--ad", type=int, default=8192, help="rtrace -ad of the BSDF crown")
+    ap.add_argument("--curvature", default="traced", choices=("traced", "planar"),
+                    help="tree.bsdf.curvature: the centre's view traced through the curved "
+                         "dome (default) or the flat stack's")
     ap.add_argument("--explicit-cache", default=None,
                     help="CSV of the explicit run's hourly façade means (read if present)")
     args = ap.parse_args()
@@ -67,7 +71,8 @@ def main() -> None:
     # project's -ad 2048 (±10 % per hour): the BSDF crown is traced with -ad 8192
     bs = replace(sc, name=f"{sc.name}-bsdf", switches={
         **sc.switches, "tree.representation": "bsdf", "bsdf.samples": args.samples,
-        "bsdf.bands": args.bands, "engine.ad": args.ad})
+        "bsdf.bands": args.bands, "engine.ad": args.ad,
+        "bsdf.curvature": args.curvature})
     t0 = time.perf_counter()
     bands = scenario_xmls(project, bs, progress=print)
     t_bsdf = time.perf_counter() - t0
