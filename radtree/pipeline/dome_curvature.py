@@ -37,8 +37,8 @@ from radtree.engines.numpy.transfer import trace_escapes
 from radtree.engines.radiance.bsdf import KEYS, klems_patch_rings, wrap_klems
 from radtree.errors import EngineError
 from radtree.optics import KLEMS_FULL_RINGS, Plastic
-from radtree.pipeline.assemble import facade_frame
 from radtree.scene import Mesh, Scene
+from radtree.site.frame import FacadeFrame
 from radtree.trees.build import build_tree
 from radtree.trees.envelope import dome_spec
 from radtree.trees.louvers_dome import dome_layer_radii
@@ -92,7 +92,7 @@ def curved_ring_row(project: Project, scenario: Scenario, tree: Tree, lo_deg: fl
     slats of ``scenario``'s sensor dome (``tree``: its tree, switches applied; see the module
     docstring)."""
     project = effective_project(project, scenario)
-    frame = facade_frame(project)
+    frame = FacadeFrame(azimuth_deg=project.street.facade_azimuth_deg)
     model = build_tree(project, scenario, frame)
     spec = dome_spec(tree, project.sensors, project.street)
     radii = dome_layer_radii(spec, tree.louvers, project.sensors)
