@@ -13,7 +13,7 @@ from radtree.optics import Trans
 from radtree.pipeline.crown_bsdf import scenario_tree
 from radtree.pipeline.dome_curvature import RingRow, curved_flux, curved_ring_row, planar_ring_row
 from radtree.scene import Mesh, Scene
-from tests.conftest import MENDOZA
+from tests.conftest import MENDOZA, copy_project, needs_radiance
 
 
 def leaf_sheet() -> Scene:
@@ -73,3 +73,34 @@ def test_curved_mendoza_dome_passes_more_scattered_light_than_its_planar_stack()
     low, high = (float(r.weight[1:].sum()) for r in rows)
     assert 0.011 < low < 0.016 and 0.023 < high < 0.031   # ≈ 0.0135 and 0.0272
     assert 0 < rows[0].reflected < rows[1].reflected < 0.1
+
+
+@needs_radiance
+def test_scenario_xml_of_the_dome_carries_the_traced_row(tmp_path):
+    """representation = "bsdf" on the dome: the computed XML (checkBSDF accepts it) has the
+    planar sample's matrices but for the normal-outgoing row, whose ring sums are the traced
+    ones; T + R stays ≤ 1 and the ring exchanges stay reciprocal."""
+    from radtree.bsdf.klems import read_klems
+    from radtree.pipeline.crown_bsdf import scenario_xmls
+
+    proj_dir = copy_project(tmp_path / "p", hours=["12:30"])
+    text = (proj_dir / "radtree.toml").read_text().replace(
+        "[tree.dome]", 'representation = "bsdf"\n\n[tree.bsdf]\nsamples = 20\nbands = 1\n\n'
+        "[tree.dome]")
+    (proj_dir / "radtree.toml").write_text(text)
+    p = load_project(proj_dir)
+    sc = p.scenario("B")
+    [(lo, hi, xml)] = scenario_xmls(p, sc)
+    assert (lo, hi) == (0.0, 90.0) and xml.parent.name == "curved"
+    planar = read_klems(xml.parent.parent / "leaf_on.xml")
+    curved = read_klems(xml)
+    ring, lam = klems_patch_rings()
+    traced = np.bincount(ring, curved.matrices["tf"][0] * lam, minlength=9)
+    row = curved_ring_row(p, sc, scenario_tree(p, sc)[0], 0.0, 90.0, 400_000)
+    np.testing.assert_allclose(traced, row.weight, rtol=2e-3, atol=1e-7)   # XML rounding
+    np.testing.assert_allclose(curved.matrices["rf"], planar.matrices["rf"], rtol=2e-3,
+                               atol=1e-6)
+    assert max(curved.energy_excess().values()) <= 1e-6
+    assert curved.reciprocity_error(75.0)["t"] <= planar.reciprocity_error(75.0)["t"] + 1e-3
+    # a second call reuses the cached XML
+    assert scenario_xmls(p, sc)[0][2] == xml

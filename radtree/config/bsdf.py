@@ -20,7 +20,8 @@ crossed along ``depth_m`` / cos θ — grazing light, which passes the rim of a 
 through a short chord, then crosses the thickest layer. ``curvature`` (sensor dome):
 ``"traced"`` (default) replaces the planar sample's view from the dome's centre (the row of
 the normal outgoing patch, ring by ring) by the one traced through the curved dome's own
-slats (:mod:`radtree.pipeline.dome_curvature`); ``"planar"`` keeps the flat stack's.
+slats (:mod:`radtree.pipeline.dome_curvature`); ``"planar"`` keeps the flat stack's (a given
+``xml`` is used as it is).
 ``tensor_tree``: 0, or the log2 resolution
 of an extra rank-4 tensor-tree XML. ``xml``: use this leaf-on XML instead of computing it
 (computed XMLs are cached under ``build/bsdf/<scenario>/``).
