@@ -11,7 +11,13 @@ from radtree.engines.numpy.transfer import trace_escapes
 from radtree.engines.radiance.bsdf import klems_patch_rings
 from radtree.optics import Trans
 from radtree.pipeline.crown_bsdf import scenario_tree
-from radtree.pipeline.dome_curvature import RingRow, curved_flux, curved_ring_row, planar_ring_row
+from radtree.pipeline.dome_curvature import (
+    RingRow,
+    curved_dome,
+    curved_flux,
+    curved_ring_row,
+    planar_ring_row,
+)
 from radtree.scene import Mesh, Scene
 from tests.conftest import MENDOZA, copy_project, needs_radiance
 
@@ -65,8 +71,8 @@ def test_curved_mendoza_dome_passes_more_scattered_light_than_its_planar_stack()
     p = load_project(MENDOZA)
     sc = p.scenario("B")
     tree = scenario_tree(p, sc)[0]
-    rows = [curved_ring_row(p, sc, tree, lo, hi, paths=60_000) for lo, hi in ((0, 30),
-                                                                              (60, 90))]
+    dome = curved_dome(p, sc, tree)
+    rows = [curved_ring_row(dome, lo, hi, paths=60_000) for lo, hi in ((0, 30), (60, 90))]
     for row in rows:
         assert 0.016 < row.weight[0] < 0.021          # ≈ 0.0186 (1.2 M paths)
         assert np.all(row.stderr < 0.1 * row.weight + 1e-4)
@@ -96,7 +102,7 @@ def test_scenario_xml_of_the_dome_carries_the_traced_row(tmp_path):
     curved = read_klems(xml)
     ring, lam = klems_patch_rings()
     traced = np.bincount(ring, curved.matrices["tf"][0] * lam, minlength=9)
-    row = curved_ring_row(p, sc, scenario_tree(p, sc)[0], 0.0, 90.0, 400_000)
+    row = curved_ring_row(curved_dome(p, sc, scenario_tree(p, sc)[0]), 0.0, 90.0, 400_000)
     np.testing.assert_allclose(traced, row.weight, rtol=2e-3, atol=1e-7)   # XML rounding
     np.testing.assert_allclose(curved.matrices["rf"], planar.matrices["rf"], rtol=2e-3,
                                atol=1e-6)

@@ -32,6 +32,13 @@ from radtree.engines.radiance.bsdf import (
 )
 from radtree.errors import ConfigError
 from radtree.fileio import write_text
+from radtree.pipeline.dome_curvature import (
+    CURVATURE_PATHS,
+    CurvedDome,
+    curved_dome,
+    curved_ring_row,
+    write_curved_xml,
+)
 from radtree.site.frame import FacadeFrame
 from radtree.trees.bsdf_shell import WALL_BAND, build_bsdf_crown
 from radtree.trees.build import apply_switches
@@ -208,27 +215,32 @@ def scenario_xmls(project: Project, scenario: Scenario,
         if h > 0:
             jobs.append(("leaf_on_wall", *WALL_BAND, 0.0, h))
     out = []
+    dome: list[CurvedDome] = []   # the explicit dome, built once for all bands that need it
+
+    def curved() -> CurvedDome:
+        if not dome:
+            dome.append(curved_dome(project, scenario, tree))
+        return dome[0]
+
     for name, lo, hi, el, half in jobs:
         folder = project.build_dir / "bsdf" / scenario.name / name
         sample = leaf_on_sample(project, scenario, el, half)
         run = ensure_bsdf(sample, settings, folder, name, progress)
         xml = run.xml
         if form == "dome" and tree.bsdf.curvature == "traced":
-            xml = ensure_curved(project, scenario, tree, sample, settings, folder, name, lo, hi,
+            xml = ensure_curved(project, tree, curved, sample, settings, folder, name, lo, hi,
                                 progress)
         out.append((lo, hi, xml))
     return out
 
 
-def ensure_curved(project: Project, scenario: Scenario, tree: Tree,
+def ensure_curved(project: Project, tree: Tree, dome: Callable[[], CurvedDome],
                   sample: SlabSample | RingSamples, settings: FluxSettings, folder: Path,
                   name: str, lo: float, hi: float,
                   progress: Callable[[str], None] | None = None) -> Path:
     """The dome band's XML with the view from the centre traced through the curved slats
-    (:mod:`radtree.pipeline.dome_curvature`), in ``folder/curved/``; reused when the planar
-    sample's key and the trace's settings match."""
-    from radtree.pipeline.dome_curvature import CURVATURE_PATHS, curved_ring_row, write_curved_xml
-
+    (``dome()``, :mod:`radtree.pipeline.dome_curvature`), in ``folder/curved/``; reused when
+    the planar sample's key and the trace's settings match."""
     key = (f"{sample_key(sample, settings)}|{lo:g}|{hi:g}|{CURVATURE_PATHS}|"
            f"{tree.louvers.seed}|{tree.dome.radius_m:g}|{project.sensors.radius_m:g}|"
            f"{project.sensors.offset_m:g}|{project.street.facade_azimuth_deg:g}")
@@ -236,8 +248,7 @@ def ensure_curved(project: Project, scenario: Scenario, tree: Tree,
     xml, key_file = sub / f"{name}_curved.xml", sub / "key.txt"
     if xml.exists() and key_file.exists() and key_file.read_text().strip() == key:
         return xml
-    row = curved_ring_row(project, scenario, tree, lo, hi, CURVATURE_PATHS,
-                          workers=os.cpu_count() or 1)
+    row = curved_ring_row(dome(), lo, hi, CURVATURE_PATHS, workers=os.cpu_count() or 1)
     comment = (f"radtree crown BSDF: {sample.name}, curved dome |elevation| {lo:g}–{hi:g}°: "
                f"the normal-outgoing row traced through the dome's slats ({row.paths} paths); "
                + " ".join(sample.notes))[:900]

@@ -34,7 +34,7 @@ import trimesh
 from radtree.config import Project, Scenario, effective_project
 from radtree.config.schema import Tree
 from radtree.engines.numpy.transfer import trace_escapes
-from radtree.engines.radiance.bsdf import KEYS, klems_patch_rings, wrap_klems
+from radtree.engines.radiance.bsdf import KEYS, klems_patch_rings, wrap_flux
 from radtree.errors import EngineError
 from radtree.optics import KLEMS_FULL_RINGS, Plastic
 from radtree.scene import Mesh, Scene
@@ -85,12 +85,20 @@ def band_directions(n_world: np.ndarray, lo_deg: float, hi_deg: float, count: in
     return np.vstack(out)[:count]
 
 
-def curved_ring_row(project: Project, scenario: Scenario, tree: Tree, lo_deg: float,
-                    hi_deg: float, paths: int = 200_000, seed: int = 1, workers: int = 2
-                    ) -> RingRow:
-    """Trace the normal-outgoing row of the band |elevation| ∈ [lo, hi]° through the explicit
-    slats of ``scenario``'s sensor dome (``tree``: its tree, switches applied; see the module
-    docstring)."""
+@dataclass(frozen=True)
+class CurvedDome:
+    """The explicit slats of a scenario's sensor dome with the sink inside them, ready to
+    trace: the scene (world axes, metres), the dome's centre, the sink's radius and the façade
+    normal (the sensors' axis)."""
+
+    scene: Scene
+    centre: np.ndarray
+    sink_radius: float
+    normal: np.ndarray
+
+
+def curved_dome(project: Project, scenario: Scenario, tree: Tree) -> CurvedDome:
+    """Build :class:`CurvedDome` of ``scenario`` (``tree``: its tree, switches applied)."""
     project = effective_project(project, scenario)
     frame = FacadeFrame(azimuth_deg=project.street.facade_azimuth_deg)
     model = build_tree(project, scenario, frame)
@@ -105,12 +113,18 @@ def curved_ring_row(project: Project, scenario: Scenario, tree: Tree, lo_deg: fl
     meshes = [m for m in model.meshes if m.material != TRUNK]
     meshes.append(Mesh(SINK, SINK, np.asarray(ball.vertices) + centre, np.asarray(ball.faces)))
     materials = {**model.materials, SINK: Plastic(SINK, 0.0)}
-    scene = Scene(meshes, materials, {}, [])
+    return CurvedDome(Scene(meshes, materials, {}, []), centre, sink_r, frame.normal)
+
+
+def curved_ring_row(dome: CurvedDome, lo_deg: float, hi_deg: float, paths: int = 200_000,
+                    seed: int = 1, workers: int = 2) -> RingRow:
+    """Trace the normal-outgoing row of the band |elevation| ∈ [lo, hi]° through the dome's
+    explicit slats (see the module docstring)."""
     rng = np.random.default_rng(seed)
-    d = band_directions(frame.normal, lo_deg, hi_deg, paths, rng)
+    d = band_directions(dome.normal, lo_deg, hi_deg, paths, rng)
     # start just outside the sink (its facets lie inside the sphere by < 0.3 %)
-    origins = centre + (sink_r + 1e-3) * d
-    esc = trace_escapes(scene, origins, d, seed=seed + 1, workers=workers)
+    origins = dome.centre + (dome.sink_radius + 1e-3) * d
+    esc = trace_escapes(dome.scene, origins, d, seed=seed + 1, workers=workers)
     cos = np.einsum("ij,ij->i", esc.direction, d[esc.path])
     theta = np.degrees(np.arccos(np.clip(cos, -1.0, 1.0)))
     front = cos > 0
@@ -152,9 +166,6 @@ def write_curved_xml(planar_folder: Path, folder: Path, name: str, row: RingRow,
     (:func:`curved_flux`), wrapped into ``folder/<name>.xml``; returns it and the factors."""
     flux = {k: np.loadtxt(planar_folder / f"{k}.dat", ndmin=2) for k in KEYS}
     curved, factor = curved_flux(flux, row)
-    folder.mkdir(parents=True, exist_ok=True)
-    for k, m in curved.items():
-        np.savetxt(folder / f"{k}.dat", m, fmt="%.7e", delimiter="\t")
     if progress:
         progress(f"curvature: ring factors {np.array2string(factor, precision=3)}")
-    return wrap_klems(folder, name, thickness, width, height, comment), factor
+    return wrap_flux(folder, curved, name, thickness, width, height, comment), factor

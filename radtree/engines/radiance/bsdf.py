@@ -260,11 +260,18 @@ def klems_bsdf_rings(folder: Path, ring_folders: list[Path], settings: FluxSetti
                 raise EngineError(f"{sub / key}.dat: {m.shape} values, expected 145 × 145",
                                   command=["rfluxmtx"], stderr="")
             flux[key][:, cols] = m[:, cols]
-    folder.mkdir(parents=True, exist_ok=True)
-    for key, m in reciprocal_rings(flux).items():
-        np.savetxt(folder / f"{key}.dat", m, fmt="%.7e", delimiter="\t")
-    xml = wrap_klems(folder, name, thickness, width, height, comment)
+    xml = wrap_flux(folder, reciprocal_rings(flux), name, thickness, width, height, comment)
     return BsdfRun(xml, check_bsdf(xml), time.perf_counter() - t0)
+
+
+def wrap_flux(folder: Path, flux: dict[str, np.ndarray], name: str, thickness: float,
+              width: float, height: float, comment: str = "") -> Path:
+    """The four flux matrices F[out, in] (``tf rf tb rb``) written to ``folder/*.dat`` and
+    wrapped (:func:`wrap_klems`) into ``folder/<name>.xml``."""
+    folder.mkdir(parents=True, exist_ok=True)
+    for key in KEYS:
+        np.savetxt(folder / f"{key}.dat", flux[key], fmt="%.7e", delimiter="\t")
+    return wrap_klems(folder, name, thickness, width, height, comment)
 
 
 def check_bsdf(xml: Path) -> str:
