@@ -31,6 +31,7 @@ MENDOZA_OVERRIDES = {
     "site.hours": ["10:30", "13:30"],
     "sensors.dense_hours": ["13:30"],
     "engine.rays": 256,
+    "engine.dense_rays": 256,   # the map with the sensors' paths, as before dense_rays
     "engine.seed": 1,
 }
 # Radiance: one hour, -ad 64 (deep -ab runs cost ~ad²), no dense map
@@ -54,6 +55,8 @@ def _copy(example: str, dst: Path) -> Path:
     text = (dst / "radtree.toml").read_text()
     # scenario F: 2 crown realisations instead of 8
     text = text.replace('"louvers.realisations" = 8', '"louvers.realisations" = 2')
+    # ... traced with the reduced rays per sensor, not F's own engine.rays switch
+    text = text.replace(', "engine.rays" = 2048 }', ' }')
     # the photo-derived scenarios (A-photo, C-photo, F-photo) are checked by
     # tests/test_photo_crowns.py, not here: the golden tables hold A–F
     text = drop_photo_scenarios(text)

@@ -34,6 +34,7 @@ from radtree.errors import ConfigError, RadtreeError
 from radtree.figures import new_figure, save_png
 from radtree.fileio import atomic_path
 from radtree.measurements import hourly_grid_means
+from radtree.pipeline.processes import spawned_map, usable_cores, with_threads
 from radtree.pipeline.trace import facade_total, trace_scenario
 from radtree.stats import nmbe, nrmse, pearson_r
 
@@ -103,6 +104,19 @@ def _sum(project: Project, sc: Scenario, rays: int, seed: int) -> tuple[float, f
     return facade_total(project, sc, seeded_engine(), rays, seed)
 
 
+#: one trace of the scan: "sum" (Σ over hours of the façade mean, its s.e.) or "hourly" (the
+#: scenario's façade mean per hour, as simulated: calculated ground terms included)
+_Job = tuple[str, Project, Scenario]
+
+
+def _run_job(job: tuple[str, Project, Scenario, int, int]) -> Any:
+    kind, project, sc, rays, seed = job
+    if kind == "sum":
+        return _sum(project, sc, rays, seed)
+    sim = trace_scenario(project, sc, seeded_engine(), rays, seed, grids=["facade"])
+    return sim.groupby("time")["lux"].mean()
+
+
 def _ratio(num: tuple[float, float], den: tuple[float, float]) -> tuple[float, float]:
     p = num[0] / den[0]
     return p, p * math.hypot(num[1] / num[0], den[1] / den[0])
@@ -144,22 +158,31 @@ def scan_permeability(project: Project, scenario: str = "A",
 
     sky_project = replace(project, light=replace(project.light, sky="perez"))
     open_sc = Scenario("open", "none", "traced", switches=dict(sc0.switches))
-    open_street = _sum(project, open_sc, rays, seed)
-    unob = _sum(unobstructed_project(project), open_sc, rays, seed)
+    crowns, fits = [], []
+    for v in values:
+        sw = {**sc0.switches, field: v}
+        crowns.append(Scenario(f"{scenario}:{field}={v}", sc0.model, "traced", form=sc0.form,
+                               switches=sw))
+        fits.append(replace(sc0, switches=sw))
+    # every trace is independent: 2 + 3 per value, in worker processes sharing the cores
+    jobs: list[_Job] = [("sum", project, open_sc), ("sum", unobstructed_project(project), open_sc)]
+    for crown, fit in zip(crowns, fits, strict=True):
+        jobs += [("sum", project, crown), ("sum", sky_project, crown), ("hourly", project, fit)]
+    workers = min(usable_cores(), len(jobs))
+    threads = max(1, usable_cores() // workers)
+    echo(f"{len(jobs)} traces ({len(values)} values × 3 + 2 references, {rays} rays/sensor) in "
+         f"{workers} process{'es' if workers > 1 else ''}")
+    out = spawned_map(_run_job, [(kind, with_threads(p, threads), sc, rays, seed)
+                                 for kind, p, sc in jobs], workers)
+    open_street, unob = out[0], out[1]
     echo(f"open street: Σ façade {open_street[0]:.0f} lx; unobstructed reference (sun + "
          f"{project.light.diffuse_horizontal_lux:g} lx sky): Σ {unob[0]:.0f} lx")
     rows = []
-    hours: list[str] = []
-    for v in values:
-        sw = {**sc0.switches, field: v}
-        crown = Scenario(f"{scenario}:{field}={v}", sc0.model, "traced", form=sc0.form,
-                         switches=sw)
-        p_street = _ratio(_sum(project, crown, rays, seed), open_street)
-        p_unob = _ratio(_sum(sky_project, crown, rays, seed), unob)
-        sim = trace_scenario(project, replace(sc0, switches=sw), seeded_engine(), rays, seed,
-                             grids=["facade"])
-        hourly = sim.groupby("time")["lux"].mean()
-        hours = list(m.index)
+    hours: list[str] = list(m.index)
+    for k, v in enumerate(values):
+        street, sky, hourly = out[2 + 3 * k: 5 + 3 * k]
+        p_street = _ratio(street, open_street)
+        p_unob = _ratio(sky, unob)
         s = hourly.reindex(m.index).to_numpy()
         row = {"value": float(v), "permeability_street": p_street[0],
                "permeability_street_se": p_street[1], "permeability_unobstructed": p_unob[0],

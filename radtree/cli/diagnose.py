@@ -56,8 +56,9 @@ from radtree.engines.registry import ENGINES
               help="With --next-measurement: a campaign TOML whose groups/hours/days are the "
                    "candidates (default: generated).")
 @click.option("--workers", type=click.IntRange(min=1), default=None,
-              help="Self-test: processes tracing ahead and diagnosing the hidden effects "
-                   "(same numbers as 1) [default: the usable cores, at most 4].")
+              help="Processes tracing ahead: each step's candidate signatures (and, with "
+                   "--selftest, the hidden effects' diagnoses); the same numbers as 1 "
+                   "[default: the usable cores, at most 4].")
 @click.option("--out", type=click.Path(file_okay=False),
               help="Output folder. Default: PROJECT/diagnose.")
 @click.option("--list-effects", is_flag=True, help="Print the effect catalogue and exit.")
@@ -136,7 +137,7 @@ def diagnose_command(project: str | None, measured: str | None, units: str | Non
     from radtree.diagnose.run import diagnose, format_steps
 
     res_d = diagnose(project, measured, units, scenario, engine, rays, seed, margin, max_steps,
-                     chosen, out, echo=click.echo, campaign=camp)
+                     chosen, out, echo=click.echo, campaign=camp, workers=workers)
     for line in format_steps(res_d.loop):
         click.echo(line)
     click.echo(f"done in {res_d.seconds:.0f} s ({res_d.simulations} simulations): "

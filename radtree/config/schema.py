@@ -306,7 +306,8 @@ class EngineParams(Checked):
     (written ``as`` in the file), ``ar``, ``aa``, ``lw``. The defaults (``-aa 0 -as 0``: no
     irradiance cache, no super-sampling) are pure Monte Carlo: behind slat crowns the cache and
     ``-as`` bias ``-I`` low by 4–8 % and the cache makes ``-ab 7`` runs take minutes instead of
-    seconds. NumPy engine: ``rays`` per sensor, ``max_bounces``, ``seed``."""
+    seconds. NumPy engine: ``rays`` per sensor (``dense_rays`` per dense-map point), ``max_bounces``,
+    ``seed``."""
 
     TABLE: ClassVar[str] = "engine"
     # an engine name of radtree.engines.registry (checked when the engine is chosen)
@@ -345,8 +346,9 @@ class EngineParams(Checked):
     pmap_photons: int | None = field(default=None, metadata=meta(1))
     pmap_caustic_photons: int | None = field(default=None, metadata=meta(1))
     pmap_bandwidth: int = field(default=50, metadata=meta(1))
-    # Radiance: -lw of the dense façade map grid only (None = lw); the map is a figure
+    # the dense façade map (a figure) only: Radiance -lw (None = lw), NumPy paths (None = rays)
     dense_lw: float | None = field(default=None, metadata=meta(0.0, 1.0))
+    dense_rays: int | None = field(default=None, metadata=meta(1))
 
 
 #: the :class:`EngineParams` fields only the Radiance photon map reads
@@ -438,7 +440,7 @@ class Project:
         if payload["tree"].get("species") is None:  # no species: hashes unchanged
             payload["tree"].pop("species", None)
         payload["engine"].pop("workers", None)
-        for key in FORWARD_KEYS + PMAP_KEYS:  # at their defaults: hashes unchanged
+        for key in FORWARD_KEYS + PMAP_KEYS + ("dense_rays",):  # at defaults: hashes unchanged
             if payload["engine"].get(key) == getattr(EngineParams, key):
                 payload["engine"].pop(key, None)
         if self.honeybee is not None:   # absent otherwise: other projects' hashes unchanged

@@ -160,6 +160,8 @@ def compute_signatures(sim: Simulator, ctx: EffectContext, base: Scenario, base_
     out: dict[str, Signature] = {}
     row_names = list(base_run.rows.columns)
     base_rows = base_run.row_daily().to_numpy(float)
+    effects = tuple(effects)
+    sim.trace_ahead(signature_scenarios(ctx, base, effects))
     for e in effects:
         st = e.strength(ctx, base)
         kind = "binary" if st is None else st.mode

@@ -21,6 +21,7 @@ from __future__ import annotations
 import hashlib
 import json
 import time
+from collections.abc import Callable
 from dataclasses import dataclass, field, replace
 from typing import Any
 
@@ -101,6 +102,10 @@ class Simulator:
     _scenes: dict[str, Any] = field(default_factory=dict, repr=False)
     _grid: Any = field(default=None, repr=False)
     _engine: Engine = field(init=False, repr=False)
+    #: traces scenarios ahead (e.g. :meth:`radtree.diagnose.parallel.TracePool.prefetch` in
+    #: worker processes); None: every run is traced here when it is asked for
+    ahead: Callable[[Simulator, list[Scenario]], int] | None = field(default=None,
+                                                                    repr=False)
 
     def __post_init__(self) -> None:
         self._engine = engine_named(self.engine)
@@ -193,6 +198,11 @@ class Simulator:
     def traced_cache(self) -> dict[str, Any]:
         """The traced parts kept so far, by traced key (what :meth:`store_traced` fills)."""
         return self._traced
+
+    def trace_ahead(self, scenarios: list[Scenario]) -> int:
+        """Let :attr:`ahead` trace ``scenarios`` before they are run (same numbers); returns
+        how many it traced (0 without :attr:`ahead`)."""
+        return 0 if self.ahead is None else self.ahead(self, scenarios)
 
     def has_traced(self, sc: Scenario) -> bool:
         """True when the traced part of ``sc`` is cached (only ground terms left to add)."""

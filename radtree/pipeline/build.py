@@ -2,17 +2,21 @@
 
 Each holds the scene as the folder engine (Radiance) writes it — ``materials.rad``,
 ``geometry/``, ``skies/``, ``grids/*.pts``, a Makefile per hour — plus ``model.png`` (in the
-first crown realisation only: the one the report shows) and a
-``manifest.json`` carrying the scenario's parameter hash, by which a stale folder is detected;
-``build/Makefile`` runs them all.
+first crown realisation only: the one the report shows), ``scene.pickle`` (radtree's own
+in-memory scene: ``simulate`` and ``report`` load it instead of building the crowns again,
+:func:`built_scene`) and a ``manifest.json`` carrying the scenario's parameter hash and every
+file's checksum, by which a stale folder is detected; ``build/Makefile`` runs them all.
 """
 
 from __future__ import annotations
 
 import json
+import multiprocessing
+import pickle
 import shutil
 import time
 from collections.abc import Callable, Iterable
+from concurrent.futures import Future, ProcessPoolExecutor
 from pathlib import Path
 from typing import Any
 
@@ -21,8 +25,9 @@ from radtree.config import Project, Scenario, effective_project
 from radtree.engines.registry import folder_engine
 from radtree.fileio import atomic_dir, write_text
 from radtree.light.hours import hour_states
-from radtree.pipeline.assemble import make_scene
+from radtree.pipeline.assemble import BuiltScene, make_scene
 from radtree.pipeline.manifest import file_sha256, manifest
+from radtree.pipeline.processes import usable_cores
 from radtree.pipeline.realisations import (
     REALISATION_MARK,
     is_later_realisation,
@@ -52,42 +57,103 @@ def build_project(project: Project, scenarios: list[str] | None = None,
     facts: dict[str, dict] = {}
     build_root = project.build_dir
     build_root.mkdir(parents=True, exist_ok=True)
-    for sc in progress_bar(chosen, "build", progress, unit="scenario"):
-        t0 = time.perf_counter()
-        states = hour_states(project, sc)
-        prep = time.perf_counter() - t0
-        built = make_scene(project, sc)
-        t1 = time.perf_counter()
-        with atomic_dir(build_root / sc.name) as tmp:
-            names = list(built.scene.grids)
-            at = {st.label: hour_grids(project, st.time, names, None, sc) for st in states}
-            engine.write_folder(built.scene, states, effective_project(project, sc).engine,
-                                built.ab, tmp, sc.name, at)
-            if pictures and built.tree is not None and project.district is None \
-                    and not is_later_realisation(sc.name):   # the report shows F@1's
-                from radtree.trees.picture import render_model_png
-
-                render_model_png(built.tree, built.scene, tmp / "model.png")
-            facts[sc.name] = {
-                "scenario": sc.name, "model": sc.model, "reflection": sc.reflection,
-                "form": sc.form or project.tree.form, "ab": built.ab,
-                "triangles": built.triangles, "notes": built.notes, "info": built.info,
-                "params_hash": project.params_hash(sc),
-                "photo": getattr(built.tree, "photo", None),
-                "seconds": {"preparation": prep, "geometry": built.geometry_seconds,
-                            "writing": time.perf_counter() - t1},
-            }
-            write_text(tmp / "manifest.json", json.dumps(
-                manifest(project, extra={"build": facts[sc.name], "files": folder_files(tmp)}),
-                indent=2, default=str))
-        echo(f"  {sc.name}: {sc.model} ({facts[sc.name]['form']}), {built.triangles} triangles, "
-             f"-ab {built.ab}, geometry {built.geometry_seconds:.2f} s → {build_root / sc.name}")
+    drawn = [sc for sc in chosen if pictures and project.district is None
+             and not is_later_realisation(sc.name)]   # the report shows F@1's picture
+    with _Pictures(len(drawn)) as painter:
+        for sc in progress_bar(chosen, "build", progress, unit="scenario"):
+            _build_one(project, sc, engine, build_root, facts, painter if sc in drawn else None,
+                       echo)
     _remove_stale_builds(project, chosen)
     engine.write_index(build_root, [s.name for s in selected(project, None)
                                     if (build_root / s.name).exists()])
     return facts
 
 
+class _Pictures:
+    """Draws ``model.png`` of the build folders: in one spawned worker process while the next
+    folders are built (two usable cores or more and several pictures), else here. Every
+    picture is written (atomically) before the context ends; a drawing error is raised then."""
+
+    def __init__(self, count: int):
+        self._pool = (ProcessPoolExecutor(1, mp_context=multiprocessing.get_context("spawn"))
+                      if count > 1 and usable_cores() > 1 else None)
+        self._futures: list[Future[Path]] = []
+
+    def __enter__(self) -> _Pictures:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        if self._pool is None:
+            return
+        try:
+            if exc[0] is None:
+                for f in self._futures:
+                    f.result()
+        finally:
+            self._pool.shutdown(wait=True, cancel_futures=True)
+
+    def draw(self, tree: Any, scene: Any, path: Path) -> None:
+        from radtree.trees.picture import render_model_png
+
+        if self._pool is None:
+            render_model_png(tree, scene, path)
+        else:
+            self._futures.append(self._pool.submit(render_model_png, tree, scene, path))
+
+
+def _build_one(project: Project, sc: Scenario, engine: Any, build_root: Path,
+               facts: dict[str, dict], painter: _Pictures | None,
+               echo: Callable[[str], None]) -> None:
+    """Write ``build/<sc>/`` (its picture drawn by ``painter`` when given) into ``facts``."""
+    t0 = time.perf_counter()
+    states = hour_states(project, sc)
+    prep = time.perf_counter() - t0
+    built = make_scene(project, sc)
+    t1 = time.perf_counter()
+    with atomic_dir(build_root / sc.name) as tmp:
+        names = list(built.scene.grids)
+        at = {st.label: hour_grids(project, st.time, names, None, sc) for st in states}
+        engine.write_folder(built.scene, states, effective_project(project, sc).engine,
+                            built.ab, tmp, sc.name, at)
+        facts[sc.name] = {
+            "scenario": sc.name, "model": sc.model, "reflection": sc.reflection,
+            "form": sc.form or project.tree.form, "ab": built.ab,
+            "triangles": built.triangles, "notes": built.notes, "info": built.info,
+            "params_hash": project.params_hash(sc),
+            "photo": getattr(built.tree, "photo", None),
+            "seconds": {"preparation": prep, "geometry": built.geometry_seconds,
+                        "writing": time.perf_counter() - t1},
+        }
+        with (tmp / SCENE_FILE).open("wb") as f:   # inside the atomic folder
+            pickle.dump(built, f, protocol=5)
+        write_text(tmp / "manifest.json", json.dumps(
+            manifest(project, extra={"build": facts[sc.name], "files": folder_files(tmp)}),
+            indent=2, default=str))
+    if painter is not None and built.tree is not None:   # model.png: not a scene file
+        painter.draw(built.tree, built.scene, build_root / sc.name / "model.png")
+    echo(f"  {sc.name}: {sc.model} ({facts[sc.name]['form']}), {built.triangles} triangles, "
+         f"-ab {built.ab}, geometry {built.geometry_seconds:.2f} s → {build_root / sc.name}")
+
+
+def built_scene(project: Project, sc: Scenario) -> BuiltScene:
+    """``make_scene(project, sc)``: loaded from ``build/<sc>/scene.pickle`` when that folder is
+    current (:func:`build_staleness`: same radtree version, parameters and files — the
+    pickle's checksum included), else built anew. The photo crowns take 1–2 s to build, the
+    pickle milliseconds to load."""
+    path = project.build_dir / sc.name / SCENE_FILE
+    if path.is_file() and build_is_current(project, sc):
+        try:
+            with path.open("rb") as f:
+                built = pickle.load(f)
+            if isinstance(built, BuiltScene):
+                return built
+        except (OSError, pickle.UnpicklingError, EOFError, AttributeError, ImportError):
+            pass   # unreadable: built anew below
+    return make_scene(project, sc)
+
+
+#: radtree's in-memory scene of a build folder (:func:`built_scene`)
+SCENE_FILE = "scene.pickle"
 #: written by the engine while tracing (not part of the built scene)
 _OUTPUTS = ("manifest.json", "model.png", "octrees", "results")
 

@@ -26,11 +26,12 @@ from radtree.fileio import atomic_path, make_folder, write_text
 from radtree.light.hours import hour_states
 from radtree.light.sky import SkyState
 from radtree.lock import PUBLISH_NAME, folder_lock
-from radtree.pipeline.assemble import BuiltScene, make_scene
-from radtree.pipeline.build import ensure_built, hour_grids, progress_bar
+from radtree.pipeline.assemble import BuiltScene
+from radtree.pipeline.build import built_scene, ensure_built, hour_grids, progress_bar
 from radtree.pipeline.limits import check_memory
 from radtree.pipeline.manifest import manifest
 from radtree.pipeline.parts import check_part, write_part
+from radtree.pipeline.processes import usable_cores, with_threads
 from radtree.pipeline.realisations import merge_realisations, parent_name, selected
 from radtree.pipeline.results import hour_rows, in_column_order, merge_write, results_path
 from radtree.scene import Scene
@@ -121,7 +122,7 @@ def prepare_scenario(project: Project, sc: Scenario, engine: Engine,
     t0 = time.perf_counter()
     states = hour_states(project, sc, hours)
     seconds = time.perf_counter() - t0
-    built = make_scene(project, sc)
+    built = built_scene(project, sc)
     scene = built.scene
     if scene.instances and not engine.instancing:
         extra = scene.instanced_triangles()
@@ -153,8 +154,15 @@ def simulate_project(project: Project, engine: str | Engine = "auto",
     timing: dict[str, dict[str, float]] = {}
     prepared: dict[str, _Prepared] = {}
     tasks: list[tuple[Scenario, SkyState]] = []
+    traced_here = project
+    if not eng.uses_build_folder and executor is None:
+        # an in-process engine's threads per hour: the cores shared out over the hours traced
+        # at once (its numbers do not depend on them; 2 hours × 1 thread take ~20 % less CPU
+        # and wall time than 2 × 2 on 2 cores)
+        at_once = max(1, min(workers, len(chosen) * len(hours or project.site.hours)))
+        traced_here = with_threads(project, max(1, usable_cores() // at_once))
     for sc in chosen:
-        prep = prepare_scenario(project, sc, eng, hours, echo)
+        prep = prepare_scenario(traced_here, sc, eng, hours, echo)
         prepared[sc.name] = prep
         timing[sc.name] = {"preparation_s": prep.seconds,
                            "geometry_s": prep.built.geometry_seconds, "tracing_s": 0.0}

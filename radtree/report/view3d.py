@@ -153,10 +153,10 @@ def write_view(project: Project, table: pd.DataFrame, out: Path) -> dict[str, An
         import plotly  # noqa: F401
     except ImportError:
         return None
-    from radtree.pipeline.assemble import make_scene
+    from radtree.pipeline.build import built_scene
 
     names = list(dict.fromkeys(table["scenario"].astype(str)))
-    scenes = {sc.name: make_scene(project, sc).scene for sc in project.scenarios
+    scenes = {sc.name: built_scene(project, sc).scene for sc in project.scenarios
               if sc.name in names and (project.build_dir / sc.name / "geometry").is_dir()}
     if not scenes:
         return None

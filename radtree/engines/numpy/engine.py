@@ -72,6 +72,7 @@ from radtree.errors import EngineError
 from radtree.light.sky import SkyState
 from radtree.light.sun import SUN_HALF_ANGLE_DEG
 from radtree.scene import Scene, SensorGrid
+from radtree.sensor_grid import DENSE_GRID
 
 __all__ = ["DEFAULT_OPTIONS", "ENGINE_NAME", "GLASS_INDEX", "Environment", "Geometry", "Optics",
            "TraceOptions", "describe", "glass_coefficients", "scene_geometry", "scene_optics",
@@ -423,8 +424,17 @@ def trace(scene: Scene, state: SkyState, params: EngineParams, grids: list[str] 
     seed = params.seed if seed is None else seed
     geo = scene_geometry(scene, options.backend, int(getattr(params, "workers", 2) or 1))
     tracer = _Tracer(geo, scene_optics(scene, state, geo.material_names), state, params, options)
-    return {name: _trace_grid(tracer, scene.grids[name], params.rays, _grid_seed(seed, name))
+    return {name: _trace_grid(tracer, scene.grids[name], grid_rays(params, name),
+                              _grid_seed(seed, name))
             for name in names}
+
+
+def grid_rays(params: EngineParams, grid: str) -> int:
+    """Paths per sensor of ``grid``: ``engine.dense_rays`` for the dense façade map when set,
+    else ``engine.rays``."""
+    if grid == DENSE_GRID and params.dense_rays is not None:
+        return int(params.dense_rays)
+    return int(params.rays)
 
 
 def trace_hour(scene: Scene, state: SkyState, params: EngineParams,

@@ -36,7 +36,9 @@ class NumpyEngine(InProcessEngine):
         return f"available ({describe()})"
 
     def sampling(self, params: EngineParams) -> str:
-        return f"{params.rays} rays/sensor, seed {params.seed}"
+        dense = (f" ({params.dense_rays} per dense-map point)"
+                 if params.dense_rays is not None else "")
+        return f"{params.rays} rays/sensor{dense}, seed {params.seed}"
 
     def prepare(self, scene: Scene, states: list[SkyState], params: EngineParams, ab: int,
                 folder: Path | None = None) -> NumpyPlan:
