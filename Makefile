@@ -6,9 +6,10 @@ VENV   := .venv
 BIN    := $(VENV)/bin
 STAMP  := $(VENV)/.installed
 EXAMPLE := examples/mendoza-street
-# engine of the demo's hourly runs: numpy (the built-in engine: the same numbers within their
-# Monte Carlo error, ~2.5x faster here) or radiance / auto (rtrace on the build folders).
-# The -ab convergence step runs Radiance either way. benchmarks/demo.py times every step.
+# engine of the demo's hourly runs and -ab convergence check: numpy (the built-in engine: the
+# same numbers within their Monte Carlo error, ~2.5x faster here; the whole -ab ladder from one
+# trace) or radiance / auto (rtrace on the build folders, one run per -ab).
+# benchmarks/demo.py times every step.
 DEMO_ENGINE ?= numpy
 
 .PHONY: install demo test lint typecheck pytest bench clean
@@ -25,7 +26,7 @@ demo: $(STAMP)
 	$(BIN)/radtree doctor
 	$(BIN)/radtree build $(EXAMPLE)
 	$(BIN)/radtree simulate $(EXAMPLE) --engine $(DEMO_ENGINE)
-	$(BIN)/radtree simulate $(EXAMPLE) --convergence -s A -s C -s E -s F
+	$(BIN)/radtree simulate $(EXAMPLE) --convergence -s A -s C -s E -s F --engine $(DEMO_ENGINE)
 	$(BIN)/radtree permeability $(EXAMPLE) -s A --rays 1024
 	$(BIN)/radtree diagnose $(EXAMPLE) -s A
 	$(BIN)/radtree hemi check $(EXAMPLE)

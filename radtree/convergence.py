@@ -18,9 +18,10 @@ from radtree.config import Project, effective_project
 from radtree.engines.base import Engine
 from radtree.fileio import atomic_path
 from radtree.pipeline.assemble import make_scene
+from radtree.pipeline.build import ensure_built
 from radtree.pipeline.realisations import is_later_realisation, parent_name, selected
 from radtree.pipeline.simulate import resolve_engine
-from radtree.pipeline.trace import trace_hours
+from radtree.pipeline.trace import trace_ab_ladder
 
 AB_LADDER = (1, 2, 3, 4, 6, 8)
 
@@ -38,34 +39,50 @@ def convergence_table(project: Project, scenarios: list[str] | None = None,
     ``previous`` (an earlier table, e.g. ``results/convergence.csv``): its rows with the same
     scenario, hour, ``-ab``, ``-ad``, engine and parameter hash are reused, not traced again.
     The remaining runs go ``workers`` at a time (default ``engine.workers``) for an engine that
-    runs external programs (Radiance), one at a time for an in-process engine."""
+    runs external programs (Radiance: one ``rtrace`` per ``-ab``), one at a time for an
+    in-process engine; an engine with ``ladder_in_one_trace`` (NumPy) traces each scenario-hour
+    once to the largest ``-ab`` and reads every step from the bounce orders of the same paths
+    (so the steps' changes carry correlated noise, not the noise of independent runs)."""
     eng = resolve_engine(project, engine)
     done = _known(previous)
     jobs: list[tuple] = []       # (scenario, name, built, hour, ab, ad, phash)
+    tasks: list[tuple] = []      # (built, scenario, hour, ab values to trace, folder)
     for sc in selected(project, scenarios):
         if is_later_realisation(sc.name):
             continue
         built = make_scene(project, sc, dense_grid=False)
+        # a build-folder engine (Radiance) traces the ladder in the scenario's build folder:
+        # one octree for every -ab (an option of rtrace, not of the scene), not one each
+        folder = ensure_built(project, sc, echo) if eng.uses_build_folder else None
         ad = effective_project(project, sc).engine.ad
         phash = project.params_hash(sc)
         for hour in hours or [project.site.hours[0]]:
+            todo = []
             for ab in sorted(set(ab_values) | {built.ab}):   # always the -ab simulate uses
                 jobs.append((sc, parent_name(sc.name), built, hour, ab, ad, phash))
+                if (parent_name(sc.name), hour, ab, ad, eng.name, phash) not in done:
+                    todo.append(ab)
+            # an engine that tallies bounce orders traces the ladder once, else one run per -ab
+            groups = [todo] if eng.ladder_in_one_trace else [[ab] for ab in todo]
+            tasks += [(built, sc, hour, g, folder) for g in groups if g]
 
-    def run(job: tuple) -> tuple[str, float]:
-        sc, name, built, hour, ab, ad, phash = job
-        hit = done.get((name, hour, ab, ad, eng.name, phash))
-        if hit is not None:
-            return hit
-        traced = trace_hours(project, sc, eng, [hour], ["facade"], ab=ab, built=built)
-        return traced.states[0].time, float(traced.results[0]["facade"].lux.mean())
+    def run(task: tuple) -> dict[tuple[str, str, int], float]:
+        built, sc, hour, abs_, folder = task
+        _, by_ab = trace_ab_ladder(project, sc, eng, hour, abs_, ["facade"], built, folder)
+        return {(sc.name, hour, ab): float(r["facade"].lux.mean()) for ab, r in by_ab.items()}
 
     n = max(1, workers or project.engine.workers) if eng.uses_build_folder else 1
+    traced: dict[tuple[str, str, int], float] = {}
     with ThreadPoolExecutor(max_workers=n) as pool:
-        means = list(pool.map(run, jobs))
+        for got in pool.map(run, tasks):
+            traced.update(got)
+    means = [done[(name, hour, ab, ad, eng.name, phash)][1]
+             if (name, hour, ab, ad, eng.name, phash) in done else traced[(sc.name, hour, ab)]
+             for sc, name, _, hour, ab, ad, phash in jobs]
     rows = []
     prev: dict[tuple[str, str], float] = {}
-    for (sc, name, built, hour, ab, ad, phash), (time_, mean) in zip(jobs, means):
+    for (sc, name, built, hour, ab, ad, phash), mean in zip(jobs, means, strict=True):
+        time_ = hour
         before = prev.get((name, hour))
         change = (mean - before) / before if before else float("nan")
         rows.append({"scenario": name, "model": sc.model, "time": time_, "ab": ab,

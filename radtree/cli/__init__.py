@@ -14,28 +14,49 @@ from __future__ import annotations
 import click
 
 from radtree import __version__
-from radtree.cli.annual import annual_command
-from radtree.cli.bsdf import bsdf_command
-from radtree.cli.build import build_command
-from radtree.cli.calibrate import calibrate_command
-from radtree.cli.diagnose import diagnose_command
-from radtree.cli.doctor import doctor_command
 from radtree.cli.errors import RadtreeGroup
-from radtree.cli.export import export_command
-from radtree.cli.hemi import hemi_command
-from radtree.cli.method import method_command
-from radtree.cli.new import new_command
 from radtree.cli.options import CONTEXT
-from radtree.cli.permeability import permeability_command
-from radtree.cli.report import report_command
-from radtree.cli.simulate import simulate_command
-from radtree.cli.sweep import sweep_command
-from radtree.cli.verify import verify_command
 
 __all__ = ["main"]
 
 
-@click.group(cls=RadtreeGroup, context_settings=CONTEXT)
+#: command name → "module:function", imported when the command runs (or ``--help`` lists it):
+#: ``radtree doctor`` need not load trimesh, scikit-image and matplotlib
+COMMANDS = {
+    "new": "radtree.cli.new:new_command",
+    "doctor": "radtree.cli.doctor:doctor_command",
+    "build": "radtree.cli.build:build_command",
+    "simulate": "radtree.cli.simulate:simulate_command",
+    "hemi": "radtree.cli.hemi:hemi_command",
+    "report": "radtree.cli.report:report_command",
+    "calibrate": "radtree.cli.calibrate:calibrate_command",
+    "sweep": "radtree.cli.sweep:sweep_command",
+    "diagnose": "radtree.cli.diagnose:diagnose_command",
+    "annual": "radtree.cli.annual:annual_command",
+    "permeability": "radtree.cli.permeability:permeability_command",
+    "verify": "radtree.cli.verify:verify_command",
+    "bsdf": "radtree.cli.bsdf:bsdf_command",
+    "method": "radtree.cli.method:method_command",
+    "export": "radtree.cli.export:export_command",
+}
+
+
+class LazyGroup(RadtreeGroup):
+    """The main group with its commands imported on first use (:data:`COMMANDS`)."""
+
+    def list_commands(self, ctx: click.Context) -> list[str]:
+        return sorted(set(self.commands) | set(COMMANDS))
+
+    def get_command(self, ctx: click.Context, name: str) -> click.Command | None:
+        if name not in self.commands and name in COMMANDS:
+            import importlib
+
+            module, attr = COMMANDS[name].split(":")
+            self.add_command(getattr(importlib.import_module(module), attr), name)
+        return super().get_command(ctx, name)
+
+
+@click.group(cls=LazyGroup, context_settings=CONTEXT)
 @click.version_option(__version__, prog_name="radtree")
 @click.option("--debug", is_flag=True, help="Show full tracebacks on errors.")
 @click.pass_context
@@ -56,11 +77,3 @@ def main(ctx: click.Context, debug: bool) -> None:
     """
     ctx.ensure_object(dict)
     ctx.obj["debug"] = debug
-
-
-main.add_command(new_command)   # radtree new (cli/new.py), apart from the tuple other branches extend
-for _command in (doctor_command, build_command, simulate_command, hemi_command, report_command,
-                 calibrate_command, sweep_command, diagnose_command, annual_command,
-                 permeability_command, verify_command, bsdf_command, method_command):
-    main.add_command(_command)
-main.add_command(export_command)   # radtree export (cli/export.py)

@@ -29,13 +29,13 @@ _PHOTO = photo_fields()
 _CLUMPING = clumping_fields()
 REFLECTION_MODES = ("traced", "calculated")
 SKY_CHOICES = ("none", "perez")
+SAMPLING_CHOICES = ("sobol", "random")  # NumPy engine's first directions (engines/numpy/qmc)
 #: Presets of the louvers slat optics (the switch ``"louvers.reading"``): the study's reading
 #: (every layer fully covered, T 0.5 in the slat) and near-opaque leaves with open gaps.
 LOUVER_READINGS: dict[str, dict[str, float]] = {
     "study": {"cover_fraction": 1.0, "transmittance": 0.5, "reflectance": 0.11},
     "gap": {"cover_fraction": 0.5, "transmittance": 0.05, "reflectance": 0.11,
-            "specular_fraction": 0.0},
-}
+            "specular_fraction": 0.0}}
 
 
 def _positive(default: float) -> Any:
@@ -307,11 +307,10 @@ class EngineParams(Checked):
     irradiance cache, no super-sampling) are pure Monte Carlo: behind slat crowns the cache and
     ``-as`` bias ``-I`` low by 4–8 % and the cache makes ``-ab 7`` runs take minutes instead of
     seconds. NumPy engine: ``rays`` per sensor (``dense_rays`` per dense-map point), ``max_bounces``,
-    ``seed``."""
+    ``seed``, ``sampling`` (first directions ``"sobol"``-stratified or ``"random"``)."""
 
     TABLE: ClassVar[str] = "engine"
-    # an engine name of radtree.engines.registry (checked when the engine is chosen)
-    name: str = "auto"
+    name: str = "auto"  # a name of radtree.engines.registry (checked when the engine is chosen)
     ab: int | None = field(default=None, metadata=meta(0, 20))
     ad: int = field(default=2048, metadata=meta(1))
     as_: int = field(default=0, metadata=meta(0, toml="as"))
@@ -321,6 +320,7 @@ class EngineParams(Checked):
     rays: int = field(default=4096, metadata=meta(1))
     max_bounces: int = field(default=8, metadata=meta(0))
     seed: int = 1
+    sampling: str = field(default="sobol", metadata=meta(choices=SAMPLING_CHOICES))
     workers: int = field(default=2, metadata=meta(1))
     # forward engine (radtree.engines.forward.settings): photons per hour, flux threshold
     # relative to a photon's launched flux, ray splitting (else Russian roulette), sun beam

@@ -57,6 +57,9 @@ class Engine(ABC):
     #: the engine places a scene's prototypes by reference (Radiance ``instance``); the others
     #: trace them expanded (:meth:`radtree.scene.Scene.solid_meshes`)
     instancing: ClassVar[bool] = False
+    #: :meth:`trace_ab_ladder` traces the whole ``-ab`` ladder at once (bounce orders tallied
+    #: from one set of paths) rather than one trace per ``-ab``
+    ladder_in_one_trace: ClassVar[bool] = False
 
     @classmethod
     @abstractmethod
@@ -109,6 +112,18 @@ class Engine(ABC):
     def write_index(self, build_dir: Path, scenarios: list[str]) -> None:
         """Write what runs every scenario's folder at once (e.g. a top-level Makefile)."""
         raise NotImplementedError(f"engine {self.name!r} writes no build folder")
+
+    def trace_ab_ladder(self, scene: Scene, state: SkyState, params: EngineParams,
+                        ab_values: list[int], folder: Path | None = None,
+                        grids: list[str] | None = None) -> dict[int, dict[str, GridResult]]:
+        """Hour ``state`` of ``scene`` traced at every ``-ab`` of ``ab_values``: lux per grid per
+        ``-ab``. Here one plan and one trace per value (in ``folder``, as :meth:`prepare`);
+        an engine with ``ladder_in_one_trace`` tallies bounce orders from one set of paths."""
+        out = {}
+        for ab in ab_values:
+            plan = self.prepare(scene, [state], params, ab, folder)
+            out[ab] = self.trace(plan, state.label, grids)
+        return out
 
     def trace_once(self, scene: Scene, state: SkyState, params: EngineParams, ab: int,
                    grids: list[str] | None = None) -> dict[str, GridResult]:

@@ -42,12 +42,14 @@ def _engine(engine: str | Engine | None) -> Engine:
 def trace_hours(project: Project, sc: Scenario, engine: str | Engine | None = None,
                 hours: list[str] | None = None, grids: list[str] | None = None,
                 rays: int | None = None, seed: int | None = None, ab: int | None = None,
-                built: BuiltScene | None = None) -> TracedHours:
+                built: BuiltScene | None = None, folder: Path | None = None) -> TracedHours:
     """Trace the scenario's hours (default the project's) with ``engine`` (a name, an instance,
     or None for the seeded engine) on ``grids`` (default every grid of
     the scene without the dense map). ``rays``/``seed`` override ``engine.rays``/``engine.seed``
     (seeded engines); ``ab`` overrides the scene's ``-ab`` rule; ``built`` reuses a scene made
-    by :func:`make_scene` (its ``-ab`` is taken afresh from the switched project)."""
+    by :func:`make_scene` (its ``-ab`` is taken afresh from the switched project); ``folder``:
+    the scenario's build folder for an engine that traces one (its octrees are made once and
+    kept there), else a temporary folder."""
     eng = _engine(engine)
     built = built or make_scene(project, sc, dense_grid=False)
     proj = effective_project(project, sc)
@@ -57,9 +59,25 @@ def trace_hours(project: Project, sc: Scenario, engine: str | Engine | None = No
                      seed=int(proj.engine.seed if seed is None else seed))
     states = hour_states(project, sc, hours)
     with tempfile.TemporaryDirectory(prefix="radtree-trace-") as tmp:
-        plan = eng.prepare(built.scene, states, params, use_ab, Path(tmp))
+        plan = eng.prepare(built.scene, states, params, use_ab, folder or Path(tmp))
         results = [eng.trace(plan, st.label, grids) for st in states]
     return TracedHours(built, states, results, use_ab)
+
+
+def trace_ab_ladder(project: Project, sc: Scenario, engine: str | Engine | None, hour: str,
+                    ab_values: list[int], grids: list[str] | None = None,
+                    built: BuiltScene | None = None, folder: Path | None = None
+                    ) -> tuple[SkyState, dict[int, dict[str, GridResult]]]:
+    """Hour ``hour`` of the scenario at every ``-ab`` of ``ab_values`` (the engine's
+    :meth:`~radtree.engines.base.Engine.trace_ab_ladder`): its sky state and lux per ``-ab``
+    and grid. ``built``/``folder`` as :func:`trace_hours`."""
+    eng = _engine(engine)
+    built = built or make_scene(project, sc, dense_grid=False)
+    params = effective_project(project, sc).engine
+    state = hour_states(project, sc, [hour])[0]
+    with tempfile.TemporaryDirectory(prefix="radtree-trace-") as tmp:
+        return state, eng.trace_ab_ladder(built.scene, state, params, sorted(set(ab_values)),
+                                          folder or Path(tmp), grids)
 
 
 def trace_scenario(project: Project, sc: Scenario, engine: str | Engine | None = None,

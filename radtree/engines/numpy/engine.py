@@ -5,8 +5,11 @@ What it computes, per sensor (a point with a normal, like ``rtrace -I``)::
     E = E_sun,direct + ∫_hemisphere L(ω) cos θ dω
 
 with cosine-weighted hemisphere sampling at the sensor (one path per sample: the per-path
-estimate is ``E_sun,direct + π · L(path)``; the reported standard error is the sample standard
-deviation of those estimates / √n).
+estimate is ``E_sun,direct + π · L(path)``). With ``engine.sampling = "sobol"`` (default) the
+first directions of a sensor's paths are stratified — randomly shifted Sobol' nets in
+replicates, the standard error from the spread of the replicate means
+(:mod:`radtree.engines.numpy.qmc`); with ``"random"`` they are pseudo-random and the standard
+error is the sample standard deviation of the per-path estimates / √n.
 
 Light sources and physics, chosen to behave like Radiance:
 
@@ -50,7 +53,7 @@ import math
 import threading
 import zlib
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -66,8 +69,11 @@ from radtree.engines.numpy.geometry import (
     scene_optics,
 )
 from radtree.engines.numpy.lockstep import Draws, LockstepRandom, SerialDraws
+from radtree.engines.numpy.qmc import FirstDirections
 from radtree.engines.numpy.raycast import embree_available, first_hits
+from radtree.engines.numpy.sampling import cosine_directions as cosine_from
 from radtree.engines.numpy.sampling import cosine_hemisphere, mirror, uniform_cone
+from radtree.engines.numpy.tally import SensorTally
 from radtree.errors import EngineError
 from radtree.light.sky import SkyState
 from radtree.light.sun import SUN_HALF_ANGLE_DEG
@@ -76,7 +82,7 @@ from radtree.sensor_grid import DENSE_GRID
 
 __all__ = ["DEFAULT_OPTIONS", "ENGINE_NAME", "GLASS_INDEX", "Environment", "Geometry", "Optics",
            "TraceOptions", "describe", "glass_coefficients", "scene_geometry", "scene_optics",
-           "trace", "trace_hour"]
+           "trace", "trace_bounce_ladder", "trace_hour"]
 
 ENGINE_NAME = "numpy"
 SHADOW_ROULETTE = 0.02  # shadow-ray transmittance below which Russian roulette starts
@@ -226,8 +232,8 @@ class _Tracer:
     # -- paths
     def paths(self, points: np.ndarray, normals: np.ndarray, rng: Draws,
               parallel: bool = True, *, dirs: np.ndarray | None = None,
-              escapes: Callable[[np.ndarray, np.ndarray, np.ndarray], None] | None = None
-              ) -> np.ndarray:
+              escapes: Callable[[np.ndarray, np.ndarray, np.ndarray], None] | None = None,
+              orders: np.ndarray | None = None) -> np.ndarray:
         """Radiance (cd/m²) seen along one cosine-sampled direction from each sensor sample.
 
         Every draw is labelled (``rng.at``) with its place in the program — (bounce, site) —
@@ -235,7 +241,10 @@ class _Tracer:
         numbers this method draws for them when it traces the whole batch. ``dirs``: the
         first directions instead of the cosine samples about ``normals``; ``escapes(path,
         direction, throughput)`` is told of every path leaving the scene (the transfer of a
-        layer, :mod:`radtree.engines.numpy.transfer`)."""
+        layer, :mod:`radtree.engines.numpy.transfer`). ``orders`` (k, max_bounces): also adds
+        each contribution to the column of its bounce order − 1 (the diffuse segments before it,
+        as ``-ab`` counts them), so that the cumulative sum over the columns is the trace at
+        ``-ab`` 1, 2, … at once (:func:`trace_bounce_ladder`)."""
         k = len(points)
         acc = np.zeros(k)
         alive = np.arange(k)
@@ -256,7 +265,10 @@ class _Tracer:
             if miss.any():
                 if escapes is not None:
                     escapes(alive[miss], d[miss], beta[miss])
-                acc[alive[miss]] += beta[miss] * self.env(d[miss])
+                got = beta[miss] * self.env(d[miss])
+                acc[alive[miss]] += got
+                if orders is not None:
+                    orders[alive[miss], depth[miss] - 1] += got
                 hit = ~miss
                 alive, o, d, beta, depth, nspec, tri, t = (
                     alive[hit], o[hit], d[hit], beta[hit], depth[hit], nspec[hit], tri[hit],
@@ -281,7 +293,10 @@ class _Tracer:
                 if need.any():
                     so = p[need] + nf[need] * (eps * np.sign(cs[need]))[:, None]
                     vis = self.shadow(so, _rows(sd, need), rng, (bounce, 1), parallel)
-                    acc[alive[need]] += beta[need] * self.dni * f[need] * vis
+                    got = beta[need] * self.dni * f[need] * vis
+                    acc[alive[need]] += got
+                    if orders is not None:
+                        orders[alive[need], depth[need] - 1] += got
 
             # scattering events: diffuse reflect, diffuse transmit, specular transmit, mirror
             if self.glass_any:
@@ -327,17 +342,19 @@ class _Tracer:
             nspec = nspec + (spec_t | mir)
         return acc
 
-
-    def paths_split(self, points: np.ndarray, normals: np.ndarray, rng: np.random.Generator
+    def paths_split(self, points: np.ndarray, normals: np.ndarray, rng: np.random.Generator,
+                    dirs: np.ndarray | None = None, orders: np.ndarray | None = None
                     ) -> np.ndarray:
         """:meth:`paths` of a batch, split into ``workers`` contiguous parts traced in parallel
         threads (each part's NumPy work and Embree queries on its own core) drawing the very
         numbers of the serial trace (:class:`~radtree.engines.numpy.lockstep.LockstepRandom`):
-        the results are identical to ``paths(points, normals, SerialDraws(rng))``."""
+        the results are identical to ``paths(points, normals, SerialDraws(rng), dirs=dirs)``.
+        ``dirs``: the paths' first directions (None: cosine samples drawn from ``rng``);
+        ``orders``: as :meth:`paths`."""
         k = len(points)
         parts = min(self.workers, k // self.opts.min_part_paths)
         if parts <= 1:
-            return self.paths(points, normals, SerialDraws(rng))
+            return self.paths(points, normals, SerialDraws(rng), dirs=dirs, orders=orders)
         bounds = np.linspace(0, k, parts + 1).astype(int)
         shared = LockstepRandom(rng, parts)
         out: list[np.ndarray | None] = [None] * parts
@@ -346,7 +363,9 @@ class _Tracer:
         def run(i: int) -> None:
             try:
                 s = slice(bounds[i], bounds[i + 1])
-                out[i] = self.paths(points[s], normals[s], shared.part(i), parallel=False)
+                out[i] = self.paths(points[s], normals[s], shared.part(i), parallel=False,
+                                    dirs=None if dirs is None else dirs[s],
+                                    orders=None if orders is None else orders[s])
             except BaseException as exc:  # re-raised in the calling thread
                 errors.append(exc)
             finally:
@@ -370,63 +389,91 @@ def _grid_seed(seed: int, name: str) -> np.random.Generator:
                                                          zlib.crc32(name.encode())]))
 
 
-def _trace_grid(tracer: _Tracer, grid: SensorGrid, n_paths: int, rng: np.random.Generator
-                ) -> GridResult:
+def _trace_grid(tracer: _Tracer, grid: SensorGrid, n_paths: int, rng: np.random.Generator,
+                sampling: str = "sobol", ladder: bool = False) -> list[GridResult]:
+    """Mean illuminance and standard error per sensor of ``grid`` from ``n_paths`` paths each:
+    one result, or with ``ladder`` one per ``-ab`` 1 … ``max_bounces`` (from the same paths,
+    each contribution counted from its bounce order on).
+
+    ``sampling = "sobol"``: first directions from randomly shifted Sobol' nets, standard errors
+    from the spread of the replicates (:mod:`radtree.engines.numpy.qmc`); ``"random"``:
+    pseudo-random first directions, standard errors from the per-path spread."""
     pts, nrm = grid.points, grid.normals
     n_s = len(grid)
     disc = tracer.opts.sun_disc
+    cols = max(1, tracer.max_bounces) if ladder else 1
     direct = np.zeros(n_s) if disc else tracer.sensor_sun(pts, nrm)
     if tracer.max_bounces <= 0 and not disc:
-        return GridResult(direct, np.zeros(n_s))
+        return [GridResult(direct, np.zeros(n_s))] * cols
     n_paths = max(1, int(n_paths))
     total = n_s * n_paths
-    count = np.zeros(n_s)
-    mean = np.zeros(n_s)
-    m2 = np.zeros(n_s)
+    first = FirstDirections(n_s, n_paths, rng) if sampling == "sobol" else None
+    tally = SensorTally(n_s, cols, first)
     batch = max(1, int(tracer.opts.batch_paths))
     for start in range(0, total, batch):
         pid = np.arange(start, min(total, start + batch))
         sensor = pid // n_paths
-        x = np.zeros(len(pid))
+        x = np.zeros((len(pid), cols))
         if tracer.max_bounces > 0:
-            x += math.pi * tracer.paths_split(pts[sensor], nrm[sensor], rng)
+            dirs = None
+            if first is not None:
+                u = first.uniforms(pid)
+                dirs = cosine_from(u[:, 0], u[:, 1], nrm[sensor])
+            orders = np.zeros((len(pid), cols)) if ladder else None
+            acc = tracer.paths_split(pts[sensor], nrm[sensor], rng, dirs, orders)
+            x += math.pi * (np.cumsum(orders, axis=1) if orders is not None else acc[:, None])
         if disc:
             x += tracer.sensor_sun(pts[sensor], nrm[sensor],
-                                   tracer.sun_directions(len(pid), rng), rng)
-        # merge the batch's per-sensor mean and M2 (Chan et al.)
-        cb = np.bincount(sensor, minlength=n_s).astype(float)
-        sb = np.bincount(sensor, x, minlength=n_s)
-        has = cb > 0
-        mb = np.where(has, sb / np.where(has, cb, 1.0), 0.0)
-        m2b = np.bincount(sensor, (x - mb[sensor]) ** 2, minlength=n_s)
-        n_new = count + cb
-        delta = mb - mean
-        with np.errstate(invalid="ignore", divide="ignore"):
-            mean = np.where(has, mean + delta * cb / np.where(has, n_new, 1.0), mean)
-            m2 = np.where(has, m2 + m2b + delta ** 2 * count * cb / np.where(has, n_new, 1.0),
-                          m2)
-        count = n_new
-    var = m2 / np.maximum(count - 1.0, 1.0)
-    stderr = np.sqrt(np.maximum(var, 0.0) / count)
-    return GridResult(direct + mean, stderr)
+                                   tracer.sun_directions(len(pid), rng), rng)[:, None]
+        tally.add(pid, sensor, x)
+    return tally.results(direct)
 
 
-def trace(scene: Scene, state: SkyState, params: EngineParams, grids: list[str] | None = None,
-          seed: int | None = None, options: TraceOptions = DEFAULT_OPTIONS
-          ) -> dict[str, GridResult]:
-    """:func:`trace_hour` with explicit :class:`TraceOptions`."""
+def _tracer(scene: Scene, state: SkyState, params: EngineParams, grids: list[str] | None,
+            options: TraceOptions) -> tuple[_Tracer, list[str]]:
     names = list(scene.grids) if grids is None else list(grids)
     missing = [g for g in names if g not in scene.grids]
     if missing:
         raise EngineError(f"unknown sensor grid(s): {', '.join(missing)}")
     if params.rays < 1:
         raise EngineError(f"engine.rays must be ≥ 1, got {params.rays}")
-    seed = params.seed if seed is None else seed
     geo = scene_geometry(scene, options.backend, int(getattr(params, "workers", 2) or 1))
-    tracer = _Tracer(geo, scene_optics(scene, state, geo.material_names), state, params, options)
+    return _Tracer(geo, scene_optics(scene, state, geo.material_names), state, params,
+                   options), names
+
+
+def trace(scene: Scene, state: SkyState, params: EngineParams, grids: list[str] | None = None,
+          seed: int | None = None, options: TraceOptions = DEFAULT_OPTIONS
+          ) -> dict[str, GridResult]:
+    """:func:`trace_hour` with explicit :class:`TraceOptions`."""
+    tracer, names = _tracer(scene, state, params, grids, options)
+    seed = params.seed if seed is None else seed
     return {name: _trace_grid(tracer, scene.grids[name], grid_rays(params, name),
-                              _grid_seed(seed, name))
+                              _grid_seed(seed, name), params.sampling)[0]
             for name in names}
+
+
+def trace_bounce_ladder(scene: Scene, state: SkyState, params: EngineParams,
+                        ab_values: list[int], grids: list[str] | None = None,
+                        seed: int | None = None, options: TraceOptions = DEFAULT_OPTIONS
+                        ) -> dict[int, dict[str, GridResult]]:
+    """The hour traced at every ``-ab`` of ``ab_values`` from *one* set of paths traced to the
+    largest: the result at ``-ab k`` sums the contributions of bounce order ≤ k, an unbiased
+    estimate of a separate trace at ``max_bounces = k`` (the same paths: the steps of the
+    ladder carry correlated, not independent, noise). ``-ab 0``: the direct sun alone."""
+    tracer, names = _tracer(scene, state, replace(params, max_bounces=max(ab_values)), grids,
+                            options)
+    seed = params.seed if seed is None else seed
+    out: dict[int, dict[str, GridResult]] = {ab: {} for ab in ab_values}
+    for name in names:
+        grid = scene.grids[name]
+        res = _trace_grid(tracer, grid, grid_rays(params, name), _grid_seed(seed, name),
+                          params.sampling, ladder=True)
+        for ab in ab_values:
+            out[ab][name] = res[ab - 1] if ab > 0 else GridResult(
+                np.zeros(len(grid)) if options.sun_disc
+                else tracer.sensor_sun(grid.points, grid.normals), np.zeros(len(grid)))
+    return out
 
 
 def grid_rays(params: EngineParams, grid: str) -> int:

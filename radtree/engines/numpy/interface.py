@@ -7,7 +7,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from radtree.engines.base import GridResult
-from radtree.engines.numpy.engine import describe, trace_hour
+from radtree.engines.numpy.engine import describe, trace_bounce_ladder, trace_hour
 from radtree.engines.numpy.inprocess import InProcessEngine
 
 if TYPE_CHECKING:
@@ -31,6 +31,7 @@ class NumpyEngine(InProcessEngine):
 
     name = "numpy"
     seeded = True
+    ladder_in_one_trace = True
 
     def describe(self) -> str:
         return f"available ({describe()})"
@@ -38,7 +39,7 @@ class NumpyEngine(InProcessEngine):
     def sampling(self, params: EngineParams) -> str:
         dense = (f" ({params.dense_rays} per dense-map point)"
                  if params.dense_rays is not None else "")
-        return f"{params.rays} rays/sensor{dense}, seed {params.seed}"
+        return f"{params.rays} rays/sensor{dense}, {params.sampling} sampling, seed {params.seed}"
 
     def prepare(self, scene: Scene, states: list[SkyState], params: EngineParams, ab: int,
                 folder: Path | None = None) -> NumpyPlan:
@@ -48,6 +49,12 @@ class NumpyEngine(InProcessEngine):
     def trace(self, plan: NumpyPlan, label: str, grids: list[str] | None = None
               ) -> dict[str, GridResult]:
         return trace_hour(plan.scene, plan.states[label], plan.params, grids=grids)
+
+    def trace_ab_ladder(self, scene: Scene, state: SkyState, params: EngineParams,
+                        ab_values: list[int], folder: Path | None = None,
+                        grids: list[str] | None = None) -> dict[int, dict[str, GridResult]]:
+        """One trace to the largest ``-ab``, its contributions tallied by bounce order."""
+        return trace_bounce_ladder(scene, state, params, ab_values, grids)
 
     def commands(self, plan: NumpyPlan, label: str) -> list[str]:
         st = plan.states[label]

@@ -33,13 +33,17 @@ def cosine_hemisphere(normals: np.ndarray, rng: Uniform) -> np.ndarray:
     k = len(normals)
     u1 = rng.random(k)
     u2 = rng.random(k)
+    return cosine_directions(u1, u2, normals)
+
+
+def cosine_directions(u1: np.ndarray, u2: np.ndarray, normals: np.ndarray) -> np.ndarray:
+    """Directions ∝ cos θ about unit ``normals`` (k, 3) from uniforms ``u1``, ``u2`` (k,)
+    (sin²θ = u1, azimuth 2π u2)."""
     r = np.sqrt(u1)
     phi = 2.0 * math.pi * u2
-    x = r * np.cos(phi)
-    y = r * np.sin(phi)
     z = np.sqrt(np.maximum(0.0, 1.0 - u1))
     t, b = orthonormal_basis(normals)
-    return t * x[:, None] + b * y[:, None] + normals * z[:, None]
+    return t * (r * np.cos(phi))[:, None] + b * (r * np.sin(phi))[:, None] + normals * z[:, None]
 
 
 def uniform_cone(axis: np.ndarray, half_angle_rad: float, k: int,
