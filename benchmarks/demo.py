@@ -2,10 +2,11 @@
 
     python benchmarks/demo.py [--engine numpy|radiance] [--keep DIR] [--compare RESULTS.csv]
 
-Runs the ``radtree`` commands of the Makefile's ``demo`` recipe, in order, on a fresh copy of
-``examples/mendoza-street`` (no build, results or report), with ``DEMO_ENGINE`` = ``--engine``
-(default: the Makefile's), and prints one line per step and the total after install — the
-figure issue 22's target (≤ 120 s on 2 cores) is about. ``--compare`` takes another run's
+Runs ``make demo`` on a fresh copy of ``examples/mendoza-street`` (no build, results or
+report), with ``DEMO_ENGINE`` = ``--engine`` (default: the Makefile's) and every step timed
+(``RUN`` = ``timestep.py``), and prints one line per step (steps run side by side where the
+Makefile lets them) and the total after install — the figure issue 22's target (≤ 120 s on 2
+cores) is about. ``--compare`` takes another run's
 ``results/illuminance.csv`` (e.g. ``--keep`` of a ``--engine radiance`` run) and prints, per
 scenario, nRMSE and nMBE against the measurements in both and the hourly façade means'
 differences in units of their Monte Carlo standard error (the radtree ``lux_stderr``
@@ -15,8 +16,8 @@ column; Radiance's ``-u-`` runs carry none, so their error is not in the denomin
 from __future__ import annotations
 
 import argparse
+import json
 import os
-import re
 import shutil
 import subprocess
 import sys
@@ -31,46 +32,36 @@ EXAMPLE = ROOT / "examples" / "mendoza-street"
 GENERATED = ("build", "results", "report", "diagnose")
 
 
-def demo_steps(engine: str | None) -> list[list[str]]:
-    """The ``$(BIN)/radtree ...`` lines of the Makefile's demo recipe, variables filled in."""
-    text = (ROOT / "Makefile").read_text()
-    default = re.search(r"^DEMO_ENGINE \?= (\S+)", text, re.M)
-    recipe = text.split("\ndemo:", 1)[1].split("\n\n", 1)[0]
-    values = {"EXAMPLE": "EXAMPLE", "DEMO_ENGINE": engine or (default.group(1) if default
-                                                              else "auto")}
-    steps = []
-    for line in recipe.splitlines():
-        line = line.strip()
-        if not line.startswith("$(BIN)/radtree"):
-            continue
-        line = re.sub(r"\$\((\w+)\)", lambda m: values.get(m.group(1), m.group(0)), line)
-        steps.append(line.split()[1:])
-    return steps
-
-
 def run(engine: str | None, folder: Path) -> float:
-    radtree = Path(sys.executable).with_name("radtree")
-    total = 0.0
-    print(f"{'step':58s} {'wall s':>7s} {'CPU s':>7s} {'peak MiB':>9s}")
-    for args in demo_steps(engine):
-        args = [str(folder) if a == "EXAMPLE" else a for a in args]
+    """``make demo`` on ``folder`` (the install already done), each step timed by
+    ``timestep.py``; prints one line per step (start and end from the demo's start) and the
+    total wall time of the whole ``make demo``."""
+    with tempfile.TemporaryDirectory(prefix="radtree-demo-log-") as tmp:
+        log = Path(tmp) / "steps.jsonl"
+        run = f"{sys.executable} {ROOT / 'benchmarks' / 'timestep.py'} {log}"
+        args = ["make", "-s", "-C", str(ROOT), "demo", f"EXAMPLE={folder}", f"RUN={run}"]
+        if engine:
+            args.append(f"DEMO_ENGINE={engine}")
         with tempfile.TemporaryFile("w+") as out:
-            t0 = time.perf_counter()
-            proc = subprocess.Popen([str(radtree), *args], stdout=out, stderr=subprocess.STDOUT,
-                                    text=True)
-            _, status, usage = os.wait4(proc.pid, 0)   # this step's own CPU and peak memory
-            wall = time.perf_counter() - t0
-            proc.returncode = os.waitstatus_to_exitcode(status)
+            t0 = time.time()
+            proc = subprocess.run(args, stdout=out, stderr=subprocess.STDOUT, text=True)
+            total = time.time() - t0
             out.seek(0)
-            log = out.read()
-        cpu, peak = usage.ru_utime + usage.ru_stime, usage.ru_maxrss / 1024
-        label = " ".join("EXAMPLE" if a == str(folder) else a for a in args)
-        print(f"{label[:58]:58s} {wall:7.1f} {cpu:7.1f} {peak:9.0f}", flush=True)
-        if proc.returncode != 0:
-            print(log[-3000:])
-            raise SystemExit(f"step failed (exit {proc.returncode}): {label}")
-        total += wall
-    print(f"{'total after install':58s} {total:7.1f}   (target 120 s, {os.cpu_count()} CPUs)")
+            text = out.read()
+        steps = [json.loads(line) for line in log.read_text().splitlines()] if log.exists() \
+            else []
+    print(f"{'step':52s} {'start s':>7s} {'end s':>7s} {'wall s':>7s} {'CPU s':>7s} "
+          f"{'peak MiB':>9s}")
+    for st in sorted(steps, key=lambda s: s["start"]):
+        label = st["step"].replace(str(folder), "EXAMPLE")
+        print(f"{label[:52]:52s} {st['start'] - t0:7.1f} {st['end'] - t0:7.1f} "
+              f"{st['end'] - st['start']:7.1f} {st['cpu']:7.1f} {st['peak_mib']:9.0f}")
+    if proc.returncode != 0:
+        print(text[-3000:])
+        raise SystemExit(f"make demo failed (exit {proc.returncode})")
+    cpu = sum(st["cpu"] for st in steps)
+    print(f"{'total after install (make demo, wall)':52s} {total:31.1f}   "
+          f"(target 120 s; CPU {cpu:.0f} s on {os.cpu_count()} CPUs)")
     return total
 
 

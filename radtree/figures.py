@@ -3,15 +3,19 @@
 from __future__ import annotations
 
 from pathlib import Path
-
-from matplotlib.backends.backend_agg import FigureCanvasAgg
-from matplotlib.figure import Figure
+from typing import TYPE_CHECKING
 
 from radtree.fileio import atomic_path
+
+if TYPE_CHECKING:   # matplotlib (0.5 s) is imported by the first figure, not by every command
+    from matplotlib.figure import Figure
 
 
 def new_figure(width: float, height: float, dpi: int) -> Figure:
     """A constrained-layout figure of ``width`` × ``height`` inches on an Agg canvas."""
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.figure import Figure
+
     fig = Figure(figsize=(width, height), dpi=dpi, layout="constrained")
     FigureCanvasAgg(fig)
     return fig

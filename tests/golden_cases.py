@@ -56,7 +56,7 @@ def _copy(example: str, dst: Path) -> Path:
     # scenario F: 2 crown realisations instead of 8
     text = text.replace('"louvers.realisations" = 8', '"louvers.realisations" = 2')
     # ... traced with the reduced rays per sensor, not F's own engine.rays switch
-    text = text.replace(', "engine.rays" = 2048 }', ' }')
+    text = text.replace(', "engine.rays" = 1024 }', ' }')
     # the photo-derived scenarios (A-photo, C-photo, F-photo) are checked by
     # tests/test_photo_crowns.py, not here: the golden tables hold A–F
     text = drop_photo_scenarios(text)
