@@ -1,9 +1,10 @@
 """A real ``radtree`` process held at a known point, so signal tests need no timing.
 
 ``python tests/held_run.py K ARGS…`` runs ``radtree ARGS…`` with every engine's ``trace``
-wrapped: the first K hours trace normally; hour K + 1 waits until the process has received a
-signal (radtree's own SIGINT/SIGTERM handler has been entered) and then fails, so it never
-writes a part. Whatever the machine's speed, exactly K parts exist when the signal arrives and
+(and an engine's own ``trace_many``, which traces several hours at once) wrapped: the first K
+hours trace normally; the call that would trace hour K + 1 waits until the process has
+received a signal (radtree's own SIGINT/SIGTERM handler has been entered) and then fails, so
+it never writes a part. Whatever the machine's speed, exactly K parts exist when the signal arrives and
 when the process exits.
 """
 
@@ -29,6 +30,7 @@ def _spy(signum, handler):  # type: ignore[no-untyped-def]
 
 
 def hold_after(k: int) -> None:
+    from radtree.engines.base import Engine
     from radtree.engines.registry import ENGINES, engine_class
 
     calls = [0]
@@ -47,6 +49,19 @@ def hold_after(k: int) -> None:
             return _original(self, plan, label, grids)
 
         cls.trace = trace  # type: ignore[method-assign]
+        if cls.trace_many is not Engine.trace_many:   # the engine's own: count its hours
+            many = cls.trace_many
+
+            def trace_many(self, plan, labels, grids=None, _many=many):  # type: ignore[no-untyped-def]
+                with lock:
+                    calls[0] += len(labels)
+                    n = calls[0]
+                if n > k:
+                    signalled.wait(300)
+                    raise RuntimeError("held hours released by the signal")
+                return _many(self, plan, labels, grids)
+
+            cls.trace_many = trace_many  # type: ignore[method-assign]
 
 
 if __name__ == "__main__":

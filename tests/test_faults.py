@@ -14,6 +14,7 @@ import shutil
 import signal
 import subprocess
 import sys
+import time
 from pathlib import Path
 
 import pandas as pd
@@ -49,9 +50,19 @@ def error_lines(res) -> list[str]:  # type: ignore[no-untyped-def]
     return lines[starts[0]:]
 
 
+def _wait_for_parts(parts: Path, k: int, proc: subprocess.Popen) -> None:
+    """Until ``k`` finished parts (CSV with its manifest) exist, or the process ended."""
+    deadline = time.time() + 120
+    while time.time() < deadline and proc.poll() is None:
+        if parts.exists() and len(list(parts.glob("*.csv.json"))) >= k:
+            return
+        time.sleep(0.05)
+
+
 def held(k: int | None, *args: str, wait_for: str = "engine:") -> subprocess.Popen:
     """``radtree ARGS`` in a child process held at hour k + 1 (k None: not held), returned once
-    its stdout (stderr, for a ``waiting`` line) has printed a line starting with ``wait_for``."""
+    its stdout (stderr, for a ``waiting`` line) has printed a line starting with ``wait_for``
+    and, when held, its first k hours' parts are written (no race with a signal sent next)."""
     env = dict(os.environ, PYTHONUNBUFFERED="1")
     head = [HELD, str(k)] if k is not None else ["-m", "radtree.cli"]
     proc = subprocess.Popen([sys.executable, *head, *args], stdout=subprocess.PIPE,
@@ -61,6 +72,8 @@ def held(k: int | None, *args: str, wait_for: str = "engine:") -> subprocess.Pop
     for line in stream:
         if line.startswith(wait_for):
             proc.first_line = line  # type: ignore[attr-defined]
+            if k is not None:
+                _wait_for_parts(Path(args[1]) / "results" / "parts", k, proc)
             return proc
     raise AssertionError(f"{args} ended before printing {wait_for!r}: {proc.communicate()}")
 
@@ -199,26 +212,24 @@ def test_killed_or_failing_engine_names_scenario_and_hour_and_resumes(tmp_path, 
     assert res.exit_code == 0, res.output
     assert "1 hours traced, 1 reused" in res.stdout
 
-    # the in-process NumPy engine raising at its second hour (a fault injected around trace)
+    # the in-process NumPy engine raising (a fault injected around trace_many): it traces a
+    # scenario's hours in one batch, so the error names both hours and nothing of B is kept
     cls = engine_class("numpy")
-    original = cls.trace
-    calls = []
+    original = cls.trace_many
 
-    def failing(self, plan, label, grids=None):  # type: ignore[no-untyped-def]
-        calls.append(label)
-        if len(calls) == 2:
-            raise MemoryError("cannot allocate 12.0 GiB for the ray bundle")
-        return original(self, plan, label, grids)
+    def failing(self, plan, labels, grids=None):  # type: ignore[no-untyped-def]
+        raise MemoryError("cannot allocate 12.0 GiB for the ray bundle")
 
-    monkeypatch.setattr(cls, "trace", failing)
+    monkeypatch.setattr(cls, "trace_many", failing)
     res = cli(*sim, "--engine", "numpy")
     assert res.exit_code == 3
     assert error_lines(res)[0] == (
-        "error: scenario B, hour 13:30: the numpy engine failed: MemoryError: cannot allocate "
-        "12.0 GiB for the ray bundle")
-    monkeypatch.setattr(cls, "trace", original)
+        "error: scenario B, hours 10:30, 13:30: the numpy engine failed: MemoryError: cannot "
+        "allocate 12.0 GiB for the ray bundle")
+    assert not [p for p in (proj / "results" / "parts").glob("*numpy*.csv")]
+    monkeypatch.setattr(cls, "trace_many", original)
     res = cli(*sim, "--engine", "numpy")
-    assert res.exit_code == 0 and "1 hours traced, 1 reused" in res.stdout
+    assert res.exit_code == 0 and "2 hours traced, 0 reused" in res.stdout
 
 
 # ---------------------------------------------------------------- 3. corrupt or stale state

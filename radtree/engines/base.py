@@ -99,6 +99,12 @@ class Engine(ABC):
               ) -> dict[str, GridResult]:
         """Trace hour ``label`` of a plan on ``grids`` (default every grid): lux per grid."""
 
+    def trace_many(self, plan: Any, labels: list[str], grids: list[str] | None = None
+                   ) -> list[dict[str, GridResult]]:
+        """:meth:`trace` of each hour of ``labels``, in order. Here one after the other; an
+        engine may trace them together (the NumPy engine: every hour's paths in one batch)."""
+        return [self.trace(plan, label, grids) for label in labels]
+
     @abstractmethod
     def commands(self, plan: Any, label: str) -> list[str]:
         """What :meth:`trace` would run for hour ``label``, as lines to print (``--dry-run``)."""

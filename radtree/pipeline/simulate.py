@@ -63,18 +63,19 @@ class _Prepared:
 
 @dataclass
 class TraceJob:
-    """One unit of work: a scenario's hour on some grids (a façade chunk), written to ``part``.
-    ``plan`` None: the worker prepares the scenario itself (in-memory engines on Dask)."""
+    """One unit of work: a scenario's hours on some grids (a façade chunk), each hour written
+    to its part (``parts[i]`` for ``states[i]``). ``plan`` None: the worker prepares the
+    scenario itself (in-memory engines on Dask)."""
 
     engine: Engine
     plan: Any
     project: Project
     scenario: Scenario
-    state: SkyState
-    grids: list[str]
+    states: list[SkyState]
+    grids: list[list[str]]  # per state
     scene: Scene            # the grids only
     phash: str
-    part: Path
+    parts: list[Path]
 
 
 _WORKER_PLANS: dict[tuple[str, str], Any] = {}
@@ -90,17 +91,32 @@ def trace_job(job: TraceJob) -> pd.DataFrame:
             _WORKER_PLANS[key] = prepare_scenario(job.project, job.scenario, job.engine,
                                                   None, lambda _m: None).plan
         plan = _WORKER_PLANS[key]
-    res = trace_hour(job.engine, plan, job.scenario, job.state, job.grids)
-    df = hour_rows(job.project, job.scenario, job.state, job.scene, res, job.engine.name,
-                   job.phash)
-    write_part(job.part, df)
-    return df
+    frames = []
+    if len(job.states) == 1:
+        results = trace_hours(job.engine, plan, job.scenario, job.states, job.grids[0])
+    else:   # each grid at the hours it is traced at, in one batch
+        results = [{} for _ in job.states]
+        for g in dict.fromkeys(g for gs in job.grids for g in gs):
+            at = [i for i, gs in enumerate(job.grids) if g in gs]
+            got = trace_hours(job.engine, plan, job.scenario, [job.states[i] for i in at], [g])
+            for i, res in zip(at, got, strict=True):
+                results[i].update(res)
+    for st, res, part in zip(job.states, results, job.parts, strict=True):
+        df = hour_rows(job.project, job.scenario, st, job.scene, res, job.engine.name,
+                       job.phash)
+        write_part(part, df)
+        frames.append(df)
+    return pd.concat(frames, ignore_index=True)
+
+
+def _district_chunks(project: Project) -> bool:
+    return project.district is not None and project.district.buildings is not None
 
 
 def task_chunks(project: Project, grids: list[str]) -> list[list[str]]:
     """The grids of one hour split into tasks: one per façade chunk for an inventory project
     with buildings (grids ``facades_000`` …), else all grids in one task."""
-    if project.district is not None and project.district.buildings is not None:
+    if _district_chunks(project):
         return [[g] for g in grids]
     return [grids]
 
@@ -177,24 +193,40 @@ def simulate_project(project: Project, engine: str | Engine = "auto",
     make_folder(parts_dir)
     lock = threading.Lock()
     frames: list[pd.DataFrame] = []
-    todo: list[TraceJob] = []
-    reused = 0
+    # an in-process engine traces a scenario's hours in one job, each grid at all the hours
+    # it is traced at in the same batches (:meth:`Engine.trace_many`; each grid draws from its
+    # own stream): a grid's numbers are those of trace_hours over the same hours, and a resumed
+    # run's those of a fresh one (the groups do not depend on what is already done)
+    groups: dict[tuple, list[tuple[SkyState, Path, list[str]]]] = {}
     for sc, st in tasks:
         prep = prepared[sc.name]
         use = hour_grids(project, st.time, list(prep.built.scene.grids), grids, sc)
         for chunk in task_chunks(project, use):
             tag = f"_{chunk[0]}" if len(chunk) == 1 and project.district is not None else ""
             part = parts_dir / f"{sc.name}_{st.label}{tag}_{eng.name}_{prep.phash}.csv"
+            key = (sc.name, tuple(chunk) if _district_chunks(project) else (),
+                   "" if not eng.uses_build_folder else st.label)
+            groups.setdefault(key, []).append((st, part, chunk))
+    todo: list[TraceJob] = []
+    reused = 0
+    by_name = {sc.name: sc for sc in chosen}
+    for (name, *_), members in groups.items():
+        sc, prep = by_name[name], prepared[name]
+        done = []
+        for st, part, _ in members:
             rows, why = check_part(part, sc.name, st.time, prep.phash) if resume and \
                 part.exists() else (None, "")
-            if rows is not None:
-                frames.append(rows)
-                reused += 1
-                continue
             if why:
                 echo(f"  results/parts/{part.name} {why}: recomputing it")
-            sub = Scene([], {}, {g: prep.built.scene.grids[g] for g in chunk})
-            todo.append(TraceJob(eng, prep.plan, project, sc, st, chunk, sub, prep.phash, part))
+            done.append(rows)
+        if all(rows is not None for rows in done):
+            frames.extend(done)
+            reused += len(done)
+            continue
+        union = dict.fromkeys(g for _, _, chunk in members for g in chunk)
+        sub = Scene([], {}, {g: prep.built.scene.grids[g] for g in union})
+        todo.append(TraceJob(eng, prep.plan, project, sc, [m[0] for m in members],
+                             [m[2] for m in members], sub, prep.phash, [m[1] for m in members]))
 
     def work(job: TraceJob) -> pd.DataFrame:
         t = time.perf_counter()
@@ -205,16 +237,17 @@ def simulate_project(project: Project, engine: str | Engine = "auto",
 
     # most sensors first (the dense map's hour, the crowns' realisations after), so the
     # workers do not end on one long task; the table's order does not depend on it
-    todo.sort(key=lambda j: -sum(len(g.points) for g in j.scene.grids.values()))
+    todo.sort(key=lambda j: -len(j.states) * sum(len(g.points) for g in j.scene.grids.values()))
     if todo:
-        bar = progress_bar(None, f"simulate ({eng.name})", progress, total=len(todo))
+        bar = progress_bar(None, f"simulate ({eng.name})", progress,
+                           total=sum(len(j.states) for j in todo), unit="hour")
         try:
             if executor is not None:
                 light = [replace(j, plan=None) if not eng.uses_build_folder else j for j in todo]
                 for df in executor(trace_job, light):
                     frames.append(df)
                     if bar is not None:
-                        bar.update(1)
+                        bar.update(df["time"].nunique())
             else:
                 with ThreadPoolExecutor(max_workers=max(1, workers)) as pool:
                     futures = {pool.submit(work, item): item for item in todo}
@@ -222,7 +255,7 @@ def simulate_project(project: Project, engine: str | Engine = "auto",
                         for fut in as_completed(futures):
                             frames.append(fut.result())
                             if bar is not None:
-                                bar.update(1)
+                                bar.update(len(futures[fut].states))
                     except BaseException:
                         for f in futures:
                             f.cancel()
@@ -252,19 +285,21 @@ def simulate_project(project: Project, engine: str | Engine = "auto",
         write_text(project.results_dir / "manifest.json", json.dumps(
             manifest(project, extra={"engine": eng.name, "scenarios": [s.name for s in chosen]}),
             indent=2, default=str))
-    return SimulationOutcome(pd.read_csv(out), out, tdf, len(todo), reused, eng.name)
+    return SimulationOutcome(pd.read_csv(out), out, tdf, sum(len(j.parts) for j in todo),
+                             reused, eng.name)
 
 
-def trace_hour(eng: Engine, plan: Any, sc: Scenario, st: SkyState, grids: list[str]
-               ) -> dict[str, Any]:
-    """``eng.trace`` of one hour; any failure of the engine (a Radiance program failing or
-    killed, the in-process engine raising) → one :class:`EngineError` naming scenario and hour.
-    Interrupts pass through."""
+def trace_hours(eng: Engine, plan: Any, sc: Scenario, states: list[SkyState],
+                grids: list[str]) -> list[dict[str, Any]]:
+    """``eng.trace_many`` of some hours; any failure of the engine (a Radiance program failing
+    or killed, the in-process engine raising) → one :class:`EngineError` naming scenario and
+    hour(s). Interrupts pass through."""
     try:
-        return eng.trace(plan, st.label, grids)
+        return eng.trace_many(plan, [st.label for st in states], grids)
     except Exception as exc:  # noqa: BLE001 - every engine failure gets its scenario and hour
         what = str(exc) if isinstance(exc, RadtreeError) else f"{type(exc).__name__}: {exc}"
-        raise EngineError(f"scenario {sc.name}, hour {st.time}: the {eng.name} engine failed: "
+        hours = ("hour " if len(states) == 1 else "hours ") + ", ".join(st.time for st in states)
+        raise EngineError(f"scenario {sc.name}, {hours}: the {eng.name} engine failed: "
                           f"{what}\n  {RESUME}") from exc
 
 

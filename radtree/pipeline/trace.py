@@ -60,7 +60,7 @@ def trace_hours(project: Project, sc: Scenario, engine: str | Engine | None = No
     states = hour_states(project, sc, hours)
     with tempfile.TemporaryDirectory(prefix="radtree-trace-") as tmp:
         plan = eng.prepare(built.scene, states, params, use_ab, folder or Path(tmp))
-        results = [eng.trace(plan, st.label, grids) for st in states]
+        results = eng.trace_many(plan, [st.label for st in states], grids)
     return TracedHours(built, states, results, use_ab)
 
 

@@ -51,14 +51,12 @@ from __future__ import annotations
 
 import math
 import threading
-import zlib
 from collections.abc import Callable
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 
 import numpy as np
 
 from radtree.config import EngineParams
-from radtree.engines.base import GridResult
 from radtree.engines.numpy.geometry import (
     GLASS_INDEX,
     Environment,
@@ -69,20 +67,13 @@ from radtree.engines.numpy.geometry import (
     scene_optics,
 )
 from radtree.engines.numpy.lockstep import Draws, LockstepRandom, SerialDraws
-from radtree.engines.numpy.qmc import FirstDirections
 from radtree.engines.numpy.raycast import embree_available, first_hits
-from radtree.engines.numpy.sampling import cosine_directions as cosine_from
 from radtree.engines.numpy.sampling import cosine_hemisphere, mirror, uniform_cone
-from radtree.engines.numpy.tally import SensorTally
-from radtree.errors import EngineError
 from radtree.light.sky import SkyState
 from radtree.light.sun import SUN_HALF_ANGLE_DEG
-from radtree.scene import Scene, SensorGrid
-from radtree.sensor_grid import DENSE_GRID
 
 __all__ = ["DEFAULT_OPTIONS", "ENGINE_NAME", "GLASS_INDEX", "Environment", "Geometry", "Optics",
-           "TraceOptions", "describe", "glass_coefficients", "scene_geometry", "scene_optics",
-           "trace", "trace_bounce_ladder", "trace_hour"]
+           "TraceOptions", "describe", "glass_coefficients", "scene_geometry", "scene_optics"]
 
 ENGINE_NAME = "numpy"
 SHADOW_ROULETTE = 0.02  # shadow-ray transmittance below which Russian roulette starts
@@ -134,7 +125,9 @@ def _rows(d: np.ndarray, sel: np.ndarray | None) -> np.ndarray:
 
 class _Tracer:
     def __init__(self, geo: Geometry, optics: Optics, state: SkyState, params: EngineParams,
-                 opts: TraceOptions):
+                 opts: TraceOptions, more: list[tuple[SkyState, Optics]] = ()):  # type: ignore[assignment]
+        """``more``: further hour states (with their optics) traced in the same batch — path
+        arrays then carry each path's state index (0 = ``state``)."""
         self.geo = geo
         self.caster = geo.caster
         self.opt = optics
@@ -154,6 +147,29 @@ class _Tracer:
         self.tri_glass_tn = optics.glass_tn[mat]
         self.tri_glass = np.isfinite(self.tri_glass_tn)
         self.glass_any = bool(self.tri_glass.any())
+        # several hour states: per-state sun, direct normal lux (0 when the sun is off), sky
+        # and per-triangle optics, looked up by each path's state index
+        self.multi = len(more) > 0
+        if self.multi:
+            states = [state, *(st for st, _ in more)]
+            self.envs = [self.env, *(Environment(st) for st, _ in more)]
+            self.suns = np.array([np.asarray(st.sun.vector, float) for st in states])
+            self.suns /= np.linalg.norm(self.suns, axis=1)[:, None]
+            self.dnis = np.array([float(st.direct_normal_lux) if st.sun_on else 0.0
+                                  for st in states])
+            self.sun_on = any(st.sun_on for st in states)
+            self.tri_coefs = np.stack([self.tri_coef, *(np.stack(
+                [o.rd, o.td, o.ts, o.rm], axis=1)[mat] for _, o in more)])
+
+    def sky(self, d: np.ndarray, hour: np.ndarray | None) -> np.ndarray:
+        """Luminance seen along escaping directions ``d`` (each path's own hour state)."""
+        if hour is None:
+            return self.env(d)
+        out = np.empty(len(d))
+        for h in np.unique(hour):
+            m = hour == h
+            out[m] = self.envs[h](d[m])
+        return out
 
     # -- sun
     def sun_directions(self, k: int, rng: Draws | np.random.Generator) -> np.ndarray:
@@ -214,18 +230,22 @@ class _Tracer:
         return vis
 
     def sensor_sun(self, points: np.ndarray, normals: np.ndarray, dirs: np.ndarray | None = None,
-                   rng: np.random.Generator | None = None) -> np.ndarray:
-        """Direct sun illuminance on sensors (shadow rays start exactly at the points)."""
+                   rng: np.random.Generator | None = None, state: int | None = None
+                   ) -> np.ndarray:
+        """Direct sun illuminance on sensors (shadow rays start exactly at the points);
+        ``state``: the index of the hour state (several states in one tracer)."""
         k = len(points)
         out = np.zeros(k)
-        if not self.sun_on or k == 0:
+        sun_on, dni, sun = ((self.sun_on, self.dni, self.sun) if state is None else
+                            (self.dnis[state] > 0, self.dnis[state], self.suns[state]))
+        if not sun_on or k == 0:
             return out
         if dirs is None:
-            dirs = np.broadcast_to(self.sun, (k, 3))
+            dirs = np.broadcast_to(sun, (k, 3))
         cos = np.einsum("ij,ij->i", normals, dirs)
         need = cos > 0
         if need.any():
-            out[need] = self.dni * cos[need] * self.shadow(points[need],
+            out[need] = dni * cos[need] * self.shadow(points[need],
                                                                _rows(dirs, need), rng)
         return out
 
@@ -233,7 +253,7 @@ class _Tracer:
     def paths(self, points: np.ndarray, normals: np.ndarray, rng: Draws,
               parallel: bool = True, *, dirs: np.ndarray | None = None,
               escapes: Callable[[np.ndarray, np.ndarray, np.ndarray], None] | None = None,
-              orders: np.ndarray | None = None) -> np.ndarray:
+              orders: np.ndarray | None = None, hour: np.ndarray | None = None) -> np.ndarray:
         """Radiance (cd/m²) seen along one cosine-sampled direction from each sensor sample.
 
         Every draw is labelled (``rng.at``) with its place in the program — (bounce, site) —
@@ -244,7 +264,8 @@ class _Tracer:
         layer, :mod:`radtree.engines.numpy.transfer`). ``orders`` (k, max_bounces): also adds
         each contribution to the column of its bounce order − 1 (the diffuse segments before it,
         as ``-ab`` counts them), so that the cumulative sum over the columns is the trace at
-        ``-ab`` 1, 2, … at once (:func:`trace_bounce_ladder`)."""
+        ``-ab`` 1, 2, … at once (:func:`trace_bounce_ladder`). ``hour``: each path's state
+        index when the tracer holds several hour states (:func:`trace_states`)."""
         k = len(points)
         acc = np.zeros(k)
         alive = np.arange(k)
@@ -265,7 +286,7 @@ class _Tracer:
             if miss.any():
                 if escapes is not None:
                     escapes(alive[miss], d[miss], beta[miss])
-                got = beta[miss] * self.env(d[miss])
+                got = beta[miss] * self.sky(d[miss], None if hour is None else hour[miss])
                 acc[alive[miss]] += got
                 if orders is not None:
                     orders[alive[miss], depth[miss] - 1] += got
@@ -273,6 +294,8 @@ class _Tracer:
                 alive, o, d, beta, depth, nspec, tri, t = (
                     alive[hit], o[hit], d[hit], beta[hit], depth[hit], nspec[hit], tri[hit],
                     t[hit])
+                if hour is not None:
+                    hour = hour[hit]
                 if len(alive) == 0:
                     break
             p = o + t[:, None] * d
@@ -280,20 +303,24 @@ class _Tracer:
             cosd = np.einsum("ij,ij->i", d, ng)
             front = cosd < 0
             nf = np.where(front[:, None], ng, -ng)  # normal on the side the ray came from
-            coef = self.tri_coef[tri]  # diffuse R, diffuse T, specular T, mirror (a copy)
+            # diffuse R, diffuse T, specular T, mirror (a copy)
+            coef = self.tri_coef[tri] if hour is None else self.tri_coefs[hour, tri]
             rd, td = coef[:, 0], coef[:, 1]
 
             # next-event estimation towards the sun
             if self.sun_on:
                 rng.at(bounce, 0)
-                sd = self.sun_directions(len(alive), rng)
+                sd = (self.sun_directions(len(alive), rng) if hour is None
+                      else self.suns[hour])
                 cs = np.einsum("ij,ij->i", nf, sd)
                 f = np.where(cs > 0, rd * cs, -td * cs) / math.pi
+                if hour is not None:
+                    f *= self.dnis[hour]   # 0 where that hour's sun is off
                 need = f > 0
                 if need.any():
                     so = p[need] + nf[need] * (eps * np.sign(cs[need]))[:, None]
                     vis = self.shadow(so, _rows(sd, need), rng, (bounce, 1), parallel)
-                    got = beta[need] * self.dni * f[need] * vis
+                    got = beta[need] * (self.dni if hour is None else 1.0) * f[need] * vis
                     acc[alive[need]] += got
                     if orders is not None:
                         orders[alive[need], depth[need] - 1] += got
@@ -322,6 +349,8 @@ class _Tracer:
             alive, p, d, nf, beta, depth, nspec, ev = (
                 alive[survive], p[survive], d[survive], nf[survive], beta[survive],
                 depth[survive], nspec[survive], ev[survive])
+            if hour is not None:
+                hour = hour[survive]
             if len(alive) == 0:
                 break
             new_d = d.copy()
@@ -343,18 +372,19 @@ class _Tracer:
         return acc
 
     def paths_split(self, points: np.ndarray, normals: np.ndarray, rng: np.random.Generator,
-                    dirs: np.ndarray | None = None, orders: np.ndarray | None = None
-                    ) -> np.ndarray:
+                    dirs: np.ndarray | None = None, orders: np.ndarray | None = None,
+                    hour: np.ndarray | None = None) -> np.ndarray:
         """:meth:`paths` of a batch, split into ``workers`` contiguous parts traced in parallel
         threads (each part's NumPy work and Embree queries on its own core) drawing the very
         numbers of the serial trace (:class:`~radtree.engines.numpy.lockstep.LockstepRandom`):
         the results are identical to ``paths(points, normals, SerialDraws(rng), dirs=dirs)``.
         ``dirs``: the paths' first directions (None: cosine samples drawn from ``rng``);
-        ``orders``: as :meth:`paths`."""
+        ``orders``, ``hour``: as :meth:`paths`."""
         k = len(points)
         parts = min(self.workers, k // self.opts.min_part_paths)
         if parts <= 1:
-            return self.paths(points, normals, SerialDraws(rng), dirs=dirs, orders=orders)
+            return self.paths(points, normals, SerialDraws(rng), dirs=dirs, orders=orders,
+                              hour=hour)
         bounds = np.linspace(0, k, parts + 1).astype(int)
         shared = LockstepRandom(rng, parts)
         out: list[np.ndarray | None] = [None] * parts
@@ -365,7 +395,8 @@ class _Tracer:
                 s = slice(bounds[i], bounds[i + 1])
                 out[i] = self.paths(points[s], normals[s], shared.part(i), parallel=False,
                                     dirs=None if dirs is None else dirs[s],
-                                    orders=None if orders is None else orders[s])
+                                    orders=None if orders is None else orders[s],
+                                    hour=None if hour is None else hour[s])
             except BaseException as exc:  # re-raised in the calling thread
                 errors.append(exc)
             finally:
@@ -379,119 +410,3 @@ class _Tracer:
         if errors:
             raise errors[0]
         return np.concatenate([o for o in out if o is not None])
-
-
-# --------------------------------------------------------------------------- public API
-
-
-def _grid_seed(seed: int, name: str) -> np.random.Generator:
-    return np.random.default_rng(np.random.SeedSequence([int(seed) & 0xFFFFFFFF,
-                                                         zlib.crc32(name.encode())]))
-
-
-def _trace_grid(tracer: _Tracer, grid: SensorGrid, n_paths: int, rng: np.random.Generator,
-                sampling: str = "sobol", ladder: bool = False) -> list[GridResult]:
-    """Mean illuminance and standard error per sensor of ``grid`` from ``n_paths`` paths each:
-    one result, or with ``ladder`` one per ``-ab`` 1 … ``max_bounces`` (from the same paths,
-    each contribution counted from its bounce order on).
-
-    ``sampling = "sobol"``: first directions from randomly shifted Sobol' nets, standard errors
-    from the spread of the replicates (:mod:`radtree.engines.numpy.qmc`); ``"random"``:
-    pseudo-random first directions, standard errors from the per-path spread."""
-    pts, nrm = grid.points, grid.normals
-    n_s = len(grid)
-    disc = tracer.opts.sun_disc
-    cols = max(1, tracer.max_bounces) if ladder else 1
-    direct = np.zeros(n_s) if disc else tracer.sensor_sun(pts, nrm)
-    if tracer.max_bounces <= 0 and not disc:
-        return [GridResult(direct, np.zeros(n_s))] * cols
-    n_paths = max(1, int(n_paths))
-    total = n_s * n_paths
-    first = FirstDirections(n_s, n_paths, rng) if sampling == "sobol" else None
-    tally = SensorTally(n_s, cols, first)
-    batch = max(1, int(tracer.opts.batch_paths))
-    for start in range(0, total, batch):
-        pid = np.arange(start, min(total, start + batch))
-        sensor = pid // n_paths
-        x = np.zeros((len(pid), cols))
-        if tracer.max_bounces > 0:
-            dirs = None
-            if first is not None:
-                u = first.uniforms(pid)
-                dirs = cosine_from(u[:, 0], u[:, 1], nrm[sensor])
-            orders = np.zeros((len(pid), cols)) if ladder else None
-            acc = tracer.paths_split(pts[sensor], nrm[sensor], rng, dirs, orders)
-            x += math.pi * (np.cumsum(orders, axis=1) if orders is not None else acc[:, None])
-        if disc:
-            x += tracer.sensor_sun(pts[sensor], nrm[sensor],
-                                   tracer.sun_directions(len(pid), rng), rng)[:, None]
-        tally.add(pid, sensor, x)
-    return tally.results(direct)
-
-
-def _tracer(scene: Scene, state: SkyState, params: EngineParams, grids: list[str] | None,
-            options: TraceOptions) -> tuple[_Tracer, list[str]]:
-    names = list(scene.grids) if grids is None else list(grids)
-    missing = [g for g in names if g not in scene.grids]
-    if missing:
-        raise EngineError(f"unknown sensor grid(s): {', '.join(missing)}")
-    if params.rays < 1:
-        raise EngineError(f"engine.rays must be ≥ 1, got {params.rays}")
-    geo = scene_geometry(scene, options.backend, int(getattr(params, "workers", 2) or 1))
-    return _Tracer(geo, scene_optics(scene, state, geo.material_names), state, params,
-                   options), names
-
-
-def trace(scene: Scene, state: SkyState, params: EngineParams, grids: list[str] | None = None,
-          seed: int | None = None, options: TraceOptions = DEFAULT_OPTIONS
-          ) -> dict[str, GridResult]:
-    """:func:`trace_hour` with explicit :class:`TraceOptions`."""
-    tracer, names = _tracer(scene, state, params, grids, options)
-    seed = params.seed if seed is None else seed
-    return {name: _trace_grid(tracer, scene.grids[name], grid_rays(params, name),
-                              _grid_seed(seed, name), params.sampling)[0]
-            for name in names}
-
-
-def trace_bounce_ladder(scene: Scene, state: SkyState, params: EngineParams,
-                        ab_values: list[int], grids: list[str] | None = None,
-                        seed: int | None = None, options: TraceOptions = DEFAULT_OPTIONS
-                        ) -> dict[int, dict[str, GridResult]]:
-    """The hour traced at every ``-ab`` of ``ab_values`` from *one* set of paths traced to the
-    largest: the result at ``-ab k`` sums the contributions of bounce order ≤ k, an unbiased
-    estimate of a separate trace at ``max_bounces = k`` (the same paths: the steps of the
-    ladder carry correlated, not independent, noise). ``-ab 0``: the direct sun alone."""
-    tracer, names = _tracer(scene, state, replace(params, max_bounces=max(ab_values)), grids,
-                            options)
-    seed = params.seed if seed is None else seed
-    out: dict[int, dict[str, GridResult]] = {ab: {} for ab in ab_values}
-    for name in names:
-        grid = scene.grids[name]
-        res = _trace_grid(tracer, grid, grid_rays(params, name), _grid_seed(seed, name),
-                          params.sampling, ladder=True)
-        for ab in ab_values:
-            out[ab][name] = res[ab - 1] if ab > 0 else GridResult(
-                np.zeros(len(grid)) if options.sun_disc
-                else tracer.sensor_sun(grid.points, grid.normals), np.zeros(len(grid)))
-    return out
-
-
-def grid_rays(params: EngineParams, grid: str) -> int:
-    """Paths per sensor of ``grid``: ``engine.dense_rays`` for the dense façade map when set,
-    else ``engine.rays``."""
-    if grid == DENSE_GRID and params.dense_rays is not None:
-        return int(params.dense_rays)
-    return int(params.rays)
-
-
-def trace_hour(scene: Scene, state: SkyState, params: EngineParams,
-               grids: list[str] | None = None, seed: int | None = None
-               ) -> dict[str, GridResult]:
-    """Illuminance (lux) and its Monte Carlo standard error per sensor of each grid, one hour.
-
-    ``params.rays`` paths per sensor, ``params.max_bounces`` diffuse bounces (like ``-ab``),
-    ``seed`` (default ``params.seed``): the same seed gives identical numbers; each grid draws
-    from its own stream (seed, grid name), so a grid's values do not depend on which other
-    grids are traced.
-    """
-    return trace(scene, state, params, grids, seed, DEFAULT_OPTIONS)

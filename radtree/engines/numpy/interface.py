@@ -7,8 +7,9 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from radtree.engines.base import GridResult
-from radtree.engines.numpy.engine import describe, trace_bounce_ladder, trace_hour
+from radtree.engines.numpy.engine import describe
 from radtree.engines.numpy.inprocess import InProcessEngine
+from radtree.engines.numpy.tracing import trace_bounce_ladder, trace_hour, trace_states
 
 if TYPE_CHECKING:
     from radtree.config import EngineParams
@@ -49,6 +50,12 @@ class NumpyEngine(InProcessEngine):
     def trace(self, plan: NumpyPlan, label: str, grids: list[str] | None = None
               ) -> dict[str, GridResult]:
         return trace_hour(plan.scene, plan.states[label], plan.params, grids=grids)
+
+    def trace_many(self, plan: NumpyPlan, labels: list[str], grids: list[str] | None = None
+                   ) -> list[dict[str, GridResult]]:
+        """Every hour's paths in the same batches (:func:`trace_states`)."""
+        return trace_states(plan.scene, [plan.states[lb] for lb in labels], plan.params,
+                            grids=grids)
 
     def trace_ab_ladder(self, scene: Scene, state: SkyState, params: EngineParams,
                         ab_values: list[int], folder: Path | None = None,
