@@ -10,7 +10,7 @@ import pytest
 
 from radtree.calibrate.scan import _run_job
 from radtree.config import Scenario, load_project
-from radtree.engines.numpy.engine import trace_hour
+from radtree.engines.numpy.tracing import trace_hour
 from radtree.light.hours import hour_states
 from radtree.pipeline import build as build_mod
 from radtree.pipeline.assemble import make_scene

@@ -40,7 +40,7 @@ def mendoza():
 def reduced(tmp_path_factory) -> Path:
     """Mendoza, 7 hours, no dense grid, few rays (for the simulation tests)."""
     p = copy_project(tmp_path_factory.mktemp("diag") / "proj",
-                     {r"^rays = 4096": "rays = 128",
+                     {r"^rays = \d+": "rays = 128",
                       r"^dense_hours = .*$": "dense_grid = false"})
     return p
 
@@ -364,7 +364,7 @@ def test_simulator_matches_simulate_project(tmp_path):
     from radtree.diagnose.simulate import Simulator
     from radtree.pipeline.simulate import simulate_project
 
-    p = copy_project(tmp_path / "p", {r"^rays = 4096": "rays = 64",
+    p = copy_project(tmp_path / "p", {r"^rays = \d+": "rays = 64",
                                       r"^dense_hours = .*$": "dense_grid = false"},
                      hours=["10:30", "13:30"])
     proj = load_project(p)

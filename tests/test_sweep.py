@@ -47,7 +47,7 @@ def project(tmp_path: Path) -> Path:
     text = re.sub(r'model = "\w+"', 'model = "none"', toml.read_text())
     text = text.replace("[sensors]\n", "[sensors]\ndense_grid = false\n")
     text = re.sub(r"^ad = \d+$", "ab = 1\nad = 128", text, flags=re.M)
-    text = re.sub(r"^rays = \d+$", "rays = 256", text, flags=re.M)
+    text = re.sub(r"^rays = \d+", "rays = 256", text, flags=re.M)
     toml.write_text(text)
     return p
 

@@ -14,11 +14,15 @@ Writes, atomically (the whole folder is assembled beside it and renamed into pla
 
 from __future__ import annotations
 
+import multiprocessing
 import shutil
 from collections.abc import Callable
+from concurrent.futures import Future, ProcessPoolExecutor
 from dataclasses import dataclass, field
 from datetime import datetime, timezone
+from functools import partial
 from pathlib import Path
+from typing import Any
 
 import pandas as pd
 
@@ -26,6 +30,7 @@ import radtree.report.figures as figures
 from radtree.config import Project
 from radtree.fileio import atomic_dir
 from radtree.lock import PUBLISH_NAME, folder_lock
+from radtree.pipeline.processes import usable_cores
 from radtree.report.data import ReportData, collect
 from radtree.report.sections import Section, environment
 from radtree.report.sections.extras import extra_sections
@@ -136,36 +141,64 @@ def _headline(data: ReportData) -> list[str]:
     return lines
 
 
-def _figures(data: ReportData, folder: Path, echo: Callable[[str], None]
-             ) -> tuple[dict[str, FigureRef], list[str]]:
-    figs: dict[str, FigureRef] = {}
-    problems: list[str] = []
-    plan: list[tuple[str, str, Callable[[ReportData, Path], str], bool]] = [
-        ("hourly", "Hourly measured and simulated façade illuminance", figures.hourly_plot, True),
-        ("scatter", "Measured against simulated illuminance", figures.scatter_plot,
-         data.comparison is not None),
-        ("facade_map", "False-colour façade maps", figures.facade_maps,
-         data.map_time is not None),
-        ("facade_map_all", "Façade maps for every hour", figures.facade_maps_all_hours,
-         data.map_time is not None and len(set(data.hourly["time"])) > 1),
-        ("timing", "Wall-clock time per scenario", figures.timing_plot, data.timing is not None),
-        ("convergence", "-ab convergence", figures.convergence_plot,
-         data.convergence is not None),
-    ]
-    for key, alt, draw, wanted in plan:
-        if not wanted:
-            continue
-        rel = f"figures/{key}.png"
+class _Figures:
+    """The report's figures: the two façade-map figures (half of the drawing time) in a spawned
+    worker process while everything else of the report is made here (when there is a second
+    core), the others drawn at once. :meth:`results` waits for the worker."""
+
+    def __init__(self, data: ReportData, folder: Path, echo: Callable[[str], None]):
+        plan: list[tuple[str, str, Callable[[ReportData, Path], str], bool]] = [
+            ("hourly", "Hourly measured and simulated façade illuminance", figures.hourly_plot,
+             True),
+            ("scatter", "Measured against simulated illuminance", figures.scatter_plot,
+             data.comparison is not None),
+            ("facade_map", "False-colour façade maps", figures.facade_maps,
+             data.map_time is not None),
+            ("facade_map_all", "Façade maps for every hour", figures.facade_maps_all_hours,
+             data.map_time is not None and len(set(data.hourly["time"])) > 1),
+            ("timing", "Wall-clock time per scenario", figures.timing_plot,
+             data.timing is not None),
+            ("convergence", "-ab convergence", figures.convergence_plot,
+             data.convergence is not None),
+        ]
+        self.wanted = [(key, alt, draw) for key, alt, draw, want in plan if want]
+        self.echo = echo
+        self.problems: list[str] = []
+        apart = [k for k, _, _ in self.wanted if k.startswith("facade_map")]
+        self.pool = (ProcessPoolExecutor(1, mp_context=multiprocessing.get_context("spawn"))
+                     if len(apart) > 1 and usable_cores() > 1 else None)
+        self.done: dict[str, Any] = {}
+        for key, _, draw in self.wanted:
+            path = folder / f"figures/{key}.png"
+            if self.pool is not None and key in apart:
+                self.done[key] = self.pool.submit(draw, data, path)
+            else:
+                self.done[key] = self._draw(key, partial(draw, data, path))
+
+    def _draw(self, key: str, call: Callable[[], str]) -> str | None:
         try:
-            caption = draw(data, folder / rel)
+            return call()
         except Exception as exc:  # a broken figure must not hide the others
-            problems.append(f"figure '{key}' could not be drawn: {type(exc).__name__}: {exc}")
-            echo(f"  warning: {problems[-1]}")
-            continue
-        figs[key] = FigureRef(rel, caption, alt)
-    for i, ref in enumerate(figs.values(), start=1):
-        ref.number = i
-    return figs, problems
+            self.problems.append(f"figure '{key}' could not be drawn: {type(exc).__name__}: "
+                                 f"{exc}")
+            self.echo(f"  warning: {self.problems[-1]}")
+            return None
+
+    def results(self) -> tuple[dict[str, FigureRef], list[str]]:
+        """The figures drawn (numbered in order) and the problems of those that were not."""
+        figs: dict[str, FigureRef] = {}
+        try:
+            for key, alt, _ in self.wanted:
+                got = self.done[key]
+                caption = (self._draw(key, got.result) if isinstance(got, Future) else got)
+                if caption is not None:
+                    figs[key] = FigureRef(f"figures/{key}.png", caption, alt)
+        finally:
+            if self.pool is not None:
+                self.pool.shutdown(wait=True, cancel_futures=True)
+        for i, ref in enumerate(figs.values(), start=1):
+            ref.number = i
+        return figs, self.problems
 
 
 def build_report(project: Project, echo: Callable[[str], None] = print) -> Path:
@@ -181,7 +214,7 @@ def build_report(project: Project, echo: Callable[[str], None] = print) -> Path:
     created = datetime.now(timezone.utc).isoformat(timespec="seconds")
     target = project.report_dir
     with atomic_dir(target) as tmp:
-        figs, problems = _figures(data, tmp, echo)
+        drawing = _Figures(data, tmp, echo)
         (tmp / "models").mkdir()
         for s in data.scenarios:
             if s.picture is not None:
@@ -207,8 +240,8 @@ def build_report(project: Project, echo: Callable[[str], None] = print) -> Path:
                           if len({s.sky for s in data.scenarios}) == 1
                           else "light per scenario (Table 1)")),
             created=created, headline=_headline(data), notes=data.notes,
-            has_measured=data.comparison is not None, tables=tables, figs=figs,
-            figure_problems=problems, models=model_pictures(data), map_reason=data.map_time_reason,
+            has_measured=data.comparison is not None, tables=tables, figs={},
+            figure_problems=[], models=model_pictures(data), map_reason=data.map_time_reason,
             method={
                 "measured": (str(p.measured.name) if p.measured is not None else ""),
                 "measured_rows": (str(p.measured_rows.name) if p.measured_rows is not None
@@ -217,6 +250,7 @@ def build_report(project: Project, echo: Callable[[str], None] = print) -> Path:
             parameters=parameters_table(data),
         )
         ctx.extras, ctx.extras_md = extra_sections(project, tmp, echo)
+        ctx.figs, ctx.figure_problems = drawing.results()
         statistics_frame(data).to_csv(tmp / "statistics.csv", index=False)
         hourly_frame(data).to_csv(tmp / "hourly.csv", index=False)
         rf = rows_frame(data)
