@@ -35,17 +35,22 @@ def hold_after(k: int) -> None:
 
     calls = [0]
     lock = threading.Lock()
+
+    def count(hours: int) -> None:
+        """Count ``hours`` more; past the first k, wait for the signal and fail."""
+        with lock:
+            calls[0] += hours
+            n = calls[0]
+        if n > k:
+            signalled.wait(300)
+            raise RuntimeError("held hour released by the signal")
+
     for name in ENGINES:
         cls = engine_class(name)
         original = cls.trace
 
         def trace(self, plan, label, grids=None, _original=original):  # type: ignore[no-untyped-def]
-            with lock:
-                calls[0] += 1
-                n = calls[0]
-            if n > k:
-                signalled.wait(300)
-                raise RuntimeError("held hour released by the signal")
+            count(1)
             return _original(self, plan, label, grids)
 
         cls.trace = trace  # type: ignore[method-assign]
@@ -53,12 +58,7 @@ def hold_after(k: int) -> None:
             many = cls.trace_many
 
             def trace_many(self, plan, labels, grids=None, _many=many):  # type: ignore[no-untyped-def]
-                with lock:
-                    calls[0] += len(labels)
-                    n = calls[0]
-                if n > k:
-                    signalled.wait(300)
-                    raise RuntimeError("held hours released by the signal")
+                count(len(labels))
                 return _many(self, plan, labels, grids)
 
             cls.trace_many = trace_many  # type: ignore[method-assign]
