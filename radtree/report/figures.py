@@ -412,5 +412,8 @@ def convergence_plot(data: ReportData, path: Path) -> str:
     ax.grid(True, alpha=0.3)
     ax.legend(fontsize=7.5)
     _save(fig, path)
-    return ("Ambient-bounce convergence: façade sensor mean illuminance (lx) against Radiance "
-            "-ab, per scenario (and hour).")
+    engines = (", ".join(sorted(map(str, c["engine"].dropna().unique())))
+               if "engine" in c.columns else "")
+    return ("Ambient-bounce convergence: façade sensor mean illuminance (lx) against the "
+            "number of ambient bounces (-ab; every engine counts them like rtrace), per scenario "
+            "(and hour)" + (f"; traced with {engines}" if engines else "") + ".")
