@@ -41,6 +41,7 @@ def test_replicate_standard_error():
                                [means.std(ddof=1) / 2])
     assert replicate_stderr(np.ones((2, 1)), np.ones((2, 1))).tolist() == [0.0, 0.0]
     assert replicates(4096) == 16 and replicates(8) == 4 and replicates(1) == 1
+    assert replicates(2) == replicates(3) == 2      # a standard error from two paths on
 
 
 def _slat_scene() -> tuple[Scene, object]:

@@ -35,8 +35,9 @@ _SCALE = 2.0 ** -32
 
 def replicates(n_paths: int) -> int:
     """Replicates of a sensor with ``n_paths`` paths: ``REPLICATES``, or fewer for few paths
-    (at least two paths a replicate when possible, so that each has a stratified net)."""
-    return max(1, min(REPLICATES, n_paths // 2))
+    (two paths a replicate where that leaves two replicates, so that each has a stratified
+    net; at least two replicates from two paths on, so that there is a standard error)."""
+    return max(min(2, n_paths), min(REPLICATES, n_paths // 2))
 
 
 @lru_cache(maxsize=16)
