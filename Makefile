@@ -20,10 +20,10 @@ $(STAMP): pyproject.toml
 
 install: $(STAMP)
 
-# The demo's steps as targets: the photo check needs no build and runs beside it; after the
-# build, the scenario runs (simulate, then the -ab check: both write results/) and the
-# analyses (permeability scan, diagnosis) are independent, so `make demo` runs them side by
-# side (-j2) and prints each step's output as one block when it ends (-O). $(RUN) prefixes every step (benchmarks/demo.py
+# The demo's steps as targets: after the build, the scenario runs (simulate, then the -ab
+# check: both write results/) and the analyses (permeability scan, diagnosis, the photo check
+# on the built crowns) are independent, so `make demo` runs the two chains side by side (-j2)
+# and prints each step's output as one block when it ends (-O). $(RUN) prefixes every step (benchmarks/demo.py
 # sets it to time them).
 RUN ?=
 DEMO_STEPS := demo-doctor demo-build demo-simulate demo-convergence demo-permeability \
@@ -49,9 +49,9 @@ demo-permeability: demo-build
 	$(RUN) $(BIN)/radtree permeability $(EXAMPLE) -s A --rays 512
 demo-diagnose: demo-permeability
 	$(RUN) $(BIN)/radtree diagnose $(EXAMPLE) -s A --rays 512
-demo-hemi: demo-doctor
+demo-hemi: demo-diagnose
 	$(RUN) $(BIN)/radtree hemi check $(EXAMPLE)
-demo-report: demo-convergence demo-diagnose demo-hemi
+demo-report: demo-convergence demo-hemi
 	$(RUN) $(BIN)/radtree report $(EXAMPLE)
 
 lint: $(STAMP)

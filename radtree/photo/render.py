@@ -31,6 +31,7 @@ from radtree.hemi.geometry import FisheyeGeometry
 from radtree.hemi.metrics import RingGrid
 from radtree.hemi.synthetic import render_geometry
 from radtree.pipeline.assemble import facade_frame, make_scene
+from radtree.pipeline.build import built_scene
 from radtree.trees.build import apply_switches, resolve_form
 from radtree.trees.photo import AXIS_OF, PhotoSource, lens_of, photo_source
 
@@ -111,7 +112,7 @@ def render_scenario(project: Project, sc: Scenario, size: int = DEFAULT_SIZE,
     if size < 64 or size > 8000:
         raise ConfigError(f"got {size} px, expected 64–8000", field="--size")
     t0 = time.perf_counter()
-    built = make_scene(project, sc, dense_grid=False)
+    built = built_scene(project, sc)   # the build folder's crown when current, else built here
     resolve_form(project, sc)
     t1 = time.perf_counter()
     c1 = time.process_time()
