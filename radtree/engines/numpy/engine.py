@@ -51,7 +51,7 @@ from __future__ import annotations
 
 import math
 import threading
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -125,7 +125,7 @@ def _rows(d: np.ndarray, sel: np.ndarray | None) -> np.ndarray:
 
 class _Tracer:
     def __init__(self, geo: Geometry, optics: Optics, state: SkyState, params: EngineParams,
-                 opts: TraceOptions, more: list[tuple[SkyState, Optics]] = ()):  # type: ignore[assignment]
+                 opts: TraceOptions, more: Sequence[tuple[SkyState, Optics]] = ()):
         """``more``: further hour states (with their optics) traced in the same batch — path
         arrays then carry each path's state index (0 = ``state``)."""
         self.geo = geo

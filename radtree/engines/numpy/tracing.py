@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import math
 import zlib
+from collections.abc import Sequence
 from dataclasses import replace
 
 import numpy as np
@@ -96,7 +97,9 @@ def _per_state(results: list[GridResult], n_states: int) -> list[GridResult]:
 
 
 def _tracer(scene: Scene, state: SkyState, params: EngineParams, grids: list[str] | None,
-            options: TraceOptions) -> tuple[_Tracer, list[str]]:
+            options: TraceOptions, more: Sequence[SkyState] = ()) -> tuple[_Tracer, list[str]]:
+    """The tracer of ``state`` (and of the further hour states ``more``, traced in the same
+    batches) and the names of the grids to trace."""
     names = list(scene.grids) if grids is None else list(grids)
     missing = [g for g in names if g not in scene.grids]
     if missing:
@@ -104,8 +107,9 @@ def _tracer(scene: Scene, state: SkyState, params: EngineParams, grids: list[str
     if params.rays < 1:
         raise EngineError(f"engine.rays must be ≥ 1, got {params.rays}")
     geo = scene_geometry(scene, options.backend, int(getattr(params, "workers", 2) or 1))
+    extra = [(st, scene_optics(scene, st, geo.material_names)) for st in more]
     return _Tracer(geo, scene_optics(scene, state, geo.material_names), state, params,
-                   options), names
+                   options, extra), names
 
 
 def trace(scene: Scene, state: SkyState, params: EngineParams, grids: list[str] | None = None,
@@ -129,9 +133,7 @@ def trace_states(scene: Scene, states: list[SkyState], params: EngineParams,
     not the same numbers). A sampled sun disc traces hour by hour."""
     if len(states) <= 1 or options.sun_disc:
         return [trace(scene, st, params, grids, seed, options) for st in states]
-    tracer, names = _tracer(scene, states[0], params, grids, options)
-    more = [(st, scene_optics(scene, st, tracer.geo.material_names)) for st in states[1:]]
-    tracer = _Tracer(tracer.geo, tracer.opt, states[0], params, options, more)
+    tracer, names = _tracer(scene, states[0], params, grids, options, states[1:])
     seed = params.seed if seed is None else seed
     per_grid = {name: _trace_grid(tracer, scene.grids[name], grid_rays(params, name),
                                   _grid_seed(seed, name), params.sampling,
