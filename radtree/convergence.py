@@ -68,7 +68,7 @@ def convergence_table(project: Project, scenarios: list[str] | None = None,
 
     def run(task: tuple) -> dict[tuple[str, str, int], float]:
         built, sc, hour, abs_, folder = task
-        _, by_ab = trace_ab_ladder(project, sc, eng, hour, abs_, ["facade"], built, folder)
+        by_ab = trace_ab_ladder(project, sc, eng, hour, abs_, ["facade"], built, folder)
         return {(sc.name, hour, ab): float(r["facade"].lux.mean()) for ab, r in by_ab.items()}
 
     n = max(1, workers or project.engine.workers) if eng.uses_build_folder else 1
@@ -82,15 +82,14 @@ def convergence_table(project: Project, scenarios: list[str] | None = None,
     rows = []
     prev: dict[tuple[str, str], float] = {}
     for (sc, name, built, hour, ab, ad, phash), mean in zip(jobs, means, strict=True):
-        time_ = hour
         before = prev.get((name, hour))
         change = (mean - before) / before if before else float("nan")
-        rows.append({"scenario": name, "model": sc.model, "time": time_, "ab": ab,
+        rows.append({"scenario": name, "model": sc.model, "time": hour, "ab": ab,
                      "ad": ad, "facade_mean_lux": round(mean, 1),
                      "change": round(change, 4) if before else None,
                      "model_recommended_ab": built.ab, "engine": eng.name,
                      "params_hash": phash})
-        echo(f"  {name} {time_} -ab {ab}: {mean:.0f} lx"
+        echo(f"  {name} {hour} -ab {ab}: {mean:.0f} lx"
              + (f" ({change:+.1%})" if before else ""))
         prev[(name, hour)] = mean
     return pd.DataFrame(rows)

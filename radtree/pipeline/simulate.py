@@ -93,12 +93,12 @@ def trace_job(job: TraceJob) -> pd.DataFrame:
         plan = _WORKER_PLANS[key]
     frames = []
     if len(job.states) == 1:
-        results = trace_hours(job.engine, plan, job.scenario, job.states, job.grids[0])
+        results = engine_trace(job.engine, plan, job.scenario, job.states, job.grids[0])
     else:   # each grid at the hours it is traced at, in one batch
         results = [{} for _ in job.states]
         for g in dict.fromkeys(g for gs in job.grids for g in gs):
             at = [i for i, gs in enumerate(job.grids) if g in gs]
-            got = trace_hours(job.engine, plan, job.scenario, [job.states[i] for i in at], [g])
+            got = engine_trace(job.engine, plan, job.scenario, [job.states[i] for i in at], [g])
             for i, res in zip(at, got, strict=True):
                 results[i].update(res)
     for st, res, part in zip(job.states, results, job.parts, strict=True):
@@ -195,8 +195,9 @@ def simulate_project(project: Project, engine: str | Engine = "auto",
     frames: list[pd.DataFrame] = []
     # an in-process engine traces a scenario's hours in one job, each grid at all the hours
     # it is traced at in the same batches (:meth:`Engine.trace_many`; each grid draws from its
-    # own stream): a grid's numbers are those of trace_hours over the same hours, and a resumed
-    # run's those of a fresh one (the groups do not depend on what is already done)
+    # own stream): a grid's numbers are those of pipeline.trace.trace_hours over the same
+    # hours, and a resumed run's those of a fresh one (the groups do not depend on what is
+    # already done)
     groups: dict[tuple, list[tuple[SkyState, Path, list[str]]]] = {}
     for sc, st in tasks:
         prep = prepared[sc.name]
@@ -289,7 +290,7 @@ def simulate_project(project: Project, engine: str | Engine = "auto",
                              reused, eng.name)
 
 
-def trace_hours(eng: Engine, plan: Any, sc: Scenario, states: list[SkyState],
+def engine_trace(eng: Engine, plan: Any, sc: Scenario, states: list[SkyState],
                 grids: list[str]) -> list[dict[str, Any]]:
     """``eng.trace_many`` of some hours; any failure of the engine (a Radiance program failing
     or killed, the in-process engine raising) → one :class:`EngineError` naming scenario and

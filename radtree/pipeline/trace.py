@@ -67,17 +67,16 @@ def trace_hours(project: Project, sc: Scenario, engine: str | Engine | None = No
 def trace_ab_ladder(project: Project, sc: Scenario, engine: str | Engine | None, hour: str,
                     ab_values: list[int], grids: list[str] | None = None,
                     built: BuiltScene | None = None, folder: Path | None = None
-                    ) -> tuple[SkyState, dict[int, dict[str, GridResult]]]:
+                    ) -> dict[int, dict[str, GridResult]]:
     """Hour ``hour`` of the scenario at every ``-ab`` of ``ab_values`` (the engine's
-    :meth:`~radtree.engines.base.Engine.trace_ab_ladder`): its sky state and lux per ``-ab``
-    and grid. ``built``/``folder`` as :func:`trace_hours`."""
+    :meth:`~radtree.engines.base.Engine.trace_ab_ladder`): lux per ``-ab`` and grid. ``built``/``folder`` as :func:`trace_hours`."""
     eng = _engine(engine)
     built = built or make_scene(project, sc, dense_grid=False)
     params = effective_project(project, sc).engine
     state = hour_states(project, sc, [hour])[0]
     with tempfile.TemporaryDirectory(prefix="radtree-trace-") as tmp:
-        return state, eng.trace_ab_ladder(built.scene, state, params, sorted(set(ab_values)),
-                                          folder or Path(tmp), grids)
+        return eng.trace_ab_ladder(built.scene, state, params, sorted(set(ab_values)),
+                                   folder or Path(tmp), grids)
 
 
 def trace_scenario(project: Project, sc: Scenario, engine: str | Engine | None = None,

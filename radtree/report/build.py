@@ -240,8 +240,8 @@ def build_report(project: Project, echo: Callable[[str], None] = print) -> Path:
                           if len({s.sky for s in data.scenarios}) == 1
                           else "light per scenario (Table 1)")),
             created=created, headline=_headline(data), notes=data.notes,
-            has_measured=data.comparison is not None, tables=tables, figs={},
-            figure_problems=[], models=model_pictures(data), map_reason=data.map_time_reason,
+            has_measured=data.comparison is not None, tables=tables,
+            models=model_pictures(data), map_reason=data.map_time_reason,
             method={
                 "measured": (str(p.measured.name) if p.measured is not None else ""),
                 "measured_rows": (str(p.measured_rows.name) if p.measured_rows is not None

@@ -143,14 +143,13 @@ class _Tracer:
         self.sun = self.sun / np.linalg.norm(self.sun)
         # per-triangle optics (one gather per query instead of material index + coefficients)
         mat = geo.tri_material
-        self.tri_coef = np.stack([optics.rd, optics.td, optics.ts, optics.rm], axis=1)[mat]
+        self.tri_coef = optics.per_triangle(mat)
         self.tri_glass_tn = optics.glass_tn[mat]
         self.tri_glass = np.isfinite(self.tri_glass_tn)
         self.glass_any = bool(self.tri_glass.any())
         # several hour states: per-state sun, direct normal lux (0 when the sun is off), sky
         # and per-triangle optics, looked up by each path's state index
-        self.multi = len(more) > 0
-        if self.multi:
+        if more:
             states = [state, *(st for st, _ in more)]
             self.envs = [self.env, *(Environment(st) for st, _ in more)]
             self.suns = np.array([np.asarray(st.sun.vector, float) for st in states])
@@ -158,8 +157,7 @@ class _Tracer:
             self.dnis = np.array([float(st.direct_normal_lux) if st.sun_on else 0.0
                                   for st in states])
             self.sun_on = any(st.sun_on for st in states)
-            self.tri_coefs = np.stack([self.tri_coef, *(np.stack(
-                [o.rd, o.td, o.ts, o.rm], axis=1)[mat] for _, o in more)])
+            self.tri_coefs = np.stack([self.tri_coef, *(o.per_triangle(mat) for _, o in more)])
 
     def sky(self, d: np.ndarray, hour: np.ndarray | None) -> np.ndarray:
         """Luminance seen along escaping directions ``d`` (each path's own hour state)."""

@@ -102,6 +102,11 @@ class Optics:
     rm: np.ndarray  # mirror reflectance (plastic specularity)
     glass_tn: np.ndarray  # glass transmissivity (NaN = not glass)
 
+    def per_triangle(self, material: np.ndarray) -> np.ndarray:
+        """(diffuse R, diffuse T, specular T, mirror) per triangle (n, 4), from each
+        triangle's material index."""
+        return np.stack([self.rd, self.td, self.ts, self.rm], axis=1)[material]
+
     @property
     def any_specular_pass(self) -> bool:
         return bool(np.any(self.ts > 0) or np.any(np.isfinite(self.glass_tn)))
