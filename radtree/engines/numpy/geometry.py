@@ -51,6 +51,8 @@ class Geometry:
         n[bad] = (0.0, 0.0, 1.0)
         length[bad] = 1.0
         self.normals = n / length[:, None]
+        self.v0 = np.ascontiguousarray(tris[:, 0])  # first vertex and centroid per triangle
+        self.centroids = tris.mean(axis=1) if len(tris) else np.zeros((0, 3))
         pts = [self.vertices] + [g.points for g in scene.grids.values()]
         allp = np.vstack(pts)
         self.size = float(np.ptp(allp, axis=0).max()) if len(allp) else 1.0

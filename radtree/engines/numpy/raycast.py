@@ -16,7 +16,6 @@ from __future__ import annotations
 import os
 import threading
 from concurrent.futures import ThreadPoolExecutor
-from dataclasses import dataclass
 from typing import Protocol
 
 import numpy as np
@@ -46,17 +45,19 @@ def embree_available() -> bool:
     return True
 
 
-def _plane_distance(tris_v0: np.ndarray, normals: np.ndarray, centroids: np.ndarray,
+def plane_distance(tris_v0: np.ndarray, normals: np.ndarray, centroids: np.ndarray,
                     origins: np.ndarray, directions: np.ndarray, idx: np.ndarray,
                     n: np.ndarray | None = None, denom: np.ndarray | None = None) -> np.ndarray:
     """Distance along each ray to the plane of its hit triangle (float64; a ray parallel to
     the plane gets the distance of the triangle's centroid along it). ``n``, ``denom``: the
     hit triangles' normals and direction · normal when already at hand (not modified)."""
     if n is None:
-        n = normals[idx]
+        n = np.take(normals, idx, axis=0)
     if denom is None:
         denom = np.einsum("ij,ij->i", directions, n)
-    num = np.einsum("ij,ij->i", tris_v0[idx] - origins, n)
+    v = np.take(tris_v0, idx, axis=0)
+    v -= origins
+    num = np.einsum("ij,ij->i", v, n)
     grazing = np.flatnonzero(np.abs(denom) < 1e-12)
     if len(grazing):
         denom = denom.copy()
@@ -91,7 +92,7 @@ class EmbreeCaster:
                                     validate=False)
         self._intersector = RayMeshIntersector(self.mesh)
         tris = np.asarray(vertices, float)[np.asarray(faces)]
-        self._v0 = tris[:, 0]
+        self._v0 = np.ascontiguousarray(tris[:, 0])
         self._centroids = tris.mean(axis=1)
         self._normals = _unit_normals(tris)
         self.workers = max(1, int(workers))
@@ -104,29 +105,40 @@ class EmbreeCaster:
         self._embree = self._intersector._scene  # trimesh's scaled Embree scene
 
     def _query(self, o: np.ndarray, d: np.ndarray) -> np.ndarray:
-        """Triangle index per ray: the arithmetic of ``RayMeshIntersector.intersects_first``
-        (identical float32 inputs to Embree) without its per-call overhead."""
-        from trimesh.util import unitize
-
+        """Triangle index per ray (int32, -1: miss): the arithmetic of
+        ``RayMeshIntersector.intersects_first`` (identical float32 inputs to Embree) without
+        its per-call overhead; one direction (a broadcast row: the point sun) is converted
+        once and handed to Embree as that broadcast row."""
         wrap = self._embree
-        o32 = np.array(o, dtype=np.float32)
         if d.ndim == 2 and d.strides[0] == 0 and len(d):  # one direction (a point sun)
-            d32 = np.tile(unitize(np.array(d[:1], dtype=np.float32)).astype(np.float32),
-                          (len(d), 1))
+            d32 = np.broadcast_to(_unit32(np.array(d[:1], dtype=np.float32)), d.shape)
         else:
-            d32 = unitize(np.array(d, dtype=np.float32)).astype(np.float32)
-        scaled = np.subtract(o32, wrap.origin, dtype=np.float64)  # float32 → float64 exactly
+            d32 = _unit32(np.array(d, dtype=np.float32))
+        scaled = np.subtract(o.astype(np.float32), wrap.origin, dtype=np.float64)  # exact
         scaled *= wrap.scale
-        return np.asarray(wrap.scene.run(scaled.astype(np.float32), d32), dtype=np.int64)
+        return wrap.scene.run(scaled.astype(np.float32), d32)
+
+    def query(self, origins: np.ndarray, directions: np.ndarray, parallel: bool = True
+              ) -> np.ndarray:
+        """Triangle index per ray (int32, -1: miss), no distances (split over the threads)."""
+        n = len(origins)
+        if n == 0:
+            return np.zeros(0, np.int32)
+        parts = self._parts(n, parallel)
+        if parts is not None and self._pool is not None:
+            return np.concatenate(list(self._pool.map(
+                lambda s: self._query(origins[s], directions[s]), parts)))
+        return self._query(origins, directions)
 
     def _chunk(self, o: np.ndarray, d: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        idx = self._query(o, d)
+        idx = self._query(o, d).astype(np.int64)
         t = np.full(len(o), np.inf)
-        hit = idx >= 0
-        if hit.any():
-            dh = d[hit] if d.strides[0] else np.broadcast_to(d[0], (int(hit.sum()), 3))
-            t[hit] = _plane_distance(self._v0, self._normals, self._centroids, o[hit], dh,
-                                     idx[hit])
+        hit = np.flatnonzero(idx >= 0)
+        if len(hit):
+            dh = (np.take(d, hit, axis=0) if d.strides[0] else
+                  np.broadcast_to(d[0], (len(hit), 3)))
+            t[hit] = plane_distance(self._v0, self._normals, self._centroids,
+                                    np.take(o, hit, axis=0), dh, idx[hit])
         return idx, t
 
     def _parts(self, n: int, parallel: bool) -> list[slice] | None:
@@ -148,54 +160,22 @@ class EmbreeCaster:
             return np.concatenate([r[0] for r in res]), np.concatenate([r[1] for r in res])
         return self._chunk(origins, directions)
 
-    def _chunk_hits(self, o: np.ndarray, d: np.ndarray, start: int = 0) -> Hits:
-        idx = self._query(o, d)
-        sel = np.flatnonzero(idx >= 0)
-        tri = idx[sel]
-        n = self._normals[tri]
-        oh = o[sel]
-        dh = d[sel] if d.strides[0] else np.broadcast_to(d[0], (len(sel), 3))
-        cos = np.einsum("ij,ij->i", dh, n)
-        t = _plane_distance(self._v0, self._normals, self._centroids, oh, dh, tri, n, cos)
-        return Hits(sel + start, tri, t, n, cos)
 
-    def hits(self, origins: np.ndarray, directions: np.ndarray, parallel: bool = True) -> Hits:
-        """The rays that hit: see :func:`first_hits`."""
-        n = len(origins)
-        parts = self._parts(n, parallel)
-        if parts is not None and self._pool is not None:
-            res = list(self._pool.map(
-                lambda s: self._chunk_hits(origins[s], directions[s], s.start), parts))
-            return Hits(*(np.concatenate([getattr(r, f) for r in res])
-                          for f in ("sel", "tri", "t", "normal", "cos")))
-        return self._chunk_hits(origins, directions)
-
-
-@dataclass
-class Hits:
-    """The rays of a query that hit something: their indices in the query (ascending), the
-    triangle, the distance (float64), the triangle's unit normal and direction · normal."""
-
-    sel: np.ndarray
-    tri: np.ndarray
-    t: np.ndarray
-    normal: np.ndarray
-    cos: np.ndarray
-
-
-def first_hits(caster: RayCaster, origins: np.ndarray, directions: np.ndarray,
-               normals: np.ndarray, parallel: bool = True) -> Hits:
-    """First hits of the rays that hit anything (``normals``: the unit normal per triangle of
-    the caster's mesh). Embree answers in its worker threads, others via ``first_hit``."""
+def hit_triangles(caster: RayCaster, origins: np.ndarray, directions: np.ndarray,
+                  parallel: bool = True) -> tuple[np.ndarray, np.ndarray | None]:
+    """The triangle each ray hits first (-1: miss) and, from casters other than Embree, the
+    distance; Embree's distances are the plane distances (:func:`plane_distance`), which the
+    caller computes for the hits it needs them for (``None`` here)."""
     if isinstance(caster, EmbreeCaster):
-        return caster.hits(origins, directions, parallel)
-    tri, t = caster.first_hit(origins, directions, parallel)
-    sel = np.flatnonzero(tri >= 0)
-    tri, t = tri[sel], t[sel]
-    n = normals[tri]
-    d = directions[sel] if directions.strides[0] else \
-        np.broadcast_to(directions[0], (len(sel), 3))
-    return Hits(sel, tri, t, n, np.einsum("ij,ij->i", d, n))
+        return caster.query(origins, directions, parallel), None
+    return caster.first_hit(origins, directions, parallel)
+
+
+def _unit32(d32: np.ndarray) -> np.ndarray:
+    """float32 unit rows exactly as ``RayMeshIntersector.intersects_first`` makes them."""
+    from trimesh.util import unitize
+
+    return np.asarray(unitize(d32), dtype=np.float32)
 
 
 def _unit_normals(tris: np.ndarray) -> np.ndarray:
