@@ -9,7 +9,20 @@ from __future__ import annotations
 
 
 class RadtreeError(Exception):
-    """A failure with a message meant for the user (no traceback needed)."""
+    """A failure with a message meant for the user (no traceback needed).
+
+    Pickled with its message and attributes (``field``, ``source``, ``command``, …), so an
+    error raised in a worker process reads the same where it is re-raised."""
+
+    def __reduce__(self) -> tuple:
+        return (_restore, (type(self), str(self), dict(self.__dict__)))
+
+
+def _restore(cls: type[RadtreeError], message: str, state: dict) -> RadtreeError:
+    exc = cls.__new__(cls)
+    Exception.__init__(exc, message)
+    exc.__dict__.update(state)
+    return exc
 
 
 class ConfigError(RadtreeError):

@@ -89,3 +89,73 @@ def test_simulate_and_report_load_the_built_scene(proj, monkeypatch):
     assert "scene.pickle" in build_staleness(proj, sc)
     again = built_scene(proj, sc)
     assert again.triangles == fresh.triangles
+
+
+def _scene_files(folder):
+    """``relative path → [bytes, sha256]`` of a build folder's scene files (its manifest),
+    without radtree's own pickle (it holds the build's timings)."""
+    import json
+
+    files = json.loads((folder / "manifest.json").read_text())["files"]
+    return {k: v for k, v in files.items() if k != SCENE_FILE}
+
+
+def test_build_in_two_processes_writes_the_same_folders(proj, tmp_path):
+    """Four folders built by this process and a spawned worker are byte for byte the folders
+    one process writes (the pickle aside); the facts come back for every scenario, in order."""
+    names = ["A", "B", "C", "E"]
+    one = build_project(proj, names, echo=lambda _m: None, progress=False, pictures=False,
+                        workers=1)
+    first = {n: _scene_files(proj.build_dir / n) for n in names}
+    lines: list[str] = []
+    two = build_project(proj, names, echo=lines.append, progress=False, pictures=False,
+                        workers=2)
+    assert list(two) == names and [two[n]["triangles"] for n in names] == [
+        one[n]["triangles"] for n in names]
+    assert {n: _scene_files(proj.build_dir / n) for n in names} == first
+    assert len(lines) == 4 and all("triangles" in m for m in lines)
+    assert not list(proj.build_dir.glob(".*"))   # no temporary folder left behind
+
+
+def test_build_keeps_current_folders_unless_fresh(proj):
+    """``fresh=False`` keeps a current folder (not rewritten, facts from its manifest) and
+    rebuilds a stale one; ``fresh=True`` rebuilds both."""
+    build_project(proj, ["C", "E"], echo=lambda _m: None, progress=False, pictures=False)
+    manifest_c = proj.build_dir / "C" / "manifest.json"
+    stamp = manifest_c.stat().st_mtime_ns
+    (proj.build_dir / "E" / "grids" / "facade.pts").write_text("0 0 0 0 1 0\n")  # stale
+    lines: list[str] = []
+    facts = build_project(proj, ["C", "E"], echo=lines.append, progress=False, pictures=False,
+                          fresh=False)
+    assert manifest_c.stat().st_mtime_ns == stamp
+    assert facts["C"]["triangles"] == 19610 and facts["C"]["model"] == "perforated"
+    assert any(m.startswith("  C: current, kept") for m in lines)
+    assert any(m.startswith("  E: homogeneous") for m in lines)
+    assert build_staleness(proj, proj.scenario("E")) == ""
+    build_project(proj, ["C"], echo=lambda _m: None, progress=False, pictures=False,
+                  fresh=True)
+    assert manifest_c.stat().st_mtime_ns != stamp
+
+
+def test_a_worker_error_reads_as_it_was_raised(tmp_path):
+    """A build error in the spawned worker (F-photo's unreadable photo: the queue gives this
+    process A-photo first, the worker F-photo) is re-raised here with its field and message,
+    and leaves no half-written folder."""
+    from radtree.errors import ConfigError
+
+    p = copy_project(tmp_path / "proj", hours=["13:30"], photo=True)
+    (p / "data" / "broken.jpg").write_bytes(b"not a JPEG")
+    toml = p / "radtree.toml"
+    head, _, tail = toml.read_text().partition('name = "F-photo"')
+    toml.write_text(head + 'name = "F-photo"' + tail.replace(
+        '"tree.photo" = "data/fisheye_chestnut_standin.jpg"', '"tree.photo" = "data/broken.jpg"',
+        1))
+    proj = load_project(p)
+    with pytest.raises(ConfigError) as err:
+        build_project(proj, ["A", "E", "F-photo", "A-photo"], echo=lambda _m: None,
+                      progress=False, pictures=False, workers=2)
+    assert err.value.field == "tree.photo" and "broken.jpg" in str(err.value)
+    assert "cannot read" in str(err.value)
+    assert not (proj.build_dir / "F-photo").exists()
+    assert (proj.build_dir / "A-photo" / "manifest.json").is_file()   # built here, first
+    assert not list(proj.build_dir.glob(".*"))

@@ -14,7 +14,14 @@ from radtree.cli.options import CONTEXT, scenarios_option, writes
 @click.argument("project", type=click.Path())
 @scenarios_option
 @click.option("--no-pictures", is_flag=True, help="Skip the PNG picture of each crown model.")
-def build_command(project: str, scenarios: tuple[str, ...], no_pictures: bool) -> None:
+@click.option("--fresh", is_flag=True,
+              help="Rebuild every folder, also those that are current (same radtree version, "
+                   "parameters, input files and scene files).")
+@click.option("--workers", type=click.IntRange(min=1), default=None,
+              help="Processes building folders side by side (default: the usable cores, "
+                   "when there are 4 folders or more to build).")
+def build_command(project: str, scenarios: tuple[str, ...], no_pictures: bool, fresh: bool,
+                  workers: int | None) -> None:
     """Write the Radiance build folder of PROJECT.
 
     \b
@@ -22,6 +29,9 @@ def build_command(project: str, scenarios: tuple[str, ...], no_pictures: bool) -
       materials.rad  geometry/*.rad  grids/*.pts  skies/<HHMM>.sky  Makefile  manifest.json
     Each Makefile has one target per hour and runs without Python:
       make -j2 -C PROJECT/build/A
+
+    A folder that is current (built by this radtree for the same parameters and input
+    files, its scene files unchanged) is kept; --fresh rebuilds it.
     """
     from radtree.config import load_project
     from radtree.pipeline.build import build_project
@@ -29,5 +39,6 @@ def build_command(project: str, scenarios: tuple[str, ...], no_pictures: bool) -
     t = time.perf_counter()
     p = load_project(project)
     click.echo(f"building {p.name} ({len(p.scenarios)} scenarios, {len(p.site.hours)} hours)")
-    build_project(p, list(scenarios) or None, echo=click.echo, pictures=not no_pictures)
+    build_project(p, list(scenarios) or None, echo=click.echo, pictures=not no_pictures,
+                  fresh=fresh, workers=workers)
     click.echo(f"build written to {p.build_dir} in {time.perf_counter() - t:.1f} s")

@@ -15,14 +15,16 @@ import multiprocessing
 import pickle
 import shutil
 import time
+from collections import deque
 from collections.abc import Callable, Iterable
-from concurrent.futures import Future, ProcessPoolExecutor
+from concurrent.futures import FIRST_COMPLETED, Future, ProcessPoolExecutor, wait
 from pathlib import Path
 from typing import Any
 
 import radtree
 from radtree.config import Project, Scenario, effective_project
 from radtree.engines.registry import folder_engine
+from radtree.errors import RadtreeError
 from radtree.fileio import atomic_dir, write_text
 from radtree.light.hours import hour_states
 from radtree.pipeline.assemble import BuiltScene, make_scene
@@ -50,34 +52,153 @@ def hour_grids(project: Project, time_: str, available: list[str],
 
 def build_project(project: Project, scenarios: list[str] | None = None,
                   echo: Callable[[str], None] = print, progress: bool = True,
-                  pictures: bool = True) -> dict[str, dict]:
-    """Write the build folders of the selected scenarios; return per-scenario build facts."""
+                  pictures: bool = True, fresh: bool = True,
+                  workers: int | None = None) -> dict[str, dict]:
+    """Write the build folders of the selected scenarios; return per-scenario build facts.
+
+    With ``fresh=False`` a folder that is current (:func:`build_staleness`, and its picture
+    there when ``pictures``) is kept and its facts read from its manifest. The folders are
+    built by this process and ``workers − 1`` spawned ones (default: the usable cores, when
+    there are at least :data:`PARALLEL_MIN` folders to build), heaviest first; each folder is
+    the same whichever process wrote it."""
     engine = folder_engine()
     chosen = selected(project, scenarios)
     facts: dict[str, dict] = {}
     build_root = project.build_dir
     build_root.mkdir(parents=True, exist_ok=True)
-    drawn = [sc for sc in chosen if pictures and project.district is None
-             and not is_later_realisation(sc.name)]   # the report shows F@1's picture
-    with _Pictures(len(drawn)) as painter:
-        for sc in progress_bar(chosen, "build", progress, unit="scenario"):
-            _build_one(project, sc, engine, build_root, facts, painter if sc in drawn else None,
-                       echo)
+    drawn = {sc.name for sc in chosen if pictures and project.district is None
+             and not is_later_realisation(sc.name)}   # the report shows F@1's picture
+    todo = []
+    for sc in chosen:
+        kept = None if fresh else _current_facts(project, sc, sc.name in drawn)
+        if kept is None:
+            todo.append(sc)
+        else:
+            facts[sc.name] = kept
+            echo(f"  {sc.name}: current, kept (--fresh rebuilds it) → {build_root / sc.name}")
+    n = min(len(todo), usable_cores() if workers is None else max(1, int(workers)))
+    if workers is None and len(todo) < PARALLEL_MIN:
+        n = 1
+    bar = progress_bar(None, "build", progress, total=len(todo), unit="scenario")
+    with _Pictures(len(drawn & {sc.name for sc in todo})) as painter:
+        def done(name: str, built_facts: dict) -> None:
+            facts[name] = built_facts
+            if name in drawn:
+                painter.draw(build_root / name)
+            echo(_built_line(built_facts, build_root / name))
+            if bar is not None:
+                bar.update(1)
+
+        try:
+            _build_all(project, sorted(todo, key=lambda sc: _weight(project, sc),
+                                                reverse=True), engine, build_root,
+                       n, done)
+        finally:
+            if bar is not None:
+                bar.close()
     _remove_stale_builds(project, chosen)
     engine.write_index(build_root, [s.name for s in selected(project, None)
                                     if (build_root / s.name).exists()])
-    return facts
+    return {sc.name: facts[sc.name] for sc in chosen}
+
+
+#: at least this many folders to build before workers are spawned (a spawned interpreter
+#: takes ~1 s to import radtree; a scenario folder 0.2–2 s to build)
+PARALLEL_MIN = 4
+
+
+def _weight(project: Project, sc: Scenario) -> int:
+    """A rough build cost, for the order of the queue (heaviest first): crowns made from a
+    photo (its analysis; a dome's cut along its sky outlines) 2, free crowns 1, the rest 0."""
+    from radtree.config.photo import photo_of
+    from radtree.trees.build import apply_switches
+
+    try:
+        tree, _ = apply_switches(project.tree, dict(sc.switches), source=str(project.source))
+    except RadtreeError:
+        return 0   # the build itself reports the error
+    if sc.model is None or sc.model == "none":
+        return 0
+    return 2 if photo_of(tree)[0] is not None else int((sc.form or tree.form) == "free")
+
+
+def _build_all(project: Project, queue: list[Scenario], engine: Any, build_root: Path,
+               n: int, done: Callable[[str, dict], None]) -> None:
+    """Build ``queue`` in order, here and in ``n − 1`` spawned workers (each given up to two
+    scenarios ahead, so it never waits for this process); ``done(name, facts)`` is called
+    here for each folder once it is written. A worker's error is raised here, the scenarios
+    not started yet are cancelled."""
+    pending = deque(queue)
+    if n <= 1:
+        while pending:
+            sc = pending.popleft()
+            done(sc.name, _build_one(project, sc, engine, build_root))
+        return
+    pool = ProcessPoolExecutor(n - 1, mp_context=multiprocessing.get_context("spawn"))
+    outstanding: dict[Future[dict], str] = {}
+
+    def top_up() -> None:
+        while pending and len(outstanding) < 2 * (n - 1):
+            sc = pending.popleft()
+            outstanding[pool.submit(_build_in_worker, project, sc, build_root)] = sc.name
+
+    def collect(block: bool) -> None:
+        if outstanding:
+            ready, _ = wait(outstanding, timeout=None if block else 0,
+                            return_when=FIRST_COMPLETED)
+            for f in ready:
+                done(outstanding.pop(f), f.result())
+
+    try:
+        mine = pending.popleft()   # this process starts at once, while the workers start up
+        top_up()
+        while True:
+            done(mine.name, _build_one(project, mine, engine, build_root))
+            collect(block=False)
+            top_up()
+            if not pending:
+                break
+            mine = pending.popleft()
+        while outstanding:
+            collect(block=True)
+    except BaseException:
+        pool.shutdown(wait=True, cancel_futures=True)
+        raise
+    pool.shutdown(wait=True)
+
+
+def _build_in_worker(project: Project, sc: Scenario, build_root: Path) -> dict:
+    """:func:`_build_one` in a spawned worker (its own folder engine)."""
+    return _build_one(project, sc, folder_engine(), build_root)
+
+
+def _built_line(f: dict, folder: Path) -> str:
+    return (f"  {f['scenario']}: {f['model']} ({f['form']}), {f['triangles']} triangles, "
+            f"-ab {f['ab']}, geometry {f['seconds']['geometry']:.2f} s → {folder}")
+
+
+def _current_facts(project: Project, sc: Scenario, picture: bool) -> dict | None:
+    """The build facts of ``build/<sc>/`` when that folder is current (and holds its
+    picture when ``picture``), else None."""
+    folder = project.build_dir / sc.name
+    if build_staleness(project, sc) or (picture and not (folder / "model.png").is_file()):
+        return None
+    try:
+        return dict(json.loads((folder / "manifest.json").read_text())["build"])
+    except (OSError, ValueError, KeyError, TypeError):
+        return None
 
 
 class _Pictures:
-    """Draws ``model.png`` of the build folders: in one spawned worker process while the next
-    folders are built (two usable cores or more and several pictures), else here. Every
-    picture is written (atomically) before the context ends; a drawing error is raised then."""
+    """Draws ``model.png`` of the build folders from their ``scene.pickle``: in one spawned
+    worker process while the next folders are built (two usable cores or more and several
+    pictures), else here. Every picture is written (atomically) before the context ends; a
+    drawing error is raised then."""
 
     def __init__(self, count: int):
         self._pool = (ProcessPoolExecutor(1, mp_context=multiprocessing.get_context("spawn"))
                       if count > 1 and usable_cores() > 1 else None)
-        self._futures: list[Future[Path]] = []
+        self._futures: list[Future[None]] = []
 
     def __enter__(self) -> _Pictures:
         return self
@@ -92,19 +213,26 @@ class _Pictures:
         finally:
             self._pool.shutdown(wait=True, cancel_futures=True)
 
-    def draw(self, tree: Any, scene: Any, path: Path) -> None:
-        from radtree.trees.picture import render_model_png
-
+    def draw(self, folder: Path) -> None:
         if self._pool is None:
-            render_model_png(tree, scene, path)
+            draw_model_png(folder)
         else:
-            self._futures.append(self._pool.submit(render_model_png, tree, scene, path))
+            self._futures.append(self._pool.submit(draw_model_png, folder))
 
 
-def _build_one(project: Project, sc: Scenario, engine: Any, build_root: Path,
-               facts: dict[str, dict], painter: _Pictures | None,
-               echo: Callable[[str], None]) -> None:
-    """Write ``build/<sc>/`` (its picture drawn by ``painter`` when given) into ``facts``."""
+def draw_model_png(folder: Path) -> None:
+    """``folder/model.png``: the crown model of the folder's ``scene.pickle`` (none without
+    a crown)."""
+    from radtree.trees.picture import render_model_png
+
+    with (folder / SCENE_FILE).open("rb") as f:
+        built = pickle.load(f)
+    if built.tree is not None:
+        render_model_png(built.tree, built.scene, folder / "model.png")
+
+
+def _build_one(project: Project, sc: Scenario, engine: Any, build_root: Path) -> dict:
+    """Write ``build/<sc>/``; return its build facts."""
     t0 = time.perf_counter()
     states = hour_states(project, sc)
     prep = time.perf_counter() - t0
@@ -115,7 +243,7 @@ def _build_one(project: Project, sc: Scenario, engine: Any, build_root: Path,
         at = {st.label: hour_grids(project, st.time, names, None, sc) for st in states}
         engine.write_folder(built.scene, states, effective_project(project, sc).engine,
                             built.ab, tmp, sc.name, at)
-        facts[sc.name] = {
+        facts = {
             "scenario": sc.name, "model": sc.model, "reflection": sc.reflection,
             "form": sc.form or project.tree.form, "ab": built.ab,
             "triangles": built.triangles, "notes": built.notes, "info": built.info,
@@ -127,12 +255,9 @@ def _build_one(project: Project, sc: Scenario, engine: Any, build_root: Path,
         with (tmp / SCENE_FILE).open("wb") as f:   # inside the atomic folder
             pickle.dump(built, f, protocol=5)
         write_text(tmp / "manifest.json", json.dumps(
-            manifest(project, extra={"build": facts[sc.name], "files": folder_files(tmp)}),
+            manifest(project, extra={"build": facts, "files": folder_files(tmp)}),
             indent=2, default=str))
-    if painter is not None and built.tree is not None:   # model.png: not a scene file
-        painter.draw(built.tree, built.scene, build_root / sc.name / "model.png")
-    echo(f"  {sc.name}: {sc.model} ({facts[sc.name]['form']}), {built.triangles} triangles, "
-         f"-ab {built.ab}, geometry {built.geometry_seconds:.2f} s → {build_root / sc.name}")
+    return facts
 
 
 def built_scene(project: Project, sc: Scenario) -> BuiltScene:

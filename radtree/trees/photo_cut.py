@@ -129,24 +129,44 @@ def cut_slats(quads: np.ndarray, centre: np.ndarray, is_sky, cell: float = CELL
         kept_by = set(own[keep].tolist())
         removed += len(set(owner) - kept_by)
         cut += len(kept_by)
-        planes = {}
-        for q in kept_by:
-            m = np.cross(rel[q, 1] - rel[q, 0], rel[q, 3] - rel[q, 0])
-            m /= np.linalg.norm(m)
-            planes[q] = (m, float(m @ rel[q, 0]))
-        for g, q in zip(got[keep], own[keep]):
-            m, h = planes[int(q)]
-            for part in getattr(g, "geoms", [g]):
-                if part.geom_type != "Polygon" or part.area <= MIN_PIECE:
-                    continue
-                xy = np.asarray(part.exterior.coords)[:-1]
-                dirs = A[None, :] + xy[:, :1] * P[None, :] + xy[:, 1:2] * Q[None, :]
-                t = h / (dirs @ m)
-                pieces.append(centre + t[:, None] * dirs)
+        pieces.extend(_pieces_on_slats(got[keep], own[keep], rel, centre, A, P, Q))
     info = {"photo_slats_whole": float(whole), "photo_slats_removed": float(removed),
             "photo_slats_cut": float(cut), "photo_pieces": float(len(pieces)),
             "photo_cell_gnomonic": cell}
     return pieces, info
+
+
+def _pieces_on_slats(got: np.ndarray, own: np.ndarray, rel: np.ndarray, centre: np.ndarray,
+                     A: np.ndarray, P: np.ndarray, Q: np.ndarray) -> list[np.ndarray]:
+    """The polygons of the kept intersections ``got`` (gnomonic X, Y of one face; multi-part
+    results split, parts that are not polygons or smaller than :data:`MIN_PIECE` dropped),
+    each mapped back onto the plane of its slat ``own`` (slat corners ``rel`` around
+    ``centre``): (m, 3) polygons in the order of ``got`` and its parts."""
+    parts, of = shapely.get_parts(got, return_index=True)
+    ok = (shapely.get_type_id(parts) == 3) & (shapely.area(parts) > MIN_PIECE)   # 3: Polygon
+    parts, of = parts[ok], of[ok]
+    if not len(parts):
+        return []
+    xy, ring = shapely.get_coordinates(shapely.get_exterior_ring(parts), return_index=True)
+    count = np.bincount(ring, minlength=len(parts))
+    last = np.cumsum(count) - 1
+    keep = np.ones(len(xy), bool)
+    keep[last] = False               # the closing vertex of each ring
+    xy, ring = xy[keep], ring[keep]
+    q = own[of]                      # the slat of each part
+    corners = rel[q]
+    m = np.cross(corners[:, 1] - corners[:, 0], corners[:, 3] - corners[:, 0])
+    m /= np.linalg.norm(m, axis=1)[:, None]
+    h = _dot(m, corners[:, 0])
+    dirs = A[None, :] + xy[:, :1] * P[None, :] + xy[:, 1:2] * Q[None, :]
+    t = h[ring] / _dot(dirs, m[ring])
+    points = centre + t[:, None] * dirs
+    return np.split(points, np.cumsum(count - 1)[:-1])
+
+
+def _dot(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Row-wise dot products of (n, 3) arrays, summed left to right."""
+    return a[:, 0] * b[:, 0] + a[:, 1] * b[:, 1] + a[:, 2] * b[:, 2]
 
 
 def dome_from_photo(quads: np.ndarray, centre: np.ndarray, src: PhotoSource,
