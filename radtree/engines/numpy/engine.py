@@ -169,6 +169,16 @@ class _Tracer:
             self.sun_on = any(st.sun_on for st in states)
             self.tri_coefs = np.stack([self.tri_coef, *(o.per_triangle(mat) for _, o in more)])
             self.tri_coefs_flat = self.tri_coefs.reshape(-1, 4)  # row hour × n_tri + tri
+        # point sun: per triangle (and hour state) the cosine sun · normal and the origin
+        # offset ±ε towards the side a shadow ray leaves, looked up instead of recomputed at
+        # every crossing (the same einsum, so the same numbers); rows hour × n_tri + tri
+        self.planes = np.ascontiguousarray(np.hstack([geo.normals, geo.v0]))
+        suns = self.suns if more else self.sun[None, :]
+        cos = np.stack([np.einsum("ij,ij->i", np.broadcast_to(sun, geo.normals.shape),
+                                  geo.normals) for sun in suns])
+        self.sun_cos = cos.reshape(-1)
+        self.sun_side = np.where(self.sun_cos < 0, -self.eps, self.eps)
+        self.sun_grazing = bool(np.any(np.abs(self.sun_cos) < 1e-12))  # plane_distance's test
 
     def sky(self, d: np.ndarray, hour: np.ndarray | None) -> np.ndarray:
         """Luminance seen along escaping directions ``d`` (each path's own hour state)."""
@@ -188,13 +198,15 @@ class _Tracer:
 
     def shadow(self, origins: np.ndarray, dirs: np.ndarray,
                rng: Draws | np.random.Generator | None = None, tag: tuple[int, ...] = (),
-               parallel: bool = True) -> np.ndarray:
+               parallel: bool = True, hour: np.ndarray | int | None = None) -> np.ndarray:
         """Transmittance towards the sun: 1 if free, product of specular passes, else 0.
 
         With ``rng``, faint shadow rays are continued by Russian roulette (unbiased); without,
         the product is exact (the sensors' own direct sun). ``tag``: the program-order label
         of the roulette draws when ``rng`` is a :class:`Draws` (layer appended); ``parallel``:
-        whether the ray caster may split its queries over threads (not inside a part thread).
+        whether the ray caster may split its queries over threads (not inside a part thread);
+        ``hour``: the hour state(s) whose point sun ``dirs`` are (per-triangle tables of the
+        cosines and offsets), None for other directions (a sampled sun disc).
         """
         k = len(origins)
         vis = np.ones(k)
@@ -238,14 +250,27 @@ class _Tracer:
                 sel, tri, ih = sel[go], tri[go], ih[go]
             idx = ih
             o, d = _take(o, sel), _rows(d, sel)
-            ng = _take(geo.normals, tri)
-            cosd = np.einsum("ij,ij->i", d, ng)
-            t = (plane_distance(geo.v0, geo.normals, geo.centroids, o, d, tri, ng, cosd)
-                 if t is None else t[sel])
+            if isinstance(hour, np.ndarray):
+                hour = hour[sel]
+            if hour is None or self.sun_grazing or t is not None:
+                ng = _take(geo.normals, tri)
+                cosd = np.einsum("ij,ij->i", d, ng)
+                t = (plane_distance(geo.v0, geo.normals, geo.centroids, o, d, tri, ng, cosd)
+                     if t is None else t[sel])
+                side = np.where(cosd < 0, -self.eps, self.eps)
+            else:  # the point sun: plane_distance's arithmetic with the cosines looked up
+                key = tri if isinstance(hour, int) and hour == 0 else tri + hour * self.n_tri
+                g = _take(self.planes, tri)
+                ng, v = g[:, :3], g[:, 3:]
+                v -= o
+                t = np.einsum("ij,ij->i", v, ng)
+                t /= np.take(self.sun_cos, key)
+                np.maximum(t, 0.0, out=t)
+                side = np.take(self.sun_side, key)
             # o + t d − n_f ε with n_f = ±n_g on the side the ray came from
             step = t[:, None] * d
             step += o
-            ng *= np.where(cosd < 0, -self.eps, self.eps)[:, None]
+            ng *= side[:, None]
             step += ng
             o = step
         vis[idx] = 0.0
@@ -262,13 +287,15 @@ class _Tracer:
                             (self.dnis[state] > 0, self.dnis[state], self.suns[state]))
         if not sun_on or k == 0:
             return out
+        hour = None
         if dirs is None:
             dirs = np.broadcast_to(sun, (k, 3))
+            hour = 0 if state is None else int(state)
         cos = np.einsum("ij,ij->i", normals, dirs)
         need = cos > 0
         if need.any():
             out[need] = dni * cos[need] * self.shadow(points[need],
-                                                               _rows(dirs, need), rng)
+                                                      _rows(dirs, need), rng, hour=hour)
         return out
 
     # -- paths
@@ -347,7 +374,9 @@ class _Tracer:
                     so = _take(nf, ni)
                     so *= (eps * np.sign(cs[ni]))[:, None]
                     so += _take(p, ni)
-                    vis = self.shadow(so, _rows(sd, ni), rng, (bounce, 1), parallel)
+                    vis = self.shadow(so, _rows(sd, ni), rng, (bounce, 1), parallel,
+                                      None if self.opts.sun_disc else
+                                      0 if hour is None else hour[ni])
                     got = beta[ni] * (self.dni if hour is None else 1.0) * f[ni] * vis
                     an = alive[ni]
                     acc[an] += got

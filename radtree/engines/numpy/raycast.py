@@ -100,6 +100,7 @@ class EmbreeCaster:
         self._pool = ThreadPoolExecutor(self.workers) if self.workers > 1 else None
         self.rays_cast = 0
         self._count_lock = threading.Lock()
+        self._rows32: dict[bytes, np.ndarray] = {}  # float32 unit row of each point sun
         # build the Embree scene now (trimesh builds it lazily on first query)
         self._intersector.intersects_first(np.zeros((1, 3)), np.array([[0.0, 0.0, 1.0]]))
         self._embree = self._intersector._scene  # trimesh's scaled Embree scene
@@ -111,7 +112,13 @@ class EmbreeCaster:
         once and handed to Embree as that broadcast row."""
         wrap = self._embree
         if d.ndim == 2 and d.strides[0] == 0 and len(d):  # one direction (a point sun)
-            d32 = np.broadcast_to(_unit32(np.array(d[:1], dtype=np.float32)), d.shape)
+            key = d[0].tobytes()
+            row = self._rows32.get(key)
+            if row is None:
+                if len(self._rows32) > 256:
+                    self._rows32.clear()
+                row = self._rows32[key] = _unit32(np.array(d[:1], dtype=np.float32))
+            d32 = np.broadcast_to(row, d.shape)
         else:
             d32 = _unit32(np.array(d, dtype=np.float32))
         scaled = np.subtract(o.astype(np.float32), wrap.origin, dtype=np.float64)  # exact
