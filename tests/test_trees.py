@@ -222,3 +222,25 @@ def test_picture(project, frame, built, tmp_path):
                   {"facade": facade_circle(project.sensors, frame)})
     out = render_model_png(tm, scene, tmp_path / "scene.png")
     assert out.stat().st_size > 10_000
+
+
+def test_clip_polygons_cuts_each_polygon_at_its_plane():
+    """Sutherland–Hodgman on many polygons at once: a unit square cut at x ≥ 0.25 keeps
+    0.75 × 1 with its corners in order; a triangle wholly kept is unchanged; polygons wholly
+    on the other side count 0."""
+    from radtree.trees.geometry import clip_polygons
+
+    sq = np.array([[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0]], float)
+    tri = np.array([[2, 0, 0], [3, 0, 0], [2, 1, 0], [0, 0, 0]], float)   # 3 corners used
+    gone = sq - [5, 0, 0]
+    corner = np.array([[-1, 0, 0], [0, 0, 0], [-1, 1, 0], [-2, 1, 0]], float)
+    polys = np.stack([sq, tri, gone, corner])
+    out, count = clip_polygons(polys, np.array([4, 3, 4, 4]), np.array([1.0, 0, 0]), 0.25)
+    assert count.tolist() == [4, 3, 0, 0]
+    np.testing.assert_allclose(out[0, :4], [[0.25, 0, 0], [1, 0, 0], [1, 1, 0], [0.25, 1, 0]])
+    np.testing.assert_array_equal(out[1, :3], tri[:3])
+    # a second cut (y ≤ 0.5) of the result: the shoelace area is 0.75 × 0.5
+    out, count = clip_polygons(out, count, np.array([0, -1.0, 0]), -0.5)
+    xy = out[0, :count[0], :2]
+    area = 0.5 * abs(np.sum(xy[:, 0] * np.roll(xy[:, 1], -1) - np.roll(xy[:, 0], -1) * xy[:, 1]))
+    assert count[0] == 4 and area == pytest.approx(0.375)

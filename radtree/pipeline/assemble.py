@@ -94,10 +94,15 @@ def make_scene(project: Project, scenario: Scenario, dense_grid: bool | None = N
     info: dict[str, float] = {}
     tree = None
     if scenario.model != "none":
-        from radtree.pipeline.crown_bsdf import bsdf_crown
-        from radtree.trees.build import build_tree
+        from radtree.trees.build import apply_switches, build_tree
 
-        tree = bsdf_crown(project, scenario, frame) or build_tree(project, scenario, frame)
+        crown, _ = apply_switches(project.tree, dict(scenario.switches),
+                                  source=str(project.source))
+        if crown.representation == "bsdf":   # imported only then: it pulls in trimesh (~1 s)
+            from radtree.pipeline.crown_bsdf import bsdf_crown
+
+            tree = bsdf_crown(project, scenario, frame)
+        tree = tree or build_tree(project, scenario, frame)
         clash = set(tree.materials) & set(materials)
         if clash:
             raise RadtreeError(f"crown model materials clash with the street's: {clash}")

@@ -255,7 +255,8 @@ def _build_one(project: Project, sc: Scenario, engine: Any, build_root: Path) ->
         with (tmp / SCENE_FILE).open("wb") as f:   # inside the atomic folder
             pickle.dump(built, f, protocol=5)
         write_text(tmp / "manifest.json", json.dumps(
-            manifest(project, extra={"build": facts, "files": folder_files(tmp)}),
+            manifest(project, extra={"build": facts, "files": folder_files(tmp)},
+                     engines=[engine]),   # the folder's engine: it wrote the folder
             indent=2, default=str))
     return facts
 

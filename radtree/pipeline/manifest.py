@@ -27,11 +27,14 @@ def input_files(project) -> dict[str, str]:
             if Path(v).exists()}
 
 
-def manifest(project, extra: dict[str, Any] | None = None) -> dict[str, Any]:
+def manifest(project, extra: dict[str, Any] | None = None,
+             engines: list[Any] | None = None) -> dict[str, Any]:
+    """Versions, parameters, seeds and input hashes of ``project`` (plus ``extra``); the
+    provenance of ``engines`` (default: every available engine)."""
     from radtree.engines.registry import available_engines
 
     d: dict[str, Any] = {"radtree_version": radtree.__version__}
-    for engine in available_engines():
+    for engine in available_engines() if engines is None else engines:
         d.update(engine.provenance())
     d.update({
         "python": platform.python_version(),

@@ -11,7 +11,7 @@ from __future__ import annotations
 import numpy as np
 
 from radtree.trees.envelope import CrownRowSpec
-from radtree.trees.geometry import clip_polygon
+from radtree.trees.geometry import clip_polygons
 
 _U, _N, _Z = np.eye(3)
 
@@ -37,14 +37,13 @@ def cut_to_share(corners: np.ndarray, spec: CrownRowSpec, lo: float, hi: float
     inside = (np.all(corners[:, :, 1] >= spec.n_clip, axis=1)
               & np.all(corners[:, :, 0] >= lo, axis=1) & np.all(corners[:, :, 0] <= hi, axis=1))
     polys: list[np.ndarray] = list(corners[inside])
-    cut = 0
-    for poly in corners[~inside]:
-        p = clip_polygon(poly, _N, spec.n_clip)
-        if np.isfinite(lo) and len(p) >= 3:
-            p = clip_polygon(p, _U, lo)
-        if np.isfinite(hi) and len(p) >= 3:
-            p = clip_polygon(p, -_U, -hi)
-        if len(p) >= 3:
-            polys.append(p)
-            cut += 1
-    return polys, cut
+    rest = corners[~inside]
+    count = np.full(len(rest), rest.shape[1])
+    rest, count = clip_polygons(rest, count, _N, spec.n_clip)
+    if np.isfinite(lo):
+        rest, count = clip_polygons(rest, count, _U, lo)
+    if np.isfinite(hi):
+        rest, count = clip_polygons(rest, count, -_U, -hi)
+    kept = np.flatnonzero(count >= 3)
+    polys.extend(rest[i, :count[i]] for i in kept)
+    return polys, len(kept)

@@ -29,7 +29,6 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
-import trimesh
 
 from radtree.config import Sensors, Street, Tree
 from radtree.errors import ConfigError
@@ -133,6 +132,8 @@ class CrownRowSpec:
     def envelope(self, i: int, subdivisions: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Crown i's envelope: local vertices, faces, and a mask of faces on the wall-side
         clip plane (the "wall cap"). Faces on the planes shared with neighbours are dropped."""
+        import trimesh  # here: importing it takes ~1 s, and most builds never get here
+
         sphere = trimesh.creation.icosphere(subdivisions=subdivisions)
         d = np.asarray(sphere.vertices, float)
         d = d / np.linalg.norm(d, axis=1)[:, None]

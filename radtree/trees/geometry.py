@@ -116,21 +116,32 @@ def hemisphere_mesh(rings: int) -> tuple[np.ndarray, np.ndarray]:
     return np.vstack(verts), np.asarray(faces, dtype=np.int64)
 
 
-def clip_polygon(poly: np.ndarray, normal: np.ndarray, offset: float) -> np.ndarray:
-    """Keep the part of a convex planar polygon (k, 3) where normal·x ≥ offset
-    (Sutherland–Hodgman). Returns (k', 3), possibly empty."""
-    d = poly @ normal - offset
-    out = []
-    k = len(poly)
-    for i in range(k):
-        p, q = poly[i], poly[(i + 1) % k]
-        dp, dq = d[i], d[(i + 1) % k]
-        if dp >= 0:
-            out.append(p)
-        if (dp >= 0) != (dq >= 0):
-            t = dp / (dp - dq)
-            out.append(p + t * (q - p))
-    return np.asarray(out, float).reshape(-1, 3)
+def clip_polygons(polys: np.ndarray, counts: np.ndarray, normal: np.ndarray, offset: float
+                  ) -> tuple[np.ndarray, np.ndarray]:
+    """Keep the part of each convex planar polygon where normal·x ≥ offset (Sutherland–Hodgman,
+    all polygons at once). ``polys`` (n, K, 3) holds polygon i in its first ``counts[i]``
+    rows; returns the clipped polygons the same way (n, K', 3) with their counts. A result
+    of fewer than 3 corners counts 0 (dropped), so later clips leave it empty."""
+    n, k, _ = polys.shape
+    if n == 0:
+        return polys, counts
+    slot = np.arange(k)
+    valid = slot[None, :] < counts[:, None]
+    nxt = (slot[None, :] + 1) % np.maximum(counts, 1)[:, None]
+    d = polys @ normal - offset
+    q = np.take_along_axis(polys, nxt[:, :, None], axis=1)
+    dq = np.take_along_axis(d, nxt, axis=1)
+    keep = valid & (d >= 0)
+    crossing = valid & ((d >= 0) != (dq >= 0))
+    with np.errstate(divide="ignore", invalid="ignore"):   # t is used where crossing only
+        t = d / (d - dq)
+        cut = polys + t[:, :, None] * (q - polys)
+    cand = np.stack([polys, cut], axis=2).reshape(n, 2 * k, 3)
+    use = np.stack([keep, crossing], axis=2).reshape(n, 2 * k)
+    out_counts = use.sum(axis=1)
+    order = np.argsort(~use, axis=1, kind="stable")[:, :max(int(out_counts.max()), 1)]
+    out = np.take_along_axis(cand, order[:, :, None], axis=1)
+    return out, np.where(out_counts >= 3, out_counts, 0)
 
 
 def polygons_to_mesh(polygons: list[np.ndarray]) -> tuple[np.ndarray, np.ndarray]:

@@ -87,11 +87,20 @@ def lens_of(name: str, field: str = "tree.lens") -> Projection:
     return lens
 
 
-def _check_mask(image: Any, mask: CircularMask, field: str) -> None:
-    """The given mask against the image circle the photo shows (when one is detected)."""
-    try:
-        found = detect_circular_mask(image.brightness())
-    except RadtreeError:
+def _check_mask(image: Any, mask: CircularMask, field: str,
+                key: tuple[str, float] | None = None) -> None:
+    """The given mask against the image circle the photo shows (when one is detected; the
+    circle found is remembered by ``key``, the file and its modification time)."""
+    if key is not None and key in _CIRCLES:
+        found = _CIRCLES[key]
+    else:
+        try:
+            found = detect_circular_mask(image.brightness())
+        except RadtreeError:
+            found = None
+        if key is not None:
+            _CIRCLES[key] = found
+    if found is None:
         return   # no detectable circle (dark canopy at the rim): trust the mask given
     off = math.hypot(found.cx - mask.cx, found.cy - mask.cy)
     if off > MASK_TOLERANCE * found.radius or abs(found.radius - mask.radius) > (
@@ -101,6 +110,10 @@ def _check_mask(image: Any, mask: CircularMask, field: str) -> None:
             f"circle of {image.name} (centre {found.cx:.0f}, {found.cy:.0f}, radius "
             f"{found.radius:.0f} px): give that circle, or leave mask out to detect it",
             field.rsplit(".", 1)[0] + ".mask")
+
+
+#: the image circle detected in a photo (None: none detectable), by file and modification time
+_CIRCLES: dict[tuple[str, float], CircularMask | None] = {}
 
 
 @lru_cache(maxsize=16)
@@ -115,7 +128,7 @@ def _analysed(path: str, mtime: float, lens: str, mask: tuple[float, float, floa
     try:
         image = load_image(p)
         if circle is not None:
-            _check_mask(image, circle, field)
+            _check_mask(image, circle, field, (path, mtime))
         config = HemiConfig(lens=projection, mask=circle, axis=axis, outlines=False,
                             channel="luma" if image.is_gray else "blue",
                             grid=RingGrid(9, 8, 0.0, float(zenith_deg)))
