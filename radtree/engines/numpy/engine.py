@@ -172,7 +172,6 @@ class _Tracer:
         # point sun: per triangle (and hour state) the cosine sun · normal and the origin
         # offset ±ε towards the side a shadow ray leaves, looked up instead of recomputed at
         # every crossing (the same einsum, so the same numbers); rows hour × n_tri + tri
-        self.planes = np.ascontiguousarray(np.hstack([geo.normals, geo.v0]))
         suns = self.suns if more else self.sun[None, :]
         cos = np.stack([np.einsum("ij,ij->i", np.broadcast_to(sun, geo.normals.shape),
                                   geo.normals) for sun in suns])
@@ -260,15 +259,14 @@ class _Tracer:
                 side = np.where(cosd < 0, -self.eps, self.eps)
             else:  # the point sun: plane_distance's arithmetic with the cosines looked up
                 key = tri if isinstance(hour, int) and hour == 0 else tri + hour * self.n_tri
-                g = _take(self.planes, tri)
-                ng, v = g[:, :3], g[:, 3:]
+                ng, v = _take(geo.normals, tri), _take(geo.v0, tri)
                 v -= o
                 t = np.einsum("ij,ij->i", v, ng)
                 t /= np.take(self.sun_cos, key)
                 np.maximum(t, 0.0, out=t)
                 side = np.take(self.sun_side, key)
             # o + t d − n_f ε with n_f = ±n_g on the side the ray came from
-            step = t[:, None] * d
+            step = t[:, None] * (d[0] if d.strides[0] == 0 else d)
             step += o
             ng *= side[:, None]
             step += ng
