@@ -8,6 +8,7 @@ same frame.
 from __future__ import annotations
 
 import math
+from functools import lru_cache
 
 import numpy as np
 
@@ -84,12 +85,13 @@ def _stitch(a: np.ndarray, a_phi: np.ndarray, b: np.ndarray, b_phi: np.ndarray) 
     return out
 
 
+@lru_cache(maxsize=16)
 def hemisphere_mesh(rings: int) -> tuple[np.ndarray, np.ndarray]:
     """A watertight unit hemisphere around +n (the half n ≥ 0), rim in the plane n = 0.
 
     ``rings`` rings of equal polar step 90°/rings; ring i carries ≈ 4·rings·sin θ_i vertices,
     so the triangles are close to equal in area. Triangles ≈ 5.1·rings². Returns unit
-    vertex directions (V, 3) and faces (F, 3).
+    vertex directions (V, 3) and faces (F, 3), read-only (cached: shared by every caller).
     """
     if rings < 1:
         raise ValueError("a hemisphere needs at least one ring")
@@ -113,7 +115,9 @@ def hemisphere_mesh(rings: int) -> tuple[np.ndarray, np.ndarray]:
         faces.append((0, first[k], first[(k + 1) % len(first)]))
     for i in range(1, rings):
         faces.extend(_stitch(ring_idx[i], ring_phi[i], ring_idx[i + 1], ring_phi[i + 1]))
-    return np.vstack(verts), np.asarray(faces, dtype=np.int64)
+    v, f = np.vstack(verts), np.asarray(faces, dtype=np.int64)
+    v.flags.writeable = f.flags.writeable = False   # cached: shared by every caller
+    return v, f
 
 
 def clip_polygons(polys: np.ndarray, counts: np.ndarray, normal: np.ndarray, offset: float

@@ -33,6 +33,7 @@ from __future__ import annotations
 import math
 from collections.abc import Callable
 from dataclasses import dataclass
+from functools import lru_cache
 from pathlib import Path
 from typing import Any
 
@@ -87,6 +88,7 @@ def _chunked(is_sky: SkyPredicate, d: np.ndarray, chunk: int = 65536) -> np.ndar
     return out
 
 
+@lru_cache(maxsize=8)
 def random_gap_pattern(openness: float, seed: int = DEFAULT_SEED, gaps: int | None = None
                        ) -> GapPattern:
     """Seeded round sky gaps over the hemisphere n ≥ 0 covering ``openness`` of its solid angle.
