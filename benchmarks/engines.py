@@ -13,12 +13,14 @@ Prints (no timing assertions):
    ``EmbreeScene.run`` (float32 rays already in trimesh's Embree frame, chunks of 65 536 over
    the same number of threads) and through the engine's ``EmbreeCaster.first_hit`` in one call
    (conversions and float64 distances included); the engine's rays/s over raw Embree's is the
-   throughput ratio (Mendoza scenarios B and F, 12:30, 1 and 2 threads);
+   throughput ratio (Mendoza scenarios B and F, 12:30, 1 and 2 threads); also Embree's own CPU
+   time inside the engine (``EmbreeScene.run`` timed where the engine calls it) as a share of
+   the engine's CPU time;
 4. when Radiance is available, the per-row relative difference NumPy − Radiance on the slat
    scene, with Radiance at ``-ab 8 -ad 8192 -as 0 -aa 0`` and with ambient super-sampling
    (``-as 4096``, biased low here); ``--with-defaults`` adds the project's ``-as 512 -aa 0.1``.
 
-Run: ``.venv/bin/python benchmarks/engines.py [--quick]``.
+Run: ``.venv/bin/python benchmarks/engines.py [--quick] [--only throughput]``.
 """
 
 from __future__ import annotations
@@ -194,6 +196,33 @@ def _recorded_queries(caster: EmbreeCaster, work: Any, *args: Any
             len(casts))
 
 
+def _embree_inside(caster: EmbreeCaster, work: Any, *args: Any) -> tuple[float, float]:
+    """CPU time of the Embree calls made while ``work(*args)`` runs (each calling thread's
+    own clock around ``EmbreeScene.run``) and the process CPU time of the whole work."""
+    wrap = caster._embree
+    spent = [0.0]
+    lock = threading.Lock()
+
+    class Scene:  # times EmbreeScene.run, passes everything else through
+        def run(self, o: np.ndarray, d: np.ndarray) -> np.ndarray:
+            t = time.thread_time()
+            out = wrap.scene.run(o, d)
+            with lock:
+                spent[0] += time.thread_time() - t
+            return out
+
+    class Wrap:
+        origin, scale, scene = wrap.origin, wrap.scale, Scene()
+
+    caster._embree = Wrap()
+    try:
+        c0 = time.process_time()
+        work(*args)
+        return spent[0], time.process_time() - c0
+    finally:
+        caster._embree = wrap
+
+
 def engine_vs_embree(quick: bool) -> None:
     print("\n== NumPy engine vs raw Embree on the same rays ==")
     from radtree.config import load_project
@@ -230,6 +259,8 @@ def engine_vs_embree(quick: bool) -> None:
                 first_hit = time.perf_counter() - t0
                 best.append((engine, raw, first_hit, engine_cpu, raw_cpu))
             engine, raw, first_hit, engine_cpu, raw_cpu = min(best)
+            inside, inside_cpu = _embree_inside(caster, trace_hour, built.scene, state, p,
+                                                ["facade"])
             n = len(o)
             print(f"  scenario {name}: {built.triangles} triangles, {workers} thread(s), "
                   f"{n / 1e6:.2f} M queries in {calls} calls: engine {n / engine / 1e6:.2f} "
@@ -237,7 +268,9 @@ def engine_vs_embree(quick: bool) -> None:
                   f"{n / raw / 1e6:.2f} M/s ({raw_cpu:.2f} s CPU), EmbreeCaster.first_hit "
                   f"{n / first_hit / 1e6:.2f} M/s → engine / raw Embree {raw / engine:.0%} "
                   f"(CPU {raw_cpu / engine_cpu:.0%}), engine / first_hit "
-                  f"{first_hit / engine:.0%}; load {os.getloadavg()[0]:.1f}", flush=True)
+                  f"{first_hit / engine:.0%}; Embree's own CPU time inside the engine "
+                  f"{inside:.2f} s = {inside / inside_cpu:.0%} of the engine's "
+                  f"{inside_cpu:.2f} s; load {os.getloadavg()[0]:.1f}", flush=True)
 
 
 def engines_differ(sc: Scene, quick: bool, with_defaults: bool) -> None:
@@ -278,13 +311,20 @@ def main() -> None:
     ap.add_argument("--quick", action="store_true", help="smaller batches")
     ap.add_argument("--with-defaults", action="store_true",
                     help="also run Radiance with the project's -as 512 -aa 0.1 (minutes)")
+    ap.add_argument("--only", choices=["rays", "hour", "throughput", "radiance"],
+                    help="run one section (1 rays, 2 hour, 3 throughput, 4 radiance)")
     args = ap.parse_args()
     load = os.getloadavg() if hasattr(os, "getloadavg") else (float("nan"),) * 3
     print(f"cpus: {os.cpu_count()}, load average {load[0]:.2f}")
-    rays_per_second(args.quick)
-    sc = engine_hour(args.quick)
-    engine_vs_embree(args.quick)
-    engines_differ(sc, args.quick, args.with_defaults)
+    run = {args.only} if args.only else {"rays", "hour", "throughput", "radiance"}
+    if "rays" in run:
+        rays_per_second(args.quick)
+    if run & {"hour", "radiance"}:
+        sc = engine_hour(args.quick) if "hour" in run else slat_scene(3000)
+    if "throughput" in run:
+        engine_vs_embree(args.quick)
+    if "radiance" in run:
+        engines_differ(sc, args.quick, args.with_defaults)
 
 
 if __name__ == "__main__":

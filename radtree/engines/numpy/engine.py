@@ -219,19 +219,20 @@ class _Tracer:
             sel = np.flatnonzero(tri >= 0)
             if len(sel) == 0:
                 return vis
-            tri = tri[sel]
-            ih = idx[sel]
+            tri = np.take(tri, sel).astype(np.intp, copy=False)  # Embree's are int32
+            ih = np.take(idx, sel)
             if not passes:
                 vis[ih] = 0.0
                 return vis
-            f = ts[tri]
+            f = np.take(ts, tri)
             if self.glass_any:
                 glass = self.tri_glass[tri]
                 if glass.any():
                     gs, gt = sel[glass], tri[glass]
                     cosg = np.einsum("ij,ij->i", _rows(d, gs), geo.normals[gt])
                     f[glass] = glass_coefficients(cosg, self.tri_glass_tn[gt])[0]
-            v = vis[ih] * f
+            v = np.take(vis, ih)
+            v *= f
             vis[ih] = v
             # Russian roulette on faint shadow rays (unbiased: survivors are promoted)
             faint = (v > 0) & (v < SHADOW_ROULETTE)
