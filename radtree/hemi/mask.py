@@ -10,10 +10,10 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
-from skimage.measure import CircleModel, label, ransac
 
 from radtree.errors import ConfigError, RadtreeError
 
@@ -166,6 +166,8 @@ def detect_circular_mask(brightness: NDArray, *, source: str = "") -> CircularMa
             np.c_[cols + 0.5, bottom + 1.0],
         ]
     ).astype(np.float64)
+    from skimage.measure import CircleModel, ransac  # here: ~0.4 s to import
+
     model, inliers = ransac(
         pts, CircleModel, min_samples=3, residual_threshold=2.5, max_trials=500, rng=0
     )
@@ -191,6 +193,8 @@ def detect_circular_mask(brightness: NDArray, *, source: str = "") -> CircularMa
 
 def _drop_specks(binary: NDArray[np.bool_], *, min_pixels: int) -> NDArray[np.bool_]:
     """Remove connected specks (noise, hot pixels) smaller than ``min_pixels``."""
+    from skimage.measure import label
+
     labels = label(binary, connectivity=2)
     sizes = np.bincount(labels.ravel())
     keep = sizes >= min_pixels
@@ -198,7 +202,8 @@ def _drop_specks(binary: NDArray[np.bool_], *, min_pixels: int) -> NDArray[np.bo
     return keep[labels]
 
 
-def _circle_params(model: CircleModel) -> tuple[float, float, float]:
+def _circle_params(model: Any) -> tuple[float, float, float]:
+    """(cx, cy, r) of a fitted ``skimage.measure.CircleModel``."""
     center = getattr(model, "center", None)
     if center is not None:  # scikit-image >= 0.26
         return float(center[0]), float(center[1]), float(model.radius)

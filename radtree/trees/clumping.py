@@ -38,8 +38,6 @@ import math
 from functools import lru_cache
 
 import numpy as np
-from scipy.optimize import brentq
-from scipy.spatial import cKDTree
 
 from radtree.hemi.metrics import DEFAULT_GAP_FLOOR, GapTable, RingGrid, lai_lang_xiang, lai_miller
 
@@ -84,6 +82,8 @@ def slats_per_cluster(omega: float, radius: float, slat: float) -> float:
 
     if miss(hi) > 0:
         raise ValueError(f"clumping {omega} is out of reach of clusters of radius {radius} m")
+    from scipy.optimize import brentq  # here: ~0.5 s to import
+
     return float(brentq(miss, lo, hi, xtol=1e-6, rtol=1e-8))
 
 
@@ -135,6 +135,8 @@ def cast_slats(direction: np.ndarray, camera: np.ndarray, centres: np.ndarray,
     unit edge vectors e1, e2, side ``slat``): candidate pairs within the slat's angular radius
     (k-d trees of the ray and slat directions, slats binned by that radius), then the exact
     ray–square test."""
+    from scipy.spatial import cKDTree
+
     hit = np.zeros(len(direction), bool)
     if len(centres) == 0:
         return hit

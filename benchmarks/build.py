@@ -1,0 +1,83 @@
+"""Wall and CPU time of `radtree build` on the Mendoza example (issue 22: ≤ 3 s), as a user runs it.
+
+Each run is the command line in a fresh process on a copy of the example (pictures off unless
+``--pictures``): a cold build into an empty folder with 1 process and with the usable cores,
+then a second `radtree build` on the built folders (every folder current: kept) and a
+`--fresh` one (every folder rebuilt). CPU includes the spawned workers. The slowest folders
+of the cold build are listed from their manifests (geometry and writing seconds).
+Run: .venv/bin/python benchmarks/build.py [--repeats N] [--pictures]
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import resource
+import shutil
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+RADTREE = Path(sys.executable).with_name("radtree")
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--repeats", type=int, default=2, help="runs of each case (default 2)")
+    ap.add_argument("--pictures", action="store_true", help="draw model.png too")
+    args = ap.parse_args()
+    cores = len(os.sched_getaffinity(0))
+    with tempfile.TemporaryDirectory() as tmp:
+        proj = Path(tmp) / "mendoza"
+        shutil.copytree(ROOT / "examples" / "mendoza-street", proj,
+                        ignore=shutil.ignore_patterns("build", "results", "report", "diagnose",
+                                                      "sweep"))
+        extra = [] if args.pictures else ["--no-pictures"]
+        rows = []
+        for label, opts, clean in (("cold, 1 process", ["--workers", "1"], True),
+                                   (f"cold, {cores} processes", [], True),
+                                   ("again, folders current (kept)", [], False),
+                                   ("again, --fresh", ["--fresh"], False)):
+            for _ in range(args.repeats):
+                if clean:
+                    shutil.rmtree(proj / "build", ignore_errors=True)
+                wall, cpu, load = _run([str(RADTREE), "build", str(proj), *extra, *opts])
+                rows.append((label, wall, cpu, load))
+        print(f"radtree build of the Mendoza example ({len(list((proj / 'build').glob('*/')))} "
+              f"folders), {'with' if args.pictures else 'without'} pictures, {cores} cores")
+        print(f"{'case':34s} {'wall s':>7s} {'CPU s':>7s} {'load':>5s}")
+        for label, wall, cpu, load in rows:
+            print(f"{label:34s} {wall:7.2f} {cpu:7.2f} {load:5.2f}")
+        shutil.rmtree(proj / "build")
+        _run([str(RADTREE), "build", str(proj), *extra, "--workers", "1"])
+        print("slowest folders (one process):")
+        facts = []
+        for mf in (proj / "build").glob("*/manifest.json"):
+            b = json.loads(mf.read_text())["build"]
+            facts.append((b["seconds"]["geometry"] + b["seconds"]["writing"], b))
+        for total, b in sorted(facts, key=lambda t: -t[0])[:6]:
+            print(f"  {b['scenario']:8s} {total:5.2f} s (geometry {b['seconds']['geometry']:.2f}, "
+                  f"writing {b['seconds']['writing']:.2f}; {b['triangles']} triangles)")
+
+
+def _run(argv: list[str]) -> tuple[float, float, float]:
+    """(wall s, CPU s of the process and its children, load average at the start)."""
+    load = os.getloadavg()[0]
+    before = resource.getrusage(resource.RUSAGE_CHILDREN)
+    t = time.perf_counter()
+    subprocess.run(argv, check=True, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    wall = time.perf_counter() - t
+    after = resource.getrusage(resource.RUSAGE_CHILDREN)
+    cpu = (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)
+    return wall, cpu, load
+
+
+if __name__ == "__main__":
+    from _common import print_resources_at_exit  # benchmarks/_common.py
+
+    print_resources_at_exit()
+    main()
