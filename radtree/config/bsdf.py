@@ -19,9 +19,10 @@ ring, :func:`radtree.trees.slab.chord_samples`); ``"slab"``: one slab ``depth_m`
 crossed along ``depth_m`` / cos θ — grazing light, which passes the rim of a real crown
 through a short chord, then crosses the thickest layer. ``curvature`` (sensor dome):
 ``"traced"`` (default) replaces the planar sample's view from the dome's centre (the row of
-the normal outgoing patch, ring by ring) by the one traced through the curved dome's own
-slats (:mod:`radtree.pipeline.dome_curvature`); ``"planar"`` keeps the flat stack's (a given
-``xml`` is used as it is).
+the normal outgoing patch, patch by patch) by the one traced through the curved dome's own
+slats (:mod:`radtree.pipeline.dome_curvature`); ``"rings"`` only rescales that row ring by
+ring to the traced ring sums (the planar azimuthal shape kept; the correction before);
+``"planar"`` keeps the flat stack's (a given ``xml`` is used as it is).
 ``tensor_tree``: 0, or the log2 resolution
 of an extra rank-4 tensor-tree XML. ``xml``: use this leaf-on XML instead of computing it
 (computed XMLs are cached under ``build/bsdf/<scenario>/``).
@@ -37,7 +38,7 @@ from radtree.config.spec import Checked, SchemaError, meta
 
 REPRESENTATIONS = ("explicit", "bsdf")
 CROSSINGS = ("chord", "slab")
-CURVATURES = ("traced", "planar")
+CURVATURES = ("traced", "rings", "planar")
 
 
 @dataclass(frozen=True)

@@ -227,7 +227,7 @@ def scenario_xmls(project: Project, scenario: Scenario,
         sample = leaf_on_sample(project, scenario, el, half)
         run = ensure_bsdf(sample, settings, folder, name, progress)
         xml = run.xml
-        if form == "dome" and tree.bsdf.curvature == "traced":
+        if form == "dome" and tree.bsdf.curvature != "planar":
             xml = ensure_curved(project, tree, curved, sample, settings, folder, name, lo, hi,
                                 progress)
         out.append((lo, hi, xml))
@@ -241,7 +241,8 @@ def ensure_curved(project: Project, tree: Tree, dome: Callable[[], CurvedDome],
     """The dome band's XML with the view from the centre traced through the curved slats
     (``dome()``, :mod:`radtree.pipeline.dome_curvature`), in ``folder/curved/``; reused when
     the planar sample's key and the trace's settings match."""
-    key = (f"{sample_key(sample, settings)}|{lo:g}|{hi:g}|{CURVATURE_PATHS}|"
+    per = "ring" if tree.bsdf.curvature == "rings" else "patch"
+    key = (f"{sample_key(sample, settings)}|{lo:g}|{hi:g}|{CURVATURE_PATHS}|{per}|"
            f"{tree.louvers.seed}|{tree.dome.radius_m:g}|{project.sensors.radius_m:g}|"
            f"{project.sensors.offset_m:g}|{project.street.facade_azimuth_deg:g}")
     sub = folder / "curved"
@@ -250,10 +251,11 @@ def ensure_curved(project: Project, tree: Tree, dome: Callable[[], CurvedDome],
         return xml
     row = curved_ring_row(dome(), lo, hi, CURVATURE_PATHS, workers=os.cpu_count() or 1)
     comment = (f"radtree crown BSDF: {sample.name}, curved dome |elevation| {lo:g}–{hi:g}°: "
-               f"the normal-outgoing row traced through the dome's slats ({row.paths} paths); "
+               f"the normal-outgoing row traced per {per} through the dome's slats "
+               f"({row.paths} paths); "
                + " ".join(sample.notes))[:900]
     out, _ = write_curved_xml(folder, sub, f"{name}_curved", row, sample.thickness,
-                              sample.width, sample.height, comment, progress)
+                              sample.width, sample.height, comment, progress, per)
     check_bsdf(out)
     write_text(key_file, key + "\n")
     return out

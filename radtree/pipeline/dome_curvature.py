@@ -13,12 +13,17 @@ Klems patch 0 of the back side). This module traces that row through the explici
 the curved dome from its centre (:func:`radtree.engines.numpy.transfer.trace_escapes`: paths
 start on a black sphere just inside the innermost shell, along directions d of the band,
 cosine-weighted about the façade normal as a façade sensor sees them; a path returning into
-that sphere is light the stack reflects back, not part of the row) and bins each escape by its
-angle to d. Per Klems ring r of incident angle the traced P_r = Σ_{j ∈ r} f[0, j] Λ_j (the
-weight of that ring of the sky in the radiance the centre receives) replaces the planar
-sample's, by scaling the row's patches in r (their azimuthal shape is kept), and the
-reciprocal column tb[j, 0] with them (Helmholtz: T_f[o, i] = T_b[i, o]). The other rows
-(light seen obliquely from off-centre points, the wall's view of the shell) stay planar.
+that sphere is light the stack reflects back, not part of the row) and bins each escape by the
+Klems patch it arrives from, in the frame the shell's ``BSDF`` material applies the XML in at
+d (:func:`shell_frames`; azimuth convention :func:`incident_patches`). The traced
+P_j = f[0, j] Λ_j (the weight of patch j of the sky in the radiance the centre receives)
+replaces the planar sample's row (``tree.bsdf.curvature = "traced"``), and the reciprocal
+column of T_b is set to match (Helmholtz: T_f[o, i] = T_b[i, o]); ``"rings"`` keeps the planar
+row's azimuthal shape and only rescales each Klems θ ring to the traced sum
+P_r = Σ_{j ∈ r} P_j (the correction before: it misses that the curved stack passes light
+arriving from above the band — from higher elevations, along the shell — up to 3–10 × the
+flat stack's at grazing incidence, but light from below 0.3–3 ×). The other rows (light seen
+obliquely from off-centre points, the wall's view of the shell) stay planar.
 """
 
 from __future__ import annotations
@@ -49,6 +54,9 @@ SINK = "curvature_sink"
 #: paths traced per band: the row's sum to ≈ 0.3 % (1 σ), ≈ 2 s a band on 2 cores
 CURVATURE_PATHS = 400_000
 RING_EDGES = np.array([lo for lo, _, _, _ in KLEMS_FULL_RINGS] + [90.0])
+#: patches per Klems ring and the index of each ring's first patch
+RING_PATCHES = np.array([n for _, _, _, n in KLEMS_FULL_RINGS])
+RING_START = np.concatenate([[0], np.cumsum(RING_PATCHES)[:-1]])
 
 
 @dataclass(frozen=True)
@@ -56,12 +64,52 @@ class RingRow:
     """The normal-outgoing row of a dome band, per Klems θ ring of incidence: ``weight``
     P_r = Σ_{j ∈ r} f[0, j] Λ_j (dimensionless: the share of a uniform sky's radiance in
     ring r that reaches the centre), its Monte Carlo standard error, the share of the launched
-    throughput the stack sent back inwards, and the paths traced."""
+    throughput the stack sent back inwards, and the paths traced; ``patch`` / ``patch_stderr``:
+    the same per Klems patch j, P_j = f[0, j] Λ_j (None: rings only)."""
 
     weight: np.ndarray
     stderr: np.ndarray
     reflected: float
     paths: int
+    patch: np.ndarray | None = None
+    patch_stderr: np.ndarray | None = None
+
+
+def klems_patch(theta_deg: np.ndarray, phi_deg: np.ndarray) -> np.ndarray:
+    """Klems-full patch index (0–144) of directions at polar angle θ and azimuth φ (degrees):
+    the ring of θ, and in it the patch whose azimuth span (centred on k · 360°/n, k = 0 … n−1)
+    holds φ."""
+    ring = np.clip(np.searchsorted(RING_EDGES, theta_deg, side="right") - 1, 0,
+                   len(KLEMS_FULL_RINGS) - 1)
+    width = 360.0 / RING_PATCHES[ring]
+    k = np.floor(((np.asarray(phi_deg) + 0.5 * width) % 360.0) / width).astype(np.int64)
+    return RING_START[ring] + k % RING_PATCHES[ring]
+
+
+def shell_frames(d: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The frame (x, y, z) the shell's ``BSDF`` material applies the XML in where the centre
+    sees it along the unit vectors ``d`` (world axes): z the inward normal −d, y the up
+    tangent (towards higher elevation above the horizon, lower below it: the lower half
+    carries the XML with up −z), x = y × z (as in the planar sample, x × y = z)."""
+    s = np.where(d[:, 2] >= 0.0, 1.0, -1.0)
+    up = s[:, None] * np.array([0.0, 0.0, 1.0]) - (s * d[:, 2])[:, None] * d
+    y = up / np.linalg.norm(up, axis=1, keepdims=True)
+    z = -d
+    return np.cross(y, z), y, z
+
+
+def incident_patches(source_local: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(T_f column, T_b row) patch indices of light arriving at the shell from the unit
+    directions ``source_local`` (towards the source, in the :func:`shell_frames` frame, on the
+    outer side: z < 0): θ from −z; the T_f incident patch by the azimuth of the light's
+    direction of travel (−source), the reciprocal T_b outgoing patch by that of the source
+    direction itself. Established on the planar sample: its row traced with the NumPy engine
+    in this convention correlates per ring with the rfluxmtx row (r 0.5–0.85 in rings 1–8);
+    with y reversed the correlation turns negative (test_dome_curvature)."""
+    x, y, z = source_local[:, 0], source_local[:, 1], source_local[:, 2]
+    theta = np.degrees(np.arccos(np.clip(-z, -1.0, 1.0)))
+    phi = np.degrees(np.arctan2(y, x))
+    return klems_patch(theta, phi + 180.0), klems_patch(theta, phi)
 
 
 def band_directions(n_world: np.ndarray, lo_deg: float, hi_deg: float, count: int,
@@ -119,23 +167,36 @@ def curved_dome(project: Project, scenario: Scenario, tree: Tree) -> CurvedDome:
 def curved_ring_row(dome: CurvedDome, lo_deg: float, hi_deg: float, paths: int = 200_000,
                     seed: int = 1, workers: int = 2) -> RingRow:
     """Trace the normal-outgoing row of the band |elevation| ∈ [lo, hi]° through the dome's
-    explicit slats (see the module docstring)."""
+    explicit slats, per Klems patch and per ring (see the module docstring)."""
     rng = np.random.default_rng(seed)
     d = band_directions(dome.normal, lo_deg, hi_deg, paths, rng)
     # start just outside the sink (its facets lie inside the sphere by < 0.3 %)
     origins = dome.centre + (dome.sink_radius + 1e-3) * d
     esc = trace_escapes(dome.scene, origins, d, seed=seed + 1, workers=workers)
-    cos = np.einsum("ij,ij->i", esc.direction, d[esc.path])
-    theta = np.degrees(np.arccos(np.clip(cos, -1.0, 1.0)))
-    front = cos > 0
-    ring = np.clip(np.searchsorted(RING_EDGES, theta[front], side="right") - 1, 0,
-                   len(KLEMS_FULL_RINGS) - 1)
-    per_path = np.zeros((len(KLEMS_FULL_RINGS), paths))
-    np.add.at(per_path, (ring, esc.path[front]), esc.weight[front])
-    weight = per_path.mean(axis=1)
-    stderr = per_path.std(axis=1, ddof=1) / math.sqrt(paths)
+    x, y, z = shell_frames(d)
+    p = esc.path
+    local = np.column_stack([np.einsum("ij,ij->i", esc.direction, f[p]) for f in (x, y, z)])
+    front = local[:, 2] < 0
+    patch = incident_patches(local[front])[0]
+    ring, _ = klems_patch_rings()
+    w, pf = esc.weight[front], p[front]
+    per_patch, patch_stderr = binned_mean(patch, pf, w, paths, ring.size)
+    weight, stderr = binned_mean(ring[patch], pf, w, paths, len(KLEMS_FULL_RINGS))
     reflected = float(esc.weight[~front].sum() / paths)
-    return RingRow(weight, stderr, reflected, paths)
+    return RingRow(weight, stderr, reflected, paths, per_patch, patch_stderr)
+
+
+def binned_mean(bins: np.ndarray, path: np.ndarray, weight: np.ndarray, paths: int,
+                size: int) -> tuple[np.ndarray, np.ndarray]:
+    """Per bin, the mean over ``paths`` launched paths of each path's summed escape
+    ``weight`` in that bin, and its standard error (a path may escape into a bin more than
+    once: the per-path sums are the independent samples)."""
+    key = bins.astype(np.int64) * paths + path
+    cell, inv = np.unique(key, return_inverse=True)
+    per_cell = np.bincount(inv, weight)
+    mean = np.bincount(cell // paths, per_cell, minlength=size) / paths
+    second = np.bincount(cell // paths, per_cell ** 2, minlength=size) / paths
+    return mean, np.sqrt(np.maximum(second - mean ** 2, 0.0) / (paths - 1))
 
 
 def planar_ring_row(flux_tf: np.ndarray) -> np.ndarray:
@@ -145,27 +206,48 @@ def planar_ring_row(flux_tf: np.ndarray) -> np.ndarray:
     return np.bincount(ring, f_row * lam, minlength=len(KLEMS_FULL_RINGS))
 
 
-def curved_flux(flux: dict[str, np.ndarray], row: RingRow) -> tuple[dict[str, np.ndarray],
-                                                                    np.ndarray]:
-    """The planar flux matrices with the normal-outgoing row of T_f (and the reciprocal column
-    of T_b) scaled ring by ring to the traced ``row``; returns them and the factors per ring
-    (1 where the planar ring is empty)."""
+def reciprocal_patch() -> np.ndarray:
+    """For each T_f incident patch j, the T_b outgoing patch of the reversed path (the azimuth
+    turned by 180°, :func:`incident_patches`)."""
     ring, _ = klems_patch_rings()
+    k = np.arange(ring.size) - RING_START[ring]
+    n = RING_PATCHES[ring]
+    return RING_START[ring] + (k + n // 2) % n
+
+
+def curved_flux(flux: dict[str, np.ndarray], row: RingRow, per: str = "patch"
+                ) -> tuple[dict[str, np.ndarray], np.ndarray]:
+    """The planar flux matrices with the normal-outgoing row of T_f replaced by the traced
+    ``row`` (``per = "patch"``: patch by patch, F_tf[0, j] = P_j Λ_0 / Λ_j, and the reciprocal
+    column of T_b set to match, F_tb[j', 0] = P_j, j' = :func:`reciprocal_patch`; ``"ring"``:
+    the planar row and column scaled ring by ring to the traced ring sums, their azimuthal
+    shape kept). Returns them and the factors per ring, traced / planar ring sum (1 where the
+    planar ring is empty)."""
+    ring, lam = klems_patch_rings()
     planar = planar_ring_row(flux["tf"])
     factor = np.where(planar > 0, row.weight / np.where(planar > 0, planar, 1.0), 1.0)
     out = {k: np.array(v, float) for k, v in flux.items()}
-    out["tf"][0, :] *= factor[ring]
-    out["tb"][:, 0] *= factor[ring]
+    if per == "ring":
+        out["tf"][0, :] *= factor[ring]
+        out["tb"][:, 0] *= factor[ring]
+        return out, factor
+    if per != "patch" or row.patch is None:
+        raise ValueError(f"curved_flux: per = {per!r} needs 'ring', or 'patch' with a row "
+                         "traced per patch")
+    out["tf"][0, :] = row.patch * lam[0] / lam
+    out["tb"][reciprocal_patch(), 0] = row.patch
     return out, factor
 
 
 def write_curved_xml(planar_folder: Path, folder: Path, name: str, row: RingRow,
                      thickness: float, width: float, height: float, comment: str = "",
-                     progress: Callable[[str], None] | None = None) -> tuple[Path, np.ndarray]:
+                     progress: Callable[[str], None] | None = None, per: str = "patch"
+                     ) -> tuple[Path, np.ndarray]:
     """The planar sample's four flux matrices (``planar_folder/*.dat``) with the traced row
-    (:func:`curved_flux`), wrapped into ``folder/<name>.xml``; returns it and the factors."""
+    (:func:`curved_flux`, ``per`` patch or ring), wrapped into ``folder/<name>.xml``; returns
+    it and the factors per ring."""
     flux = {k: np.loadtxt(planar_folder / f"{k}.dat", ndmin=2) for k in KEYS}
-    curved, factor = curved_flux(flux, row)
+    curved, factor = curved_flux(flux, row, per)
     if progress:
         progress(f"curvature: ring factors {np.array2string(factor, precision=3)}")
     return wrap_flux(folder, curved, name, thickness, width, height, comment), factor
