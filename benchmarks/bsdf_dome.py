@@ -1,13 +1,24 @@
 """BSDF crown against the explicit-slat crown on the Mendoza sensor dome (scenario B's set-up).
 
-    PYTHONPATH=. python benchmarks/bsdf_dome.py [--samples N] [--hours 7]
+    PYTHONPATH=. python benchmarks/bsdf_dome.py [--samples N] [--bands 3] [--segments 0]
+        [--ads 8192,12000,16384,24000] [--explicit-ads 2048,1810,1963,2290,2463]
+        [--project DIR]
 
 Traces scenario B (explicit slats, Radiance) and the same scenario with
 ``tree.representation = "bsdf"`` (the dome as a shell of the crown layer's Klems BSDF) at the
 project's hours and prints the façade means per hour, their ratio and the 7-hour mean
-(``--curvature planar``: the flat stack's BSDF without the traced view from the centre); then
-what the BSDF cannot represent: the lateral displacement of light inside the 2.2 m thick slat
-stack (see :func:`lateral_displacement`).
+(``--curvature rings``: the traced row only rescaled ring by ring; ``planar``: the flat stack's
+BSDF without the traced view from the centre); then what the BSDF cannot represent: the
+lateral displacement of light inside the 2.2 m thick slat stack (see
+:func:`lateral_displacement`).
+
+Noise: rtrace runs with ``-u-`` (the same octree and options give the same numbers), so each
+crown is traced once per ``-ad`` of ``--ads`` / ``--explicit-ads`` — values that give
+different ambient divisions (Radiance rounds -ad to n_θ × n_φ strata: 2047 and 2048 trace
+alike, and above ≈ 25 000 the BSDF crown's numbers stop changing) — and the table gives the
+mean over them with the standard deviation of one run (sd) per hour. ``--segments``: the
+BSDF shell's ``tree.dome.segments`` (rings = segments / 4; the slat dome does not use it).
+Run it on a copy of the example (``--project``) when others use its build folder.
 """
 
 from __future__ import annotations
@@ -53,53 +64,84 @@ def lateral_displacement(project, sc, xml: Path) -> dict[str, float]:
                                                           / float(radii[0]))}
 
 
+def ads(text: str) -> list[int]:
+    return [int(a) for a in text.split(",") if a.strip()]
+
+
+def repeats(project, sc, ad_values: list[int], label: str) -> pd.DataFrame:
+    """Façade mean per hour (rows) and -ad (columns) of scenario ``sc``."""
+    cols = {}
+    for ad in ad_values:
+        s = replace(sc, switches={**sc.switches, "engine.ad": ad})
+        t0 = time.perf_counter()
+        rows = trace_scenario(project, s, "radiance", grids=["facade"])
+        cols[ad] = rows.groupby("time")["lux"].mean()
+        print(f"{label} -ad {ad}: {time.perf_counter() - t0:.0f} s, "
+              + " ".join(f"{v:.0f}" for v in cols[ad]), flush=True)
+    return pd.DataFrame(cols)
+
+
 def main() -> None:
     ap = argparse.ArgumentParser()
+    ap.add_argument("--project", default=str(ROOT / "examples" / "mendoza-street"))
     ap.add_argument("--samples", type=int, default=500)
     ap.add_argument("--scenario", default="B")
     ap.add_argument("--bands", type=int, default=3, help="elevation bands of the dome shell")
-    ap.add_argument("--ad", type=int, default=8192, help="rtrace -ad of the BSDF crown")
-    ap.add_argument("--curvature", default="traced", choices=("traced", "planar"),
+    ap.add_argument("--segments", type=int, default=0,
+                    help="tree.dome.segments of the BSDF shell (rings = segments / 4; 0: the "
+                         "project's, 48 — 192 read 3 %% higher at every hour, no closer)")
+    ap.add_argument("--ads", type=ads, default=[8192, 12000, 16384, 24000],
+                    help="rtrace -ad of the BSDF crown, one run each")
+    ap.add_argument("--explicit-ads", type=ads, default=[2048, 1810, 1963, 2290, 2463],
+                    help="rtrace -ad of the explicit slats, one run each")
+    ap.add_argument("--curvature", default="traced", choices=("traced", "rings", "planar"),
                     help="tree.bsdf.curvature: the centre's view traced through the curved "
-                         "dome (default) or the flat stack's")
+                         "dome per patch (default), per ring, or the flat stack's")
     ap.add_argument("--explicit-cache", default=None,
-                    help="CSV of the explicit run's hourly façade means (read if present)")
+                    help="CSV of the explicit runs' hourly façade means (read if present)")
     args = ap.parse_args()
-    project = load_project(ROOT / "examples" / "mendoza-street")
+    project = load_project(Path(args.project))
     sc = project.scenario(args.scenario)
-    # the BSDF shell's Klems sampling is noisier than the slats' specular paths at the
-    # project's -ad 2048 (±10 % per hour): the BSDF crown is traced with -ad 8192
+    # the BSDF crown's hours scatter by 1–5 % between -ad values (the sampling of the shell's
+    # Klems BSDF): several runs are averaged (see the module text)
     bs = replace(sc, name=f"{sc.name}-bsdf", switches={
         **sc.switches, "tree.representation": "bsdf", "bsdf.samples": args.samples,
-        "bsdf.bands": args.bands, "engine.ad": args.ad,
-        "bsdf.curvature": args.curvature})
+        "bsdf.bands": args.bands, "bsdf.curvature": args.curvature,
+        **({"dome.segments": args.segments} if args.segments else {})})
     t0 = time.perf_counter()
     bands = scenario_xmls(project, bs, progress=print)
     t_bsdf = time.perf_counter() - t0
     print(f"crown BSDFs ({t_bsdf:.0f} s): " + "; ".join(
         f"|elevation| {lo:g}–{hi:g}°: {xml}" for lo, hi, xml in bands))
     print(leaf_on_sample(project, bs, 0.5 * (bands[0][0] + bands[0][1])).notes[0][:200] + "…")
-    out = {}
     cache = Path(args.explicit_cache) if args.explicit_cache else None
-    for label, s in (("explicit", sc), ("bsdf", bs)):
-        if label == "explicit" and cache is not None and cache.exists():
-            out[label] = pd.read_csv(cache, index_col=0)["lux"]
-            print(f"explicit: read {cache}")
-            continue
-        t0 = time.perf_counter()
-        rows = trace_scenario(project, s, "radiance", grids=["facade"])
-        out[label] = rows.groupby("time")["lux"].mean()
-        print(f"{label}: {time.perf_counter() - t0:.0f} s for {len(out[label])} hours")
-        if label == "explicit" and cache is not None:
-            out[label].to_csv(cache)
-    print(f"{'time':>6} {'explicit':>9} {'bsdf':>9} {'ratio':>6}")
-    for t in out["explicit"].index:
-        e, b = out["explicit"][t], out["bsdf"][t]
-        print(f"{t:>6} {e:9.1f} {b:9.1f} {b / e:6.3f}")
-    e, b = float(out["explicit"].mean()), float(out["bsdf"].mean())
-    print(f"{'mean':>6} {e:9.1f} {b:9.1f} {b / e:6.3f}  ({100 * (b / e - 1):+.1f} %)")
-    worst = float(np.max(np.abs(out["bsdf"] / out["explicit"] - 1.0)))
-    print(f"largest hourly difference {100 * worst:.1f} %")
+    if cache is not None and cache.exists():
+        explicit = pd.read_csv(cache, index_col=0)
+        explicit.columns = [int(c) for c in explicit.columns]
+        print(f"explicit: read {cache}")
+    else:
+        explicit = repeats(project, sc, args.explicit_ads, "explicit")
+        if cache is not None:
+            explicit.to_csv(cache)
+    bsdf = repeats(project, bs, args.ads, "bsdf")
+    e_m, b_m = explicit.mean(axis=1), bsdf.mean(axis=1)
+    e_sd = explicit.std(axis=1, ddof=1) if explicit.shape[1] > 1 else 0 * e_m
+    b_sd = bsdf.std(axis=1, ddof=1) if bsdf.shape[1] > 1 else 0 * b_m
+    # standard error of the ratio of the two means
+    se = (b_m / e_m) * np.sqrt((b_sd / b_m) ** 2 / bsdf.shape[1]
+                               + (e_sd / e_m) ** 2 / explicit.shape[1])
+    print(f"{'time':>6} {'explicit':>9} {'sd %':>5} {'bsdf':>9} {'sd %':>5} {'ratio':>6} "
+          f"{'± s.e.':>6}")
+    for t in e_m.index:
+        print(f"{t:>6} {e_m[t]:9.1f} {100 * e_sd[t] / e_m[t]:5.1f} {b_m[t]:9.1f} "
+              f"{100 * b_sd[t] / b_m[t]:5.1f} {b_m[t] / e_m[t]:6.3f} {se[t]:6.3f}")
+    e, b = float(e_m.mean()), float(b_m.mean())
+    print(f"{'mean':>6} {e:9.1f} {'':>5} {b:9.1f} {'':>5} {b / e:6.3f}  "
+          f"({100 * (b / e - 1):+.1f} %; {len(args.explicit_ads)} explicit and "
+          f"{len(args.ads)} BSDF runs)")
+    worst = float(np.max(np.abs(b_m / e_m - 1.0)))
+    print(f"largest hourly difference {100 * worst:.1f} %; hours within 5 %: "
+          f"{int(np.sum(np.abs(b_m / e_m - 1.0) <= 0.05))} of {len(e_m)}")
     lat = lateral_displacement(project, bs, bands[len(bands) // 2][2])
     print(f"lateral displacement: stack {lat['stack_m']:.2f} m thick; "
           f"{100 * lat['scattered_share']:.0f} % of the normal transmission "
