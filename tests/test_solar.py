@@ -31,6 +31,26 @@ def test_sun_matches_nrel_spa(t):
     assert angular_separation_deg(sun.vector, ref) < 0.05
 
 
+@pytest.mark.parametrize("when,lat,lon,elev", [
+    ("2024-12-22T10:30:00-03:00", -32.89, -68.83, 750.0),
+    ("2023-06-21T06:15:00+02:00", 52.52, 13.40, 34.0),
+    ("2025-03-20T17:45:30-05:00", 40.71, -74.01, 10.0),
+    ("2024-09-01T12:00:00+10:00", -33.87, 151.21, 0.0)])
+def test_sun_is_pvlibs_spa_python_to_the_bit(when, lat, lon, elev):
+    """The SPA module loaded on its own, with spa_python's defaults, gives exactly what
+    ``pvlib.solarposition.spa_python`` gives (apparent elevation and azimuth)."""
+    from datetime import datetime
+
+    import pandas as pd
+    from pvlib.solarposition import spa_python
+
+    t = datetime.fromisoformat(when)
+    ref = spa_python(pd.DatetimeIndex([pd.Timestamp(t)]), lat, lon, altitude=elev)
+    sun = sun_position(t, lat, lon, elev)
+    assert sun.altitude_deg == float(ref["apparent_elevation"].iloc[0])
+    assert sun.azimuth_deg == float(ref["azimuth"].iloc[0])
+
+
 def test_radiance_azimuth_convention():
     assert compass_to_radiance_azimuth(180.0) == 0.0     # south
     assert compass_to_radiance_azimuth(270.0) == 90.0    # west

@@ -8,10 +8,13 @@ from north (compass). Vectors in the scene frame: x east, y north, z up.
 from __future__ import annotations
 
 import functools
+import importlib.util
 import math
 from dataclasses import dataclass
 from datetime import datetime, timedelta, timezone
 from functools import lru_cache
+from pathlib import Path
+from types import ModuleType
 
 import numpy as np
 
@@ -79,17 +82,39 @@ def sun_position(
     return _spa(when, float(latitude), float(longitude), float(elevation_m))
 
 
+#: pvlib.solarposition.spa_python's defaults: pressure (hPa), temperature (°C), ΔT (s),
+#: atmospheric refraction at sunrise/sunset (degrees), threads
+SPA_DEFAULTS = (101325.0 / 100.0, 12.0, 67.0, 0.5667, 4)
+
+
 @lru_cache(maxsize=4096)
 def _spa(when: datetime, latitude: float, longitude: float, elevation_m: float) -> SunPosition:
-    import pandas as pd
-    import pvlib
+    """``pvlib.solarposition.spa_python`` at one instant with its defaults, called on pvlib's
+    SPA module directly (the same numbers: ``tests/test_solar.py``)."""
+    pressure, temperature, delta_t, refraction, threads = SPA_DEFAULTS
+    _app_zenith, _zenith, app_elevation, _elevation, azimuth, _eot = _spa_module().solar_position(
+        np.array([when.timestamp()]), latitude, longitude, elevation_m, pressure, temperature,
+        delta_t, refraction, threads)
+    return SunPosition(altitude_deg=float(app_elevation[0]), azimuth_deg=float(azimuth[0]))
 
-    times = pd.DatetimeIndex([pd.Timestamp(when)])
-    sp = pvlib.solarposition.spa_python(times, latitude, longitude, altitude=elevation_m)
-    return SunPosition(
-        altitude_deg=float(sp["apparent_elevation"].iloc[0]),
-        azimuth_deg=float(sp["azimuth"].iloc[0]),
-    )
+
+@functools.cache
+def _spa_module() -> ModuleType:
+    """pvlib's NREL SPA (``pvlib/spa.py``: NumPy only) loaded on its own. ``import pvlib``
+    imports the whole package (≈ 1.2 s, SciPy included) in every process that needs one
+    sun position; the SPA module alone loads in milliseconds."""
+    found = importlib.util.find_spec("pvlib")
+    path = (Path(found.submodule_search_locations[0]) / "spa.py"
+            if found is not None and found.submodule_search_locations else None)
+    if path is None or not path.is_file():   # an unusual install: the package's own import
+        from pvlib import spa
+
+        return spa
+    spec = importlib.util.spec_from_file_location("radtree._pvlib_spa", path)
+    assert spec is not None and spec.loader is not None
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
 
 
 def angular_separation_deg(a: np.ndarray, b: np.ndarray) -> float:
