@@ -3,6 +3,10 @@
 Copies ``examples/office-block`` twice into ``--work`` (kept, so a rerun reuses the crown BSDFs
 and every cached matrix: pass a fresh folder to time from scratch), runs
 
+Options: ``--sun-crowns explicit-direct,bsdf`` (``AnnualOptions.sun_crown`` variants of the
+3-phase run, the later ones reusing the first's matrices: the hourly direct sun through the
+explicit crown, or through the BSDF crown), ``--no-second-weather`` (a quicker comparison).
+
 1. ``radtree annual`` (``--method dc``: rcontrib daylight coefficients of the explicit slat
    crown, leaf-on and bare-branch scenes);
 2. ``radtree annual --method 3phase`` (crown BSDFs leaf-on/off with ``tree.bsdf.samples``
@@ -134,8 +138,14 @@ def main() -> None:
     ap.add_argument("--same-crown", action="store_true",
                     help="also trace rcontrib sky coefficients on the 3-phase BSDF crowns")
     ap.add_argument("--methods", default="dc,3phase", help="comma-separated: dc, 3phase")
+    ap.add_argument("--sun-crowns", default="explicit-direct,bsdf",
+                    help="3phase variants run in turn (AnnualOptions.sun_crown): the first is "
+                         "'3phase' (timed, second weather file), the others reuse its matrices")
+    ap.add_argument("--no-second-weather", action="store_true",
+                    help="skip the second weather file (a quicker comparison)")
     args = ap.parse_args()
     methods = [m for m in ("dc", "3phase") if m in args.methods.split(",")]
+    sun_crowns = args.sun_crowns.split(",")
     src = ROOT / "examples" / "office-block"
     args.work.mkdir(parents=True, exist_ok=True)
     dirs = {}
@@ -148,16 +158,27 @@ def main() -> None:
     runs: dict[str, tuple[AnnualResult, float, float]] = {}
     for m in methods:
         print(f"\n== {m}", flush=True)
-        opts = AnnualOptions(nproc=args.processes, method=m,
+        opts = AnnualOptions(nproc=args.processes, method=m, sun_crown=sun_crowns[0],
                              daylight_samples=args.daylight_samples)
         runs[m] = timed(dirs[m], opts, over)
-    epw2 = second_weather(runs[methods[0]][0].weather.path, args.work / "second_weather.epw")
+    variants: dict[str, tuple[AnnualResult, float, float]] = {}
+    if "3phase" in runs:
+        variants[sun_crowns[0]] = runs["3phase"]
+        for sc in sun_crowns[1:]:
+            print(f"\n== 3phase, sun crown {sc} (matrices reused)", flush=True)
+            opts = AnnualOptions(nproc=args.processes, method="3phase", sun_crown=sc,
+                                 daylight_samples=args.daylight_samples)
+            variants[sc] = timed(dirs["3phase"], opts, over)
     again: dict[str, tuple[AnnualResult, float, float]] = {}
-    for m in methods:
-        print(f"\n== {m}, second weather file", flush=True)
-        opts = AnnualOptions(nproc=args.processes, method=m, epw=epw2,
-                             daylight_samples=args.daylight_samples)
-        again[m] = timed(dirs[m], opts, over)
+    if not args.no_second_weather:
+        epw2 = second_weather(runs[methods[0]][0].weather.path,
+                              args.work / "second_weather.epw")
+        for m in methods:
+            print(f"\n== {m}, second weather file", flush=True)
+            opts = AnnualOptions(nproc=args.processes, method=m, epw=epw2,
+                                 sun_crown=sun_crowns[0],
+                                 daylight_samples=args.daylight_samples)
+            again[m] = timed(dirs[m], opts, over)
 
     pd.set_option("display.width", 250)
     pd.set_option("display.max_columns", None)
@@ -179,6 +200,19 @@ def main() -> None:
         print("largest |difference|: "
               + ", ".join(f"{g}/{t} {float(np.abs((b - a).loc[(g, t)]).max()):.1f} pp"
                           for g, t in a.index))
+    if "dc" in runs and len(variants) > 1:
+        a = figures(runs["dc"][0])
+        rows = {"dc": a}
+        for sc, (r, _, _) in variants.items():
+            rows[f"3phase sun={sc}"] = figures(r)
+            rows[f"diff_pp sun={sc}"] = figures(r) - a
+        print("\n3-phase sun variants against dc (percentage points), with the tree:")
+        table = pd.concat(rows, axis=0, names=["run"]).xs("with", level="tree")
+        print(table.round(1))
+        for sc, (r, wall, cpu) in variants.items():
+            print(f"  sun={sc}: wall {wall:.1f} s, CPU {cpu:.1f} s, sun runs "
+                  + ", ".join(f"{s} {r.timing.get(f'{s}_sun_s', float('nan')):.1f} s"
+                              for s in ("leaf_on", "leaf_off")))
     print(f"\nload now {os.getloadavg()}")
     for label, pair in (("project weather", runs), ("second weather file", again)):
         for m, (r, wall, cpu) in pair.items():

@@ -214,3 +214,43 @@ def test_facet_groups_face_the_sensors():
     for g in facet_groups(model, sensors_inside=True):      # a dome: wound inwards
         out = g.triangles.mean(axis=1) - [0.0, 5.0, 6.0]
         assert np.all(out @ g.normal < 0)
+
+
+@needs_radiance
+def test_direct_sun_through_the_explicit_crown(runs, tmp_path):
+    """``sun_crown = "explicit-direct"`` (the default): the hourly direct sun (-ab 0) of each
+    leaf state is the default method's, traced through the explicit slats / bare branches —
+    recomputed here on the annual scenes in a fresh folder, it agrees to float precision."""
+    from radtree.annual.coefficients import CoefficientRunner, TraceParams
+    from radtree.annual.run import LUX, annual_scenes, choose_scenarios
+    from radtree.annual.weather_year import annual_weather
+
+    project, first, _, _, _ = runs
+    assert first.options.sun_crown == "explicit-direct"
+    opts = first.options
+    with_sc, without_sc, _ = choose_scenarios(project, opts)
+    scenes, grids, _, _ = annual_scenes(project, with_sc, without_sc, opts.branches, None)
+    year = annual_weather(project, None, 1, 1, first.ground_reflectance, lambda s: None)
+    suns = year[3]
+    trace = TraceParams(ab=4, ad=192, lw=1e-3)
+    for state in ("leaf_on", "leaf_off"):
+        runner = CoefficientRunner(scenes[state], grids, tmp_path / state,
+                                   first.ground_reflectance)
+        c_dir = runner.suns("direct", suns.direction, 0, trace)
+        ref = (c_dir.astype(np.float64) @ LUX) * suns.radiance[None, :]
+        got = np.concatenate([first.direct[state][g] for g in grids])[:, suns.hour_index]
+        np.testing.assert_allclose(got, ref, rtol=1e-5, atol=1e-3)
+        assert ref.max() > 1e4                   # façade points in full sun at some hours
+    # the bare branches let more direct sun through than the leafed slats
+    on = np.concatenate([first.direct["leaf_on"][g] for g in grids]).sum()
+    off = np.concatenate([first.direct["leaf_off"][g] for g in grids]).sum()
+    assert off > 1.2 * on, (on, off)
+    assert any("through the explicit crown" in n for n in first.notes)
+
+
+def test_unknown_sun_crown_is_refused():
+    from radtree.annual.run import AnnualOptions
+    from radtree.errors import ConfigError
+
+    with pytest.raises(ConfigError, match="unknown sun crown 'slats'.*explicit-direct"):
+        AnnualOptions(method="3phase", sun_crown="slats")

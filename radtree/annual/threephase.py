@@ -295,6 +295,14 @@ class ThreePhase:
         return dc.astype(np.float32)
 
 
+SUN_NOTES = {
+    "explicit-direct": "the hourly direct sun (-ab 0) through the explicit crown (slats, "
+                       "bare branches) of each leaf state, the reflected sun on its BSDF crown",
+    "explicit": "both on the explicit crown (slats, bare branches) of each leaf state",
+    "bsdf": "both on the BSDF-crown scene of each leaf state",
+}
+
+
 def sky_lux(dc: np.ndarray, sky: np.ndarray) -> np.ndarray:
     """(sensors, hours) lux: the coefficients (sensors, patches, 3) times the sky matrix
     (patches, hours, 3), channel by channel (as ``dctimestep DC sky`` does)."""
@@ -340,10 +348,15 @@ def compute_annual_3phase(project: Project, options: AnnualOptions,
     weather, wea, sky, suns, verts, weights, need, patch_dirs = year
     timing["weather_s"] = time.perf_counter() - t1
 
-    def dc(scene: Scene, folder: Path, with_sky: bool) -> tuple[np.ndarray, np.ndarray]:
+    def dc(scene: Scene, folder: Path, with_sky: bool, direct_of: str | None = None
+           ) -> tuple[np.ndarray, np.ndarray]:
+        """``direct_of``: the variant whose explicit scene the hourly direct sun is traced
+        on (in the default method's folder: a project that ran it reuses its run)."""
         runner = CoefficientRunner(scene, grids, folder, rho, echo=echo)
+        direct = None if direct_of is None else CoefficientRunner(
+            scenes[direct_of], grids, work / "coefficients" / direct_of, rho, echo=echo)
         return scene_year_lux(runner, year, options.mf, options.sun_mf, trace, sun_trace,
-                              with_sky)
+                              with_sky, direct)
 
     echo(f"  3-phase: {form} crown, BSDFs {', '.join(sorted({Path(b[2]).name for s in STATES for b in xmls[s]}))}")
     tp = ThreePhase(work / "threephase", bare, models, form, grids, rho, options.mf, trace,
@@ -358,8 +371,13 @@ def compute_annual_3phase(project: Project, options: AnnualOptions,
     timing["without_s"] = time.perf_counter() - tv
     for state in STATES:
         tv = time.perf_counter()
-        scene = _scene_with(bare, models[state])
-        sun_tot, sun_dir = dc(scene, work / "threephase" / f"sun_{state}", False)
+        if options.sun_crown == "explicit":        # the default method's sun runs
+            sun_tot, sun_dir = dc(scenes[state], work / "coefficients" / state, False)
+        else:
+            sun_tot, sun_dir = dc(_scene_with(bare, models[state]),
+                                  work / "threephase" / f"sun_{state}", False,
+                                  state if options.sun_crown == "explicit-direct" else None)
+        timing[f"{state}_sun_s"] = time.perf_counter() - tv
         td = time.perf_counter()
         dcs[state] = tp.coefficients(state, views, v_sky)
         timing[f"{state}_matrices_s"] = time.perf_counter() - td
@@ -386,7 +404,7 @@ def compute_annual_3phase(project: Project, options: AnnualOptions,
     notes.append(f"Crown {options.leaf.describe() if phen is None else phen.describe()}.")
     notes.append(f"Method: three-phase (V·T·D·s with dctimestep; {len(tp.groups)} shell facet "
                  "groups; the crown BSDFs leaf-on and leaf-off); direct and reflected sun as "
-                 "the default method, on the BSDF-crown scene of each leaf state.")
+                 f"the default method, {SUN_NOTES[options.sun_crown]}.")
     notes += METHOD_NOTES
     timing["total_s"] = time.perf_counter() - t0
     return AnnualResult(project=project, options=options, weather=weather, wea=wea,
