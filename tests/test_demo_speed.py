@@ -138,24 +138,21 @@ def test_build_keeps_current_folders_unless_fresh(proj):
 
 
 def test_a_worker_error_reads_as_it_was_raised(tmp_path):
-    """A build error in the spawned worker (F-photo's unreadable photo: the queue gives this
-    process A-photo first, the worker F-photo) is re-raised here with its field and message,
-    and leaves no half-written folder."""
+    """A build error in the spawned worker is re-raised here with its field and message, and
+    leaves no half-written folder. The queue is heaviest first: this process takes A-photo
+    from the front, the worker takes E (a dome too large for the sensors: an error only the
+    build finds) from the back."""
     from radtree.errors import ConfigError
 
     p = copy_project(tmp_path / "proj", hours=["13:30"], photo=True)
-    (p / "data" / "broken.jpg").write_bytes(b"not a JPEG")
     toml = p / "radtree.toml"
-    head, _, tail = toml.read_text().partition('name = "F-photo"')
-    toml.write_text(head + 'name = "F-photo"' + tail.replace(
-        '"tree.photo" = "data/fisheye_chestnut_standin.jpg"', '"tree.photo" = "data/broken.jpg"',
-        1))
+    head, _, tail = toml.read_text().partition('name = "E"\n')
+    toml.write_text(head + 'name = "E"\nswitches = { "dome.radius_m" = 6.0 }\n' + tail)
     proj = load_project(p)
     with pytest.raises(ConfigError) as err:
-        build_project(proj, ["A", "E", "F-photo", "A-photo"], echo=lambda _m: None,
-                      progress=False, pictures=False, workers=2)
-    assert err.value.field == "tree.photo" and "broken.jpg" in str(err.value)
-    assert "cannot read" in str(err.value)
-    assert not (proj.build_dir / "F-photo").exists()
+        build_project(proj, ["A", "E", "A-photo"], echo=lambda _m: None, progress=False,
+                      pictures=False, workers=2)
+    assert err.value.field == "tree.dome.radius_m" and "radius 6 m" in str(err.value)
+    assert not (proj.build_dir / "E").exists()
     assert (proj.build_dir / "A-photo" / "manifest.json").is_file()   # built here, first
     assert not list(proj.build_dir.glob(".*"))

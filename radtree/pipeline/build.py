@@ -124,10 +124,12 @@ def _weight(project: Project, sc: Scenario) -> int:
 
 def _build_all(project: Project, queue: list[Scenario], engine: Any, build_root: Path,
                n: int, done: Callable[[str, dict], None]) -> None:
-    """Build ``queue`` in order, here and in ``n − 1`` spawned workers (each given up to two
-    scenarios ahead, so it never waits for this process); ``done(name, facts)`` is called
-    here for each folder once it is written. A worker's error is raised here, the scenarios
-    not started yet are cancelled."""
+    """Build ``queue`` (heaviest first) here and in ``n − 1`` spawned workers: this process
+    takes scenarios from the front — it starts at once, and the photo crowns that share a
+    photo's analysis stay in one process — the workers from the back, each given up to two
+    ahead so it never waits for this process. ``done(name, facts)`` is called here for each
+    folder once it is written. A worker's error is raised here, the scenarios not started
+    yet are cancelled."""
     pending = deque(queue)
     if n <= 1:
         while pending:
@@ -139,7 +141,7 @@ def _build_all(project: Project, queue: list[Scenario], engine: Any, build_root:
 
     def top_up() -> None:
         while pending and len(outstanding) < 2 * (n - 1):
-            sc = pending.popleft()
+            sc = pending.pop()
             outstanding[pool.submit(_build_in_worker, project, sc, build_root)] = sc.name
 
     def collect(block: bool) -> None:
@@ -150,7 +152,7 @@ def _build_all(project: Project, queue: list[Scenario], engine: Any, build_root:
                 done(outstanding.pop(f), f.result())
 
     try:
-        mine = pending.popleft()   # this process starts at once, while the workers start up
+        mine = pending.popleft()
         top_up()
         while True:
             done(mine.name, _build_one(project, mine, engine, build_root))
