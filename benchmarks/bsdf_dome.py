@@ -1,8 +1,8 @@
 """BSDF crown against the explicit-slat crown on the Mendoza sensor dome (scenario B's set-up).
 
     PYTHONPATH=. python benchmarks/bsdf_dome.py [--samples N] [--bands 3] [--segments 0]
-        [--ads 8192,12000,16384,24000] [--explicit-ads 2048,1810,1963,2290,2463]
-        [--project DIR]
+        [--sectors 0] [--ads 8192,12000,16384,24000]
+        [--explicit-ads 2048,1810,1963,2290,2463] [--project DIR] [--explicit-cache CSV]
 
 Traces scenario B (explicit slats, Radiance) and the same scenario with
 ``tree.representation = "bsdf"`` (the dome as a shell of the crown layer's Klems BSDF) at the
@@ -87,6 +87,10 @@ def main() -> None:
     ap.add_argument("--samples", type=int, default=500)
     ap.add_argument("--scenario", default="B")
     ap.add_argument("--bands", type=int, default=3, help="elevation bands of the dome shell")
+    ap.add_argument("--sectors", type=int, default=0,
+                    help="tree.bsdf.sectors: each band cut into this many sectors of the "
+                         "horizontal angle from the façade normal, each with its own traced "
+                         "row (0: the project's)")
     ap.add_argument("--segments", type=int, default=0,
                     help="tree.dome.segments of the BSDF shell (rings = segments / 4; 0: the "
                          "project's, 48 — 192 read 3 %% higher at every hour, no closer)")
@@ -107,7 +111,8 @@ def main() -> None:
     bs = replace(sc, name=f"{sc.name}-bsdf", switches={
         **sc.switches, "tree.representation": "bsdf", "bsdf.samples": args.samples,
         "bsdf.bands": args.bands, "bsdf.curvature": args.curvature,
-        **({"dome.segments": args.segments} if args.segments else {})})
+        **({"dome.segments": args.segments} if args.segments else {}),
+        **({"bsdf.sectors": args.sectors} if args.sectors else {})})
     t0 = time.perf_counter()
     bands = scenario_xmls(project, bs, progress=print)
     t_bsdf = time.perf_counter() - t0

@@ -9,7 +9,11 @@ recommendation), ``ad``, ``lw``; ``tiles`` × ``tiles`` periodic copies of the s
 ``bands``: the sensor dome's shell is cut into this many elevation bands of equal width
 (|elevation| 0–90°, the lower half mirrored), each with the BSDF of the slats as tilted at the
 band's middle elevation (the dome's slats turn with elevation); ``bands = 1``: one BSDF, the
-slats as tilted where the shell is seen ``elevation_deg`` above the horizon.
+slats as tilted where the shell is seen ``elevation_deg`` above the horizon. ``sectors``
+(sensor dome, ``curvature`` traced or rings): each band is cut further into this many equal
+sectors of the horizontal angle from the façade normal (−90° … 90°), each with the view from
+the centre traced through its own part of the curved dome (the part near the wall's rim passes
+grazing light along the wall differently from the part facing the street).
 
 Free crowns: ``depth_m`` is the crown depth one crossing of the envelope carries at normal
 incidence (0: the crown's vertical semi-axis, so the two crossings of a vertical line through
@@ -53,6 +57,7 @@ class CrownBsdf(Checked):
     tiles: int = field(default=9, metadata=meta(1, 41))
     elevation_deg: float = field(default=30.0, metadata=meta(0.0, 90.0))
     bands: int = field(default=3, metadata=meta(1, 9))
+    sectors: int = field(default=1, metadata=meta(1, 9))
     depth_m: float = field(default=0.0, metadata=meta(0.0, 50.0))
     crossing: str = field(default="chord", metadata=meta(choices=CROSSINGS))
     curvature: str = field(default="traced", metadata=meta(choices=CURVATURES))

@@ -34,13 +34,14 @@ from radtree.errors import ConfigError
 from radtree.fileio import write_text
 from radtree.pipeline.dome_curvature import (
     CURVATURE_PATHS,
+    CURVATURE_VERSION,
     CurvedDome,
     curved_dome,
     curved_ring_row,
     write_curved_xml,
 )
 from radtree.site.frame import FacadeFrame
-from radtree.trees.bsdf_shell import WALL_BAND, build_bsdf_crown
+from radtree.trees.bsdf_shell import WALL_BAND, build_bsdf_crown, sector_bounds
 from radtree.trees.build import apply_switches
 from radtree.trees.envelope import crown_row_spec
 from radtree.trees.model import TreeModel
@@ -197,7 +198,9 @@ def scenario_xmls(project: Project, scenario: Scenario,
                   progress: Callable[[str], None] | None = None
                   ) -> list[tuple[float, float, Path]]:
     """The leaf-on XML of each band of ``scenario``'s BSDF shell, (lowest, highest |elevation|,
-    XML): ``tree.bsdf.xml`` for every band when given, else computed and cached in
+    XML) — for a dome with ``tree.bsdf.sectors`` > 1 one entry per band and sector
+    (band-major, :func:`radtree.trees.bsdf_shell.sector_bounds`): ``tree.bsdf.xml`` for every
+    band when given, else computed and cached in
     ``build/bsdf/<scenario>/leaf_on[_b<k>]/``. A free crown with the chord crossing that
     reaches the wall adds its wall cap as a last entry :data:`WALL_BAND` (its own half chord,
     :func:`wall_half_chord`; ``leaf_on_wall/``)."""
@@ -205,7 +208,8 @@ def scenario_xmls(project: Project, scenario: Scenario,
     bands = band_elevations(tree, form)
     if tree.bsdf.xml is not None:
         check_bsdf(Path(tree.bsdf.xml))
-        return [(lo, hi, Path(tree.bsdf.xml)) for lo, hi, _ in bands]
+        copies = tree.bsdf.sectors if form == "dome" else 1
+        return [(lo, hi, Path(tree.bsdf.xml)) for lo, hi, _ in bands for _ in range(copies)]
     settings = flux_settings(tree, form, os.cpu_count() or 1)
     jobs: list[tuple[str, float, float, float, float | None]] = [
         ("leaf_on" if len(bands) == 1 else f"leaf_on_b{k}", lo, hi, el, None)
@@ -222,39 +226,49 @@ def scenario_xmls(project: Project, scenario: Scenario,
             dome.append(curved_dome(project, scenario, tree))
         return dome[0]
 
+    sectors = sector_bounds(tree.bsdf.sectors) if form == "dome" else [(-90.0, 90.0)]
     for name, lo, hi, el, half in jobs:
         folder = project.build_dir / "bsdf" / scenario.name / name
         sample = leaf_on_sample(project, scenario, el, half)
         run = ensure_bsdf(sample, settings, folder, name, progress)
-        xml = run.xml
-        if form == "dome" and tree.bsdf.curvature != "planar":
-            xml = ensure_curved(project, tree, curved, sample, settings, folder, name, lo, hi,
-                                progress)
-        out.append((lo, hi, xml))
+        for sector in sectors:
+            xml = run.xml
+            if form == "dome" and tree.bsdf.curvature != "planar":
+                xml = ensure_curved(project, tree, curved, sample, settings, folder, name, lo,
+                                    hi, progress, sector if len(sectors) > 1 else None)
+            out.append((lo, hi, xml))
     return out
 
 
 def ensure_curved(project: Project, tree: Tree, dome: Callable[[], CurvedDome],
                   sample: SlabSample | RingSamples, settings: FluxSettings, folder: Path,
                   name: str, lo: float, hi: float,
-                  progress: Callable[[str], None] | None = None) -> Path:
+                  progress: Callable[[str], None] | None = None,
+                  sector: tuple[float, float] | None = None) -> Path:
     """The dome band's XML with the view from the centre traced through the curved slats
     (``dome()``, :mod:`radtree.pipeline.dome_curvature`), in ``folder/curved/``; reused when
-    the planar sample's key and the trace's settings match."""
+    the planar sample's key and the trace's settings match. ``sector``: (lowest, highest)
+    horizontal angle from the façade normal of the part of the band traced
+    (``tree.bsdf.sectors``; in ``folder/curved_s<lo>_<hi>/``), None: the whole band."""
     per = "ring" if tree.bsdf.curvature == "rings" else "patch"
-    key = (f"{sample_key(sample, settings)}|{lo:g}|{hi:g}|{CURVATURE_PATHS}|{per}|"
+    span = (-90.0, 90.0) if sector is None else sector
+    key = (f"{sample_key(sample, settings)}|{lo:g}|{hi:g}|{CURVATURE_PATHS}|{per}|v{CURVATURE_VERSION}|"
            f"{tree.louvers.seed}|{tree.dome.radius_m:g}|{project.sensors.radius_m:g}|"
-           f"{project.sensors.offset_m:g}|{project.street.facade_azimuth_deg:g}")
-    sub = folder / "curved"
-    xml, key_file = sub / f"{name}_curved.xml", sub / "key.txt"
+           f"{project.sensors.offset_m:g}|{project.street.facade_azimuth_deg:g}"
+           + ("" if sector is None else f"|{span[0]:g}|{span[1]:g}"))
+    tag = "" if sector is None else f"_s{span[0]:g}_{span[1]:g}"
+    sub = folder / f"curved{tag}"
+    xml, key_file = sub / f"{name}_curved{tag}.xml", sub / "key.txt"
     if xml.exists() and key_file.exists() and key_file.read_text().strip() == key:
         return xml
-    row = curved_ring_row(dome(), lo, hi, CURVATURE_PATHS, workers=os.cpu_count() or 1)
-    comment = (f"radtree crown BSDF: {sample.name}, curved dome |elevation| {lo:g}–{hi:g}°: "
-               f"the normal-outgoing row traced per {per} through the dome's slats "
+    row = curved_ring_row(dome(), lo, hi, CURVATURE_PATHS, workers=os.cpu_count() or 1,
+                          sector_deg=span)
+    where = "" if sector is None else f", {span[0]:g}° to {span[1]:g}° from the façade normal"
+    comment = (f"radtree crown BSDF: {sample.name}, curved dome |elevation| {lo:g}–{hi:g}°"
+               f"{where}: the normal-outgoing row traced per {per} through the dome's slats "
                f"({row.paths} paths); "
                + " ".join(sample.notes))[:900]
-    out, _ = write_curved_xml(folder, sub, f"{name}_curved", row, sample.thickness,
+    out, _ = write_curved_xml(folder, sub, f"{name}_curved{tag}", row, sample.thickness,
                               sample.width, sample.height, comment, progress, per)
     check_bsdf(out)
     write_text(key_file, key + "\n")

@@ -24,6 +24,21 @@ P_r = Σ_{j ∈ r} P_j (the correction before: it misses that the curved stack p
 arriving from above the band — from higher elevations, along the shell — up to 3–10 × the
 flat stack's at grazing incidence, but light from below 0.3–3 ×). The other rows (light seen
 obliquely from off-centre points, the wall's view of the shell) stay planar.
+
+The façade: the dome stands against it, and the explicit stack's shells end in the wall plane.
+The trace carries the part of the façade inside the BSDF shell (the annulus from the sink to
+the dome's radius, the paint's reflectance): light the stack sends towards it comes back into
+the stack, as in the explicit scene. An escape heading behind the façade plane is not sky
+light (beyond the shell the façade is the BSDF scene's own surface), so it is dropped, and a
+Klems patch partly behind the plane (grazing patches of the shell near the wall's rim) gets
+the mean over its part in front (:func:`visible_fraction`). Before (version 1), such escapes
+— light leaving the stack through its open face in the wall plane — counted as sky light.
+
+Sectors (``tree.bsdf.sectors``): the row depends on where the shell point lies relative to
+the wall's rim, not only on its elevation (in the band at the horizon, grazing light passes
+1.5 × more near the rim than facing the street), so a band can be traced in sectors of the
+horizontal angle from the façade normal (:func:`radtree.trees.bsdf_shell.facade_angle`), each
+with its own XML.
 """
 
 from __future__ import annotations
@@ -44,6 +59,7 @@ from radtree.errors import EngineError
 from radtree.optics import KLEMS_FULL_RINGS, Plastic
 from radtree.scene import Mesh, Scene
 from radtree.site.frame import FacadeFrame
+from radtree.trees.bsdf_shell import facade_angle
 from radtree.trees.build import build_tree
 from radtree.trees.envelope import dome_spec
 from radtree.trees.louvers_dome import dome_layer_radii
@@ -51,8 +67,14 @@ from radtree.trees.model import TRUNK
 
 #: the sphere inside the innermost shell that ends paths coming back (reflected by the stack)
 SINK = "curvature_sink"
+#: the façade inside the dome's BSDF shell, traced with the slats
+WALL = "curvature_wall"
 #: paths traced per band: the row's sum to ≈ 0.3 % (1 σ), ≈ 2 s a band on 2 cores
 CURVATURE_PATHS = 400_000
+#: version of the traced row (part of the cache key): 4 — the façade inside the shell is traced
+#: (its reflectance), no sky light comes from behind the façade plane (a patch partly behind
+#: it keeps its front part's mean)
+CURVATURE_VERSION = 4
 RING_EDGES = np.array([lo for lo, _, _, _ in KLEMS_FULL_RINGS] + [90.0])
 #: patches per Klems ring and the index of each ring's first patch
 RING_PATCHES = np.array([n for _, _, _, n in KLEMS_FULL_RINGS])
@@ -113,9 +135,12 @@ def incident_patches(source_local: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
 
 
 def band_directions(n_world: np.ndarray, lo_deg: float, hi_deg: float, count: int,
-                    rng: np.random.Generator) -> np.ndarray:
+                    rng: np.random.Generator,
+                    sector_deg: tuple[float, float] = (-90.0, 90.0)) -> np.ndarray:
     """``count`` directions cosine-distributed about the façade normal ``n_world`` (horizontal)
-    whose |elevation| lies in [lo, hi] degrees (rejection sampling)."""
+    whose |elevation| lies in [lo, hi] degrees and whose horizontal angle from the normal
+    (:func:`radtree.trees.bsdf_shell.facade_angle`, −90° … 90°) lies in ``sector_deg``
+    (rejection sampling)."""
     n = np.asarray(n_world, float) / np.linalg.norm(n_world)
     u = np.cross([0.0, 0.0, 1.0], n)
     out: list[np.ndarray] = []
@@ -127,7 +152,9 @@ def band_directions(n_world: np.ndarray, lo_deg: float, hi_deg: float, count: in
         local = np.column_stack([r * np.cos(phi), r * np.sin(phi), np.sqrt(1.0 - a)])
         d = local[:, :1] * u + local[:, 1:2] * np.array([0.0, 0.0, 1.0]) + local[:, 2:] * n
         el = np.degrees(np.arcsin(np.clip(np.abs(d[:, 2]), 0.0, 1.0)))
-        keep = d[(el >= lo_deg) & (el <= hi_deg)]
+        psi = facade_angle(d, n)
+        keep = d[(el >= lo_deg) & (el <= hi_deg) & (psi >= sector_deg[0])
+                 & (psi <= sector_deg[1])]
         out.append(keep)
         have += len(keep)
     return np.vstack(out)[:count]
@@ -145,6 +172,20 @@ class CurvedDome:
     normal: np.ndarray
 
 
+def wall_annulus(centre: np.ndarray, along: np.ndarray, r_in: float, r_out: float,
+                 segments: int = 180) -> tuple[np.ndarray, np.ndarray]:
+    """Vertices and faces of the annulus r_in … r_out (m) about ``centre`` in the façade plane
+    (spanned by ``along`` and world z)."""
+    a = np.linspace(0.0, 2 * math.pi, segments, endpoint=False)
+    ring = np.cos(a)[:, None] * np.asarray(along, float) + np.sin(a)[:, None] * [0.0, 0.0, 1.0]
+    verts = np.vstack([centre + r_in * ring, centre + r_out * ring])
+    k = np.arange(segments)
+    k1 = (k + 1) % segments
+    faces = np.vstack([np.column_stack([k, k1, segments + k]),
+                       np.column_stack([k1, segments + k1, segments + k])])
+    return verts, faces
+
+
 def curved_dome(project: Project, scenario: Scenario, tree: Tree) -> CurvedDome:
     """Build :class:`CurvedDome` of ``scenario`` (``tree``: its tree, switches applied)."""
     project = effective_project(project, scenario)
@@ -160,16 +201,23 @@ def curved_dome(project: Project, scenario: Scenario, tree: Tree) -> CurvedDome:
     ball = trimesh.creation.icosphere(subdivisions=4, radius=sink_r)
     meshes = [m for m in model.meshes if m.material != TRUNK]
     meshes.append(Mesh(SINK, SINK, np.asarray(ball.vertices) + centre, np.asarray(ball.faces)))
-    materials = {**model.materials, SINK: Plastic(SINK, 0.0)}
+    # the façade inside the BSDF shell (the annulus from the sink to the dome's radius, its
+    # paint's reflectance): light the stack sends towards it comes back into the stack; the
+    # façade beyond the shell is the scene's own (escapes behind the façade plane are not sky)
+    meshes.append(Mesh(WALL, WALL, *wall_annulus(centre, frame.along, sink_r, spec.radius)))
+    materials = {**model.materials, SINK: Plastic(SINK, 0.0),
+                 WALL: Plastic(WALL, project.street.facade_reflectance)}
     return CurvedDome(Scene(meshes, materials, {}, []), centre, sink_r, frame.normal)
 
 
 def curved_ring_row(dome: CurvedDome, lo_deg: float, hi_deg: float, paths: int = 200_000,
-                    seed: int = 1, workers: int = 2) -> RingRow:
-    """Trace the normal-outgoing row of the band |elevation| ∈ [lo, hi]° through the dome's
-    explicit slats, per Klems patch and per ring (see the module docstring)."""
+                    seed: int = 1, workers: int = 2,
+                    sector_deg: tuple[float, float] = (-90.0, 90.0)) -> RingRow:
+    """Trace the normal-outgoing row of the band |elevation| ∈ [lo, hi]° (and horizontal
+    angle from the façade normal in ``sector_deg``, :func:`band_directions`) through the
+    dome's explicit slats, per Klems patch and per ring (see the module docstring)."""
     rng = np.random.default_rng(seed)
-    d = band_directions(dome.normal, lo_deg, hi_deg, paths, rng)
+    d = band_directions(dome.normal, lo_deg, hi_deg, paths, rng, sector_deg)
     # start just outside the sink (its facets lie inside the sphere by < 0.3 %)
     origins = dome.centre + (dome.sink_radius + 1e-3) * d
     esc = trace_escapes(dome.scene, origins, d, seed=seed + 1, workers=workers)
@@ -177,13 +225,54 @@ def curved_ring_row(dome: CurvedDome, lo_deg: float, hi_deg: float, paths: int =
     p = esc.path
     local = np.column_stack([np.einsum("ij,ij->i", esc.direction, f[p]) for f in (x, y, z)])
     front = local[:, 2] < 0
-    patch = incident_patches(local[front])[0]
-    ring, _ = klems_patch_rings()
-    w, pf = esc.weight[front], p[front]
+    # no sky light comes from behind the façade plane (the façade beyond the shell is the
+    # BSDF scene's own; the annulus inside it returned what reached it)
+    sky = front & (esc.direction @ dome.normal > 0.0)
+    patch = incident_patches(local[sky])[0]
+    ring, lam = klems_patch_rings()
+    w, pf = esc.weight[sky], p[sky]
     per_patch, patch_stderr = binned_mean(patch, pf, w, paths, ring.size)
-    weight, stderr = binned_mean(ring[patch], pf, w, paths, len(KLEMS_FULL_RINGS))
+    # a patch partly behind the wall: its value is the mean over its part in front of it
+    vis = visible_fraction(d, dome.normal, rng)
+    scale = np.where(vis > 0.02, 1.0 / np.maximum(vis, 0.02), 0.0)
+    per_patch, patch_stderr = per_patch * scale, patch_stderr * scale
+    weight = np.bincount(ring, per_patch, minlength=len(KLEMS_FULL_RINGS))
+    stderr = np.sqrt(np.bincount(ring, patch_stderr ** 2, minlength=len(KLEMS_FULL_RINGS)))
     reflected = float(esc.weight[~front].sum() / paths)
     return RingRow(weight, stderr, reflected, paths, per_patch, patch_stderr)
+
+
+def patch_directions(per_patch: int, rng: np.random.Generator) -> np.ndarray:
+    """``per_patch`` source directions in each Klems patch (145 × per_patch × 3, the
+    :func:`shell_frames` frame, on the outer side), uniform in projected solid angle, with the
+    T_f column convention of :func:`incident_patches`."""
+    rows = []
+    for lo, hi, _, n in KLEMS_FULL_RINGS:
+        width = 360.0 / n
+        for k in range(n):
+            s2 = rng.uniform(math.sin(math.radians(lo)) ** 2, math.sin(math.radians(hi)) ** 2,
+                             per_patch)
+            theta = np.arcsin(np.sqrt(s2))
+            travel = np.radians(k * width + (rng.random(per_patch) - 0.5) * width)
+            src = travel - math.pi
+            rows.append(np.column_stack([np.sin(theta) * np.cos(src),
+                                         np.sin(theta) * np.sin(src), -np.cos(theta)]))
+    return np.array(rows)
+
+
+def visible_fraction(d: np.ndarray, normal: np.ndarray, rng: np.random.Generator,
+                     views: int = 400, per_patch: int = 64) -> np.ndarray:
+    """Per Klems patch (T_f column), the share of its projected solid angle that lies in
+    front of the wall (world direction · façade ``normal`` > 0), averaged over ``views`` of
+    the traced view directions ``d`` (each with its :func:`shell_frames` frame)."""
+    pick = d[rng.choice(len(d), size=min(views, len(d)), replace=False)]
+    x, y, z = shell_frames(pick)
+    loc = patch_directions(per_patch, rng)            # (145, m, 3)
+    n = np.asarray(normal, float)
+    # world · n = loc_x (x·n) + loc_y (y·n) + loc_z (z·n), per view
+    coef = np.column_stack([x @ n, y @ n, z @ n])      # (views, 3)
+    dots = np.einsum("pmk,vk->pmv", loc, coef)
+    return (dots > 0.0).mean(axis=(1, 2))
 
 
 def binned_mean(bins: np.ndarray, path: np.ndarray, weight: np.ndarray, paths: int,

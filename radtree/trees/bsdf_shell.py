@@ -65,14 +65,41 @@ def elevation_bands(el: np.ndarray, faces: np.ndarray, bands: list[tuple[float, 
     return out
 
 
+def facade_angle(d: np.ndarray, normal: np.ndarray) -> np.ndarray:
+    """Horizontal angle (degrees, −90 … 90 in front of the wall) of the directions ``d`` (world
+    axes) from the façade's outward ``normal``, positive towards z × normal."""
+    n = np.asarray(normal, float) / np.linalg.norm(normal)
+    u = np.cross([0.0, 0.0, 1.0], n)
+    return np.degrees(np.arctan2(d @ u, d @ n))
+
+
+def sector_bounds(sectors: int) -> list[tuple[float, float]]:
+    """(lowest, highest) :func:`facade_angle` of each of ``sectors`` equal sectors, degrees."""
+    step = 180.0 / sectors
+    return [(-90.0 + k * step, -90.0 + (k + 1) * step) for k in range(sectors)]
+
+
 def dome_bands(verts: np.ndarray, faces: np.ndarray, centre: np.ndarray,
-               bands: list[tuple[float, float, Path]]
-               ) -> list[tuple[str, Bsdf, np.ndarray]]:
+               bands: list[tuple[float, float, Path]], normal: np.ndarray | None = None,
+               sectors: int = 1) -> list[tuple[str, Bsdf, np.ndarray]]:
     """:func:`elevation_bands` by the elevation of each triangle's centroid seen from
-    ``centre``."""
+    ``centre``; ``sectors`` > 1: ``bands`` holds one entry per elevation band and sector
+    (band-major), a triangle's sector that of its centroid's :func:`facade_angle` from the
+    façade ``normal``."""
     c = verts[faces].mean(axis=1) - centre
-    return elevation_bands(np.degrees(np.arctan2(c[:, 2], np.hypot(c[:, 0], c[:, 1]))),
-                           faces, bands)
+    el = np.degrees(np.arctan2(c[:, 2], np.hypot(c[:, 0], c[:, 1])))
+    if sectors == 1:
+        return elevation_bands(el, faces, bands)
+    if normal is None or len(bands) % sectors:
+        raise ValueError(f"dome_bands: {sectors} sectors need the façade normal and one XML "
+                         f"per band and sector, got {len(bands)}")
+    psi = facade_angle(c, normal)
+    out = []
+    for k, (lo, hi) in enumerate(sector_bounds(sectors)):
+        sel = (psi >= lo) & ((psi <= hi) if k == sectors - 1 else (psi < hi))
+        for name, mat, fs in elevation_bands(el[sel], faces[sel], bands[k::sectors]):
+            out.append((f"{name}_s{k}", Bsdf(f"{name}_s{k}", mat.xml, mat.up), fs))
+    return out
 
 
 def normal_bands(verts: np.ndarray, faces: np.ndarray, bands: list[tuple[float, float, Path]]
@@ -102,7 +129,8 @@ def build_bsdf_crown(tree: Tree, sensors: Sensors, street: Street, frame: Facade
         verts, faces = spec.shell(max(3, spec.segments // 4))
         verts = frame.to_world(verts)
         centre = frame.to_world(spec.centre[None, :])[0]
-        for name, mat, fs in dome_bands(verts, inward(verts, faces, centre), centre, bands):
+        for name, mat, fs in dome_bands(verts, inward(verts, faces, centre), centre, bands,
+                                        frame.normal, tree.bsdf.sectors):
             materials[name] = mat
             meshes.append(Mesh(name, name, verts, fs))
         notes.extend(dome_notes(spec))
