@@ -7,9 +7,10 @@
 Traces scenario B (explicit slats, Radiance) and the same scenario with
 ``tree.representation = "bsdf"`` (the dome as a shell of the crown layer's Klems BSDF) at the
 project's hours and prints the façade means per hour, their ratio and the 7-hour mean
-(``--curvature rings``: the traced row only rescaled ring by ring; ``planar``: the flat stack's
-BSDF without the traced view from the centre); then what the BSDF cannot represent: the
-lateral displacement of light inside the 2.2 m thick slat stack (see
+(``--curvature rings``: the traced row only rescaled ring by ring; ``planar``: the flat
+stack's BSDF without the traced view from the centre; ``--sectors N``: each band's row traced
+in N sectors of the horizontal angle from the façade normal); then what the BSDF cannot
+represent: the lateral displacement of light inside the 2.2 m thick slat stack (see
 :func:`lateral_displacement`).
 
 Noise: rtrace runs with ``-u-`` (the same octree and options give the same numbers), so each
