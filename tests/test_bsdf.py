@@ -104,6 +104,10 @@ def test_branch_slab_cover_and_config_keys():
     assert check_key("bsdf.samples", 64)[0].name == "tree.bsdf.samples"
     with pytest.raises(ConfigError, match="tree.bsdf.tiles.*odd"):
         CrownBsdf(tiles=4)
+    assert check_key("bsdf.sectors", 5)[0].name == "tree.bsdf.sectors"
+    assert CrownBsdf().sectors == 1
+    with pytest.raises(ConfigError, match="tree.bsdf.sectors"):
+        CrownBsdf(sectors=0)
     proj = load_project(MENDOZA)
     with pytest.raises(ConfigError, match="model 'perforated'.*louvers"):
         leaf_on_sample(proj, proj.scenario("C"))
