@@ -156,3 +156,22 @@ def test_a_worker_error_reads_as_it_was_raised(tmp_path):
     assert not (proj.build_dir / "E").exists()
     assert (proj.build_dir / "A-photo" / "manifest.json").is_file()   # built here, first
     assert not list(proj.build_dir.glob(".*"))
+
+
+def _worker_dies(*_args):
+    """A build worker killed mid-folder (run in the spawned process)."""
+    import os
+
+    os._exit(9)
+
+
+def test_a_dead_worker_is_a_clear_error(proj, monkeypatch):
+    """A worker process that dies (killed, out of memory) is reported as a RadtreeError
+    naming the folder it was building and the one-process way out."""
+    from radtree.errors import RadtreeError
+
+    monkeypatch.setattr(build_mod, "_build_in_worker", _worker_dies)
+    with pytest.raises(RadtreeError, match=r"worker process building (A|E) ended abruptly.*"
+                                           r"--workers 1"):
+        build_project(proj, ["C", "A", "E"], echo=lambda _m: None, progress=False,
+                      pictures=False, workers=2)

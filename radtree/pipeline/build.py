@@ -18,6 +18,7 @@ import time
 from collections import deque
 from collections.abc import Callable, Iterable
 from concurrent.futures import FIRST_COMPLETED, Future, ProcessPoolExecutor, wait
+from concurrent.futures.process import BrokenProcessPool
 from pathlib import Path
 from typing import Any
 
@@ -149,7 +150,14 @@ def _build_all(project: Project, queue: list[Scenario], engine: Any, build_root:
             ready, _ = wait(outstanding, timeout=None if block else 0,
                             return_when=FIRST_COMPLETED)
             for f in ready:
-                done(outstanding.pop(f), f.result())
+                name = outstanding.pop(f)
+                try:
+                    built = f.result()
+                except BrokenProcessPool:
+                    raise RadtreeError(
+                        f"the worker process building {name} ended abruptly (killed, or out of "
+                        "memory?); `radtree build --workers 1` builds in one process") from None
+                done(name, built)
 
     try:
         mine = pending.popleft()
