@@ -217,16 +217,17 @@ def test_facet_groups_face_the_sensors():
 
 
 @needs_radiance
-def test_direct_sun_through_the_explicit_crown(runs, tmp_path):
-    """``sun_crown = "explicit-direct"`` (the default): the hourly direct sun (-ab 0) of each
-    leaf state is the default method's, traced through the explicit slats / bare branches —
-    recomputed here on the annual scenes in a fresh folder, it agrees to float precision."""
+def test_sun_through_the_explicit_crown(runs, tmp_path):
+    """``sun_crown = "explicit"`` (the default): the hourly direct sun (-ab 0) of each leaf
+    state is the default method's, traced through the explicit slats / bare branches —
+    recomputed here on the annual scenes in a fresh folder, it agrees to float precision
+    (shadow rays only: deterministic)."""
     from radtree.annual.coefficients import CoefficientRunner, TraceParams
     from radtree.annual.run import LUX, annual_scenes, choose_scenarios
     from radtree.annual.weather_year import annual_weather
 
     project, first, _, _, _ = runs
-    assert first.options.sun_crown == "explicit-direct"
+    assert first.options.sun_crown == "explicit"
     opts = first.options
     with_sc, without_sc, _ = choose_scenarios(project, opts)
     scenes, grids, _, _ = annual_scenes(project, with_sc, without_sc, opts.branches, None)
@@ -245,12 +246,16 @@ def test_direct_sun_through_the_explicit_crown(runs, tmp_path):
     on = np.concatenate([first.direct["leaf_on"][g] for g in grids]).sum()
     off = np.concatenate([first.direct["leaf_off"][g] for g in grids]).sum()
     assert off > 1.2 * on, (on, off)
-    assert any("through the explicit crown" in n for n in first.notes)
+    # the sun runs sit in the default method's folders (a dc run of the project reuses them)
+    coeffs = project.results_dir / "annual" / "coefficients"
+    for state in ("leaf_on", "leaf_off"):
+        assert list((coeffs / state).glob("sun_direct_*.npy"))
+    assert any("explicit crown" in n for n in first.notes)
 
 
 def test_unknown_sun_crown_is_refused():
     from radtree.annual.run import AnnualOptions
     from radtree.errors import ConfigError
 
-    with pytest.raises(ConfigError, match="unknown sun crown 'slats'.*explicit-direct"):
+    with pytest.raises(ConfigError, match="unknown sun crown 'slats'.*explicit, bsdf"):
         AnnualOptions(method="3phase", sun_crown="slats")

@@ -85,7 +85,7 @@ METHOD_NOTES = [
 ]
 METHODS = ("dc", "3phase")
 #: ``AnnualOptions.sun_crown`` values (3phase)
-SUN_CROWNS = ("explicit-direct", "explicit", "bsdf")
+SUN_CROWNS = ("explicit", "bsdf")
 MONTHLY_COLUMNS = ["grid", "tree", "month", "mean_lux", "mean_direct_lux", "leaf_on_days",
                    "days", "crown"]
 
@@ -116,11 +116,10 @@ class AnnualOptions:
     method: str = "dc"
     #: 3phase: rays per Klems patch of each daylight matrix (rfluxmtx -c)
     daylight_samples: int = 400
-    #: 3phase: the crown the sun is traced through (:data:`SUN_CROWNS`): "explicit-direct"
-    #: (the hourly direct sun, ``-ab 0``, through the explicit crown of the default method's
-    #: leaf-on / bare-branch scene; the reflected sun on the BSDF crown), "explicit" (direct
-    #: and reflected sun as the default method, explicit crown), "bsdf" (both on the BSDF crown)
-    sun_crown: str = "explicit-direct"
+    #: 3phase: the crown the sun is traced through (:data:`SUN_CROWNS`): "explicit" (the
+    #: default method's sun runs — hourly direct sun and reflected sun — on its leaf-on /
+    #: bare-branch scenes) or "bsdf" (both on the BSDF-crown scene)
+    sun_crown: str = "explicit"
 
     def __post_init__(self) -> None:
         if self.method not in METHODS:
@@ -288,17 +287,14 @@ def combine(c_sky: np.ndarray, sky: np.ndarray, c_dir: np.ndarray, suns: Suns,
 
 
 def scene_year_lux(runner: CoefficientRunner, year: YearInputs, mf: int, sun_mf: int,
-                   trace: TraceParams, sun_trace: TraceParams, with_sky: bool = True,
-                   direct_runner: CoefficientRunner | None = None
+                   trace: TraceParams, sun_trace: TraceParams, with_sky: bool = True
                    ) -> tuple[np.ndarray, np.ndarray]:
     """(total, direct) lux, each (sensors, hours), of one scene over ``year``: sky coefficients
-    (zero unless ``with_sky``), exact suns at ``-ab 0`` and the sun patches' reflected part.
-    ``direct_runner``: trace the exact suns at ``-ab 0`` on that runner's scene instead (same
-    sensors; the 3-phase method's direct sun through the explicit crown)."""
+    (zero unless ``with_sky``), exact suns at ``-ab 0`` and the sun patches' reflected part."""
     _, wea, sky, suns, verts, weights, need, patch_dirs = year
     c_sky = runner.sky(mf, trace) if with_sky else np.zeros(
         (runner.n_sensors, patch_count(mf), 3), np.float32)
-    c_dir = (direct_runner or runner).suns("direct", suns.direction, 0, trace)
+    c_dir = runner.suns("direct", suns.direction, 0, trace)
     c_n = runner.suns(f"patch{sun_mf}_ab{trace.ab}", patch_dirs[need], trace.ab, sun_trace)
     c_0 = runner.suns(f"patch{sun_mf}_ab0", patch_dirs[need], 0, sun_trace)
     c_ind = np.zeros((runner.n_sensors, len(patch_dirs), 3), np.float32)

@@ -28,11 +28,22 @@ For every sensor and hour (lux, as :mod:`radtree.annual.run`)
   leaf state; times ``s`` for the 8760 hours in NumPy (``dctimestep``'s product).
 
 **Direct sun: as the existing annual does** (no fifth phase): ``rcontrib`` with a 0.533° sun
-exactly at each hour's position at ``-ab 0`` (the LM-83 direct sunlight, through the BSDF's
-undeviated "through" part) and the inter-reflected sun from unit suns at Reinhart patch
-centres (``-ab N`` minus ``-ab 0``), traced on the BSDF-crown scene of each leaf state
-(:class:`~radtree.annual.coefficients.CoefficientRunner`, cached by content). The scene without
-the tree is computed as the default method does (there is no crown to factor out).
+exactly at each hour's position at ``-ab 0`` (the LM-83 direct sunlight) and the
+inter-reflected sun from unit suns at Reinhart patch centres (``-ab N`` minus ``-ab 0``)
+(:class:`~radtree.annual.coefficients.CoefficientRunner`, cached by content).
+``AnnualOptions.sun_crown`` says through which crown: ``"explicit"`` (default) runs the
+default method's sun runs on its explicit scenes of each leaf state (slats, bare branches;
+its folders and cache, so a project that ran ``--method dc`` reuses them); ``"bsdf"`` traces
+both on the BSDF-crown scene (a Klems BSDF passes no sun at ``-ab 0``, measured: 0.0 lx on
+the office example; the sun through the crown, gaps included, comes from the ``-ab N`` run,
+smeared over Klems patches). Measured on the office example (README,
+three-phase section): the sun scattered by the BSDF crown is where the two methods differed
+most (work-plane UDI > 3000 lx +5.4 pp, façade +9.6 pp with ``"bsdf"``; +0.7 / +0.9 pp with
+``"explicit"``, for 214 s more of sun runs through the slats). Tracing only the ``-ab 0``
+direct sun through the explicit crown and the reflected sun on the BSDF crown counts the
+crown's gaps twice (the BSDF's ``-ab N`` run carries them) and was no better than ``"bsdf"``
+(README). The scene without the tree is computed as the default
+method does.
 
 A second weather file reruns ``gendaymtx`` and the products only (the sun coefficients
 are reused when the sun positions are the same, i.e. the same site); a second leaf state
@@ -296,8 +307,6 @@ class ThreePhase:
 
 
 SUN_NOTES = {
-    "explicit-direct": "the hourly direct sun (-ab 0) through the explicit crown (slats, "
-                       "bare branches) of each leaf state, the reflected sun on its BSDF crown",
     "explicit": "both on the explicit crown (slats, bare branches) of each leaf state",
     "bsdf": "both on the BSDF-crown scene of each leaf state",
 }
@@ -348,15 +357,10 @@ def compute_annual_3phase(project: Project, options: AnnualOptions,
     weather, wea, sky, suns, verts, weights, need, patch_dirs = year
     timing["weather_s"] = time.perf_counter() - t1
 
-    def dc(scene: Scene, folder: Path, with_sky: bool, direct_of: str | None = None
-           ) -> tuple[np.ndarray, np.ndarray]:
-        """``direct_of``: the variant whose explicit scene the hourly direct sun is traced
-        on (in the default method's folder: a project that ran it reuses its run)."""
+    def dc(scene: Scene, folder: Path, with_sky: bool) -> tuple[np.ndarray, np.ndarray]:
         runner = CoefficientRunner(scene, grids, folder, rho, echo=echo)
-        direct = None if direct_of is None else CoefficientRunner(
-            scenes[direct_of], grids, work / "coefficients" / direct_of, rho, echo=echo)
         return scene_year_lux(runner, year, options.mf, options.sun_mf, trace, sun_trace,
-                              with_sky, direct)
+                              with_sky)
 
     echo(f"  3-phase: {form} crown, BSDFs {', '.join(sorted({Path(b[2]).name for s in STATES for b in xmls[s]}))}")
     tp = ThreePhase(work / "threephase", bare, models, form, grids, rho, options.mf, trace,
@@ -371,12 +375,11 @@ def compute_annual_3phase(project: Project, options: AnnualOptions,
     timing["without_s"] = time.perf_counter() - tv
     for state in STATES:
         tv = time.perf_counter()
-        if options.sun_crown == "explicit":        # the default method's sun runs
+        if options.sun_crown == "explicit":   # the default method's sun runs and cache
             sun_tot, sun_dir = dc(scenes[state], work / "coefficients" / state, False)
         else:
             sun_tot, sun_dir = dc(_scene_with(bare, models[state]),
-                                  work / "threephase" / f"sun_{state}", False,
-                                  state if options.sun_crown == "explicit-direct" else None)
+                                  work / "threephase" / f"sun_{state}", False)
         timing[f"{state}_sun_s"] = time.perf_counter() - tv
         td = time.perf_counter()
         dcs[state] = tp.coefficients(state, views, v_sky)
