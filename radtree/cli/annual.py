@@ -46,11 +46,16 @@ from radtree.cli.options import CONTEXT, writes
 @click.option("--method", type=click.Choice(["dc", "3phase"]), default="dc", show_default=True,
               help="dc: daylight coefficients of the explicit crown; 3phase: view matrix · "
                    "crown BSDF (leaf-on/off) · daylight matrix · sky (rfluxmtx, dctimestep).")
+@click.option("--sun-crown", type=click.Choice(["explicit", "bsdf"]), default="explicit",
+              show_default=True,
+              help="3phase: the hourly sun traced through the explicit crown (its gaps and "
+                   "slats, as the dc method does) or through the BSDF crown.")
 def annual_command(project: Path, leaf_on: str, leaf_off: str, mf: int, sun_mf: int,
                    occupancy: str, epw: Path | None, with_scenario: str | None,
                    without_scenario: str | None, ab: int | None, ad: int | None,
                    lw: float | None, processes: int, no_figures: bool,
-                   use_dates: bool = False, method: str = "dc") -> None:
+                   use_dates: bool = False, method: str = "dc",
+                   sun_crown: str = "explicit") -> None:
     """Annual daylight (8760 h) with a deciduous tree: UDI, DA, sDA, ASE, monthly means.
 
     The crown is in leaf from --leaf-on to --leaf-off; with ``[tree] species`` each hour
@@ -69,7 +74,7 @@ def annual_command(project: Path, leaf_on: str, leaf_off: str, mf: int, sun_mf: 
         leaf=LeafSchedule(leaf_on, leaf_off), mf=mf, sun_mf=sun_mf,
         occupancy=parse_occupancy(occupancy), ab=ab, ad=ad, lw=lw, nproc=processes,
         with_scenario=with_scenario, without_scenario=without_scenario, epw=epw,
-        species_phenology=not use_dates, method=method)
+        species_phenology=not use_dates, method=method, sun_crown=sun_crown)
     click.echo(f"annual: {proj.name}")
     out = run_annual(proj, options, echo=click.echo, progress=True,
                      figures=not no_figures)
