@@ -158,16 +158,19 @@ def test_a_worker_error_reads_as_it_was_raised(tmp_path):
     assert not list(proj.build_dir.glob(".*"))
 
 
-def _worker_dies(*_args):
-    """A build worker killed mid-folder (run in the spawned process)."""
+def _worker_dies(_project, sc, build_root):
+    """A build worker killed mid-folder (run in the spawned process): its temporary folder
+    begun, then the process gone."""
     import os
 
+    (build_root / f".{sc.name}.begun").mkdir()
     os._exit(9)
 
 
 def test_a_dead_worker_is_a_clear_error(proj, monkeypatch):
     """A worker process that dies (killed, out of memory) is reported as a RadtreeError
-    naming the folder it was building and the one-process way out."""
+    naming the folder it was building and the one-process way out; no temporary folder is
+    left behind."""
     from radtree.errors import RadtreeError
 
     monkeypatch.setattr(build_mod, "_build_in_worker", _worker_dies)
@@ -175,3 +178,4 @@ def test_a_dead_worker_is_a_clear_error(proj, monkeypatch):
                                            r"--workers 1"):
         build_project(proj, ["C", "A", "E"], echo=lambda _m: None, progress=False,
                       pictures=False, workers=2)
+    assert not list(proj.build_dir.glob(".*"))   # the temporary folders begun are gone

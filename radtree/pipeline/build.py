@@ -153,7 +153,10 @@ def _build_all(project: Project, queue: list[Scenario], engine: Any, build_root:
                 name = outstanding.pop(f)
                 try:
                     built = f.result()
-                except BrokenProcessPool:
+                except BrokenProcessPool:   # every worker's folders: their atomic_dirs
+                    for gone in [name, *outstanding.values()]:
+                        for tmp in build_root.glob(f".{gone}.*"):
+                            shutil.rmtree(tmp, ignore_errors=True)
                     raise RadtreeError(
                         f"the worker process building {name} ended abruptly (killed, or out of "
                         "memory?); `radtree build --workers 1` builds in one process") from None
