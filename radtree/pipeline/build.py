@@ -114,12 +114,12 @@ def _weight(project: Project, sc: Scenario) -> int:
     from radtree.config.photo import photo_of
     from radtree.trees.build import apply_switches
 
+    if sc.model == "none":
+        return 0
     try:
         tree, _ = apply_switches(project.tree, dict(sc.switches), source=str(project.source))
     except RadtreeError:
         return 0   # the build itself reports the error
-    if sc.model is None or sc.model == "none":
-        return 0
     return 2 if photo_of(tree)[0] is not None else int((sc.form or tree.form) == "free")
 
 
