@@ -2,11 +2,16 @@
 
 from __future__ import annotations
 
+import os
 import re
 import shutil
 from pathlib import Path
 
 import pytest
+
+# The build cache (radtree.cache) is off in tests: a test that changes a crown builder would
+# otherwise be served another test's crown. tests/test_build_cache.py turns it on in tmp_path.
+os.environ["RADTREE_CACHE_DIR"] = "off"
 
 ROOT = Path(__file__).resolve().parents[1]
 MENDOZA = ROOT / "examples" / "mendoza-street"

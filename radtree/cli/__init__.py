@@ -38,6 +38,7 @@ COMMANDS = {
     "bsdf": "radtree.cli.bsdf:bsdf_command",
     "method": "radtree.cli.method:method_command",
     "export": "radtree.cli.export:export_command",
+    "cache": "radtree.cli.cache:cache_command",
 }
 
 

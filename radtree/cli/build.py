@@ -19,7 +19,7 @@ from radtree.cli.options import CONTEXT, scenarios_option, writes
                    "parameters, input files and scene files).")
 @click.option("--workers", type=click.IntRange(min=1), default=None,
               help="Processes building folders side by side (default: the usable cores, "
-                   "when there are 4 folders or more to build).")
+                   "when there are 4 crowns or more to build that the build cache lacks).")
 def build_command(project: str, scenarios: tuple[str, ...], no_pictures: bool, fresh: bool,
                   workers: int | None) -> None:
     """Write the Radiance build folder of PROJECT.
@@ -31,7 +31,9 @@ def build_command(project: str, scenarios: tuple[str, ...], no_pictures: bool, f
       make -j2 -C PROJECT/build/A
 
     A folder that is current (built by this radtree for the same parameters and input
-    files, its scene files unchanged) is kept; --fresh rebuilds it.
+    files, its scene files unchanged) is kept; --fresh rebuilds it. Crowns built before
+    (by any project, keyed by all that shapes them) come from the build cache: see
+    `radtree cache` (RADTREE_CACHE_DIR=off turns it off).
     """
     from radtree.config import load_project
     from radtree.pipeline.build import build_project

@@ -6,11 +6,8 @@ as local clock ``HH:MM``. Bounds, choices and TOML names are field metadata (:fu
 
 from __future__ import annotations
 
-import functools
-import hashlib
-import json
 from collections.abc import Callable
-from dataclasses import dataclass, field, fields, is_dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, ClassVar
 
@@ -18,7 +15,8 @@ from radtree.config.bsdf import REPRESENTATIONS, CrownBsdf
 from radtree.config.clumping import clumping_fields
 from radtree.config.honeybee import HoneybeeSite
 from radtree.config.limits import Limits
-from radtree.config.photo import INCLINATION_DISTRIBUTIONS, drop_photo_defaults, photo_fields
+from radtree.config.params_hash import params_hashes, plain
+from radtree.config.photo import INCLINATION_DISTRIBUTIONS, photo_fields
 from radtree.config.spec import TIME_RE, Checked, meta
 from radtree.errors import ConfigError
 
@@ -351,13 +349,6 @@ class EngineParams(Checked):
     dense_rays: int | None = field(default=None, metadata=meta(1))
 
 
-#: the :class:`EngineParams` fields only the Radiance photon map reads
-PMAP_KEYS = ("pmap_photons", "pmap_caustic_photons", "pmap_bandwidth")
-#: the :class:`EngineParams` fields only the forward engine reads
-FORWARD_KEYS = ("photons", "forward_threshold", "forward_splitting", "beam_diameter_m",
-                "patch_m", "forward_batches", "forward_focus_m", "forward_split",
-                "forward_split_radius_m", "forward_guide", "forward_guide_radius_m")
-
 
 @dataclass(frozen=True)
 class Scenario(Checked):
@@ -428,68 +419,16 @@ class Project:
                           f"{', '.join(s.name for s in self.scenarios)})", source=str(self.source))
 
     def to_dict(self) -> dict[str, Any]:
-        return _plain(self)
+        return plain(self)
 
     def params_hash(self, scenario: Scenario) -> str:
-        """Short hash of everything that changes a scenario's numbers. Input files count by
-        their path relative to the project folder and their content (:func:`_file_key`), so
-        a moved project keeps its hashes and an edited input file changes them."""
-        d = _plain(self, lambda p: _file_key(p, self.root))
-        payload = {k: d[k] for k in ("site", "street", "light", "tree", "sensors", "engine",
-                                     "office", "extra_geometry")}
-        if payload["tree"].get("species") is None:  # no species: hashes unchanged
-            payload["tree"].pop("species", None)
-        payload["engine"].pop("workers", None)
-        for key in FORWARD_KEYS + PMAP_KEYS + ("dense_rays",):  # at defaults: hashes unchanged
-            if payload["engine"].get(key) == getattr(EngineParams, key):
-                payload["engine"].pop(key, None)
-        if self.honeybee is not None:   # absent otherwise: other projects' hashes unchanged
-            payload["honeybee"] = {**d["honeybee"], "sha256": self.honeybee.digest()}
-        drop_photo_defaults(payload["tree"])  # photo fields at their defaults: hashes unchanged
-        for key, default in (("representation", "explicit"), ("bsdf", _plain(CrownBsdf()))):
-            if payload["tree"].get(key) == default:   # BSDF settings unused: hashes unchanged
-                payload["tree"].pop(key, None)
-        if self.district is not None:   # inventory inputs: relative path + content (_file_key)
-            payload["district"] = d["district"]
-        payload["scenario"] = _plain(scenario)
-        text = json.dumps(payload, sort_keys=True, default=str)
-        return hashlib.sha256(text.encode()).hexdigest()[:12]
+        """Short hash of everything that changes a scenario's numbers (input files by their
+        path relative to the project folder and their content): :mod:`.params_hash`."""
+        return self.params_hashes([scenario])[scenario.name]
 
-
-def _plain(obj: Any, path: Callable[[Path], Any] = str) -> Any:
-    if is_dataclass(obj) and not isinstance(obj, type):
-        return {f.name: _plain(getattr(obj, f.name), path) for f in fields(obj)}
-    if isinstance(obj, dict):
-        return {k: _plain(v, path) for k, v in obj.items()}
-    if isinstance(obj, list | tuple):
-        return [_plain(v, path) for v in obj]
-    if isinstance(obj, Path):
-        return path(obj)
-    return obj
-
-
-def _file_key(path: Path, root: Path) -> str:
-    """``relative/path sha256:…`` of an input file (the path as given when it is missing)."""
-    try:
-        name = str(path.resolve().relative_to(root.resolve()))
-    except ValueError:
-        name = str(path)
-    try:
-        st = path.stat()
-    except OSError:
-        return name
-    if not path.is_file():
-        return name
-    return f"{name} sha256:{_content_hash(str(path), st.st_mtime_ns, st.st_size)}"
-
-
-@functools.lru_cache(maxsize=256)
-def _content_hash(path: str, mtime_ns: int, size: int) -> str:
-    h = hashlib.sha256()
-    with open(path, "rb") as f:
-        for chunk in iter(lambda: f.read(1 << 20), b""):
-            h.update(chunk)
-    return h.hexdigest()
+    def params_hashes(self, scenarios: list[Scenario]) -> dict[str, str]:
+        """``{scenario name: params_hash}``, the project's part read once for all."""
+        return params_hashes(self, scenarios)
 
 
 def parse_time(value: Any, where: str = "time", source: str | None = None) -> str:

@@ -28,7 +28,7 @@ from radtree.engines.registry import folder_engine
 from radtree.errors import RadtreeError
 from radtree.fileio import atomic_dir, write_text
 from radtree.light.hours import hour_states
-from radtree.pipeline.assemble import BuiltScene, make_scene
+from radtree.pipeline.assemble import BuiltScene, facade_frame, make_scene
 from radtree.pipeline.manifest import file_sha256, manifest
 from radtree.pipeline.processes import usable_cores
 from radtree.pipeline.realisations import (
@@ -77,9 +77,10 @@ def build_project(project: Project, scenarios: list[str] | None = None,
         else:
             facts[sc.name] = kept
             echo(f"  {sc.name}: current, kept (--fresh rebuilds it) → {build_root / sc.name}")
+    weight = {sc.name: _weight(project, sc) for sc in todo}
     n = min(len(todo), usable_cores() if workers is None else max(1, int(workers)))
-    if workers is None and len(todo) < PARALLEL_MIN:
-        n = 1
+    if workers is None and sum(w > 0 for w in weight.values()) < PARALLEL_MIN:
+        n = 1     # crowns from the cache (or none): a folder takes ~0.1 s, a worker ~1 s
     bar = progress_bar(None, "build", progress, total=len(todo), unit="scenario")
     with _Pictures(len(drawn & {sc.name for sc in todo})) as painter:
         def done(name: str, built_facts: dict) -> None:
@@ -91,9 +92,8 @@ def build_project(project: Project, scenarios: list[str] | None = None,
                 bar.update(1)
 
         try:
-            _build_all(project, sorted(todo, key=lambda sc: _weight(project, sc),
-                                                reverse=True), engine, build_root,
-                       n, done)
+            _build_all(project, sorted(todo, key=lambda sc: weight[sc.name], reverse=True),
+                       engine, build_root, n, done)
         finally:
             if bar is not None:
                 bar.close()
@@ -103,24 +103,29 @@ def build_project(project: Project, scenarios: list[str] | None = None,
     return {sc.name: facts[sc.name] for sc in chosen}
 
 
-#: at least this many folders to build before workers are spawned (a spawned interpreter
-#: takes ~1 s to import radtree; a scenario folder 0.2–2 s to build)
+#: at least this many crowns to build (not in the build cache) before workers are spawned
+#: (a spawned interpreter takes ~1 s to import radtree; a crown 0.1–3 s to build)
 PARALLEL_MIN = 4
 
 
 def _weight(project: Project, sc: Scenario) -> int:
     """A rough build cost, for the order of the queue (heaviest first): crowns made from a
-    photo (its analysis; a dome's cut along its sky outlines) 2, free crowns 1, the rest 0."""
+    photo (its analysis; a dome's cut along its sky outlines) 3, free crowns 2, other crowns
+    1; 0 without a crown or with the crown in the build cache (:mod:`radtree.cache`)."""
     from radtree.config.photo import photo_of
-    from radtree.trees.build import apply_switches
+    from radtree.trees.build import apply_switches, crown_in_cache
 
     if sc.model == "none":
         return 0
     try:
         tree, _ = apply_switches(project.tree, dict(sc.switches), source=str(project.source))
+        if project.district is None:
+            eff = effective_project(project, sc)
+            if crown_in_cache(eff, sc, facade_frame(eff)):
+                return 0
     except RadtreeError:
         return 0   # the build itself reports the error
-    return 2 if photo_of(tree)[0] is not None else int((sc.form or tree.form) == "free")
+    return 3 if photo_of(tree)[0] is not None else 1 + int((sc.form or tree.form) == "free")
 
 
 def _build_all(project: Project, queue: list[Scenario], engine: Any, build_root: Path,
@@ -187,7 +192,8 @@ def _build_in_worker(project: Project, sc: Scenario, build_root: Path) -> dict:
 
 def _built_line(f: dict, folder: Path) -> str:
     return (f"  {f['scenario']}: {f['model']} ({f['form']}), {f['triangles']} triangles, "
-            f"-ab {f['ab']}, geometry {f['seconds']['geometry']:.2f} s → {folder}")
+            f"-ab {f['ab']}, geometry {f['seconds']['geometry']:.2f} s"
+            f"{' (crown from the cache)' if f.get('crown_from_cache') else ''} → {folder}")
 
 
 def _current_facts(project: Project, sc: Scenario, picture: bool) -> dict | None:
@@ -262,6 +268,7 @@ def _build_one(project: Project, sc: Scenario, engine: Any, build_root: Path) ->
             "triangles": built.triangles, "notes": built.notes, "info": built.info,
             "params_hash": project.params_hash(sc),
             "photo": getattr(built.tree, "photo", None),
+            "crown_from_cache": bool(getattr(built.tree, "from_cache", False)),
             "seconds": {"preparation": prep, "geometry": built.geometry_seconds,
                         "writing": time.perf_counter() - t1},
         }

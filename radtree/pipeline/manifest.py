@@ -43,7 +43,7 @@ def manifest(project, extra: dict[str, Any] | None = None,
         "parameters": project.to_dict(),
         "seeds": {"engine": project.engine.seed, "louvers": project.tree.louvers.seed},
         "inputs": input_files(project),
-        "params_hash": {s.name: project.params_hash(s) for s in project.scenarios},
+        "params_hash": project.params_hashes(project.scenarios),
     })
     if extra:
         d.update(extra)

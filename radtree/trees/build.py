@@ -111,8 +111,32 @@ def build_crown(project: Project, model: str, form: str, frame: FacadeFrame,
     return result
 
 
-def build_tree(project: Project, scenario: Scenario, frame: FacadeFrame) -> TreeModel:
-    """The crown model of ``scenario`` (form, model and switches applied), in world space."""
+def _crown_key(project: Project, model: str, form: str, frame: FacadeFrame,
+               tree: Tree) -> str:
+    """The build-cache key of a crown: model, form, tree tables (files by path and content),
+    sensors, street, frame and radtree's code (:func:`radtree.cache.content_key`)."""
+    from radtree.cache import content_key
+
+    return content_key(what="crown", model=model, form=form, tree=tree,
+                       sensors=project.sensors, street=project.street, frame=frame)
+
+
+def _crown_of(project: Project, model: str, form: str, frame: FacadeFrame,
+              tree: Tree) -> TreeModel:
+    """:func:`build_crown`, or the same crown from the build cache (:mod:`radtree.cache`);
+    ``TreeModel.from_cache`` says which."""
+    if model == "none":
+        return build_crown(project, model, form, frame, tree)
+    from radtree.cache import cached_object
+
+    crown, hit = cached_object(_crown_key(project, model, form, frame, tree),
+                               lambda: build_crown(project, model, form, frame, tree))
+    crown.from_cache = hit
+    return crown  # type: ignore[no-any-return]
+
+
+def _scenario_tree(project: Project, scenario: Scenario) -> tuple[Tree, list[str], str]:
+    """The scenario's ``[tree]`` after its switches, what they changed, and its form."""
     source = str(project.source)
     tree, changed = apply_switches(project.tree, scenario.switches, source=source,
                                    root=project.root)
@@ -120,7 +144,24 @@ def build_tree(project: Project, scenario: Scenario, frame: FacadeFrame) -> Tree
     if form not in TREE_FORMS:
         raise ConfigError(f"got {form!r}, expected one of {', '.join(TREE_FORMS)}",
                           source=source, field="tree.form")
-    model = build_crown(project, scenario.model, form, frame, tree)
+    return tree, changed, form
+
+
+def crown_in_cache(project: Project, scenario: Scenario, frame: FacadeFrame) -> bool:
+    """True when the build cache holds the scenario's crown (``project``: the scenario's
+    effective project), so building it costs no crown geometry."""
+    from radtree.cache import has_object
+
+    if scenario.model == "none":
+        return True
+    tree, _, form = _scenario_tree(project, scenario)
+    return has_object(_crown_key(project, scenario.model, form, frame, tree))
+
+
+def build_tree(project: Project, scenario: Scenario, frame: FacadeFrame) -> TreeModel:
+    """The crown model of ``scenario`` (form, model and switches applied), in world space."""
+    tree, changed, form = _scenario_tree(project, scenario)
+    model = _crown_of(project, scenario.model, form, frame, tree)
     if changed:
         model.notes.insert(0, f"Scenario '{scenario.name}' switches: " + "; ".join(changed) + ".")
     return model

@@ -41,6 +41,7 @@ class TreeModel:
     # in their own frame and where each tree places one (radtree.scene.Instance)
     prototypes: dict[str, list[Mesh]] = field(default_factory=dict)
     instances: list[Instance] = field(default_factory=list)
+    from_cache: bool = False  # loaded from the build cache (radtree.cache), not built
 
     def __post_init__(self) -> None:
         for m in [*self.meshes, *(p for ms in self.prototypes.values() for p in ms)]:

@@ -21,6 +21,9 @@ below :data:`MESH_MIN_TRIANGLES` (façades, ground: a few triangles) stay readab
 
 from __future__ import annotations
 
+from pathlib import Path
+
+from radtree.cache import cached_file, content_key
 from radtree.scene import Mesh
 
 #: meshes with at least this many triangles are written as obj2mesh meshes
@@ -41,6 +44,15 @@ def obj_text(mesh: Mesh) -> str:
     verts = ("v %.5f %.5f %.5f\n" * len(mesh.vertices)) % tuple(mesh.vertices.ravel().tolist())
     faces = ("f %d %d %d\n" * len(mesh.faces)) % tuple((mesh.faces + 1).ravel().tolist())
     return head + verts + faces
+
+
+def write_obj(mesh: Mesh, path: Path) -> bool:
+    """Write :func:`obj_text` of ``mesh`` to ``path`` (atomically): copied from the build cache
+    (:mod:`radtree.cache`, keyed by the mesh's name, material, vertices and faces) when a
+    build wrote it before (True), else formatted and stored there (False)."""
+    key = content_key(mesh.vertices, mesh.faces, what="obj", name=mesh.name,
+                      material=mesh.material)
+    return cached_file(key, ".obj", lambda: obj_text(mesh), path)
 
 
 def mesh_primitive_text(mesh: Mesh, rtm: str) -> str:
