@@ -1,9 +1,12 @@
 """Wall and CPU time of `radtree build` on the Mendoza example (issue 22: ≤ 3 s), as a user runs it.
 
 Each run is the command line in a fresh process on a copy of the example (pictures off unless
-``--pictures``): a cold build into an empty folder with 1 process and with the usable cores,
-then a second `radtree build` on the built folders (every folder current: kept) and a
-`--fresh` one (every folder rebuilt). CPU includes the spawned workers. The slowest folders
+``--pictures``), with its own build cache (``RADTREE_CACHE_DIR`` in the temporary folder):
+a cold build into an empty folder and an empty cache, with 1 process and with the usable
+cores; a build into an empty folder with the crowns in the cache (what any build after the
+first is: another project folder, ``--fresh``, a changed hour or sky); a second
+`radtree build` on the built folders (every folder current: kept) and a `--fresh` one (every
+folder rebuilt, crowns from the cache). CPU includes the spawned workers. The slowest folders
 of the cold build are listed from their manifests (geometry and writing seconds).
 Run: .venv/bin/python benchmarks/build.py [--repeats N] [--pictures]
 """
@@ -37,22 +40,28 @@ def main() -> None:
                         ignore=shutil.ignore_patterns("build", "results", "report", "diagnose",
                                                       "sweep"))
         extra = [] if args.pictures else ["--no-pictures"]
+        cache = Path(tmp) / "cache"
+        os.environ["RADTREE_CACHE_DIR"] = str(cache)
         rows = []
-        for label, opts, clean in (("cold, 1 process", ["--workers", "1"], True),
-                                   (f"cold, {cores} processes", [], True),
-                                   ("again, folders current (kept)", [], False),
-                                   ("again, --fresh", ["--fresh"], False)):
+        for label, opts, clean in (("cold, empty cache, 1 process", ["--workers", "1"], 2),
+                                   (f"cold, empty cache, {cores} processes", [], 2),
+                                   ("empty folder, crowns cached", [], 1),
+                                   ("again, folders current (kept)", [], 0),
+                                   ("again, --fresh (crowns cached)", ["--fresh"], 0)):
             for _ in range(args.repeats):
                 if clean:
                     shutil.rmtree(proj / "build", ignore_errors=True)
+                if clean == 2:
+                    shutil.rmtree(cache, ignore_errors=True)
                 wall, cpu, load = _run([str(RADTREE), "build", str(proj), *extra, *opts])
                 rows.append((label, wall, cpu, load))
         print(f"radtree build of the Mendoza example ({len(list((proj / 'build').glob('*/')))} "
               f"folders), {'with' if args.pictures else 'without'} pictures, {cores} cores")
-        print(f"{'case':34s} {'wall s':>7s} {'CPU s':>7s} {'load':>5s}")
+        print(f"{'case':38s} {'wall s':>7s} {'CPU s':>7s} {'load':>5s}")
         for label, wall, cpu, load in rows:
-            print(f"{label:34s} {wall:7.2f} {cpu:7.2f} {load:5.2f}")
+            print(f"{label:38s} {wall:7.2f} {cpu:7.2f} {load:5.2f}")
         shutil.rmtree(proj / "build")
+        shutil.rmtree(cache)
         _run([str(RADTREE), "build", str(proj), *extra, "--workers", "1"])
         print("slowest folders (one process):")
         facts = []
