@@ -65,18 +65,22 @@ def _limit_bytes() -> int:
 
 @functools.lru_cache(maxsize=1)
 def code_fingerprint() -> str:
-    """SHA-256 of the radtree package's files (paths and bytes) and the numerical libraries'
-    versions: any edit or upgrade gives new keys."""
+    """SHA-256 of the radtree package's files and its shipped ``materials/`` and
+    ``templates/`` (a checkout keeps them beside the package; paths and bytes) and the
+    numerical libraries' versions: any edit or upgrade gives new keys."""
     from importlib import metadata
 
     import radtree
+    from radtree.resources import FOLDERS, folder
 
     root = Path(radtree.__file__).parent
     h = hashlib.sha256(radtree.__version__.encode())
-    for f in sorted(root.rglob("*")):
-        if f.is_file() and "__pycache__" not in f.parts and f.suffix not in (".pyc", ".pyo"):
-            h.update(str(f.relative_to(root)).encode())
-            h.update(f.read_bytes())
+    tops = [root] + [Path(str(folder(name))) for name in FOLDERS]
+    for top in dict.fromkeys(t for t in tops if t.is_dir()):
+        for f in sorted(top.rglob("*")):
+            if f.is_file() and "__pycache__" not in f.parts and f.suffix not in (".pyc", ".pyo"):
+                h.update(str(f.relative_to(top.parent)).encode())
+                h.update(f.read_bytes())
     for lib in _LIBRARIES:
         try:
             h.update(f"{lib}={metadata.version(lib)}".encode())
