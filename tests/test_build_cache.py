@@ -38,7 +38,8 @@ def test_a_fresh_build_takes_its_crowns_from_the_cache(tmp_path, cache_dir, monk
     cached the queue weights are 0 (no worker is spawned for them)."""
     p = load_project(copy_project(tmp_path / "proj", hours=["13:30"]))
     b, e = p.scenario("B"), p.scenario("E")
-    assert build_mod._weight(p, b) == 1 and not crown_in_cache(p, b, facade_frame(p))
+    assert build_mod._weight(p, b) == build_mod._weight(p, e) == 1
+    assert not crown_in_cache(p, b, facade_frame(p))
     lines: list[str] = []
     first = build_project(p, ["B", "E"], echo=lines.append, progress=False, pictures=False,
                           workers=1)
