@@ -182,10 +182,10 @@ def _recorded_queries(caster: EmbreeCaster, work: Any, *args: Any
     lock = threading.Lock()
     original = caster._query
 
-    def recording(o: np.ndarray, d: np.ndarray) -> np.ndarray:
-        with lock:
-            casts.append((np.array(o), np.array(d)))
-        return original(o, d)
+    def recording(o_t: np.ndarray, d: np.ndarray) -> np.ndarray:
+        with lock:  # origins arrive as (3, n), one row per axis
+            casts.append((np.array(o_t.T), np.array(d)))
+        return original(o_t, d)
 
     caster._query = recording  # type: ignore[method-assign]
     try:

@@ -67,8 +67,11 @@ from radtree.engines.numpy.geometry import (
     scene_optics,
 )
 from radtree.engines.numpy.lockstep import Draws, LockstepRandom, SerialDraws
-from radtree.engines.numpy.raycast import embree_available, hit_triangles, plane_distance
+from radtree.engines.numpy.raycast import embree_available
 from radtree.engines.numpy.sampling import cosine_hemisphere, mirror, uniform_cone
+from radtree.engines.numpy.shadow import rows as _rows
+from radtree.engines.numpy.shadow import take as _take
+from radtree.engines.numpy.shadow import transmittance
 from radtree.light.sky import SkyState
 from radtree.light.sun import SUN_HALF_ANGLE_DEG
 
@@ -76,7 +79,6 @@ __all__ = ["DEFAULT_OPTIONS", "ENGINE_NAME", "GLASS_INDEX", "Environment", "Geom
            "TraceOptions", "describe", "glass_coefficients", "scene_geometry", "scene_optics"]
 
 ENGINE_NAME = "numpy"
-SHADOW_ROULETTE = 0.02  # shadow-ray transmittance below which Russian roulette starts
 
 
 @dataclass(frozen=True)
@@ -111,24 +113,6 @@ def describe(backend: str = "auto") -> str:
 
 
 # --------------------------------------------------------------------------- the tracer
-
-
-def _take(a: np.ndarray, i: np.ndarray) -> np.ndarray:
-    """Rows ``a[i]`` of a 2-D array at integer indices (``np.take`` is several times faster
-    than fancy indexing on rows)."""
-    return np.take(a, i, axis=0)
-
-
-def _rows(d: np.ndarray, sel: np.ndarray | None) -> np.ndarray:
-    """``d[sel]`` (``sel``: indices or a mask; None: all rows, copied) — except that a
-    broadcast row (stride 0, the point sun's direction) stays a broadcast row."""
-    if d.ndim == 2 and d.strides[0] == 0:
-        k = len(d) if sel is None else (int(np.count_nonzero(sel)) if sel.dtype == bool
-                                        else len(sel))
-        return np.broadcast_to(d[0], (k, d.shape[1]))
-    if sel is None:
-        return np.array(d)
-    return np.take(d, np.flatnonzero(sel) if sel.dtype == bool else sel, axis=0)
 
 
 class _Tracer:
@@ -207,73 +191,7 @@ class _Tracer:
         ``hour``: the hour state(s) whose point sun ``dirs`` are (per-triangle tables of the
         cosines and offsets), None for other directions (a sampled sun disc).
         """
-        k = len(origins)
-        vis = np.ones(k)
-        idx = np.arange(k)
-        o = np.array(origins, float)
-        d = _rows(np.asarray(dirs, float), None)  # a point sun stays one broadcast row
-        passes = self.opt.any_specular_pass
-        geo, ts = self.geo, self.tri_ts
-        for layer in range(self.opts.max_shadow_layers):
-            tri, t = hit_triangles(self.caster, o, d, parallel)
-            sel = np.flatnonzero(tri >= 0)
-            if len(sel) == 0:
-                return vis
-            tri = np.take(tri, sel).astype(np.intp, copy=False)  # Embree's are int32
-            ih = np.take(idx, sel)
-            if not passes:
-                vis[ih] = 0.0
-                return vis
-            f = np.take(ts, tri)
-            if self.glass_any:
-                glass = self.tri_glass[tri]
-                if glass.any():
-                    gs, gt = sel[glass], tri[glass]
-                    cosg = np.einsum("ij,ij->i", _rows(d, gs), geo.normals[gt])
-                    f[glass] = glass_coefficients(cosg, self.tri_glass_tn[gt])[0]
-            v = np.take(vis, ih)
-            v *= f
-            vis[ih] = v
-            # Russian roulette on faint shadow rays (unbiased: survivors are promoted)
-            faint = (v > 0) & (v < SHADOW_ROULETTE)
-            if rng is not None and faint.any():
-                if tag:
-                    rng.at(*tag, layer)  # type: ignore[union-attr]
-                keep = rng.random(int(faint.sum())) * SHADOW_ROULETTE < v[faint]
-                v[faint] = np.where(keep, SHADOW_ROULETTE, 0.0)
-                vis[ih] = v
-            go = np.flatnonzero(v > 0)
-            if len(go) == 0:
-                return vis
-            # only the rays that go on: their hit points, offset past the surface crossed
-            if len(go) < len(v):
-                sel, tri, ih = sel[go], tri[go], ih[go]
-            idx = ih
-            o, d = _take(o, sel), _rows(d, sel)
-            if isinstance(hour, np.ndarray):
-                hour = hour[sel]
-            if hour is None or self.sun_grazing or t is not None:
-                ng = _take(geo.normals, tri)
-                cosd = np.einsum("ij,ij->i", d, ng)
-                t = (plane_distance(geo.v0, geo.normals, geo.centroids, o, d, tri, ng, cosd)
-                     if t is None else t[sel])
-                side = np.where(cosd < 0, -self.eps, self.eps)
-            else:  # the point sun: plane_distance's arithmetic with the cosines looked up
-                key = tri if isinstance(hour, int) and hour == 0 else tri + hour * self.n_tri
-                ng, v = _take(geo.normals, tri), _take(geo.v0, tri)
-                v -= o
-                t = np.einsum("ij,ij->i", v, ng)
-                t /= np.take(self.sun_cos, key)
-                np.maximum(t, 0.0, out=t)
-                side = np.take(self.sun_side, key)
-            # o + t d − n_f ε with n_f = ±n_g on the side the ray came from
-            step = t[:, None] * (d[0] if d.strides[0] == 0 else d)
-            step += o
-            ng *= side[:, None]
-            step += ng
-            o = step
-        vis[idx] = 0.0
-        return vis
+        return transmittance(self, origins, dirs, rng, tag, parallel, hour)
 
     def sensor_sun(self, points: np.ndarray, normals: np.ndarray, dirs: np.ndarray | None = None,
                    rng: np.random.Generator | None = None, state: int | None = None

@@ -53,6 +53,10 @@ class Geometry:
         self.normals = n / length[:, None]
         self.v0 = np.ascontiguousarray(tris[:, 0])  # first vertex and centroid per triangle
         self.centroids = tris.mean(axis=1) if len(tris) else np.zeros((0, 3))
+        # the same as (3, n) tables, one row per axis: gathered by the shadow-ray loop, whose
+        # arithmetic runs on rows of all rays (contiguous) instead of 3-wide rows
+        self.normals_t = np.ascontiguousarray(self.normals.T)
+        self.v0_t = np.ascontiguousarray(self.v0.T)
         pts = [self.vertices] + [g.points for g in scene.grids.values()]
         allp = np.vstack(pts)
         self.size = float(np.ptp(allp, axis=0).max()) if len(allp) else 1.0

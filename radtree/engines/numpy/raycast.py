@@ -104,12 +104,15 @@ class EmbreeCaster:
         # build the Embree scene now (trimesh builds it lazily on first query)
         self._intersector.intersects_first(np.zeros((1, 3)), np.array([[0.0, 0.0, 1.0]]))
         self._embree = self._intersector._scene  # trimesh's scaled Embree scene
+        self._origin_t = np.asarray(self._embree.origin, np.float64)[:, None]  # (3, 1)
 
-    def _query(self, o: np.ndarray, d: np.ndarray) -> np.ndarray:
-        """Triangle index per ray (int32, -1: miss): the arithmetic of
+    def _query(self, o_t: np.ndarray, d: np.ndarray) -> np.ndarray:
+        """Triangle index per ray (int32, -1: miss) of origins ``o_t`` (3, n) — one row per
+        axis, or the transpose of (n, 3) rows — and directions ``d`` (n, 3): the arithmetic of
         ``RayMeshIntersector.intersects_first`` (identical float32 inputs to Embree) without
-        its per-call overhead; one direction (a broadcast row: the point sun) is converted
-        once and handed to Embree as that broadcast row."""
+        its per-call overhead, on rows of all rays (a (3, n) array, handed to Embree as its
+        transpose); one direction (a broadcast row: the point sun) is converted once and
+        handed to Embree as that broadcast row."""
         wrap = self._embree
         if d.ndim == 2 and d.strides[0] == 0 and len(d):  # one direction (a point sun)
             key = d[0].tobytes()
@@ -121,24 +124,26 @@ class EmbreeCaster:
             d32 = np.broadcast_to(row, d.shape)
         else:
             d32 = _unit32(np.array(d, dtype=np.float32))
-        scaled = np.subtract(o.astype(np.float32), wrap.origin, dtype=np.float64)  # exact
+        o32 = np.array(o_t, dtype=np.float32, order="C")
+        scaled = np.subtract(o32, self._origin_t, dtype=np.float64)  # exact
         scaled *= wrap.scale
-        return wrap.scene.run(scaled.astype(np.float32), d32)
+        return wrap.scene.run(scaled.astype(np.float32).T, d32)
 
-    def query(self, origins: np.ndarray, directions: np.ndarray, parallel: bool = True
+    def query(self, origins_t: np.ndarray, directions: np.ndarray, parallel: bool = True
               ) -> np.ndarray:
-        """Triangle index per ray (int32, -1: miss), no distances (split over the threads)."""
-        n = len(origins)
+        """Triangle index per ray (int32, -1: miss), no distances (split over the threads);
+        ``origins_t``: (3, n), one row per axis."""
+        n = origins_t.shape[1]
         if n == 0:
             return np.zeros(0, np.int32)
         parts = self._parts(n, parallel)
         if parts is not None and self._pool is not None:
             return np.concatenate(list(self._pool.map(
-                lambda s: self._query(origins[s], directions[s]), parts)))
-        return self._query(origins, directions)
+                lambda s: self._query(origins_t[:, s], directions[s]), parts)))
+        return self._query(origins_t, directions)
 
     def _chunk(self, o: np.ndarray, d: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        idx = self._query(o, d).astype(np.int64)
+        idx = self._query(o.T, d).astype(np.int64)
         t = np.full(len(o), np.inf)
         hit = np.flatnonzero(idx >= 0)
         if len(hit):
@@ -168,14 +173,15 @@ class EmbreeCaster:
         return self._chunk(origins, directions)
 
 
-def hit_triangles(caster: RayCaster, origins: np.ndarray, directions: np.ndarray,
+def hit_triangles(caster: RayCaster, origins_t: np.ndarray, directions: np.ndarray,
                   parallel: bool = True) -> tuple[np.ndarray, np.ndarray | None]:
     """The triangle each ray hits first (-1: miss) and, from casters other than Embree, the
     distance; Embree's distances are the plane distances (:func:`plane_distance`), which the
-    caller computes for the hits it needs them for (``None`` here)."""
+    caller computes for the hits it needs them for (``None`` here). ``origins_t``: the rays'
+    origins as a (3, n) array, one row per axis; ``directions``: (n, 3)."""
     if isinstance(caster, EmbreeCaster):
-        return caster.query(origins, directions, parallel), None
-    return caster.first_hit(origins, directions, parallel)
+        return caster.query(origins_t, directions, parallel), None
+    return caster.first_hit(np.ascontiguousarray(origins_t.T), directions, parallel)
 
 
 def _unit32(d32: np.ndarray) -> np.ndarray:

@@ -1,0 +1,175 @@
+"""The shadow rays of the NumPy engine: transmittance from points towards the sun through the
+scene's specular passes (a shadow ray is continued past every surface it crosses, its
+transmittance multiplied by the surface's, Russian roulette on faint rays).
+
+The per-crossing arithmetic keeps the rays' origins as a (3, n) array, one row per axis: NumPy
+broadcasts over 3-wide rows ((n, 1) × (3,)) several times slower than over long rows, and
+gathers 3-wide float64 rows slower than one row per axis. Every number is the one the (n, 3)
+arithmetic gives (sums of three products in ``einsum``'s order).
+"""
+
+from __future__ import annotations
+
+from typing import Protocol
+
+import numpy as np
+
+from radtree.engines.numpy.geometry import Geometry, Optics, glass_coefficients
+from radtree.engines.numpy.lockstep import Draws
+from radtree.engines.numpy.raycast import RayCaster, hit_triangles, plane_distance
+
+SHADOW_ROULETTE = 0.02  # shadow-ray transmittance below which Russian roulette starts
+
+
+class _Options(Protocol):
+    @property
+    def max_shadow_layers(self) -> int:
+        """Transmissive surfaces a shadow ray may cross."""
+        ...
+
+
+class ShadowTracer(Protocol):
+    """What the shadow rays need of the tracer (``engine._Tracer``): the geometry, its ray
+    caster, the optics, per-triangle tables (specular transmittance ``tri_ts``; glass; for the
+    point sun of each hour state, rows hour × ``n_tri`` + triangle, the cosine sun · normal
+    ``sun_cos`` and the origin offset ±ε ``sun_side``) and ``eps`` (m)."""
+
+    geo: Geometry
+    caster: RayCaster
+    opt: Optics
+    eps: float
+    n_tri: int
+    tri_ts: np.ndarray
+    tri_glass: np.ndarray
+    tri_glass_tn: np.ndarray
+    glass_any: bool
+    sun_cos: np.ndarray
+    sun_side: np.ndarray
+    sun_grazing: bool
+
+    @property
+    def opts(self) -> _Options:
+        """The trace options (``max_shadow_layers``)."""
+        ...
+
+
+def take(a: np.ndarray, i: np.ndarray) -> np.ndarray:
+    """Rows ``a[i]`` of a 2-D array at integer indices (``np.take`` is several times faster
+    than fancy indexing on rows)."""
+    return np.take(a, i, axis=0)
+
+
+def rows(d: np.ndarray, sel: np.ndarray | None) -> np.ndarray:
+    """``d[sel]`` (``sel``: indices or a mask; None: all rows, copied) — except that a
+    broadcast row (stride 0, the point sun's direction) stays a broadcast row."""
+    if d.ndim == 2 and d.strides[0] == 0:
+        k = len(d) if sel is None else (int(np.count_nonzero(sel)) if sel.dtype == bool
+                                        else len(sel))
+        return np.broadcast_to(d[0], (k, d.shape[1]))
+    if sel is None:
+        return np.array(d)
+    return np.take(d, np.flatnonzero(sel) if sel.dtype == bool else sel, axis=0)
+
+
+def transmittance(tr: ShadowTracer, origins: np.ndarray, dirs: np.ndarray,
+                  rng: Draws | np.random.Generator | None = None, tag: tuple[int, ...] = (),
+                  parallel: bool = True, hour: np.ndarray | int | None = None) -> np.ndarray:
+    """Transmittance of shadow rays from ``origins`` (k, 3) along ``dirs`` (k, 3, or one
+    broadcast row) for the tracer ``tr``: :meth:`_Tracer.shadow`."""
+    k = len(origins)
+    vis = np.ones(k)
+    idx = np.arange(k)
+    # origins as rows of all rays, (3, k): the per-crossing arithmetic on long contiguous
+    # rows (NumPy broadcasts over 3-wide rows several times slower)
+    o = np.array(np.asarray(origins, float).T, order="C")
+    d = rows(np.asarray(dirs, float), None)  # a point sun stays one broadcast row
+    passes = tr.opt.any_specular_pass
+    geo, ts = tr.geo, tr.tri_ts
+    for layer in range(tr.opts.max_shadow_layers):
+        tri, t = hit_triangles(tr.caster, o, d, parallel)
+        sel = np.flatnonzero(tri >= 0)
+        if len(sel) == 0:
+            return vis
+        tri = np.take(tri, sel).astype(np.intp, copy=False)  # Embree's are int32
+        ih = np.take(idx, sel)
+        if not passes:
+            vis[ih] = 0.0
+            return vis
+        f = np.take(ts, tri)
+        if tr.glass_any:
+            glass = tr.tri_glass[tri]
+            if glass.any():
+                gs, gt = sel[glass], tri[glass]
+                cosg = np.einsum("ij,ij->i", rows(d, gs), geo.normals[gt])
+                f[glass] = glass_coefficients(cosg, tr.tri_glass_tn[gt])[0]
+        v = np.take(vis, ih)
+        v *= f
+        vis[ih] = v
+        # Russian roulette on faint shadow rays (unbiased: survivors are promoted)
+        faint = (v > 0) & (v < SHADOW_ROULETTE)
+        if rng is not None and faint.any():
+            if tag:
+                rng.at(*tag, layer)  # type: ignore[union-attr]
+            keep = rng.random(int(faint.sum())) * SHADOW_ROULETTE < v[faint]
+            v[faint] = np.where(keep, SHADOW_ROULETTE, 0.0)
+            vis[ih] = v
+        go = np.flatnonzero(v > 0)
+        if len(go) == 0:
+            return vis
+        # only the rays that go on: their hit points, offset past the surface crossed
+        if len(go) < len(v):
+            sel, tri, ih = sel[go], tri[go], ih[go]
+        idx = ih
+        o, d = np.take(o, sel, axis=1), rows(d, sel)
+        if isinstance(hour, np.ndarray):
+            hour = hour[sel]
+        if hour is None or tr.sun_grazing or t is not None:
+            o = crossed(tr, o, d, tri, None if t is None else t[sel])
+        else:
+            o = crossed_sun(tr, o, d, tri, hour)
+    vis[idx] = 0.0
+    return vis
+
+
+def crossed(tr: ShadowTracer, o: np.ndarray, d: np.ndarray, tri: np.ndarray, t: np.ndarray | None
+            ) -> np.ndarray:
+    """Origins (3, m) of shadow rays continued past the triangles ``tri`` they hit from
+    origins ``o`` (3, m) along ``d`` (m, 3): the hit point ``o + t d`` (``t``: the
+    distances, m; None: the plane distances) offset by ε to the far side."""
+    geo = tr.geo
+    oa = np.ascontiguousarray(o.T)
+    ng = take(geo.normals, tri)
+    cosd = np.einsum("ij,ij->i", d, ng)
+    if t is None:
+        t = plane_distance(geo.v0, geo.normals, geo.centroids, oa, d, tri, ng, cosd)
+    side = np.where(cosd < 0, -tr.eps, tr.eps)
+    # o + t d − n_f ε with n_f = ±n_g on the side the ray came from
+    step = t[:, None] * (d[0] if d.strides[0] == 0 else d)
+    step += oa
+    ng *= side[:, None]
+    step += ng
+    return np.ascontiguousarray(step.T)
+
+
+def crossed_sun(tr: ShadowTracer, o: np.ndarray, d: np.ndarray, tri: np.ndarray,
+                hour: np.ndarray | int) -> np.ndarray:
+    """:func:`crossed` towards the point sun of ``hour`` (the state index, one or per ray):
+    the same numbers, with the cosines sun · normal and the offsets looked up per triangle
+    and every step on rows of all rays (``(a·b)`` summed as ``einsum`` sums 3 terms:
+    ``(a₀b₀ + a₂b₂) + a₁b₁``)."""
+    geo = tr.geo
+    key = tri if isinstance(hour, int) and hour == 0 else tri + hour * tr.n_tri
+    ng, v = np.take(geo.normals_t, tri, axis=1), np.take(geo.v0_t, tri, axis=1)
+    v -= o
+    v *= ng
+    t = v[0] + v[2]
+    t += v[1]
+    t /= np.take(tr.sun_cos, key)
+    np.maximum(t, 0.0, out=t)
+    # o + t d − n_f ε with n_f = ±n_g on the side the ray came from
+    step = np.empty_like(o)
+    np.multiply(d[0][:, None] if d.strides[0] == 0 else d.T, t, out=step)
+    step += o
+    ng *= np.take(tr.sun_side, key)
+    step += ng
+    return step
