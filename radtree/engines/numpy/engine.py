@@ -68,7 +68,7 @@ from radtree.engines.numpy.geometry import (
 )
 from radtree.engines.numpy.lockstep import Draws, LockstepRandom, SerialDraws
 from radtree.engines.numpy.raycast import embree_available
-from radtree.engines.numpy.sampling import cosine_hemisphere, mirror, uniform_cone
+from radtree.engines.numpy.sampling import cosine_hemisphere, cosine_rows, mirror, uniform_cone
 from radtree.engines.numpy.shadow import rows as _rows
 from radtree.engines.numpy.shadow import take as _take
 from radtree.engines.numpy.shadow import transmittance
@@ -115,6 +115,25 @@ def describe(backend: str = "auto") -> str:
 # --------------------------------------------------------------------------- the tracer
 
 
+def _cumulative(coef: np.ndarray) -> np.ndarray:
+    """Running sums (4, k) of the event coefficients (4, k) down the rows (``np.cumsum``
+    along the events, in the same order)."""
+    cum = np.empty_like(coef)
+    cum[0] = coef[0]
+    for j in range(1, len(coef)):
+        np.add(cum[j - 1], coef[j], out=cum[j])
+    return cum
+
+
+def _event(pick: np.ndarray, cum: np.ndarray) -> np.ndarray:
+    """Index (k,) of the event each ``pick`` (k, in [0, total)) falls into, from the running
+    sums ``cum`` (4, k): how many running sums are ≤ the pick, at most 3."""
+    ev = np.zeros(len(pick), np.int64)
+    for row in cum:
+        ev += pick >= row
+    return np.minimum(ev, 3, out=ev)
+
+
 class _Tracer:
     def __init__(self, geo: Geometry, optics: Optics, state: SkyState, params: EngineParams,
                  opts: TraceOptions, more: Sequence[tuple[SkyState, Optics]] = ()):
@@ -136,6 +155,7 @@ class _Tracer:
         # per-triangle optics (one gather per query instead of material index + coefficients)
         mat = geo.tri_material
         self.tri_coef = optics.per_triangle(mat)
+        self.tri_coef_t = np.ascontiguousarray(self.tri_coef.T)  # (4, n): a row per event
         self.tri_ts = np.ascontiguousarray(self.tri_coef[:, 2])
         self.n_tri = len(mat)
         self.tri_glass_tn = optics.glass_tn[mat]
@@ -152,7 +172,8 @@ class _Tracer:
                                   for st in states])
             self.sun_on = any(st.sun_on for st in states)
             self.tri_coefs = np.stack([self.tri_coef, *(o.per_triangle(mat) for _, o in more)])
-            self.tri_coefs_flat = self.tri_coefs.reshape(-1, 4)  # row hour × n_tri + tri
+            # (4, hours × n): column hour × n_tri + tri
+            self.tri_coefs_flat_t = np.ascontiguousarray(self.tri_coefs.reshape(-1, 4).T)
         # point sun: per triangle (and hour state) the cosine sun · normal and the origin
         # offset ±ε towards the side a shadow ray leaves, looked up instead of recomputed at
         # every crossing (the same einsum, so the same numbers); rows hour × n_tri + tri
@@ -272,10 +293,10 @@ class _Tracer:
             cosd = np.einsum("ij,ij->i", d, ng)
             front = cosd < 0
             nf = np.where(front[:, None], ng, -ng)  # normal on the side the ray came from
-            # diffuse R, diffuse T, specular T, mirror (a copy)
-            coef = (_take(self.tri_coef, tri) if hour is None else
-                    _take(self.tri_coefs_flat, hour * self.n_tri + tri))
-            rd, td = coef[:, 0], coef[:, 1]
+            # diffuse R, diffuse T, specular T, mirror (a copy, (4, k): one row per event)
+            coef = (np.take(self.tri_coef_t, tri, axis=1) if hour is None else
+                    np.take(self.tri_coefs_flat_t, hour * self.n_tri + tri, axis=1))
+            rd, td = coef[0], coef[1]
 
             # next-event estimation towards the sun
             if self.sun_on:
@@ -305,21 +326,21 @@ class _Tracer:
                 glass = self.tri_glass[tri]
                 if glass.any():
                     tg, rg = glass_coefficients(cosd[glass], self.tri_glass_tn[tri][glass])
-                    coef[glass, 2] = tg
-                    coef[glass, 3] = rg
-            coef[:, :2] *= (depth < self.max_bounces)[:, None]
-            coef[:, 2:] *= (nspec < self.opts.max_specular)[:, None]
-            total = coef.sum(axis=1)
+                    coef[2, glass] = tg
+                    coef[3, glass] = rg
+            coef[:2] *= depth < self.max_bounces
+            coef[2:] *= nspec < self.opts.max_specular
+            cum = _cumulative(coef)   # the last row: the total, summed in order
+            total = cum[3]
             beta = beta * total
             rng.at(bounce, 2)
             u = rng.random(len(alive))
             low = beta < thr
             survive = (total > 0) & (~low | (u * thr < beta))
             beta = np.where(low, thr, beta)
-            cum = np.cumsum(coef, axis=1)
             rng.at(bounce, 3)
             pick = rng.random(len(alive)) * total
-            ev = np.minimum((pick[:, None] >= cum).sum(axis=1), 3)
+            ev = _event(pick, cum)
 
             si = np.flatnonzero(survive)
             if len(si) < len(alive):
@@ -336,10 +357,10 @@ class _Tracer:
             diffuse = diff_r | diff_t
             if diffuse.any():
                 di = np.flatnonzero(diffuse)
-                nfd = _take(nf, di)
-                axis = np.where(diff_r[di, None], nfd, -nfd)
+                axis = np.empty((3, len(di)))  # ±n_f, one row per axis
+                np.multiply(_take(nf, di).T, np.where(diff_r[di], 1.0, -1.0), out=axis)
                 rng.at(bounce, 4)
-                new_d[di] = cosine_hemisphere(axis, rng)
+                new_d[di] = cosine_rows(axis, rng).T
             spec_t, mir = ev == 2, ev == 3
             if mir.any():
                 new_d[mir] = mirror(d[mir], nf[mir])

@@ -46,6 +46,30 @@ def cosine_directions(u1: np.ndarray, u2: np.ndarray, normals: np.ndarray) -> np
     return t * (r * np.cos(phi))[:, None] + b * (r * np.sin(phi))[:, None] + normals * z[:, None]
 
 
+def cosine_rows(normals_t: np.ndarray, rng: Uniform) -> np.ndarray:
+    """:func:`cosine_hemisphere` with normals and directions as (3, k) arrays, one row per
+    axis (the same draws and the same numbers, computed on long rows)."""
+    k = normals_t.shape[1]
+    u1 = rng.random(k)
+    u2 = rng.random(k)
+    r = np.sqrt(u1)
+    phi = 2.0 * math.pi * u2
+    z = np.sqrt(np.maximum(0.0, 1.0 - u1))
+    x, y = r * np.cos(phi), r * np.sin(phi)
+    nx, ny, nz = normals_t
+    sign = np.where(nz >= 0.0, 1.0, -1.0)
+    a = -1.0 / (sign + nz)
+    b = nx * ny * a
+    out = np.empty_like(normals_t)
+    # t · x + b · y + n · z per axis, with Duff et al.'s tangents t and b (orthonormal_basis)
+    for row, t_c, b_c in ((0, 1.0 + sign * nx * nx * a, b), (1, sign * b, sign + ny * ny * a),
+                          (2, -sign * nx, -ny)):
+        np.multiply(t_c, x, out=out[row])
+        out[row] += b_c * y
+        out[row] += normals_t[row] * z
+    return out
+
+
 def uniform_cone(axis: np.ndarray, half_angle_rad: float, k: int,
                  rng: Uniform) -> np.ndarray:
     """``k`` directions uniform in solid angle within a cone about one unit ``axis`` (3,)."""
