@@ -125,9 +125,10 @@ class EmbreeCaster:
         else:
             d32 = _unit32(np.array(d, dtype=np.float32))
         o32 = np.array(o_t, dtype=np.float32, order="C")
-        scaled = np.subtract(o32, self._origin_t, dtype=np.float64)  # exact
-        scaled *= wrap.scale
-        return wrap.scene.run(scaled.astype(np.float32).T, d32)
+        shifted = np.subtract(o32, self._origin_t, dtype=np.float64)  # exact
+        # × scale in float64, rounded to float32 as it is stored (one pass, the same numbers)
+        return wrap.scene.run(np.multiply(shifted, wrap.scale, out=o32, casting="same_kind").T,
+                              d32)
 
     def query(self, origins_t: np.ndarray, directions: np.ndarray, parallel: bool = True
               ) -> np.ndarray:
