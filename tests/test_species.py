@@ -183,11 +183,11 @@ def test_tree_species_fills_what_the_project_leaves_out(tmp_path: Path) -> None:
 def test_no_species_changes_no_hash(monkeypatch: pytest.MonkeyPatch) -> None:
     """Without a species, no ``species`` key enters the hashed text (hashes as before it
     existed); with one, it does and the hash changes."""
-    import radtree.config.schema as schema
+    import radtree.config.params_hash as hashing
 
     hashed: list[bytes] = []
     real = hashlib.sha256
-    monkeypatch.setattr(schema.hashlib, "sha256", lambda b=b"": hashed.append(b) or real(b))
+    monkeypatch.setattr(hashing.hashlib, "sha256", lambda b=b"": hashed.append(b) or real(b))
     p = load_project(MENDOZA)
     assert p.tree.species is None
     plain = p.params_hash(p.scenarios[0])
