@@ -70,7 +70,6 @@ from radtree.engines.numpy.lockstep import Draws, LockstepRandom, SerialDraws
 from radtree.engines.numpy.raycast import embree_available
 from radtree.engines.numpy.sampling import cosine_hemisphere, cosine_rows, mirror, uniform_cone
 from radtree.engines.numpy.shadow import rows as _rows
-from radtree.engines.numpy.shadow import take as _take
 from radtree.engines.numpy.shadow import transmittance
 from radtree.light.sky import SkyState
 from radtree.light.sun import SUN_HALF_ANGLE_DEG
@@ -271,47 +270,47 @@ class _Tracer:
             tri, t = self.caster.first_hit(o, d, parallel)
             miss = tri < 0
             if miss.any():
-                mi = np.flatnonzero(miss)
-                am, dm, bm = alive[mi], _take(d, mi), beta[mi]
+                mi = miss.nonzero()[0]
+                am, dm, bm = alive[mi], d.take(mi, axis=0), beta[mi]
                 if escapes is not None:
                     escapes(am, dm, bm)
                 got = bm * self.sky(dm, None if hour is None else hour[mi])
                 acc[am] += got
                 if orders is not None:
                     orders[am, depth[mi] - 1] += got
-                hi = np.flatnonzero(~miss)
+                hi = (~miss).nonzero()[0]
                 alive, o, d, beta, depth, nspec, tri, t = (
-                    alive[hi], _take(o, hi), _take(d, hi), beta[hi], depth[hi], nspec[hi],
-                    tri[hi], t[hi])
+                    alive[hi], o.take(hi, axis=0), d.take(hi, axis=0), beta[hi], depth[hi],
+                    nspec[hi], tri[hi], t[hi])
                 if hour is not None:
                     hour = hour[hi]
                 if len(alive) == 0:
                     break
             p = t[:, None] * d
             p += o
-            ng = _take(geo.normals, tri)
+            ng = geo.normals.take(tri, axis=0)
             cosd = np.einsum("ij,ij->i", d, ng)
             front = cosd < 0
             nf = np.where(front[:, None], ng, -ng)  # normal on the side the ray came from
             # diffuse R, diffuse T, specular T, mirror (a copy, (4, k): one row per event)
-            coef = (np.take(self.tri_coef_t, tri, axis=1) if hour is None else
-                    np.take(self.tri_coefs_flat_t, hour * self.n_tri + tri, axis=1))
+            coef = (self.tri_coef_t.take(tri, axis=1) if hour is None else
+                    self.tri_coefs_flat_t.take(hour * self.n_tri + tri, axis=1))
             rd, td = coef[0], coef[1]
 
             # next-event estimation towards the sun
             if self.sun_on:
                 rng.at(bounce, 0)
                 sd = (self.sun_directions(len(alive), rng) if hour is None
-                      else _take(self.suns, hour))
+                      else self.suns.take(hour, axis=0))
                 cs = np.einsum("ij,ij->i", nf, sd)
                 f = np.where(cs > 0, rd * cs, -td * cs) / math.pi
                 if hour is not None:
                     f *= self.dnis[hour]   # 0 where that hour's sun is off
-                ni = np.flatnonzero(f > 0)
+                ni = (f > 0).nonzero()[0]
                 if len(ni):
-                    so = _take(nf, ni)
+                    so = nf.take(ni, axis=0)
                     so *= (eps * np.sign(cs[ni]))[:, None]
-                    so += _take(p, ni)
+                    so += p.take(ni, axis=0)
                     vis = self.shadow(so, _rows(sd, ni), rng, (bounce, 1), parallel,
                                       None if self.opts.sun_disc else
                                       0 if hour is None else hour[ni])
@@ -342,10 +341,11 @@ class _Tracer:
             pick = rng.random(len(alive)) * total
             ev = _event(pick, cum)
 
-            si = np.flatnonzero(survive)
+            si = survive.nonzero()[0]
             if len(si) < len(alive):
                 alive, p, d, nf, beta, depth, nspec, ev = (
-                    alive[si], _take(p, si), _take(d, si), _take(nf, si), beta[si],
+                    alive[si], p.take(si, axis=0), d.take(si, axis=0), nf.take(si, axis=0),
+                    beta[si],
                     depth[si], nspec[si], ev[si])
                 if hour is not None:
                     hour = hour[si]
@@ -356,9 +356,9 @@ class _Tracer:
             diff_r, diff_t = ev == 0, ev == 1
             diffuse = diff_r | diff_t
             if diffuse.any():
-                di = np.flatnonzero(diffuse)
+                di = diffuse.nonzero()[0]
                 axis = np.empty((3, len(di)))  # ±n_f, one row per axis
-                np.multiply(_take(nf, di).T, np.where(diff_r[di], 1.0, -1.0), out=axis)
+                np.multiply(nf.take(di, axis=0).T, np.where(diff_r[di], 1.0, -1.0), out=axis)
                 rng.at(bounce, 4)
                 new_d[di] = cosine_rows(axis, rng).T
             spec_t, mir = ev == 2, ev == 3

@@ -146,12 +146,12 @@ class EmbreeCaster:
     def _chunk(self, o: np.ndarray, d: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         idx = self._query(o.T, d).astype(np.int64)
         t = np.full(len(o), np.inf)
-        hit = np.flatnonzero(idx >= 0)
+        hit = (idx >= 0).nonzero()[0]
         if len(hit):
-            dh = (np.take(d, hit, axis=0) if d.strides[0] else
+            dh = (d.take(hit, axis=0) if d.strides[0] else
                   np.broadcast_to(d[0], (len(hit), 3)))
             t[hit] = plane_distance(self._v0, self._normals, self._centroids,
-                                    np.take(o, hit, axis=0), dh, idx[hit])
+                                    o.take(hit, axis=0), dh, idx[hit])
         return idx, t
 
     def _parts(self, n: int, parallel: bool) -> list[slice] | None:

@@ -65,7 +65,7 @@ def rows(d: np.ndarray, sel: np.ndarray | None) -> np.ndarray:
     if d.ndim == 2 and d.strides[0] == 0:
         k = len(d) if sel is None else (int(np.count_nonzero(sel)) if sel.dtype == bool
                                         else len(sel))
-        return np.broadcast_to(d[0], (k, d.shape[1]))
+        return d[:k] if k <= len(d) else np.broadcast_to(d[0], (k, d.shape[1]))
     if sel is None:
         return np.array(d)
     return np.take(d, np.flatnonzero(sel) if sel.dtype == bool else sel, axis=0)
@@ -87,22 +87,22 @@ def transmittance(tr: ShadowTracer, origins: np.ndarray, dirs: np.ndarray,
     geo, ts = tr.geo, tr.tri_ts
     for layer in range(tr.opts.max_shadow_layers):
         tri, t = hit_triangles(tr.caster, o, d, parallel)
-        sel = np.flatnonzero(tri >= 0)
+        sel = (tri >= 0).nonzero()[0]
         if len(sel) == 0:
             return vis
-        tri = np.take(tri, sel).astype(np.intp, copy=False)  # Embree's are int32
-        ih = np.take(idx, sel)
+        tri = tri.take(sel).astype(np.intp, copy=False)  # Embree's are int32
+        ih = idx.take(sel)
         if not passes:
             vis[ih] = 0.0
             return vis
-        f = np.take(ts, tri)
+        f = ts.take(tri)
         if tr.glass_any:
             glass = tr.tri_glass[tri]
             if glass.any():
                 gs, gt = sel[glass], tri[glass]
                 cosg = np.einsum("ij,ij->i", rows(d, gs), geo.normals[gt])
                 f[glass] = glass_coefficients(cosg, tr.tri_glass_tn[gt])[0]
-        v = np.take(vis, ih)
+        v = vis.take(ih)
         v *= f
         vis[ih] = v
         # Russian roulette on faint shadow rays (unbiased: survivors are promoted)
@@ -113,14 +113,14 @@ def transmittance(tr: ShadowTracer, origins: np.ndarray, dirs: np.ndarray,
             keep = rng.random(int(faint.sum())) * SHADOW_ROULETTE < v[faint]
             v[faint] = np.where(keep, SHADOW_ROULETTE, 0.0)
             vis[ih] = v
-        go = np.flatnonzero(v > 0)
+        go = (v > 0).nonzero()[0]
         if len(go) == 0:
             return vis
         # only the rays that go on: their hit points, offset past the surface crossed
         if len(go) < len(v):
             sel, tri, ih = sel[go], tri[go], ih[go]
         idx = ih
-        o, d = np.take(o, sel, axis=1), rows(d, sel)
+        o, d = o.take(sel, axis=1), rows(d, sel)
         if isinstance(hour, np.ndarray):
             hour = hour[sel]
         if hour is None or tr.sun_grazing or t is not None:
@@ -159,17 +159,17 @@ def crossed_sun(tr: ShadowTracer, o: np.ndarray, d: np.ndarray, tri: np.ndarray,
     ``(a₀b₀ + a₂b₂) + a₁b₁``)."""
     geo = tr.geo
     key = tri if isinstance(hour, int) and hour == 0 else tri + hour * tr.n_tri
-    ng, v = np.take(geo.normals_t, tri, axis=1), np.take(geo.v0_t, tri, axis=1)
+    ng, v = geo.normals_t.take(tri, axis=1), geo.v0_t.take(tri, axis=1)
     v -= o
     v *= ng
     t = v[0] + v[2]
     t += v[1]
-    t /= np.take(tr.sun_cos, key)
+    t /= tr.sun_cos.take(key)
     np.maximum(t, 0.0, out=t)
     # o + t d − n_f ε with n_f = ±n_g on the side the ray came from
     step = np.empty_like(o)
     np.multiply(d[0][:, None] if d.strides[0] == 0 else d.T, t, out=step)
     step += o
-    ng *= np.take(tr.sun_side, key)
+    ng *= tr.sun_side.take(key)
     step += ng
     return step
