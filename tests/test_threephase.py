@@ -145,13 +145,19 @@ def test_second_leaf_schedule_reuses_every_matrix(runs):
     project, first, second, folder, stamps = runs
     views = [n for n in stamps if n.startswith("view_")]
     groups = len(list(folder.glob("view_g*.vmx")))
-    assert len(views) == 1                       # one view matrix serves both leaf states
-    # a free crown: per group and leaf state, D of the light it transmits and reflects
+    # two view matrices (the tiles, then the groups given daylight matrices) serve both
+    # leaf states
+    assert len(views) == 2
+    # a free crown: per leaf state, D of the light each group transmits and reflects — the
+    # tiles the sensors see on their own, the others of a material and direction merged
+    n_days = int(first.timing["3phase_daylight_groups"])
+    assert 0 < n_days <= groups
     for tag in ("daylight_g", "daylight_r"):
-        assert len([n for n in stamps if n.startswith(tag)]) == 2 * groups
+        assert len([n for n in stamps if n.startswith(tag)]) == 2 * n_days
     after = {n: (folder / n).stat().st_mtime_ns for n in stamps}
     assert after == stamps                       # nothing recomputed for the second run
-    assert "3phase_view_s" not in second.timing
+    assert "3phase_view_g_s" in first.timing and "3phase_view_d_s" in first.timing
+    assert "3phase_view_g_s" not in second.timing and "3phase_view_d_s" not in second.timing
     g = "facade"
     np.testing.assert_allclose(second.total["leaf_on"][g], first.total["leaf_on"][g])
     wea = first.wea
@@ -213,6 +219,13 @@ def test_facet_groups_face_the_sensors():
     for g in facet_groups(model, sensors_inside=True):      # a dome: wound inwards
         out = g.triangles.mean(axis=1) - [0.0, 5.0, 6.0]
         assert np.all(out @ g.normal < 0)
+    # cut into tiles of a 1.5 m world grid: more groups, each within one cell
+    tiles = facet_groups(model, sensors_inside=False, tile_m=1.5)
+    assert len(tiles) > len(groups)
+    assert sum(len(g.triangles) for g in tiles) == len(f)
+    for g in tiles:
+        cells = np.floor(g.triangles.mean(axis=1) / 1.5)
+        assert len(np.unique(cells, axis=0)) == 1
 
 
 @needs_radiance

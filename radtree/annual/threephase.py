@@ -85,7 +85,7 @@ from radtree.engines.radiance import threephase as rad3
 from radtree.errors import ConfigError
 from radtree.optics import Bsdf
 from radtree.scene import Mesh, Scene
-from radtree.trees.bsdf_shell import BSDF_SHELL
+from radtree.trees.bsdf_shell import BSDF_SHELL, WALL_CAP
 from radtree.trees.model import TreeModel
 
 STATES = ("leaf_on", "leaf_off")
@@ -97,6 +97,19 @@ _DIRS = np.array([(i, j, k) for i in (-1, 0, 1) for j in (-1, 0, 1) for k in (-1
 _DIRS /= np.linalg.norm(_DIRS, axis=1)[:, None]
 #: the daylight matrices' ray weight limit (path tracing, -ad 2)
 D_LW_MIN = 1e-3
+#: a free crown's wall cap is cut into tiles of this size (m, cells of a world grid): a
+#: daylight matrix is the mean over its sender's area, and the light inside a crown varies
+#: along the 20 m × 8 m cap (measured on the office example, uniform sky: the light arriving
+#: at the cap in front of the window is 0.54 of the whole cap's mean). Only the cap: it is
+#: planar, so the BSDF material's frame (up +z) is the tiles' Klems frame; tiles of the
+#: curved bands read 1.2–1.24 × rcontrib on the same BSDF crown (their material frames turn
+#: over the crown, rfluxmtx's up is fixed), whole bands 0.94–0.99
+GROUP_TILE_M = 1.5
+#: a tile whose view-matrix share reaches this for some sensor gets its own daylight matrix;
+#: the other tiles of a material and direction share one (their views summed), which is
+#: dropped when its share stays below VISIBLE_SHARE for every sensor
+TILE_SHARE = 2e-3
+VISIBLE_SHARE = 1e-4
 
 
 @dataclass
@@ -106,16 +119,26 @@ class FacetGroup:
     material: str
     triangles: np.ndarray  # (k, 3, 3)
     normal: np.ndarray     # unit mean normal, towards the sensors
+    direction: int = -1    # index of the nearest of the 14 directions
+
+    @property
+    def area(self) -> float:
+        t = self.triangles
+        return float(0.5 * np.linalg.norm(np.cross(t[:, 1] - t[:, 0], t[:, 2] - t[:, 0]),
+                                          axis=1).sum())
 
     @property
     def key(self) -> str:
         return f"{self.material}_{len(self.triangles)}"
 
 
-def facet_groups(model: TreeModel, sensors_inside: bool) -> list[FacetGroup]:
-    """The shell's facets grouped by BSDF material and by the nearest of 14 directions; each
-    triangle wound so that its normal points to the sensors (the shell's own normals point
-    inwards: to the sensors inside a dome, away from them for free crowns)."""
+def facet_groups(model: TreeModel, sensors_inside: bool, tile_m: float = 0.0,
+                 tiled: tuple[str, ...] | None = None) -> list[FacetGroup]:
+    """The shell's facets grouped by BSDF material, by the nearest of 14 directions and
+    (``tile_m`` > 0, for the materials in ``tiled`` or all when None) by the cell of a world
+    grid of ``tile_m`` holding their centroid; each triangle wound so that its normal points
+    to the sensors (the shell's own normals point inwards: to the sensors inside a dome,
+    away from them for free crowns)."""
     groups = []
     for mesh in model.meshes:
         if not mesh.material.startswith(BSDF_SHELL):
@@ -125,11 +148,16 @@ def facet_groups(model: TreeModel, sensors_inside: bool) -> list[FacetGroup]:
         area = np.linalg.norm(n, axis=1)
         keep = area > 1e-12
         tri, n = tri[keep], n[keep] / area[keep][:, None]
-        which = np.argmax(n @ _DIRS.T, axis=1)
+        which = direction = np.argmax(n @ _DIRS.T, axis=1)
+        if tile_m > 0 and (tiled is None or mesh.material in tiled):
+            cell = np.floor(tri.mean(axis=1) / tile_m).astype(np.int64)
+            _, which = np.unique(np.column_stack([which, cell]), axis=0, return_inverse=True)
+            which = which.ravel()
         for d in np.unique(which):
             pick = which == d
             mean = (n[pick] * area[keep][pick][:, None]).sum(axis=0)
-            groups.append(FacetGroup(mesh.material, tri[pick], mean / np.linalg.norm(mean)))
+            groups.append(FacetGroup(mesh.material, tri[pick], mean / np.linalg.norm(mean),
+                                     int(direction[pick][0])))
     return groups
 
 
@@ -198,7 +226,7 @@ class ThreePhase:
         self.bare, self.models, self.grids, self.rho, self.mf = bare, models, grids, rho, mf
         self.inside = form == "dome"
         self.trace, self.echo = trace, echo
-        self.groups = facet_groups(models["leaf_on"], self.inside)
+        self.groups = facet_groups(models["leaf_on"], self.inside, GROUP_TILE_M, (WALL_CAP,))
         self.points = points_text(bare, grids)
         self.n = sum(len(bare.grids[g]) for g in grids)
         self.timing: dict[str, float] = {}
@@ -211,9 +239,12 @@ class ThreePhase:
             tmp.replace(path)
         return path
 
-    def view(self) -> tuple[list[Path], np.ndarray]:
-        """The per-group view matrices (files) and V_sky (sensors, patches, 3)."""
-        receivers = (rad3.group_receivers_text([(g.triangles, g.normal) for g in self.groups])
+    def view(self, groups: list[FacetGroup] | None = None, tag: str = "g"
+             ) -> tuple[list[Path], np.ndarray]:
+        """The view matrix of each of ``groups`` (default: every tile; files
+        ``view_<tag><k>.vmx``) and V_sky (sensors, patches, 3)."""
+        groups = self.groups if groups is None else groups
+        receivers = (rad3.group_receivers_text([(g.triangles, g.normal) for g in groups])
                      + "\n" + rad3.sky_receivers_text(self.mf))
         scene = _without_shell(_scene_with(self.bare, self.models["leaf_on"]))  # trunks stay
         octree_text = scene_text(scene, self.rho)
@@ -222,27 +253,51 @@ class ThreePhase:
 
         def compute() -> Path:
             t0 = time.perf_counter()
-            self.echo(f"    rfluxmtx view matrix: {self.n} sensors → {len(self.groups)} shell "
+            self.echo(f"    rfluxmtx view matrix: {self.n} sensors → {len(groups)} shell "
                       f"groups × {KLEMS} + {patch_count(self.mf)} sky patches")
             octree = _octree(self.folder, "view", scene, self.rho)
             m = rad3.view_matrix(self.folder, octree, self.points, self.n, receivers, ambient,
                                  self.trace.nproc)
-            self.timing["view_s"] = time.perf_counter() - t0
+            self.timing[f"view_{tag}_s"] = time.perf_counter() - t0
             return rad3.write_matrix(self.folder / "view.vmx.tmp", m)
 
         path = self._cached("view", key, compute)
         m = rad3.read_matrix(path.read_bytes(), str(path))
         files = []
-        for k in range(len(self.groups)):
-            f = self.folder / f"view_g{k}.vmx"
+        for k in range(len(groups)):
+            f = self.folder / f"view_{tag}{k}.vmx"
             rad3.write_matrix(f, m[:, k * KLEMS:(k + 1) * KLEMS])
             files.append(f)
-        return files, m[:, len(self.groups) * KLEMS:]
+        return files, m[:, len(groups) * KLEMS:]
 
-    def daylight(self, state: str, room_side: bool = False) -> list[Path]:
-        """The daylight matrix of every group: of the light it transmits into the room (the
-        dome's: one for both states), or (``room_side``) of the light arriving at it from
-        the room's side, which it reflects back."""
+    def d_groups(self, views: list[Path], v_sky: np.ndarray) -> list[FacetGroup]:
+        """The groups given daylight matrices: every tile whose view share (its columns'
+        sum over all of a sensor's, sky included; ``views`` of :meth:`view`) reaches
+        :data:`TILE_SHARE` for some sensor on its own; the other tiles of each material and
+        direction merged, unless even merged they stay below :data:`VISIBLE_SHARE`."""
+        sums = np.stack([rad3.read_matrix(v.read_bytes(), str(v)).sum(axis=(1, 2))
+                         for v in views])
+        total = sums.sum(axis=0) + v_sky.sum(axis=(1, 2))
+        share = sums / np.where(total > 0, total, 1.0)
+        groups = [g for k, g in enumerate(self.groups) if share[k].max() >= TILE_SHARE]
+        rest: dict[tuple[str, int], list[int]] = {}
+        for k, g in enumerate(self.groups):
+            if share[k].max() < TILE_SHARE:
+                rest.setdefault((g.material, g.direction), []).append(k)
+        for (material, direction), ks in sorted(rest.items()):
+            if share[ks].sum(axis=0).max() < VISIBLE_SHARE:
+                continue
+            mean = np.sum([self.groups[k].normal * self.groups[k].area for k in ks], axis=0)
+            groups.append(FacetGroup(material, np.concatenate([self.groups[k].triangles
+                                                               for k in ks]),
+                                     mean / np.linalg.norm(mean), direction))
+        return groups
+
+    def daylight(self, state: str, groups: list[FacetGroup], room_side: bool = False
+                 ) -> list[Path]:
+        """The daylight matrix of each of ``groups``: of the light it transmits into the
+        room (the dome's: one for both states), or (``room_side``) of the light arriving at
+        it from the room's side, which it reflects back."""
         with_crown = _scene_with(self.bare, self.models[state])
         own = self.inside and not room_side      # the dome's outward D meets no crown
         scene = _without_shell(with_crown) if own else with_crown
@@ -253,10 +308,10 @@ class ThreePhase:
         ambient = ["-ab", str(self.trace.ab), "-ad", "2", "-lw",
                    f"{max(self.trace.lw, D_LW_MIN):g}", "-aa", "0"]
         octree: list[Path] = []
-        out = []
         t0 = time.perf_counter()
         tag = "r" if room_side else "g"
-        for k, g in enumerate(self.groups):
+        out: list[Path] = []
+        for k, g in enumerate(groups):
             sender = rad3.sender_text(g.triangles, g.normal, room_side)
             key = "|".join([sender, text, " ".join(ambient), str(self.samples), str(self.mf)])
 
@@ -271,36 +326,42 @@ class ThreePhase:
         self.timing[name] = time.perf_counter() - t0
         if octree:
             self.echo(f"    rfluxmtx daylight matrices ({state}{', room side' if room_side else ''}"
-                      f"): {len(self.groups)} groups, -c {self.samples}, "
+                      f"): {len(groups)} groups (tiles seen from the sensors, the rest "
+                      f"merged), -c {self.samples}, "
                       f"{self.timing[name]:.0f} s")
         return out
 
-    def transmission(self, state: str, reflection: bool = False) -> list[Path]:
+    def transmission(self, state: str, groups: list[FacetGroup], reflection: bool = False
+                     ) -> list[Path]:
         """T of every group: its band's XML (turned for free crowns); ``reflection``: the
         XML of its reflection back into the room."""
         mats = self.models[state].materials
-        out = []
-        for g in self.groups:
-            mat = mats[g.material]
+        done: dict[str, Path] = {}
+        for name in {g.material for g in groups}:
+            mat = mats[name]
             assert isinstance(mat, Bsdf)
             xml = Path(mat.xml)
             if not self.inside:
-                xml = rad3.turned_xml(xml, self.folder / f"{state}_{g.material}_turned.xml")
+                xml = rad3.turned_xml(xml, self.folder / f"{state}_{name}_turned.xml")
             if reflection:
                 xml = rad3.room_reflection_xml(xml, self.folder /
-                                               f"{state}_{g.material}_room_reflection.xml")
-            out.append(xml)
-        return out
+                                               f"{state}_{name}_room_reflection.xml")
+            done[name] = xml
+        return [done[g.material] for g in groups]
 
     def coefficients(self, state: str, views: list[Path], v_sky: np.ndarray) -> np.ndarray:
         """(sensors, patches, 3) daylight coefficients of the state: Σ_g V_g·T_g·D_g
         + Σ_g V_g·R_g·D'_g (``rmtxop``) + V_sky."""
-        days, back = self.daylight(state), self.daylight(state, room_side=True)
+        groups = self.d_groups(views, v_sky)
+        files, v_sky = self.view(groups, "d")    # their own frames (a merged group's mean)
+        self.timing["daylight_groups"] = float(len(groups))
+        days = self.daylight(state, groups)
+        back = self.daylight(state, groups, room_side=True)
         t0 = time.perf_counter()
         dc = v_sky.astype(np.float64)
-        for v, t, d in zip(views, self.transmission(state), days):
+        for v, t, d in zip(files, self.transmission(state, groups), days):
             dc = dc + rad3.multiply(v, t, d)
-        for v, r, d in zip(views, self.transmission(state, reflection=True), back):
+        for v, r, d in zip(files, self.transmission(state, groups, reflection=True), back):
             dc = dc + rad3.multiply(v, r, d)
         self.timing[f"rmtxop_{state}_s"] = time.perf_counter() - t0
         return dc.astype(np.float32)

@@ -27,6 +27,10 @@ the normal outgoing patch, patch by patch) by the one traced through the curved 
 slats (:mod:`radtree.pipeline.dome_curvature`); ``"rings"`` only rescales that row ring by
 ring to the traced ring sums (the planar azimuthal shape kept; the correction before);
 ``"planar"`` keeps the flat stack's (a given ``xml`` is used as it is).
+``wall_depth`` (free crowns reaching the wall, chord crossing): the wall cap's crown depth per
+Klems patch as seen from the sensors' point on the cap (``"sensors"``, default,
+:mod:`radtree.pipeline.wall_cap`), or per ring as at the cap's foot point (``"centre"``: the
+half chord h cos ψ, h the crown centre's distance from the cap; before).
 ``tensor_tree``: 0, or the log2 resolution
 of an extra rank-4 tensor-tree XML. ``xml``: use this leaf-on XML instead of computing it
 (computed XMLs are cached under ``build/bsdf/<scenario>/``).
@@ -43,6 +47,7 @@ from radtree.config.spec import Checked, SchemaError, meta
 REPRESENTATIONS = ("explicit", "bsdf")
 CROSSINGS = ("chord", "slab")
 CURVATURES = ("traced", "rings", "planar")
+WALL_DEPTHS = ("sensors", "centre")
 
 
 @dataclass(frozen=True)
@@ -61,6 +66,7 @@ class CrownBsdf(Checked):
     depth_m: float = field(default=0.0, metadata=meta(0.0, 50.0))
     crossing: str = field(default="chord", metadata=meta(choices=CROSSINGS))
     curvature: str = field(default="traced", metadata=meta(choices=CURVATURES))
+    wall_depth: str = field(default="sensors", metadata=meta(choices=WALL_DEPTHS))
     tensor_tree: int = field(default=0, metadata=meta(0, 6))
     xml: Path | None = None
 

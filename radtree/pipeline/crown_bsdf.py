@@ -40,6 +40,7 @@ from radtree.pipeline.dome_curvature import (
     curved_ring_row,
     write_curved_xml,
 )
+from radtree.pipeline.wall_cap import PatchDepthSample, depth_bsdf, wall_cap_sample
 from radtree.site.frame import FacadeFrame
 from radtree.trees.bsdf_shell import WALL_BAND, build_bsdf_crown, sector_bounds
 from radtree.trees.build import apply_switches
@@ -143,9 +144,12 @@ def flux_settings(tree: Tree, form: str, nproc: int = 1) -> FluxSettings:
                         tiles=b.tiles, nproc=nproc, tensor_tree=b.tensor_tree)
 
 
-def sample_key(sample: SlabSample | RingSamples, settings: FluxSettings) -> str:
+def sample_key(sample: SlabSample | RingSamples | PatchDepthSample,
+               settings: FluxSettings) -> str:
     h = hashlib.sha256()
-    slabs = sample.rings if isinstance(sample, RingSamples) else [sample]
+    slabs = sample.rings if isinstance(sample, (RingSamples, PatchDepthSample)) else [sample]
+    if isinstance(sample, PatchDepthSample):
+        h.update(sample.key_bytes())
     for slab in slabs:
         for name in sorted(slab.polygons):
             h.update(name.encode())
@@ -157,7 +161,8 @@ def sample_key(sample: SlabSample | RingSamples, settings: FluxSettings) -> str:
     return h.hexdigest()[:16]
 
 
-def ensure_bsdf(sample: SlabSample | RingSamples, settings: FluxSettings, folder: Path,
+def ensure_bsdf(sample: SlabSample | RingSamples | PatchDepthSample, settings: FluxSettings,
+                folder: Path,
                 name: str, progress: Callable[[str], None] | None = None) -> BsdfRun:
     """The XML of ``sample`` in ``folder`` (``<name>.xml``): reused when its key matches,
     else computed (rfluxmtx, wrapBSDF, checkBSDF; an envelope sample: one system per Klems
@@ -168,6 +173,10 @@ def ensure_bsdf(sample: SlabSample | RingSamples, settings: FluxSettings, folder
         tt = folder / f"{name}_t4.xml"
         return BsdfRun(xml, check_bsdf(xml), 0.0, tt if tt.exists() else None)
     comment = (f"radtree crown BSDF: {sample.name}; " + " ".join(sample.notes))[:900]
+    if isinstance(sample, PatchDepthSample):
+        result = depth_bsdf(folder, sample, settings, name, comment, progress)
+        write_text(key_file, key + "\n")
+        return result
     if isinstance(sample, RingSamples):
         if settings.tensor_tree:
             raise ConfigError("tree.bsdf.tensor_tree needs tree.bsdf.crossing = 'slab' (the "
@@ -229,11 +238,17 @@ def scenario_xmls(project: Project, scenario: Scenario,
     sectors = sector_bounds(tree.bsdf.sectors) if form == "dome" else [(-90.0, 90.0)]
     for name, lo, hi, el, half in jobs:
         folder = project.build_dir / "bsdf" / scenario.name / name
-        sample = leaf_on_sample(project, scenario, el, half)
+        sample: SlabSample | RingSamples | PatchDepthSample
+        if (lo, hi) == WALL_BAND and tree.bsdf.wall_depth == "sensors":
+            sample = wall_cap_sample(project, scenario, tree, slab_depth(tree),
+                                     CHORD_MIN_SLATS * tree.louvers.slat_size_m)
+        else:
+            sample = leaf_on_sample(project, scenario, el, half)
         run = ensure_bsdf(sample, settings, folder, name, progress)
         for sector in sectors:
             xml = run.xml
-            if form == "dome" and tree.bsdf.curvature != "planar":
+            if (form == "dome" and tree.bsdf.curvature != "planar"
+                    and not isinstance(sample, PatchDepthSample)):
                 xml = ensure_curved(project, tree, curved, sample, settings, folder, name, lo,
                                     hi, progress, sector if len(sectors) > 1 else None)
             out.append((lo, hi, xml))

@@ -31,6 +31,11 @@ from radtree.trees.envelope import crown_row_spec, dome_notes, dome_spec, icosph
 from radtree.trees.model import BARK_REFLECTANCE, TRUNK, TreeModel
 
 BSDF_SHELL = "crown_bsdf"
+#: the material (and mesh) of a free crown's wall cap
+WALL_CAP = f"{BSDF_SHELL}_wall"
+#: the wall cap is re-meshed into cells of this size (m) in the wall plane, so that the
+#: three-phase method can cut it into tiles (the convex hull leaves it a fan of slivers)
+CAP_CELL_M = 0.5
 #: (lowest, highest) of a band entry that is a free crown's wall cap, not an elevation band
 WALL_BAND = (-1.0, -1.0)
 
@@ -63,6 +68,38 @@ def elevation_bands(el: np.ndarray, faces: np.ndarray, bands: list[tuple[float, 
                 name = f"{BSDF_SHELL}{'' if len(bands) == 1 else f'_b{k}'}{half}"
                 out.append((name, Bsdf(name, str(Path(xml).resolve()), up), faces[pick]))
     return out
+
+
+def _clip(poly: list[np.ndarray], axis: int, value: float, keep_above: bool
+          ) -> list[np.ndarray]:
+    """Sutherland–Hodgman: the part of the polygon on one side of ``p[axis] = value``."""
+    out = []
+    for a, b in zip(poly, poly[1:] + poly[:1]):
+        ina, inb = (a[axis] >= value) == keep_above, (b[axis] >= value) == keep_above
+        if ina:
+            out.append(a)
+        if ina != inb:
+            out.append(a + (value - a[axis]) / (b[axis] - a[axis]) * (b - a))
+    return out
+
+
+def cap_cells(triangles: np.ndarray, cell: float) -> np.ndarray:
+    """Triangles in the wall plane (façade frame, n constant) cut along the grid lines
+    u, z = k · ``cell``: the same surface, no triangle across a cell boundary (fans of the
+    clipped polygons, winding kept)."""
+    out = []
+    for tri in triangles:
+        lo, hi = tri.min(axis=0), tri.max(axis=0)
+        for i in range(int(np.floor(lo[0] / cell)), int(np.ceil(hi[0] / cell))):
+            for j in range(int(np.floor(lo[2] / cell)), int(np.ceil(hi[2] / cell))):
+                poly = list(tri)
+                for axis, value, above in ((0, i * cell, True), (0, (i + 1) * cell, False),
+                                           (2, j * cell, True), (2, (j + 1) * cell, False)):
+                    poly = _clip(poly, axis, value, above) if len(poly) >= 3 else []
+                out += [[poly[0], poly[k], poly[k + 1]] for k in range(1, len(poly) - 1)]
+    tris = np.array(out, float).reshape(-1, 3, 3)
+    area = np.linalg.norm(np.cross(tris[:, 1] - tris[:, 0], tris[:, 2] - tris[:, 0]), axis=1)
+    return tris[area > 1e-10]
 
 
 def facade_angle(d: np.ndarray, normal: np.ndarray) -> np.ndarray:
@@ -138,24 +175,29 @@ def build_bsdf_crown(tree: Tree, sensors: Sensors, street: Street, frame: Facade
     else:
         spec_r = crown_row_spec(tree, sensors, street, source)
         level = icosphere_level(360.0 / tree.crown.segments)
-        verts_all, faces_all, walls, base = [], [], [], 0
+        verts_all, faces_all, caps, base = [], [], [], 0
         for i in range(spec_r.count):
             v, f, on_wall = spec_r.envelope(i, level)
-            v = frame.to_world(v)
             inner = frame.to_world(spec_r.hull_point(i)[None, :])[0]
+            if wall and np.any(on_wall):     # the cap in cells, wound inwards
+                t = frame.to_world(cap_cells(v[f[on_wall]], CAP_CELL_M).reshape(-1, 3))
+                caps.append((t, inward(t, np.arange(len(t)).reshape(-1, 3), inner)))
+                f = f[~on_wall]
+            v = frame.to_world(v)
             verts_all.append(v)
             faces_all.append(inward(v, f, inner) + base)
-            walls.append(on_wall)
             base += len(v)
         verts, faces = np.concatenate(verts_all), np.concatenate(faces_all)
-        on_wall = np.concatenate(walls) if wall else np.zeros(len(faces), bool)
-        parts = normal_bands(verts, faces[~on_wall], bands)
-        if np.any(on_wall):
-            name = f"{BSDF_SHELL}_wall"
-            parts.append((name, Bsdf(name, str(Path(wall[0]).resolve())), faces[on_wall]))
-        for name, mat, fs in parts:
+        for name, mat, fs in normal_bands(verts, faces, bands):
             materials[name] = mat
             meshes.append(Mesh(name, name, verts, fs))
+        if caps:
+            name = WALL_CAP
+            materials[name] = Bsdf(name, str(Path(wall[0]).resolve()))
+            cv = np.concatenate([c[0] for c in caps])
+            offsets = np.cumsum([0] + [len(c[0]) for c in caps[:-1]])
+            cf = np.concatenate([c[1] + o for c, o in zip(caps, offsets)])
+            meshes.append(Mesh(name, name, cv, cf))
         tv, tf = spec_r.trunks()
         materials[TRUNK] = Plastic(TRUNK, BARK_REFLECTANCE)
         meshes.append(Mesh("tree_trunks", TRUNK, frame.to_world(tv), tf))
