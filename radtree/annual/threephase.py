@@ -10,8 +10,11 @@ For every sensor and hour (lux, as :mod:`radtree.annual.run`)
 * the crown is the BSDF shell of ``[tree] representation = "bsdf"``
   (:mod:`radtree.trees.bsdf_shell`): the sensor dome, or the free crowns' envelopes; its
   facets are grouped by orientation (:func:`facet_groups`, one Klems hemisphere per group);
-* ``V`` — one ``rfluxmtx`` run, sensors → every group (Klems) and the sky (Reinhart): the
-  shell absorbs in this run, so ``V`` holds no crown optics and serves every leaf state;
+* ``V`` — ``rfluxmtx``, sensors → every group (Klems) and the sky (Reinhart): the shell
+  absorbs in this run, so ``V`` holds no crown optics and serves every leaf state. A free
+  crown's wall cap is cut into tiles (:data:`GROUP_TILE_M`): a first run over all groups says
+  which tiles the sensors see (:meth:`ThreePhase.d_groups`), a second traces ``V`` of the
+  groups given daylight matrices (those tiles, and per material and orientation the rest);
 * ``T`` — the crown BSDF of ``radtree bsdf`` (:mod:`radtree.bsdf.run`), leaf-on and leaf-off
   (the branch slab), per elevation band on the dome; for free crowns turned front ↔ back
   (light leaves a crown from its inside, :func:`radtree.engines.radiance.threephase.turned_xml`);
