@@ -40,7 +40,12 @@ from radtree.pipeline.dome_curvature import (
     curved_ring_row,
     write_curved_xml,
 )
-from radtree.pipeline.wall_cap import PatchDepthSample, depth_bsdf, wall_cap_sample
+from radtree.pipeline.wall_cap import (
+    PatchDepthSample,
+    depth_bsdf,
+    wall_cap_sample,
+    write_systems,
+)
 from radtree.site.frame import FacadeFrame
 from radtree.trees.bsdf_shell import WALL_BAND, build_bsdf_crown, sector_bounds
 from radtree.trees.build import apply_switches
@@ -182,12 +187,7 @@ def ensure_bsdf(sample: SlabSample | RingSamples | PatchDepthSample, settings: F
             raise ConfigError("tree.bsdf.tensor_tree needs tree.bsdf.crossing = 'slab' (the "
                               "chord envelope is assembled ring by ring in the Klems basis)",
                               field="tree.bsdf.tensor_tree")
-        subs = []
-        for k, slab in enumerate(sample.rings):
-            sub = folder / f"ring{k}"
-            write_system(sub, slab.polygons, slab.materials, slab.width, slab.height,
-                         slab.thickness, settings.tiles)
-            subs.append(sub)
+        subs = write_systems(folder, "ring", sample.rings, settings.tiles)
         result = klems_bsdf_rings(folder, subs, settings, name, sample.thickness,
                                   sample.width, sample.height, comment, progress)
         write_text(key_file, key + "\n")

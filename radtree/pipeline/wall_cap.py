@@ -217,18 +217,24 @@ def mixed(matrices: list[np.ndarray], nodes: np.ndarray, taus: np.ndarray,
     return out
 
 
+def write_systems(folder: Path, prefix: str, slabs: list[SlabSample], tiles: int) -> list[Path]:
+    """One rfluxmtx system folder per slab sample, ``folder/<prefix><k>/``; their paths."""
+    subs = []
+    for k, slab in enumerate(slabs):
+        sub = folder / f"{prefix}{k}"
+        write_system(sub, slab.polygons, slab.materials, slab.width, slab.height,
+                     slab.thickness, tiles)
+        subs.append(sub)
+    return subs
+
+
 def depth_bsdf(folder: Path, sample: PatchDepthSample, settings: FluxSettings, name: str,
                comment: str = "", progress: Callable[[str], None] | None = None) -> BsdfRun:
     """The XML of ``sample`` in ``folder/<name>.xml``: both rfluxmtx passes per node
     (``folder/node<k>/``, ``settings.nproc`` at a time), columns mixed per patch
     (:func:`mixed`), made reciprocal by ring blocks (:func:`reciprocal_rings`), wrapped."""
     t0 = time.perf_counter()
-    subs = []
-    for k, slab in enumerate(sample.rings):
-        sub = folder / f"node{k}"
-        write_system(sub, slab.polygons, slab.materials, slab.width, slab.height,
-                     slab.thickness, settings.tiles)
-        subs.append(sub)
+    subs = write_systems(folder, "node", sample.rings, settings.tiles)
     single = replace(settings, nproc=1)
     with ThreadPoolExecutor(max_workers=max(1, min(settings.nproc, len(subs)))) as pool:
         list(pool.map(lambda sub: flux_passes(sub, single, progress), subs))
