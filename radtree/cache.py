@@ -9,7 +9,8 @@ radtree package (every file's bytes) and of the numerical libraries' versions, s
 or an upgrade never serves an old crown. The photo crowns (the photo's analysis, mask check
 and cut: 2.5–4 s each) load in milliseconds on the next build, ``--fresh`` ones included;
 a large mesh's Wavefront OBJ text (``"%.5f"`` formatting of up to 10⁵ vertices) is copied
-instead of formatted again, keyed by its name, material, vertex and face bytes.
+instead of formatted again, keyed by its name, material, vertex and face bytes; a build
+folder's ``model.png`` is copied when its crown and scene are the same to the byte.
 
 Where: ``$RADTREE_CACHE_DIR`` (``off`` turns the cache off), else
 ``$XDG_CACHE_HOME/radtree``, else ``~/.cache/radtree``. Size: at most ``$RADTREE_CACHE_MB``
@@ -37,9 +38,10 @@ __all__ = ["CacheInfo", "cache_dir", "cache_info", "cached_file", "cached_object
            "clear_cache", "content_key", "has_object"]
 
 #: libraries whose numbers a crown depends on (a new version may change the last bit)
-_LIBRARIES = ("numpy", "shapely", "scikit-image", "scipy", "pillow")
-#: what the cache holds: ``<key>.pickle`` (crowns) and ``<key>.obj`` (mesh text)
-_SUFFIXES = (".pickle", ".obj")
+_LIBRARIES = ("numpy", "shapely", "scikit-image", "scipy", "pillow", "matplotlib")
+#: what the cache holds: ``<key>.pickle`` (crowns), ``<key>.obj`` (mesh text) and
+#: ``<key>.png`` (a build folder's picture of its crown)
+_SUFFIXES = (".pickle", ".obj", ".png")
 DEFAULT_MB = 2048
 
 
@@ -146,9 +148,9 @@ def has_object(key: str) -> bool:
     return folder is not None and (folder / f"{key}.pickle").is_file()
 
 
-def cached_file(key: str, suffix: str, make: Callable[[], str], dest: Path) -> bool:
-    """Write the text ``make()`` to ``dest`` atomically, copied from the cache entry ``key``
-    when there (True) or made and stored (False)."""
+def cached_file(key: str, suffix: str, make: Callable[[Path], Any], dest: Path) -> bool:
+    """Make the file ``dest`` (atomically): copied from the cache entry ``key`` when there
+    (True), else written by ``make(path)`` and stored (False)."""
     folder = cache_dir()
     path = None if folder is None else folder / f"{key}{suffix}"
     if path is not None and path.is_file():
@@ -159,9 +161,8 @@ def cached_file(key: str, suffix: str, make: Callable[[], str], dest: Path) -> b
             return True
         except FileNotFoundError:           # evicted by another process meanwhile
             pass
-    text = make()
     with atomic_path(dest) as tmp:
-        tmp.write_text(text, encoding="utf-8")
+        make(tmp)
     if path is not None:
         _store(path, lambda t: shutil.copyfile(dest, t))
     return False

@@ -114,7 +114,7 @@ def test_off_caches_nothing(tmp_path, monkeypatch):
     assert cache.cache_dir() is None
     assert cache.cached_object("k", lambda: 3) == (3, False)
     dest = tmp_path / "m.obj"
-    assert cache.cached_file("k", ".obj", lambda: "v 0 0 0\n", dest) is False
+    assert cache.cached_file("k", ".obj", lambda p: p.write_text("v 0 0 0\n"), dest) is False
     assert dest.read_text() == "v 0 0 0\n"
     assert "off" in cache.cache_info().describe()
 
@@ -122,9 +122,9 @@ def test_off_caches_nothing(tmp_path, monkeypatch):
 def test_obj_text_is_copied_from_the_cache(tmp_path, cache_dir):
     made: list[int] = []
 
-    def make() -> str:
+    def make(path) -> None:
         made.append(1)
-        return "v 0.00000 1.00000 2.00000\n"
+        path.write_text("v 0.00000 1.00000 2.00000\n")
 
     assert cache.cached_file("m", ".obj", make, tmp_path / "a.obj") is False
     assert cache.cached_file("m", ".obj", make, tmp_path / "b.obj") is True
@@ -141,3 +141,21 @@ def test_radtree_cache_command_shows_and_clears(cache_dir):
     res = CliRunner().invoke(cache_command, ["--clear"])
     assert res.exit_code == 0 and "removed 2 cache entries" in res.output
     assert "0 entries" in res.output and not list(cache_dir.glob("*.pickle"))
+
+
+def test_the_crown_picture_is_copied_for_the_same_crown_and_scene(tmp_path, cache_dir,
+                                                                   monkeypatch):
+    """A second build draws no picture: model.png comes from the cache, the same bytes."""
+    from radtree.trees import picture
+
+    p = load_project(copy_project(tmp_path / "proj", hours=["13:30"]))
+    build_project(p, ["E"], echo=lambda s: None, progress=False, workers=1)
+    png = (p.build_dir / "E" / "model.png").read_bytes()
+    assert png[:4] == b"\x89PNG" and len(list(cache_dir.glob("*.png"))) == 1
+
+    def no_drawing(*args, **kwargs):
+        raise AssertionError("the picture was drawn again")
+
+    monkeypatch.setattr(picture, "render_model_png", no_drawing)
+    build_project(p, ["E"], echo=lambda s: None, progress=False, fresh=True, workers=1)
+    assert (p.build_dir / "E" / "model.png").read_bytes() == png

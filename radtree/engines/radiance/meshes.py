@@ -52,7 +52,8 @@ def write_obj(mesh: Mesh, path: Path) -> bool:
     build wrote it before (True), else formatted and stored there (False)."""
     key = content_key(mesh.vertices, mesh.faces, what="obj", name=mesh.name,
                       material=mesh.material)
-    return cached_file(key, ".obj", lambda: obj_text(mesh), path)
+    return cached_file(key, ".obj", lambda p: p.write_text(obj_text(mesh), encoding="utf-8"),
+                       path)
 
 
 def mesh_primitive_text(mesh: Mesh, rtm: str) -> str:
