@@ -91,27 +91,32 @@ def code_fingerprint() -> str:
     return h.hexdigest()
 
 
-def _plain(obj: Any) -> Any:
-    """JSON-able form of a dataclass tree; a file counts by its resolved path and content."""
+def _plain(obj: Any, located: bool) -> Any:
+    """JSON-able form of a dataclass tree; a file counts by its content, and by its resolved
+    path too when ``located`` (what is built records where its input came from)."""
     from dataclasses import fields, is_dataclass
 
     if is_dataclass(obj) and not isinstance(obj, type):
-        return {"@": type(obj).__name__, **{f.name: _plain(getattr(obj, f.name))
+        return {"@": type(obj).__name__, **{f.name: _plain(getattr(obj, f.name), located)
                                              for f in fields(obj)}}
     if isinstance(obj, dict):
-        return {str(k): _plain(v) for k, v in obj.items()}
+        return {str(k): _plain(v, located) for k, v in obj.items()}
     if isinstance(obj, list | tuple):
-        return [_plain(v) for v in obj]
+        return [_plain(v, located) for v in obj]
     if isinstance(obj, Path):
         p = obj.resolve()
-        return {"path": str(p), "sha256": file_sha256(p) if p.is_file() else None}
+        return {"path": str(p) if located else p.name,
+                "sha256": file_sha256(p) if p.is_file() else None}
     return obj
 
 
-def content_key(*arrays: Any, **parts: Any) -> str:
+def content_key(*arrays: Any, located: tuple[str, ...] = (), **parts: Any) -> str:
     """The cache key of what is made from ``parts`` (dataclasses, strings, numbers, paths)
-    and ``arrays`` (their bytes), by radtree's code as installed."""
-    text = json.dumps({"code": code_fingerprint(), **{k: _plain(v) for k, v in parts.items()}},
+    and ``arrays`` (their bytes), by radtree's code as installed. Files count by name and
+    content; in the parts named in ``located`` by their full path too (a crown made from a
+    photo records the photo's path)."""
+    text = json.dumps({"code": code_fingerprint(),
+                       **{k: _plain(v, k in located) for k, v in parts.items()}},
                       sort_keys=True, default=repr)
     h = hashlib.sha256(text.encode())
     for a in arrays:

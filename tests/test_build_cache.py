@@ -80,6 +80,12 @@ def test_a_switch_or_an_edited_input_file_is_another_crown(tmp_path, cache_dir):
     assert cache.content_key(what="crown", photo=photo) == k1
     photo.write_bytes(b"\xff\xd8 two")
     assert cache.content_key(what="crown", photo=photo) != k1
+    moved = tmp_path / "elsewhere" / "photo.jpg"     # a copied project: the same file
+    moved.parent.mkdir()
+    moved.write_bytes(photo.read_bytes())
+    assert cache.content_key(photo=moved) == cache.content_key(photo=photo)
+    assert (cache.content_key(photo=moved, located=("photo",))
+            != cache.content_key(photo=photo, located=("photo",)))   # its path is recorded
     a = np.arange(6.0)
     assert cache.content_key(a) != cache.content_key(a.reshape(2, 3))   # shape counts
 

@@ -113,11 +113,12 @@ def build_crown(project: Project, model: str, form: str, frame: FacadeFrame,
 
 def _crown_key(project: Project, model: str, form: str, frame: FacadeFrame,
                tree: Tree) -> str:
-    """The build-cache key of a crown: model, form, tree tables (files by path and content),
-    sensors, street, frame and radtree's code (:func:`radtree.cache.content_key`)."""
+    """The build-cache key of a crown: model, form, tree tables (files by path and content:
+    a photo crown records its photo's path), sensors, street (files by name and content),
+    frame and radtree's code (:func:`radtree.cache.content_key`)."""
     from radtree.cache import content_key
 
-    return content_key(what="crown", model=model, form=form, tree=tree,
+    return content_key(what="crown", model=model, form=form, tree=tree, located=("tree",),
                        sensors=project.sensors, street=project.street, frame=frame)
 
 
