@@ -32,7 +32,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from radtree.fileio import atomic_path, file_sha256, make_folder
+from radtree.fileio import atomic_path, file_sha256_cached, make_folder
 
 __all__ = ["CacheInfo", "cache_dir", "cache_info", "cached_file", "cached_object",
            "clear_cache", "content_key", "has_object"]
@@ -106,7 +106,7 @@ def _plain(obj: Any, located: bool) -> Any:
     if isinstance(obj, Path):
         p = obj.resolve()
         return {"path": str(p) if located else p.name,
-                "sha256": file_sha256(p) if p.is_file() else None}
+                "sha256": file_sha256_cached(p) if p.is_file() else None}
     return obj
 
 

@@ -8,7 +8,6 @@ keys) are left out, so older build folders and results keep their hashes.
 
 from __future__ import annotations
 
-import functools
 import hashlib
 import json
 from collections.abc import Callable
@@ -17,6 +16,7 @@ from pathlib import Path
 from typing import Any
 
 from radtree.config.photo import drop_photo_defaults
+from radtree.fileio import file_sha256_cached
 
 #: the ``EngineParams`` fields only the Radiance photon map reads
 PMAP_KEYS = ("pmap_photons", "pmap_caustic_photons", "pmap_bandwidth")
@@ -76,19 +76,6 @@ def _file_key(path: Path, root: Path) -> str:
         name = str(path.resolve().relative_to(root.resolve()))
     except ValueError:
         name = str(path)
-    try:
-        st = path.stat()
-    except OSError:
-        return name
     if not path.is_file():
         return name
-    return f"{name} sha256:{_content_hash(str(path), st.st_mtime_ns, st.st_size)}"
-
-
-@functools.lru_cache(maxsize=256)
-def _content_hash(path: str, mtime_ns: int, size: int) -> str:
-    h = hashlib.sha256()
-    with open(path, "rb") as f:
-        for chunk in iter(lambda: f.read(1 << 20), b""):
-            h.update(chunk)
-    return h.hexdigest()
+    return f"{name} sha256:{file_sha256_cached(path)}"

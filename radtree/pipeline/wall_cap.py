@@ -48,7 +48,7 @@ from radtree.engines.radiance.bsdf import (
 )
 from radtree.optics import KLEMS_FULL_RINGS
 from radtree.trees.envelope import CrownRowSpec, crown_row_spec, icosphere_level
-from radtree.trees.slab import CELL_SLATS, SlabSample, volume_slab
+from radtree.trees.slab import CELL_SLATS, RingDimensions, SlabSample, volume_slab
 
 #: depth nodes are spaced by at most this ratio
 NODE_RATIO = 1.5
@@ -61,7 +61,7 @@ MAX_NODE_CELLS = 1.5
 
 
 @dataclass
-class PatchDepthSample:
+class PatchDepthSample(RingDimensions):
     """Slabs at the depth nodes ``node_tau`` (m) and each Klems patch's slab depth for front
     (``tau_front``) and back (``tau_back``) incidence; ``thickness``: the normal half chord."""
 
@@ -73,14 +73,6 @@ class PatchDepthSample:
     thickness: float
     notes: list[str] = field(default_factory=list)
     info: dict[str, float] = field(default_factory=dict)
-
-    @property
-    def width(self) -> float:
-        return self.rings[0].width
-
-    @property
-    def height(self) -> float:
-        return self.rings[0].height
 
     def key_bytes(self) -> bytes:
         taus = np.concatenate([self.node_tau, self.tau_front, self.tau_back]).round(6)

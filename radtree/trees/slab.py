@@ -237,8 +237,22 @@ def branch_slab(cover: float, depth_m: float, inclination_deg: float, diameter_m
                       cell_m, thickness, notes, {"branch_cover": cover, "sticks": float(n)})
 
 
+class RingDimensions:
+    """``width`` / ``height`` (m) of a sample made of ``rings`` (planar samples of one size)."""
+
+    rings: list[SlabSample]
+
+    @property
+    def width(self) -> float:
+        return self.rings[0].width
+
+    @property
+    def height(self) -> float:
+        return self.rings[0].height
+
+
 @dataclass
-class RingSamples:
+class RingSamples(RingDimensions):
     """A crown *envelope* sample: one planar sample per Klems θ ring of incidence
     (:data:`radtree.optics.KLEMS_FULL_RINGS`); ring k's sample supplies the BSDF columns of the
     incident patches of ring k. ``thickness``: the half chord at normal incidence (m)."""
@@ -253,14 +267,6 @@ class RingSamples:
         if len(self.rings) != len(KLEMS_FULL_RINGS):
             raise ValueError(f"envelope sample '{self.name}': {len(self.rings)} ring samples, "
                              f"expected {len(KLEMS_FULL_RINGS)}")
-
-    @property
-    def width(self) -> float:
-        return self.rings[0].width
-
-    @property
-    def height(self) -> float:
-        return self.rings[0].height
 
     @property
     def count(self) -> int:
