@@ -24,6 +24,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from radtree.cache import cached_file, content_key
+from radtree.engines.radiance.numtext import format_rows
 from radtree.scene import Mesh
 
 #: meshes with at least this many triangles are written as obj2mesh meshes
@@ -39,11 +40,10 @@ def as_compiled_mesh(mesh: Mesh) -> bool:
 
 def obj_text(mesh: Mesh) -> str:
     """The mesh as Wavefront OBJ: a comment, its vertices (``v``, 5 decimals as the polygon
-    text) and its triangles (``f``, 1-based vertex indices)."""
+    text) and its triangles (``f``, 1-based vertex indices); the same bytes as printf's
+    ``"v %.5f %.5f %.5f"`` / ``"f %d %d %d"`` (:mod:`radtree.engines.radiance.numtext`)."""
     head = f"# {mesh.name}: {mesh.n_triangles} triangles, material {mesh.material}\n"
-    verts = ("v %.5f %.5f %.5f\n" * len(mesh.vertices)) % tuple(mesh.vertices.ravel().tolist())
-    faces = ("f %d %d %d\n" * len(mesh.faces)) % tuple((mesh.faces + 1).ravel().tolist())
-    return head + verts + faces
+    return head + format_rows("v", mesh.vertices, 5) + format_rows("f", mesh.faces + 1, 0)
 
 
 def write_obj(mesh: Mesh, path: Path) -> bool:
