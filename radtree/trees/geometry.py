@@ -160,7 +160,7 @@ def polygons_to_mesh(polygons: list[np.ndarray]) -> tuple[np.ndarray, np.ndarray
     first = np.repeat(offset, n_tri)
     local = np.arange(int(n_tri.sum())) - np.repeat(np.cumsum(n_tri) - n_tri, n_tri) + 1
     faces = np.column_stack([first, first + local, first + local + 1])
-    return np.vstack(kept), faces
+    return np.concatenate(kept), faces
 
 
 def quads_to_mesh(quads: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
