@@ -9,13 +9,13 @@ Prints (no timing assertions):
    Perez sky + sun of 11:30) at the default budget, and on the Mendoza project's own louvers
    crown (``radtree.pipeline.assemble.make_scene``) when that builds;
 3. the NumPy engine's ray throughput against raw Embree on the very same rays: every
-   Embree query of one traced hour is recorded, then replayed through embreex's
-   ``EmbreeScene.run`` (float32 rays already in trimesh's Embree frame, chunks of 65 536 over
+   Embree query of one traced hour is recorded as handed to Embree, then replayed through
+   embreex's ``EmbreeScene.run`` (the same float32 rays in trimesh's Embree frame, chunks of 65 536 over
    the same number of threads) and through the engine's ``EmbreeCaster.first_hit`` in one call
    (conversions and float64 distances included); the engine's rays/s over raw Embree's is the
    throughput ratio (Mendoza scenarios B and F, 12:30, 1 and 2 threads); also Embree's own CPU
    time inside the engine (``EmbreeScene.run`` timed where the engine calls it) as a share of
-   the engine's CPU time;
+   the engine's CPU time, and which shadow-ray kernel ran (``RADTREE_KERNEL``: c or numpy);
 4. when Radiance is available, the per-row relative difference NumPy − Radiance on the slat
    scene, with Radiance at ``-ab 8 -ad 8192 -as 0 -aa 0`` and with ambient super-sampling
    (``-as 4096``, biased low here); ``--with-defaults`` adds the project's ``-as 512 -aa 0.1``.
@@ -159,12 +159,10 @@ def engine_hour(quick: bool) -> Scene:
     return sc
 
 
-def _replay_raw(caster: EmbreeCaster, o: np.ndarray, d: np.ndarray, workers: int) -> float:
-    """Wall time of raw ``EmbreeScene.run`` on the rays (prepared beforehand, not timed)."""
+def _replay_raw(caster: EmbreeCaster, o32: np.ndarray, d32: np.ndarray, workers: int) -> float:
+    """Wall time of raw ``EmbreeScene.run`` on the recorded float32 rays (already in Embree's
+    frame: exactly what the engine handed Embree)."""
     wrap = caster._embree
-    o32 = ((np.asarray(o, np.float32).astype(np.float64) - wrap.origin) * wrap.scale
-           ).astype(np.float32)
-    d32 = np.asarray(d, np.float32)
     step = 1 << 16
     starts = range(0, len(o32), step)
     with ThreadPoolExecutor(workers) as pool:
@@ -176,22 +174,24 @@ def _replay_raw(caster: EmbreeCaster, o: np.ndarray, d: np.ndarray, workers: int
 
 def _recorded_queries(caster: EmbreeCaster, work: Any, *args: Any
                       ) -> tuple[np.ndarray, np.ndarray, int]:
-    """Every ray ``work(*args)`` sends to Embree through ``caster`` (origins, directions,
-    queries): recorded at the caster's one Embree call, whichever caster method made it."""
+    """Every ray ``work(*args)`` sends to Embree through ``caster`` (float32 origins in Embree's
+    frame, float32 unit directions, calls): recorded at the caster's one Embree call
+    (``EmbreeCaster._run``), whichever caster method made it — with the C kernel the shadow
+    rays' origins arrive there already converted."""
     casts: list[tuple[np.ndarray, np.ndarray]] = []
     lock = threading.Lock()
-    original = caster._query
+    original = caster._run
 
-    def recording(o_t: np.ndarray, d: np.ndarray) -> np.ndarray:
-        with lock:  # origins arrive as (3, n), one row per axis
-            casts.append((np.array(o_t.T), np.array(d)))
-        return original(o_t, d)
+    def recording(o32: np.ndarray, d32: np.ndarray) -> np.ndarray:
+        with lock:
+            casts.append((np.array(o32, np.float32), np.array(d32, np.float32)))
+        return original(o32, d32)
 
-    caster._query = recording  # type: ignore[method-assign]
+    caster._run = recording  # type: ignore[method-assign]
     try:
         work(*args)
     finally:
-        caster._query = original  # type: ignore[method-assign]
+        caster._run = original  # type: ignore[method-assign]
     return (np.concatenate([c[0] for c in casts]), np.concatenate([c[1] for c in casts]),
             len(casts))
 
@@ -244,15 +244,18 @@ def engine_vs_embree(quick: bool) -> None:
                 print("  embreex not installed: skipped")
                 return
             trace_hour(built.scene, state, replace(p, rays=16), ["facade"])
-            o, d, calls = _recorded_queries(caster, trace_hour, built.scene, state, p,
-                                            ["facade"])
+            o32, d32, calls = _recorded_queries(caster, trace_hour, built.scene, state, p,
+                                                ["facade"])
+            # the same rays in world coordinates, float64, for EmbreeCaster.first_hit
+            o = o32.astype(np.float64) / caster.frame[3] + caster.frame[:3]
+            d = d32.astype(np.float64)
             best = []
             for _ in range(2):  # best of 2 of each, measured back to back
                 c0, t0 = time.process_time(), time.perf_counter()
                 trace_hour(built.scene, state, p, ["facade"])
                 engine, engine_cpu = time.perf_counter() - t0, time.process_time() - c0
                 c0 = time.process_time()
-                raw = _replay_raw(caster, o, d, workers)
+                raw = _replay_raw(caster, o32, d32, workers)
                 raw_cpu = time.process_time() - c0
                 t0 = time.perf_counter()
                 caster.first_hit(o, d)
@@ -261,6 +264,7 @@ def engine_vs_embree(quick: bool) -> None:
             engine, raw, first_hit, engine_cpu, raw_cpu = min(best)
             inside, inside_cpu = _embree_inside(caster, trace_hour, built.scene, state, p,
                                                 ["facade"])
+            from radtree.engines.numpy.kernel import name as kernel_name
             n = len(o)
             print(f"  scenario {name}: {built.triangles} triangles, {workers} thread(s), "
                   f"{n / 1e6:.2f} M queries in {calls} calls: engine {n / engine / 1e6:.2f} "
@@ -270,7 +274,8 @@ def engine_vs_embree(quick: bool) -> None:
                   f"(CPU {raw_cpu / engine_cpu:.0%}), engine / first_hit "
                   f"{first_hit / engine:.0%}; Embree's own CPU time inside the engine "
                   f"{inside:.2f} s = {inside / inside_cpu:.0%} of the engine's "
-                  f"{inside_cpu:.2f} s; load {os.getloadavg()[0]:.1f}", flush=True)
+                  f"{inside_cpu:.2f} s; shadow-ray kernel {kernel_name()}; load "
+                  f"{os.getloadavg()[0]:.1f}", flush=True)
 
 
 def engines_differ(sc: Scene, quick: bool, with_defaults: bool) -> None:

@@ -66,11 +66,13 @@ from radtree.engines.numpy.geometry import (
     scene_geometry,
     scene_optics,
 )
+from radtree.engines.numpy.kernel import describe as kernel_describe
+from radtree.engines.numpy.kernel import kernel
 from radtree.engines.numpy.lockstep import Draws, LockstepRandom, SerialDraws
 from radtree.engines.numpy.raycast import embree_available
 from radtree.engines.numpy.sampling import cosine_hemisphere, cosine_rows, mirror, uniform_cone
+from radtree.engines.numpy.shadow import kernel_tables, transmittance
 from radtree.engines.numpy.shadow import rows as _rows
-from radtree.engines.numpy.shadow import transmittance
 from radtree.light.sky import SkyState
 from radtree.light.sun import SUN_HALF_ANGLE_DEG
 
@@ -98,7 +100,8 @@ DEFAULT_OPTIONS = TraceOptions()
 
 
 def describe(backend: str = "auto") -> str:
-    """Which ray backend the engine uses: ``embree`` (trimesh + embreex) or ``numpy-bvh``."""
+    """Which ray backend the engine uses: ``embree`` (trimesh + embreex) or ``numpy-bvh``, and
+    with Embree which shadow-ray kernel (the compiled one or NumPy: the same numbers)."""
     import os
 
     chosen = backend if backend != "auto" else os.environ.get("RADTREE_RAY_BACKEND", "auto")
@@ -107,7 +110,8 @@ def describe(backend: str = "auto") -> str:
     if chosen == "embree":
         import trimesh
 
-        return f"numpy Monte Carlo engine, ray backend embree (trimesh {trimesh.__version__} + embreex)"
+        return (f"numpy Monte Carlo engine, ray backend embree (trimesh {trimesh.__version__} + "
+                f"embreex), {kernel_describe()}")
     return "numpy Monte Carlo engine, ray backend numpy-bvh (vectorised NumPy BVH)"
 
 
@@ -182,6 +186,14 @@ class _Tracer:
         self.sun_cos = cos.reshape(-1)
         self.sun_side = np.where(self.sun_cos < 0, -self.eps, self.eps)
         self.sun_grazing = bool(np.any(np.abs(self.sun_cos) < 1e-12))  # plane_distance's test
+        # the C kernel's tables (radtree.engines.numpy.kernel): per triangle its normal, first
+        # vertex and specular transmittance in one 64-byte row; per (hour, triangle) the
+        # cosine and the offset above, side by side
+        self.tri_pack: np.ndarray | None = None
+        self.sun_pack: np.ndarray | None = None
+        if kernel() is not None:
+            self.tri_pack = kernel_tables(geo.normals, geo.v0, self.tri_ts)
+            self.sun_pack = np.ascontiguousarray(np.stack([self.sun_cos, self.sun_side], axis=1))
 
     def sky(self, d: np.ndarray, hour: np.ndarray | None) -> np.ndarray:
         """Luminance seen along escaping directions ``d`` (each path's own hour state)."""

@@ -9,6 +9,7 @@ from typing import TYPE_CHECKING
 from radtree.engines.base import GridResult
 from radtree.engines.numpy.engine import describe
 from radtree.engines.numpy.inprocess import InProcessEngine
+from radtree.engines.numpy.kernel import name as kernel_name
 from radtree.engines.numpy.tracing import trace_bounce_ladder, trace_hour, trace_states
 
 if TYPE_CHECKING:
@@ -36,6 +37,11 @@ class NumpyEngine(InProcessEngine):
 
     def describe(self) -> str:
         return f"available ({describe()})"
+
+    def provenance(self) -> dict[str, str | None]:
+        """The NumPy version (and Embree) and which shadow-ray kernel traced: ``c`` (the
+        compiled one) or ``numpy`` — the same numbers either way."""
+        return {**super().provenance(), "numpy_kernel": kernel_name()}
 
     def sampling(self, params: EngineParams) -> str:
         dense = (f" ({params.dense_rays} per dense-map point)"

@@ -20,6 +20,8 @@ from typing import Protocol
 
 import numpy as np
 
+from radtree.engines.numpy.kernel import kernel
+
 BACKENDS = ("embree", "numpy-bvh")
 
 
@@ -105,15 +107,13 @@ class EmbreeCaster:
         self._intersector.intersects_first(np.zeros((1, 3)), np.array([[0.0, 0.0, 1.0]]))
         self._embree = self._intersector._scene  # trimesh's scaled Embree scene
         self._origin_t = np.asarray(self._embree.origin, np.float64)[:, None]  # (3, 1)
+        # the frame for the C kernel: origin (3) and scale, float64
+        self.frame = np.array([*self._origin_t[:, 0], self._embree.scale], np.float64)
 
-    def _query(self, o_t: np.ndarray, d: np.ndarray) -> np.ndarray:
-        """Triangle index per ray (int32, -1: miss) of origins ``o_t`` (3, n) — one row per
-        axis, or the transpose of (n, 3) rows — and directions ``d`` (n, 3): the arithmetic of
-        ``RayMeshIntersector.intersects_first`` (identical float32 inputs to Embree) without
-        its per-call overhead, on rows of all rays (a (3, n) array, handed to Embree as its
-        transpose); one direction (a broadcast row: the point sun) is converted once and
-        handed to Embree as that broadcast row."""
-        wrap = self._embree
+    def _dir32(self, d: np.ndarray) -> np.ndarray:
+        """Directions ``d`` (n, 3) as the float32 unit rows ``intersects_first`` makes; one
+        direction (a broadcast row: the point sun) is converted once and handed to Embree as
+        that broadcast row."""
         if d.ndim == 2 and d.strides[0] == 0 and len(d):  # one direction (a point sun)
             key = d[0].tobytes()
             row = self._rows32.get(key)
@@ -121,14 +121,47 @@ class EmbreeCaster:
                 if len(self._rows32) > 256:
                     self._rows32.clear()
                 row = self._rows32[key] = _unit32(np.array(d[:1], dtype=np.float32))
-            d32 = np.broadcast_to(row, d.shape)
-        else:
-            d32 = _unit32(np.array(d, dtype=np.float32))
+            return np.broadcast_to(row, d.shape)
+        return _unit32(np.array(d, dtype=np.float32))
+
+    def _query(self, o_t: np.ndarray, d: np.ndarray) -> np.ndarray:
+        """Triangle index per ray (int32, -1: miss) of origins ``o_t`` (3, n) — one row per
+        axis, or the transpose of (n, 3) rows — and directions ``d`` (n, 3): the arithmetic of
+        ``RayMeshIntersector.intersects_first`` (identical float32 inputs to Embree) without
+        its per-call overhead, on rows of all rays (a (3, n) array, handed to Embree as its
+        transpose; with the C kernel converted in one pass into an (n, 3) array, the same
+        float32 numbers)."""
+        d32 = self._dir32(d)
+        k = kernel()
+        if k is not None:
+            o32 = np.empty((o_t.shape[1], 3), np.float32)
+            k.frame(o_t, self.frame, o32)
+            return self._run(o32, d32)
         o32 = np.array(o_t, dtype=np.float32, order="C")
         shifted = np.subtract(o32, self._origin_t, dtype=np.float64)  # exact
         # × scale in float64, rounded to float32 as it is stored (one pass, the same numbers)
-        return wrap.scene.run(np.multiply(shifted, wrap.scale, out=o32, casting="same_kind").T,
-                              d32)
+        return self._run(np.multiply(shifted, self._embree.scale, out=o32,
+                                     casting="same_kind").T, d32)
+
+    def _run(self, o32: np.ndarray, d32: np.ndarray) -> np.ndarray:
+        """Embree's answer (triangle per ray, int32) for float32 rays already in its frame: the
+        one place the caster calls Embree."""
+        return self._embree.scene.run(o32, d32)
+
+    def query_frame(self, o32: np.ndarray, directions: np.ndarray, parallel: bool = True
+                    ) -> np.ndarray:
+        """:meth:`query` of origins already converted to Embree's float32 frame, ``o32``
+        (n, 3) (the C kernel writes them with the next origins: ``frame`` holds the origin
+        and scale of that frame)."""
+        n = len(o32)
+        if n == 0:
+            return np.zeros(0, np.int32)
+        d32 = self._dir32(directions)
+        parts = self._parts(n, parallel)
+        if parts is not None and self._pool is not None:
+            return np.concatenate(list(self._pool.map(
+                lambda s: self._run(o32[s], d32[s]), parts)))
+        return self._run(o32, d32)
 
     def query(self, origins_t: np.ndarray, directions: np.ndarray, parallel: bool = True
               ) -> np.ndarray:

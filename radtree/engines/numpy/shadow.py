@@ -10,13 +10,14 @@ arithmetic gives (sums of three products in ``einsum``'s order).
 
 from __future__ import annotations
 
-from typing import Protocol
+from typing import Any, Protocol
 
 import numpy as np
 
 from radtree.engines.numpy.geometry import Geometry, Optics, glass_coefficients
+from radtree.engines.numpy.kernel import kernel
 from radtree.engines.numpy.lockstep import Draws
-from radtree.engines.numpy.raycast import RayCaster, hit_triangles, plane_distance
+from radtree.engines.numpy.raycast import EmbreeCaster, RayCaster, hit_triangles, plane_distance
 
 SHADOW_ROULETTE = 0.02  # shadow-ray transmittance below which Russian roulette starts
 
@@ -46,6 +47,9 @@ class ShadowTracer(Protocol):
     sun_cos: np.ndarray
     sun_side: np.ndarray
     sun_grazing: bool
+    suns: np.ndarray
+    tri_pack: np.ndarray | None
+    sun_pack: np.ndarray | None
 
     @property
     def opts(self) -> _Options:
@@ -76,6 +80,12 @@ def transmittance(tr: ShadowTracer, origins: np.ndarray, dirs: np.ndarray,
                   parallel: bool = True, hour: np.ndarray | int | None = None) -> np.ndarray:
     """Transmittance of shadow rays from ``origins`` (k, 3) along ``dirs`` (k, 3, or one
     broadcast row) for the tracer ``tr``: :meth:`_Tracer.shadow`."""
+    if (hour is not None and tr.tri_pack is not None
+            and not tr.sun_grazing and not tr.glass_any and tr.opt.any_specular_pass
+            and isinstance(tr.caster, EmbreeCaster)):
+        k_mod = kernel()
+        if k_mod is not None and (isinstance(hour, int) or np.asarray(dirs).strides[0] != 0):
+            return _transmittance_c(k_mod, tr, origins, dirs, rng, tag, parallel, hour)
     k = len(origins)
     vis = np.ones(k)
     idx = np.arange(k)
@@ -128,6 +138,64 @@ def transmittance(tr: ShadowTracer, origins: np.ndarray, dirs: np.ndarray,
         else:
             o = crossed_sun(tr, o, d, tri, hour)
     vis[idx] = 0.0
+    return vis
+
+
+def kernel_tables(normals: np.ndarray, v0: np.ndarray, ts: np.ndarray
+                  ) -> np.ndarray:
+    """The C kernel's per-triangle rows (n, 8): normal, first vertex, specular transmittance
+    and a 0, one 64-byte row a triangle (one cache line where the allocation allows)."""
+    n = len(normals)
+    raw = np.zeros(8 * n + 8)
+    skip = (-raw.ctypes.data % 64) // 8  # a row starts on a 64-byte boundary
+    pack = raw[skip:skip + 8 * n].reshape(n, 8)
+    pack[:, 0:3] = normals
+    pack[:, 3:6] = v0
+    pack[:, 6] = ts
+    return pack
+
+
+def _transmittance_c(k_mod: Any, tr: ShadowTracer, origins: np.ndarray, dirs: np.ndarray,
+                     rng: Draws | np.random.Generator | None, tag: tuple[int, ...],
+                     parallel: bool, hour: np.ndarray | int) -> np.ndarray:
+    """:func:`transmittance` towards the point sun through Embree with the C kernel: per
+    crossing one Embree query, one pass for the transmittance products (``hits``), the
+    roulette draws in NumPy, one pass for roulette, compaction, next origins and their float32
+    copy in Embree's frame (``cross``). The same numbers as the NumPy loop."""
+    caster = tr.caster
+    assert isinstance(caster, EmbreeCaster)
+    k = len(origins)
+    vis = np.ones(k)
+    idx = np.arange(k, dtype=np.int64)
+    o = np.array(np.asarray(origins, float).T, order="C")  # (3, k), compacted in place
+    o32 = np.empty((k, 3), np.float32)
+    k_mod.frame(o, caster.frame, o32)
+    if isinstance(hour, np.ndarray):  # several hour states: each ray towards its own sun
+        hours: np.ndarray | None = np.array(hour, dtype=np.int64)
+        h0, suns = 0, np.ascontiguousarray(tr.suns, dtype=float)
+        d = np.asarray(dirs, float)
+    else:
+        hours, h0 = None, int(hour)
+        d = np.asarray(dirs, float)
+        suns = np.array(d[0], dtype=float)
+    pack, sun_pack = tr.tri_pack, tr.sun_pack
+    m = k
+    for layer in range(tr.opts.max_shadow_layers):
+        tri = caster.query_frame(o32[:m], d[:m] if hours is None or layer == 0 else
+                                 tr.suns.take(hours[:m], axis=0), parallel)
+        n_hit, n_faint = k_mod.hits(tri, idx, vis, pack, SHADOW_ROULETTE)
+        if n_hit == 0:
+            return vis
+        draws = None
+        if rng is not None and n_faint:
+            if tag:
+                rng.at(*tag, layer)  # type: ignore[union-attr]
+            draws = rng.random(n_faint)
+        m = k_mod.cross(tri, idx, vis, draws, SHADOW_ROULETTE, pack, sun_pack, tr.n_tri, h0,
+                        hours, suns, o, caster.frame, o32)
+        if m == 0:
+            return vis
+    vis[idx[:m]] = 0.0
     return vis
 
 

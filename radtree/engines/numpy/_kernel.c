@@ -1,0 +1,289 @@
+/* radtree.engines.numpy._kernel — the shadow-ray loop's per-crossing arithmetic in one pass.
+ *
+ * An optional accelerator of radtree/engines/numpy/shadow.py (the NumPy code there is the
+ * reference and the fallback). Every number is the one the NumPy code computes: the same IEEE
+ * operations in the same order on the same float64 / float32 values — compiled with
+ * -ffp-contract=off -fno-fast-math (no fused multiply-add, no reassociation), no
+ * transcendental functions. tests/test_numpy_kernel.py compares both paths with array_equal.
+ *
+ * Arrays arrive through the buffer protocol (no NumPy headers at build time); the Python side
+ * (radtree/engines/numpy/kernel.py) checks dtypes and shapes before calling.
+ *
+ *   hits(tri, idx, vis, pack, roulette) -> (hits, faint)
+ *       for every ray i that hit (tri[i] >= 0): vis[idx[i]] *= its triangle's specular
+ *       transmittance (pack: 8 numbers a triangle, nx ny nz v0x v0y v0z ts 0);
+ *       counts the hits and the faint ones (0 < v < roulette).
+ *   cross(tri, idx, vis, draws, roulette, pack, sun_pack, n_tri, hour, hours, suns, o,
+ *         frame, o32) -> m
+ *       for the hits, in order: Russian roulette on the faint ones with draws (None: none),
+ *       then for the rays that go on (v > 0), compacted in place to the front of idx, hours
+ *       and o (3, n): the next origin o + t d ± ε n past the triangle crossed (t: the plane
+ *       distance towards the point sun d — suns[hours[i]], or suns[0] when hours is None and
+ *       every ray has the state `hour` — summed as einsum sums three products,
+ *       (a0 b0 + a2 b2) + a1 b1) and its float32 copy in trimesh's Embree frame, o32 (n, 3).
+ *   frame(o, frame, o32) -> None
+ *       o (3, n), any strides -> o32 (n, 3): float32(o), - origin in float64, × scale,
+ *       rounded to float32 (EmbreeCaster._query's conversion).
+ */
+#define PY_SSIZE_T_CLEAN
+#include <Python.h>
+#include <stdint.h>
+#include <string.h>
+
+/* A double rounded to float32 and back. The volatile store keeps the rounding: gcc 12 -O2's
+ * SLP vectoriser folds (double)(float)x into x when it pairs two such lines (seen on x86-64). */
+static inline double round32(double x) {
+    volatile float f = (float)x;
+    return (double)f;
+}
+
+typedef struct {
+    Py_buffer view;
+    int held;
+} Buf;
+
+static void release(Buf *b, int n) {
+    for (int i = 0; i < n; i++)
+        if (b[i].held) {
+            PyBuffer_Release(&b[i].view);
+            b[i].held = 0;
+        }
+}
+
+/* A C-contiguous buffer of items of `itemsize` bytes, at least `need` of them. */
+static int get_flat(PyObject *obj, Buf *b, int writable, Py_ssize_t itemsize,
+                    Py_ssize_t need, const char *what) {
+    int flags = PyBUF_C_CONTIGUOUS | PyBUF_FORMAT | (writable ? PyBUF_WRITABLE : 0);
+    if (PyObject_GetBuffer(obj, &b->view, flags) < 0)
+        return -1;
+    b->held = 1;
+    if (b->view.itemsize != itemsize || b->view.len / itemsize < need) {
+        PyErr_Format(PyExc_ValueError, "%s: %zd items of %zd bytes expected, got %zd of %zd",
+                     what, need, itemsize, b->view.len / (b->view.itemsize ? b->view.itemsize : 1),
+                     b->view.itemsize);
+        return -1;
+    }
+    return 0;
+}
+
+/* A 2-D float64 buffer of shape (3, >= need), any strides (multiples of 8 bytes). */
+static int get_rows(PyObject *obj, Buf *b, int writable, Py_ssize_t need, const char *what) {
+    int flags = PyBUF_STRIDES | PyBUF_FORMAT | (writable ? PyBUF_WRITABLE : 0);
+    if (PyObject_GetBuffer(obj, &b->view, flags) < 0)
+        return -1;
+    b->held = 1;
+    if (b->view.ndim != 2 || b->view.itemsize != 8 || b->view.shape[0] != 3 ||
+        b->view.shape[1] < need || b->view.strides[0] % 8 || b->view.strides[1] % 8 ||
+        (b->view.format && strcmp(b->view.format, "d") != 0)) {
+        PyErr_Format(PyExc_ValueError, "%s: a float64 array (3, >= %zd) expected", what, need);
+        return -1;
+    }
+    return 0;
+}
+
+static PyObject *k_hits(PyObject *self, PyObject *args) {
+    PyObject *otri, *oidx, *ovis, *opack;
+    double roulette;
+    if (!PyArg_ParseTuple(args, "OOOOd", &otri, &oidx, &ovis, &opack, &roulette))
+        return NULL;
+    Buf b[4] = {{{0}}};
+    if (get_flat(otri, &b[0], 0, 4, 0, "tri") < 0) goto fail;
+    Py_ssize_t n = b[0].view.len / 4;
+    if (get_flat(oidx, &b[1], 0, 8, n, "idx") < 0) goto fail;
+    if (get_flat(ovis, &b[2], 1, 8, 0, "vis") < 0) goto fail;
+    if (get_flat(opack, &b[3], 0, 8, 0, "pack") < 0) goto fail;
+    const int32_t *tri = b[0].view.buf;
+    const int64_t *idx = b[1].view.buf;
+    double *vis = b[2].view.buf;
+    const double *pack = b[3].view.buf;
+    const Py_ssize_t nvis = b[2].view.len / 8, ntri = b[3].view.len / 64;
+    Py_ssize_t hits = 0, faint = 0, bad = 0;
+    Py_BEGIN_ALLOW_THREADS
+    for (Py_ssize_t i = 0; i < n; i++) {
+        const int32_t t = tri[i];
+        if (t < 0)
+            continue;
+        const int64_t j = idx[i];
+        if (t >= ntri || j < 0 || j >= nvis) {
+            bad = 1;
+            break;
+        }
+        const double v = vis[j] * pack[8 * (Py_ssize_t)t + 6];
+        vis[j] = v;
+        hits++;
+        faint += (v > 0.0) & (v < roulette);
+    }
+    Py_END_ALLOW_THREADS
+    release(b, 4);
+    if (bad) {
+        PyErr_SetString(PyExc_IndexError, "triangle or ray index out of range");
+        return NULL;
+    }
+    return Py_BuildValue("nn", hits, faint);
+fail:
+    release(b, 4);
+    return NULL;
+}
+
+static PyObject *k_cross(PyObject *self, PyObject *args) {
+    PyObject *otri, *oidx, *ovis, *odraws, *opack, *osun_pack, *ohours, *osuns, *oo, *oframe,
+        *oo32;
+    double roulette;
+    Py_ssize_t n_tri, hour;
+    if (!PyArg_ParseTuple(args, "OOOOdOOnnOOOOO", &otri, &oidx, &ovis, &odraws, &roulette,
+                          &opack, &osun_pack, &n_tri, &hour, &ohours, &osuns, &oo, &oframe,
+                          &oo32))
+        return NULL;
+    Buf b[11] = {{{0}}};
+    if (get_flat(otri, &b[0], 0, 4, 0, "tri") < 0) goto fail;
+    const Py_ssize_t n = b[0].view.len / 4;
+    if (get_flat(oidx, &b[1], 1, 8, n, "idx") < 0) goto fail;
+    if (get_flat(ovis, &b[2], 1, 8, 0, "vis") < 0) goto fail;
+    const int has_draws = odraws != Py_None;
+    if (has_draws && get_flat(odraws, &b[3], 0, 8, 0, "draws") < 0) goto fail;
+    if (get_flat(opack, &b[4], 0, 8, 8 * n_tri, "pack") < 0) goto fail;
+    if (get_flat(osun_pack, &b[5], 0, 8, 0, "sun_pack") < 0) goto fail;
+    const int has_hours = ohours != Py_None;
+    if (has_hours && get_flat(ohours, &b[6], 1, 8, n, "hours") < 0) goto fail;
+    if (get_flat(osuns, &b[7], 0, 8, 3, "suns") < 0) goto fail;
+    if (get_rows(oo, &b[8], 1, n, "o") < 0) goto fail;
+    if (get_flat(oframe, &b[9], 0, 8, 4, "frame") < 0) goto fail;
+    if (get_flat(oo32, &b[10], 1, 4, 3 * n, "o32") < 0) goto fail;
+
+    const int32_t *tri = b[0].view.buf;
+    int64_t *idx = b[1].view.buf;
+    double *vis = b[2].view.buf;
+    const double *draws = has_draws ? b[3].view.buf : NULL;
+    const Py_ssize_t ndraws = has_draws ? b[3].view.len / 8 : 0;
+    const double *pack = b[4].view.buf;
+    const double *sun_pack = b[5].view.buf;
+    const Py_ssize_t nkeys = b[5].view.len / 16;
+    int64_t *hours = has_hours ? b[6].view.buf : NULL;
+    const double *suns = b[7].view.buf;
+    const Py_ssize_t nsuns = b[7].view.len / 24;
+    char *obase = b[8].view.buf;
+    const Py_ssize_t sr = b[8].view.strides[0] / 8, sc = b[8].view.strides[1] / 8;
+    double *ox = (double *)obase, *oy = ox + sr, *oz = ox + 2 * sr;
+    const double *fr = b[9].view.buf;
+    const double org0 = fr[0], org1 = fr[1], org2 = fr[2], scale = fr[3];
+    float *o32 = b[10].view.buf;
+    const Py_ssize_t nvis = b[2].view.len / 8;
+
+    Py_ssize_t m = 0, c = 0;
+    int bad = 0;
+    Py_BEGIN_ALLOW_THREADS
+    for (Py_ssize_t i = 0; i < n; i++) {
+        const int32_t t = tri[i];
+        if (t < 0)
+            continue;
+        const int64_t j = idx[i];
+        if (t >= n_tri || j < 0 || j >= nvis) {
+            bad = 1;
+            break;
+        }
+        double v = vis[j];
+        if (draws != NULL && v > 0.0 && v < roulette) {
+            if (c >= ndraws) {
+                bad = 2;
+                break;
+            }
+            /* keep = u · R < v; v = where(keep, R, 0) */
+            v = draws[c++] * roulette < v ? roulette : 0.0;
+            vis[j] = v;
+        }
+        if (!(v > 0.0))
+            continue;
+        const int64_t h = has_hours ? hours[i] : (int64_t)hour;
+        const int64_t key = (int64_t)t + h * (int64_t)n_tri;
+        const Py_ssize_t srow = has_hours ? (Py_ssize_t)h : 0;
+        if (key < 0 || key >= nkeys || srow >= nsuns) {
+            bad = 1;
+            break;
+        }
+        const double *p = pack + 8 * (Py_ssize_t)t; /* nx ny nz v0x v0y v0z ts 0 */
+        const double cos_sun = sun_pack[2 * key], side = sun_pack[2 * key + 1];
+        const double d0 = suns[3 * srow], d1 = suns[3 * srow + 1], d2 = suns[3 * srow + 2];
+        const double x = ox[i * sc], y = oy[i * sc], z = oz[i * sc];
+        /* (v0 - o) · n summed as einsum sums three products: (a0b0 + a2b2) + a1b1 */
+        const double w0 = (p[3] - x) * p[0];
+        const double w1 = (p[4] - y) * p[1];
+        const double w2 = (p[5] - z) * p[2];
+        double s = w0 + w2;
+        s = s + w1;
+        s = s / cos_sun;
+        if (s < 0.0) /* np.maximum(t, 0): a NaN stays NaN */
+            s = 0.0;
+        /* o + t d, then + n · (±ε) */
+        const double nx = (d0 * s + x) + p[0] * side;
+        const double ny = (d1 * s + y) + p[1] * side;
+        const double nz = (d2 * s + z) + p[2] * side;
+        ox[m * sc] = nx;
+        oy[m * sc] = ny;
+        oz[m * sc] = nz;
+        idx[m] = j;
+        if (has_hours)
+            hours[m] = h;
+        /* float32(o), − origin in float64, × scale, rounded to float32 */
+        o32[3 * m] = (float)((round32(nx) - org0) * scale);
+        o32[3 * m + 1] = (float)((round32(ny) - org1) * scale);
+        o32[3 * m + 2] = (float)((round32(nz) - org2) * scale);
+        m++;
+    }
+    if (!bad && draws != NULL && c != ndraws)
+        bad = 2;
+    Py_END_ALLOW_THREADS
+    release(b, 11);
+    if (bad == 1) {
+        PyErr_SetString(PyExc_IndexError, "triangle, ray or hour index out of range");
+        return NULL;
+    }
+    if (bad == 2) {
+        PyErr_SetString(PyExc_ValueError, "draws: one per faint shadow ray expected");
+        return NULL;
+    }
+    return PyLong_FromSsize_t(m);
+fail:
+    release(b, 11);
+    return NULL;
+}
+
+static PyObject *k_frame(PyObject *self, PyObject *args) {
+    PyObject *oo, *oframe, *oo32;
+    if (!PyArg_ParseTuple(args, "OOO", &oo, &oframe, &oo32))
+        return NULL;
+    Buf b[3] = {{{0}}};
+    if (get_rows(oo, &b[0], 0, 0, "o") < 0) goto fail;
+    const Py_ssize_t n = b[0].view.shape[1];
+    if (get_flat(oframe, &b[1], 0, 8, 4, "frame") < 0) goto fail;
+    if (get_flat(oo32, &b[2], 1, 4, 3 * n, "o32") < 0) goto fail;
+    const char *base = b[0].view.buf;
+    const Py_ssize_t sr = b[0].view.strides[0], sc = b[0].view.strides[1];
+    const double *fr = b[1].view.buf;
+    float *o32 = b[2].view.buf;
+    Py_BEGIN_ALLOW_THREADS
+    for (int a = 0; a < 3; a++) {
+        const char *row = base + a * sr;
+        const double org = fr[a], scale = fr[3];
+        for (Py_ssize_t i = 0; i < n; i++)
+            o32[3 * i + a] = (float)((round32(*(const double *)(row + i * sc)) - org) * scale);
+    }
+    Py_END_ALLOW_THREADS
+    release(b, 3);
+    Py_RETURN_NONE;
+fail:
+    release(b, 3);
+    return NULL;
+}
+
+static PyMethodDef methods[] = {
+    {"hits", k_hits, METH_VARARGS, "Shadow-ray hits: transmittance products, hits and faint."},
+    {"cross", k_cross, METH_VARARGS,
+     "Shadow rays past the surfaces they crossed: roulette, compaction, next origins."},
+    {"frame", k_frame, METH_VARARGS, "Origins (3, n) float64 to Embree's float32 frame (n, 3)."},
+    {NULL, NULL, 0, NULL}};
+
+static struct PyModuleDef module = {PyModuleDef_HEAD_INIT, "_kernel",
+                                    "The NumPy engine's fused shadow-ray kernel (optional).", -1,
+                                    methods};
+
+PyMODINIT_FUNC PyInit__kernel(void) { return PyModule_Create(&module); }
