@@ -113,19 +113,18 @@ def _weight(project: Project, sc: Scenario) -> int:
     photo (its analysis; a dome's cut along its sky outlines) 3, free crowns 2, other crowns
     1; 0 without a crown or with the crown in the build cache (:mod:`radtree.cache`)."""
     from radtree.config.photo import photo_of
-    from radtree.trees.build import apply_switches, crown_in_cache
+    from radtree.trees.build import crown_in_cache, scenario_tree
 
     if sc.model == "none":
         return 0
     try:
-        tree, _ = apply_switches(project.tree, dict(sc.switches), source=str(project.source))
-        if project.district is None:
-            eff = effective_project(project, sc)
-            if crown_in_cache(eff, sc, facade_frame(eff)):
-                return 0
+        eff = effective_project(project, sc) if project.district is None else project
+        tree, _, form = scenario_tree(eff, sc)
+        if project.district is None and crown_in_cache(eff, sc, facade_frame(eff), (tree, form)):
+            return 0
     except RadtreeError:
         return 0   # the build itself reports the error
-    return 3 if photo_of(tree)[0] is not None else 1 + int((sc.form or tree.form) == "free")
+    return 3 if photo_of(tree)[0] is not None else 1 + int(form == "free")
 
 
 def _build_all(project: Project, queue: list[Scenario], engine: Any, build_root: Path,

@@ -136,7 +136,7 @@ def _crown_of(project: Project, model: str, form: str, frame: FacadeFrame,
     return crown  # type: ignore[no-any-return]
 
 
-def _scenario_tree(project: Project, scenario: Scenario) -> tuple[Tree, list[str], str]:
+def scenario_tree(project: Project, scenario: Scenario) -> tuple[Tree, list[str], str]:
     """The scenario's ``[tree]`` after its switches, what they changed, and its form."""
     source = str(project.source)
     tree, changed = apply_switches(project.tree, scenario.switches, source=source,
@@ -148,20 +148,25 @@ def _scenario_tree(project: Project, scenario: Scenario) -> tuple[Tree, list[str
     return tree, changed, form
 
 
-def crown_in_cache(project: Project, scenario: Scenario, frame: FacadeFrame) -> bool:
+def crown_in_cache(project: Project, scenario: Scenario, frame: FacadeFrame,
+                   tree_form: tuple[Tree, str] | None = None) -> bool:
     """True when the build cache holds the scenario's crown (``project``: the scenario's
-    effective project), so building it costs no crown geometry."""
+    effective project), so building it costs no crown geometry. ``tree_form``: the scenario's
+    tree and form from :func:`scenario_tree` when the caller has them."""
     from radtree.cache import has_object
 
     if scenario.model == "none":
         return True
-    tree, _, form = _scenario_tree(project, scenario)
+    if tree_form is None:
+        tree, _, form = scenario_tree(project, scenario)
+    else:
+        tree, form = tree_form
     return has_object(_crown_key(project, scenario.model, form, frame, tree))
 
 
 def build_tree(project: Project, scenario: Scenario, frame: FacadeFrame) -> TreeModel:
     """The crown model of ``scenario`` (form, model and switches applied), in world space."""
-    tree, changed, form = _scenario_tree(project, scenario)
+    tree, changed, form = scenario_tree(project, scenario)
     model = _crown_of(project, scenario.model, form, frame, tree)
     if changed:
         model.notes.insert(0, f"Scenario '{scenario.name}' switches: " + "; ".join(changed) + ".")
