@@ -271,3 +271,31 @@ def test_unknown_sun_crown_is_refused():
 
     with pytest.raises(ConfigError, match="unknown sun crown 'slats'.*explicit, bsdf"):
         AnnualOptions(method="3phase", sun_crown="slats")
+
+
+@needs_radiance
+def test_default_method_reuses_the_three_phase_sun_runs(runs):
+    """One project, both methods: with ``sun_crown = "explicit"`` the 3-phase year's direct
+    and reflected sun are the default method's rcontrib runs, so a ``--method dc`` run after
+    it traces no sun again (the same files, untouched) and the two years differ only by the
+    sky (``benchmarks/threephase.py --sun-runs shared`` relies on it: two traces of the same
+    reflected sun differ by 34 % per point on the office example)."""
+    from radtree.annual.methods import compute as compute_annual
+    from radtree.annual.run import AnnualOptions
+
+    project, first, _, _, _ = runs
+    coeffs = project.results_dir / "annual" / "coefficients"
+    before = {f: f.stat().st_mtime_ns for s in ("leaf_on", "leaf_off")
+              for f in (coeffs / s).glob("sun_*.npy")}
+    assert len(before) == 6                  # direct, patch -ab 0, patch -ab N per state
+    dc = compute_annual(project, AnnualOptions(nproc=1, method="dc", sun_ad=32),
+                        echo=lambda s: None)
+    after = {f: f.stat().st_mtime_ns for s in ("leaf_on", "leaf_off")
+             for f in (coeffs / s).glob("sun_*.npy")}
+    assert after == before
+    for state in ("leaf_on", "leaf_off"):
+        for g in first.direct[state]:
+            np.testing.assert_array_equal(dc.direct[state][g], first.direct[state][g])
+    # the sky is what differs: the totals are not the same numbers
+    assert any(not np.array_equal(dc.total["leaf_on"][g], first.total["leaf_on"][g])
+               for g in first.total["leaf_on"])
