@@ -157,7 +157,7 @@ def test_frame_conversion_equals_numpy():
 @needs_kernel
 @pytest.mark.parametrize("states", [1, 3])
 def test_crossing_equals_the_numpy_crossing(monkeypatch, states):
-    """One ``hits`` + ``cross`` on hits of given triangles: the next origins equal
+    """One ``cross`` + ``roulette`` on hits of given triangles: the next origins equal
     ``shadow.crossed_sun``'s (and so ``crossed``'s plane-distance arithmetic) to the bit, their
     float32 copies NumPy's conversion, the roulette NumPy's ``u · R < v``, the compaction
     ``(v > 0).nonzero()``'s order."""
@@ -172,7 +172,7 @@ def test_crossing_equals_the_numpy_crossing(monkeypatch, states):
     tri = rng.integers(-1, tr.n_tri, n).astype(np.int32)  # -1: a miss
     o = np.ascontiguousarray((tr.geo.centroids[tri] + rng.normal(scale=0.3, size=(n, 3))).T)
     hour = rng.integers(0, states, n)
-    vis = rng.choice([1.0, 0.5, 0.03, 0.01, 0.001], n)
+    vis = rng.choice([1.0, 0.5, 0.03, 0.01, 0.001, 0.0], n)
     idx = rng.permutation(n).astype(np.int64)
     hit = (tri >= 0).nonzero()[0]
     # NumPy: the transmittance loop's steps
@@ -186,7 +186,7 @@ def test_crossing_equals_the_numpy_crossing(monkeypatch, states):
     d = sun.take(hour[go], axis=0) if states > 1 else np.broadcast_to(sun[0], (len(go), 3))
     ref_o = shadow.crossed_sun(tr, o[:, go], d, tri[go].astype(np.intp), h)
     ref_vis = vis.copy()
-    ref_vis[idx[hit]] = np.where(v > 0, v, 0.0)
+    ref_vis[idx[hit]] = v
     ref32 = np.array(ref_o, np.float32)
     ref32 = np.multiply(np.subtract(ref32, tr.caster.frame[:3, None], dtype=np.float64),
                         tr.caster.frame[3], out=ref32, casting="same_kind").T
@@ -194,10 +194,11 @@ def test_crossing_equals_the_numpy_crossing(monkeypatch, states):
     kv, ki, ko = vis.copy(), idx.copy(), o.copy()
     hours = hour.astype(np.int64) if states > 1 else None
     o32 = np.empty((n, 3), np.float32)
-    assert k_mod.hits(tri, ki, kv, tr.tri_pack, shadow.SHADOW_ROULETTE) == (len(hit),
-                                                                             len(u))
-    m = k_mod.cross(tri, ki, kv, u, shadow.SHADOW_ROULETTE, tr.tri_pack, tr.sun_pack,
-                    tr.n_tri, 0, hours, np.ascontiguousarray(sun), ko, tr.caster.frame, o32)
+    n_hit, m, n_faint = k_mod.cross(tri, ki, kv, shadow.SHADOW_ROULETTE, tr.tri_pack,
+                                    tr.sun_cos, tr.n_tri, 0, hours, np.ascontiguousarray(sun),
+                                    tr.eps, ko, tr.caster.frame, o32)
+    assert (n_hit, n_faint) == (len(hit), len(u)) and m > len(go)
+    m = k_mod.roulette(ki, kv, hours, ko, o32, m, u, shadow.SHADOW_ROULETTE)
     assert m == len(go) and 0 < m < len(hit)
     assert np.array_equal(ko[:, :m], ref_o)
     assert np.array_equal(o32[:m], ref32)

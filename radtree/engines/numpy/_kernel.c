@@ -9,18 +9,24 @@
  * Arrays arrive through the buffer protocol (no NumPy headers at build time); the Python side
  * (radtree/engines/numpy/kernel.py) checks dtypes and shapes before calling.
  *
- *   hits(tri, idx, vis, pack, roulette) -> (hits, faint)
- *       for every ray i that hit (tri[i] >= 0): vis[idx[i]] *= its triangle's specular
- *       transmittance (pack: 8 numbers a triangle, nx ny nz v0x v0y v0z ts 0);
- *       counts the hits and the faint ones (0 < v < roulette).
- *   cross(tri, idx, vis, draws, roulette, pack, sun_pack, n_tri, hour, hours, suns, o,
- *         frame, o32) -> m
- *       for the hits, in order: Russian roulette on the faint ones with draws (None: none),
- *       then for the rays that go on (v > 0), compacted in place to the front of idx, hours
- *       and o (3, n): the next origin o + t d ± ε n past the triangle crossed (t: the plane
- *       distance towards the point sun d — suns[hours[i]], or suns[0] when hours is None and
- *       every ray has the state `hour` — summed as einsum sums three products,
- *       (a0 b0 + a2 b2) + a1 b1) and its float32 copy in trimesh's Embree frame, o32 (n, 3).
+ *   cross(tri, idx, vis, roulette, pack, sun_cos, n_tri, hour, hours, suns, eps, o, frame,
+ *         o32) -> (hits, m, faint)
+ *       one pass over the rays in order: for each ray i that hit (tri[i] >= 0), v =
+ *       vis[idx[i]] · its triangle's specular transmittance, stored in vis; the rays with
+ *       v > 0 (m of them, `faint` of them with v < roulette) are compacted in place to the
+ *       front of idx, hours and o (3, n) with the next origin o + t d ± ε n past the triangle
+ *       crossed (t: the plane distance towards the point sun d — suns[hours[i]], or suns[0]
+ *       when hours is None and every ray has the state `hour` — summed as einsum sums three
+ *       products, (a0 b0 + a2 b2) + a1 b1; ±ε on the side sun · n says, as the engine's
+ *       table) and its float32 copy in trimesh's Embree frame, o32 (n, 3).
+ *       pack: 8 numbers a triangle, nx ny nz v0x v0y v0z ts cos (cos = sun · n of state 0,
+ *       the other states' in sun_cos[state · n_tri + triangle]): one cache line a crossing.
+ *   roulette(idx, vis, hours, o, o32, m, draws, roulette) -> m'
+ *       Russian roulette on the faint rays among the first m (keep = u · R < v: v = R, else
+ *       0), one draw each in order; the survivors compacted in place (order kept).
+ *   The two together do what the NumPy loop does per crossing (transmittance, roulette, the
+ *   rays going on, their next origins): the origins of faint rays the roulette then drops
+ *   are computed and discarded.
  *   frame(o, frame, o32) -> None
  *       o (3, n), any strides -> o32 (n, 3): float32(o), - origin in float64, × scale,
  *       rounded to float32 (EmbreeCaster._query's conversion).
@@ -36,6 +42,13 @@ static inline double round32(double x) {
     volatile float f = (float)x;
     return (double)f;
 }
+
+#ifndef PREFETCH
+#define PREFETCH 16
+#endif
+#if !defined(__GNUC__) && !defined(__clang__)
+#define __builtin_prefetch(p) ((void)0)
+#endif
 
 typedef struct {
     Py_buffer view;
@@ -81,98 +94,53 @@ static int get_rows(PyObject *obj, Buf *b, int writable, Py_ssize_t need, const 
     return 0;
 }
 
-static PyObject *k_hits(PyObject *self, PyObject *args) {
-    PyObject *otri, *oidx, *ovis, *opack;
-    double roulette;
-    if (!PyArg_ParseTuple(args, "OOOOd", &otri, &oidx, &ovis, &opack, &roulette))
-        return NULL;
-    Buf b[4] = {{{0}}};
-    if (get_flat(otri, &b[0], 0, 4, 0, "tri") < 0) goto fail;
-    Py_ssize_t n = b[0].view.len / 4;
-    if (get_flat(oidx, &b[1], 0, 8, n, "idx") < 0) goto fail;
-    if (get_flat(ovis, &b[2], 1, 8, 0, "vis") < 0) goto fail;
-    if (get_flat(opack, &b[3], 0, 8, 0, "pack") < 0) goto fail;
-    const int32_t *tri = b[0].view.buf;
-    const int64_t *idx = b[1].view.buf;
-    double *vis = b[2].view.buf;
-    const double *pack = b[3].view.buf;
-    const Py_ssize_t nvis = b[2].view.len / 8, ntri = b[3].view.len / 64;
-    Py_ssize_t hits = 0, faint = 0, bad = 0;
-    Py_BEGIN_ALLOW_THREADS
-    for (Py_ssize_t i = 0; i < n; i++) {
-        const int32_t t = tri[i];
-        if (t < 0)
-            continue;
-        const int64_t j = idx[i];
-        if (t >= ntri || j < 0 || j >= nvis) {
-            bad = 1;
-            break;
-        }
-        const double v = vis[j] * pack[8 * (Py_ssize_t)t + 6];
-        vis[j] = v;
-        hits++;
-        faint += (v > 0.0) & (v < roulette);
-    }
-    Py_END_ALLOW_THREADS
-    release(b, 4);
-    if (bad) {
-        PyErr_SetString(PyExc_IndexError, "triangle or ray index out of range");
-        return NULL;
-    }
-    return Py_BuildValue("nn", hits, faint);
-fail:
-    release(b, 4);
-    return NULL;
-}
-
 static PyObject *k_cross(PyObject *self, PyObject *args) {
-    PyObject *otri, *oidx, *ovis, *odraws, *opack, *osun_pack, *ohours, *osuns, *oo, *oframe,
-        *oo32;
-    double roulette;
+    PyObject *otri, *oidx, *ovis, *opack, *osun_cos, *ohours, *osuns, *oo, *oframe, *oo32;
+    double roulette, eps;
     Py_ssize_t n_tri, hour;
-    if (!PyArg_ParseTuple(args, "OOOOdOOnnOOOOO", &otri, &oidx, &ovis, &odraws, &roulette,
-                          &opack, &osun_pack, &n_tri, &hour, &ohours, &osuns, &oo, &oframe,
-                          &oo32))
+    if (!PyArg_ParseTuple(args, "OOOdOOnnOOdOOO", &otri, &oidx, &ovis, &roulette, &opack,
+                          &osun_cos, &n_tri, &hour, &ohours, &osuns, &eps, &oo, &oframe, &oo32))
         return NULL;
-    Buf b[11] = {{{0}}};
+    Buf b[10] = {{{0}}};
     if (get_flat(otri, &b[0], 0, 4, 0, "tri") < 0) goto fail;
     const Py_ssize_t n = b[0].view.len / 4;
     if (get_flat(oidx, &b[1], 1, 8, n, "idx") < 0) goto fail;
     if (get_flat(ovis, &b[2], 1, 8, 0, "vis") < 0) goto fail;
-    const int has_draws = odraws != Py_None;
-    if (has_draws && get_flat(odraws, &b[3], 0, 8, 0, "draws") < 0) goto fail;
-    if (get_flat(opack, &b[4], 0, 8, 8 * n_tri, "pack") < 0) goto fail;
-    if (get_flat(osun_pack, &b[5], 0, 8, 0, "sun_pack") < 0) goto fail;
+    if (get_flat(opack, &b[3], 0, 8, 8 * n_tri, "pack") < 0) goto fail;
+    if (get_flat(osun_cos, &b[4], 0, 8, 0, "sun_cos") < 0) goto fail;
     const int has_hours = ohours != Py_None;
-    if (has_hours && get_flat(ohours, &b[6], 1, 8, n, "hours") < 0) goto fail;
-    if (get_flat(osuns, &b[7], 0, 8, 3, "suns") < 0) goto fail;
-    if (get_rows(oo, &b[8], 1, n, "o") < 0) goto fail;
-    if (get_flat(oframe, &b[9], 0, 8, 4, "frame") < 0) goto fail;
-    if (get_flat(oo32, &b[10], 1, 4, 3 * n, "o32") < 0) goto fail;
+    if (has_hours && get_flat(ohours, &b[5], 1, 8, n, "hours") < 0) goto fail;
+    if (get_flat(osuns, &b[6], 0, 8, 3, "suns") < 0) goto fail;
+    if (get_rows(oo, &b[7], 1, n, "o") < 0) goto fail;
+    if (get_flat(oframe, &b[8], 0, 8, 4, "frame") < 0) goto fail;
+    if (get_flat(oo32, &b[9], 1, 4, 3 * n, "o32") < 0) goto fail;
 
     const int32_t *tri = b[0].view.buf;
     int64_t *idx = b[1].view.buf;
     double *vis = b[2].view.buf;
-    const double *draws = has_draws ? b[3].view.buf : NULL;
-    const Py_ssize_t ndraws = has_draws ? b[3].view.len / 8 : 0;
-    const double *pack = b[4].view.buf;
-    const double *sun_pack = b[5].view.buf;
-    const Py_ssize_t nkeys = b[5].view.len / 16;
-    int64_t *hours = has_hours ? b[6].view.buf : NULL;
-    const double *suns = b[7].view.buf;
-    const Py_ssize_t nsuns = b[7].view.len / 24;
-    char *obase = b[8].view.buf;
-    const Py_ssize_t sr = b[8].view.strides[0] / 8, sc = b[8].view.strides[1] / 8;
-    double *ox = (double *)obase, *oy = ox + sr, *oz = ox + 2 * sr;
-    const double *fr = b[9].view.buf;
-    const double org0 = fr[0], org1 = fr[1], org2 = fr[2], scale = fr[3];
-    float *o32 = b[10].view.buf;
     const Py_ssize_t nvis = b[2].view.len / 8;
+    const double *pack = b[3].view.buf;
+    const double *sun_cos = b[4].view.buf;
+    const Py_ssize_t nkeys = b[4].view.len / 8;
+    int64_t *hours = has_hours ? b[5].view.buf : NULL;
+    const double *suns = b[6].view.buf;
+    const Py_ssize_t nsuns = b[6].view.len / 24;
+    double *ox = b[7].view.buf;
+    const Py_ssize_t sr = b[7].view.strides[0] / 8, sc = b[7].view.strides[1] / 8;
+    double *oy = ox + sr, *oz = ox + 2 * sr;
+    const double *fr = b[8].view.buf;
+    const double org0 = fr[0], org1 = fr[1], org2 = fr[2], scale = fr[3];
+    float *o32 = b[9].view.buf;
 
-    Py_ssize_t m = 0, c = 0;
+    Py_ssize_t hits = 0, m = 0, faint = 0;
     int bad = 0;
     Py_BEGIN_ALLOW_THREADS
     for (Py_ssize_t i = 0; i < n; i++) {
+        if (i + PREFETCH < n) { /* the triangle rows of later rays (random addresses) */
+            const int32_t ta = tri[i + PREFETCH];
+            if (ta >= 0 && ta < n_tri)
+                __builtin_prefetch(pack + 8 * (Py_ssize_t)ta);
+        }
         const int32_t t = tri[i];
         if (t < 0)
             continue;
@@ -181,27 +149,31 @@ static PyObject *k_cross(PyObject *self, PyObject *args) {
             bad = 1;
             break;
         }
-        double v = vis[j];
-        if (draws != NULL && v > 0.0 && v < roulette) {
-            if (c >= ndraws) {
-                bad = 2;
-                break;
-            }
-            /* keep = u · R < v; v = where(keep, R, 0) */
-            v = draws[c++] * roulette < v ? roulette : 0.0;
-            vis[j] = v;
-        }
+        const double *p = pack + 8 * (Py_ssize_t)t; /* nx ny nz v0x v0y v0z ts cos */
+        const double v = vis[j] * p[6];
+        vis[j] = v;
+        hits++;
         if (!(v > 0.0))
             continue;
+        faint += v < roulette;
         const int64_t h = has_hours ? hours[i] : (int64_t)hour;
-        const int64_t key = (int64_t)t + h * (int64_t)n_tri;
         const Py_ssize_t srow = has_hours ? (Py_ssize_t)h : 0;
-        if (key < 0 || key >= nkeys || srow >= nsuns) {
+        double cos_sun;
+        if (h == 0) {
+            cos_sun = p[7];
+        } else {
+            const int64_t key = (int64_t)t + h * (int64_t)n_tri;
+            if (key < 0 || key >= nkeys) {
+                bad = 1;
+                break;
+            }
+            cos_sun = sun_cos[key];
+        }
+        if (srow < 0 || srow >= nsuns) {
             bad = 1;
             break;
         }
-        const double *p = pack + 8 * (Py_ssize_t)t; /* nx ny nz v0x v0y v0z ts 0 */
-        const double cos_sun = sun_pack[2 * key], side = sun_pack[2 * key + 1];
+        const double side = cos_sun < 0 ? -eps : eps;
         const double d0 = suns[3 * srow], d1 = suns[3 * srow + 1], d2 = suns[3 * srow + 2];
         const double x = ox[i * sc], y = oy[i * sc], z = oz[i * sc];
         /* (v0 - o) · n summed as einsum sums three products: (a0b0 + a2b2) + a1b1 */
@@ -229,21 +201,94 @@ static PyObject *k_cross(PyObject *self, PyObject *args) {
         o32[3 * m + 2] = (float)((round32(nz) - org2) * scale);
         m++;
     }
-    if (!bad && draws != NULL && c != ndraws)
+    Py_END_ALLOW_THREADS
+    release(b, 10);
+    if (bad) {
+        PyErr_SetString(PyExc_IndexError, "triangle, ray or hour index out of range");
+        return NULL;
+    }
+    return Py_BuildValue("nnn", hits, m, faint);
+fail:
+    release(b, 10);
+    return NULL;
+}
+
+static PyObject *k_roulette(PyObject *self, PyObject *args) {
+    PyObject *oidx, *ovis, *ohours, *oo, *oo32, *odraws;
+    Py_ssize_t m;
+    double roulette;
+    if (!PyArg_ParseTuple(args, "OOOOOnOd", &oidx, &ovis, &ohours, &oo, &oo32, &m, &odraws,
+                          &roulette))
+        return NULL;
+    Buf b[6] = {{{0}}};
+    if (m < 0) {
+        PyErr_SetString(PyExc_ValueError, "m must be >= 0");
+        return NULL;
+    }
+    if (get_flat(oidx, &b[0], 1, 8, m, "idx") < 0) goto fail;
+    if (get_flat(ovis, &b[1], 1, 8, 0, "vis") < 0) goto fail;
+    const int has_hours = ohours != Py_None;
+    if (has_hours && get_flat(ohours, &b[2], 1, 8, m, "hours") < 0) goto fail;
+    if (get_rows(oo, &b[3], 1, m, "o") < 0) goto fail;
+    if (get_flat(oo32, &b[4], 1, 4, 3 * m, "o32") < 0) goto fail;
+    if (get_flat(odraws, &b[5], 0, 8, 0, "draws") < 0) goto fail;
+    int64_t *idx = b[0].view.buf;
+    double *vis = b[1].view.buf;
+    const Py_ssize_t nvis = b[1].view.len / 8;
+    int64_t *hours = has_hours ? b[2].view.buf : NULL;
+    double *ox = b[3].view.buf;
+    const Py_ssize_t sr = b[3].view.strides[0] / 8, sc = b[3].view.strides[1] / 8;
+    float *o32 = b[4].view.buf;
+    const double *draws = b[5].view.buf;
+    const Py_ssize_t ndraws = b[5].view.len / 8;
+    Py_ssize_t w = 0, c = 0;
+    int bad = 0;
+    Py_BEGIN_ALLOW_THREADS
+    for (Py_ssize_t i = 0; i < m; i++) {
+        const int64_t j = idx[i];
+        if (j < 0 || j >= nvis) {
+            bad = 1;
+            break;
+        }
+        const double v = vis[j];
+        if (v > 0.0 && v < roulette) {
+            if (c >= ndraws) {
+                bad = 2;
+                break;
+            }
+            /* keep = u · R < v; v = where(keep, R, 0) */
+            if (!(draws[c++] * roulette < v)) {
+                vis[j] = 0.0;
+                continue;
+            }
+            vis[j] = roulette;
+        }
+        if (w != i) {
+            ox[w * sc] = ox[i * sc];
+            ox[sr + w * sc] = ox[sr + i * sc];
+            ox[2 * sr + w * sc] = ox[2 * sr + i * sc];
+            memcpy(o32 + 3 * w, o32 + 3 * i, 3 * sizeof(float));
+            idx[w] = j;
+            if (has_hours)
+                hours[w] = hours[i];
+        }
+        w++;
+    }
+    if (!bad && c != ndraws)
         bad = 2;
     Py_END_ALLOW_THREADS
-    release(b, 11);
+    release(b, 6);
     if (bad == 1) {
-        PyErr_SetString(PyExc_IndexError, "triangle, ray or hour index out of range");
+        PyErr_SetString(PyExc_IndexError, "ray index out of range");
         return NULL;
     }
     if (bad == 2) {
         PyErr_SetString(PyExc_ValueError, "draws: one per faint shadow ray expected");
         return NULL;
     }
-    return PyLong_FromSsize_t(m);
+    return PyLong_FromSsize_t(w);
 fail:
-    release(b, 11);
+    release(b, 6);
     return NULL;
 }
 
@@ -276,9 +321,10 @@ fail:
 }
 
 static PyMethodDef methods[] = {
-    {"hits", k_hits, METH_VARARGS, "Shadow-ray hits: transmittance products, hits and faint."},
     {"cross", k_cross, METH_VARARGS,
-     "Shadow rays past the surfaces they crossed: roulette, compaction, next origins."},
+     "Shadow rays past the surfaces they crossed: transmittance, compaction, next origins."},
+    {"roulette", k_roulette, METH_VARARGS,
+     "Russian roulette on the faint shadow rays going on, survivors compacted."},
     {"frame", k_frame, METH_VARARGS, "Origins (3, n) float64 to Embree's float32 frame (n, 3)."},
     {NULL, NULL, 0, NULL}};
 

@@ -186,14 +186,11 @@ class _Tracer:
         self.sun_cos = cos.reshape(-1)
         self.sun_side = np.where(self.sun_cos < 0, -self.eps, self.eps)
         self.sun_grazing = bool(np.any(np.abs(self.sun_cos) < 1e-12))  # plane_distance's test
-        # the C kernel's tables (radtree.engines.numpy.kernel): per triangle its normal, first
-        # vertex and specular transmittance in one 64-byte row; per (hour, triangle) the
-        # cosine and the offset above, side by side
+        # the C kernel's table (radtree.engines.numpy.kernel): per triangle its normal, first
+        # vertex, specular transmittance and cosine to the first state's sun, one 64-byte row
         self.tri_pack: np.ndarray | None = None
-        self.sun_pack: np.ndarray | None = None
         if kernel() is not None:
-            self.tri_pack = kernel_tables(geo.normals, geo.v0, self.tri_ts)
-            self.sun_pack = np.ascontiguousarray(np.stack([self.sun_cos, self.sun_side], axis=1))
+            self.tri_pack = kernel_tables(geo.normals, geo.v0, self.tri_ts, self.sun_cos)
 
     def sky(self, d: np.ndarray, hour: np.ndarray | None) -> np.ndarray:
         """Luminance seen along escaping directions ``d`` (each path's own hour state)."""

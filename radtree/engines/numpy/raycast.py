@@ -110,7 +110,7 @@ class EmbreeCaster:
         # the frame for the C kernel: origin (3) and scale, float64
         self.frame = np.array([*self._origin_t[:, 0], self._embree.scale], np.float64)
 
-    def _dir32(self, d: np.ndarray) -> np.ndarray:
+    def directions32(self, d: np.ndarray) -> np.ndarray:
         """Directions ``d`` (n, 3) as the float32 unit rows ``intersects_first`` makes; one
         direction (a broadcast row: the point sun) is converted once and handed to Embree as
         that broadcast row."""
@@ -131,7 +131,7 @@ class EmbreeCaster:
         its per-call overhead, on rows of all rays (a (3, n) array, handed to Embree as its
         transpose; with the C kernel converted in one pass into an (n, 3) array, the same
         float32 numbers)."""
-        d32 = self._dir32(d)
+        d32 = self.directions32(d)
         k = kernel()
         if k is not None:
             o32 = np.empty((o_t.shape[1], 3), np.float32)
@@ -148,15 +148,15 @@ class EmbreeCaster:
         one place the caster calls Embree."""
         return self._embree.scene.run(o32, d32)
 
-    def query_frame(self, o32: np.ndarray, directions: np.ndarray, parallel: bool = True
+    def query_frame(self, o32: np.ndarray, d32: np.ndarray, parallel: bool = True
                     ) -> np.ndarray:
-        """:meth:`query` of origins already converted to Embree's float32 frame, ``o32``
-        (n, 3) (the C kernel writes them with the next origins: ``frame`` holds the origin
-        and scale of that frame)."""
+        """:meth:`query` of rays already converted for Embree: origins ``o32`` (n, 3) in its
+        float32 frame (the C kernel writes them with the next origins; ``frame`` holds the
+        origin and scale of that frame) and float32 unit directions ``d32`` (n, 3, or one
+        broadcast row) from :meth:`directions32`."""
         n = len(o32)
         if n == 0:
             return np.zeros(0, np.int32)
-        d32 = self._dir32(directions)
         parts = self._parts(n, parallel)
         if parts is not None and self._pool is not None:
             return np.concatenate(list(self._pool.map(

@@ -49,7 +49,6 @@ class ShadowTracer(Protocol):
     sun_grazing: bool
     suns: np.ndarray
     tri_pack: np.ndarray | None
-    sun_pack: np.ndarray | None
 
     @property
     def opts(self) -> _Options:
@@ -141,10 +140,11 @@ def transmittance(tr: ShadowTracer, origins: np.ndarray, dirs: np.ndarray,
     return vis
 
 
-def kernel_tables(normals: np.ndarray, v0: np.ndarray, ts: np.ndarray
+def kernel_tables(normals: np.ndarray, v0: np.ndarray, ts: np.ndarray, sun_cos: np.ndarray
                   ) -> np.ndarray:
     """The C kernel's per-triangle rows (n, 8): normal, first vertex, specular transmittance
-    and a 0, one 64-byte row a triangle (one cache line where the allocation allows)."""
+    and the cosine sun · normal of the first hour state — what a crossing needs, in one
+    64-byte row (one cache line where the allocation allows)."""
     n = len(normals)
     raw = np.zeros(8 * n + 8)
     skip = (-raw.ctypes.data % 64) // 8  # a row starts on a 64-byte boundary
@@ -152,6 +152,7 @@ def kernel_tables(normals: np.ndarray, v0: np.ndarray, ts: np.ndarray
     pack[:, 0:3] = normals
     pack[:, 3:6] = v0
     pack[:, 6] = ts
+    pack[:, 7] = sun_cos[:n]
     return pack
 
 
@@ -159,9 +160,10 @@ def _transmittance_c(k_mod: Any, tr: ShadowTracer, origins: np.ndarray, dirs: np
                      rng: Draws | np.random.Generator | None, tag: tuple[int, ...],
                      parallel: bool, hour: np.ndarray | int) -> np.ndarray:
     """:func:`transmittance` towards the point sun through Embree with the C kernel: per
-    crossing one Embree query, one pass for the transmittance products (``hits``), the
-    roulette draws in NumPy, one pass for roulette, compaction, next origins and their float32
-    copy in Embree's frame (``cross``). The same numbers as the NumPy loop."""
+    crossing one Embree query and one pass (``cross``: transmittance products, the rays going
+    on, their next origins and float32 copies in Embree's frame), and when some are faint
+    the roulette draws in NumPy and a pass over the rays going on (``roulette``). The same
+    numbers as the NumPy loop."""
     caster = tr.caster
     assert isinstance(caster, EmbreeCaster)
     k = len(origins)
@@ -170,29 +172,28 @@ def _transmittance_c(k_mod: Any, tr: ShadowTracer, origins: np.ndarray, dirs: np
     o = np.array(np.asarray(origins, float).T, order="C")  # (3, k), compacted in place
     o32 = np.empty((k, 3), np.float32)
     k_mod.frame(o, caster.frame, o32)
+    d = np.asarray(dirs, float)
     if isinstance(hour, np.ndarray):  # several hour states: each ray towards its own sun
         hours: np.ndarray | None = np.array(hour, dtype=np.int64)
         h0, suns = 0, np.ascontiguousarray(tr.suns, dtype=float)
-        d = np.asarray(dirs, float)
     else:
-        hours, h0 = None, int(hour)
-        d = np.asarray(dirs, float)
-        suns = np.array(d[0], dtype=float)
-    pack, sun_pack = tr.tri_pack, tr.sun_pack
+        hours, h0, suns = None, int(hour), np.array(d[0], dtype=float)
+    pack, sun_cos, n_tri, eps, frame = tr.tri_pack, tr.sun_cos, tr.n_tri, tr.eps, caster.frame
+    d32 = caster.directions32(d)  # one broadcast row for a point sun
     m = k
     for layer in range(tr.opts.max_shadow_layers):
-        tri = caster.query_frame(o32[:m], d[:m] if hours is None or layer == 0 else
-                                 tr.suns.take(hours[:m], axis=0), parallel)
-        n_hit, n_faint = k_mod.hits(tri, idx, vis, pack, SHADOW_ROULETTE)
+        if hours is not None and layer:
+            d32 = caster.directions32(tr.suns.take(hours[:m], axis=0))
+        tri = caster.query_frame(o32[:m], d32[:m], parallel)
+        n_hit, m, n_faint = k_mod.cross(tri, idx, vis, SHADOW_ROULETTE, pack, sun_cos, n_tri,
+                                        h0, hours, suns, eps, o, frame, o32)
         if n_hit == 0:
             return vis
-        draws = None
         if rng is not None and n_faint:
             if tag:
                 rng.at(*tag, layer)  # type: ignore[union-attr]
-            draws = rng.random(n_faint)
-        m = k_mod.cross(tri, idx, vis, draws, SHADOW_ROULETTE, pack, sun_pack, tr.n_tri, h0,
-                        hours, suns, o, caster.frame, o32)
+            m = k_mod.roulette(idx, vis, hours, o, o32, m, rng.random(n_faint),
+                               SHADOW_ROULETTE)
         if m == 0:
             return vis
     vis[idx[:m]] = 0.0
