@@ -206,3 +206,68 @@ def test_crossing_equals_the_numpy_crossing(monkeypatch, states):
     assert np.array_equal(kv, ref_vis)
     if hours is not None:
         assert np.array_equal(hours[:m], hour[go])
+
+
+@needs_kernel
+def test_first_hit_distances_equal_plane_distance():
+    """``distances`` (EmbreeCaster._chunk with the kernel) against ``plane_distance``: hits,
+    misses (inf), grazing rays (the centroid's distance), a broadcast direction row."""
+    from radtree.engines.numpy.raycast import plane_distance
+
+    k_mod = kernel._load()[0]
+    scene, _ = _scene()
+    tr, _ = tracing._tracer(scene, _scene()[1][0], EngineParams(rays=8), None,
+                            DEFAULT_OPTIONS)
+    c = tr.caster
+    assert isinstance(c, EmbreeCaster)
+    rng = np.random.default_rng(4)
+    n = 8000
+    tri = rng.integers(-1, tr.n_tri, n).astype(np.int32)
+    o = c._centroids[tri] + rng.normal(scale=0.5, size=(n, 3))
+    d = rng.normal(size=(n, 3))
+    d /= np.linalg.norm(d, axis=1)[:, None]
+    g = rng.random(n) < 0.05  # grazing: d in the triangle's plane
+    d[g] = np.cross(c._normals[tri[g]], rng.normal(size=(int(g.sum()), 3)))
+    d[g] /= np.linalg.norm(d[g], axis=1)[:, None]
+    for dirs in (d, np.broadcast_to(d[0], (n, 3))):
+        idx, t = np.empty(n, np.int64), np.empty(n)
+        assert k_mod.distances(tri, o, dirs, c._rows, c._centroids, idx, t) == (tri >= 0).sum()
+        hit = (tri >= 0).nonzero()[0]
+        ref = np.full(n, np.inf)
+        ref[hit] = plane_distance(c._v0, c._normals, c._centroids, o[hit],
+                                  np.ascontiguousarray(dirs[hit]), tri[hit].astype(np.intp))
+        assert np.array_equal(idx, tri) and np.array_equal(t, ref)
+        assert np.any(t == 0) and np.any(np.isinf(t)) and np.any(t > 0)
+
+
+@needs_kernel
+@pytest.mark.parametrize("states", [1, 3])
+def test_surface_equals_the_path_loop_arithmetic(states):
+    """``surface`` against the path loop's NumPy lines: hit points ``t[:, None] * d + o``,
+    cosines by einsum, facing normals by ``where``, event coefficients by ``take``."""
+    k_mod = kernel._load()[0]
+    scene, hours = _scene(states)
+    tr, _ = tracing._tracer(scene, hours[0], EngineParams(rays=8), None, DEFAULT_OPTIONS,
+                            hours[1:])
+    assert tr.tri_pack is not None
+    rng = np.random.default_rng(6)
+    n = 7000
+    tri = rng.integers(0, tr.n_tri, n)
+    t = rng.random(n) * 10.0 ** rng.uniform(-4, 1, n)
+    o = rng.normal(scale=3.0, size=(n, 3))
+    d = rng.normal(size=(n, 3))
+    d /= np.linalg.norm(d, axis=1)[:, None]
+    hour = rng.integers(0, states, n) if states > 1 else None
+    p, nf, cosd, coef = np.empty((n, 3)), np.empty((n, 3)), np.empty(n), np.empty((4, n))
+    k_mod.surface(tri, t, o, d, tr.tri_pack, tr.tri_coef_t if hour is None else
+                  tr.tri_coefs_flat_t, hour, tr.n_tri, p, nf, cosd, coef)
+    ref_p = t[:, None] * d
+    ref_p += o
+    ng = tr.geo.normals.take(tri, axis=0)
+    ref_cos = np.einsum("ij,ij->i", d, ng)
+    ref_nf = np.where((ref_cos < 0)[:, None], ng, -ng)
+    ref_coef = (tr.tri_coef_t.take(tri, axis=1) if hour is None else
+                tr.tri_coefs_flat_t.take(hour * tr.n_tri + tri, axis=1))
+    assert np.array_equal(p, ref_p) and np.array_equal(cosd, ref_cos)
+    assert np.array_equal(nf, ref_nf) and np.array_equal(coef, ref_coef)
+    assert np.any(ref_cos < 0) and np.any(ref_cos > 0)

@@ -27,12 +27,23 @@
  *   The two together do what the NumPy loop does per crossing (transmittance, roulette, the
  *   rays going on, their next origins): the origins of faint rays the roulette then drops
  *   are computed and discarded.
+ *   distances(tri, o, d, pack, centroids, idx, t) -> hits
+ *       the first hits of rays (EmbreeCaster._chunk + raycast.plane_distance): idx = tri as
+ *       int64, t = the distance along d (n, 3, any strides: a broadcast row too) from o
+ *       (n, 3) to the plane of the triangle hit — (v0 − o) · n / (d · n), both dot products
+ *       summed as einsum sums them; |d · n| < 1e-12: (centroid − o) · d — at least 0, inf
+ *       for a miss.
+ *   surface(tri, t, o, d, rows, coef_t, hours, n_tri, p, nf, cosd, coef) -> None
+ *       where the paths' rays hit (engine._Tracer.paths): p = o + t d, cosd = d · n (einsum's
+ *       order), nf = n or −n facing the ray (n where cosd < 0), coef (4, k) = the triangle's
+ *       column of coef_t (4, N) — column hours[i] · n_tri + tri[i] when hours is given.
  *   frame(o, frame, o32) -> None
  *       o (3, n), any strides -> o32 (n, 3): float32(o), - origin in float64, × scale,
  *       rounded to float32 (EmbreeCaster._query's conversion).
  */
 #define PY_SSIZE_T_CLEAN
 #include <Python.h>
+#include <math.h>
 #include <stdint.h>
 #include <string.h>
 
@@ -292,6 +303,183 @@ fail:
     return NULL;
 }
 
+/* A 2-D float64 buffer of shape (n, 3), any strides (a broadcast row: stride 0). */
+static int get_n3(PyObject *obj, Buf *b, Py_ssize_t n, const char *what) {
+    if (PyObject_GetBuffer(obj, &b->view, PyBUF_STRIDES | PyBUF_FORMAT) < 0)
+        return -1;
+    b->held = 1;
+    if (b->view.ndim != 2 || b->view.itemsize != 8 || b->view.shape[1] != 3 ||
+        b->view.shape[0] != n || b->view.strides[0] % 8 || b->view.strides[1] % 8 ||
+        (b->view.format && strcmp(b->view.format, "d") != 0)) {
+        PyErr_Format(PyExc_ValueError, "%s: a float64 array (%zd, 3) expected", what, n);
+        return -1;
+    }
+    return 0;
+}
+
+static PyObject *k_distances(PyObject *self, PyObject *args) {
+    PyObject *otri, *oo, *od, *opack, *ocent, *oidx, *ot;
+    if (!PyArg_ParseTuple(args, "OOOOOOO", &otri, &oo, &od, &opack, &ocent, &oidx, &ot))
+        return NULL;
+    Buf b[7] = {{{0}}};
+    if (get_flat(otri, &b[0], 0, 4, 0, "tri") < 0) goto fail;
+    const Py_ssize_t n = b[0].view.len / 4;
+    if (get_n3(oo, &b[1], n, "o") < 0) goto fail;
+    if (get_n3(od, &b[2], n, "d") < 0) goto fail;
+    if (get_flat(opack, &b[3], 0, 8, 0, "pack") < 0) goto fail;
+    if (get_flat(ocent, &b[4], 0, 8, 0, "centroids") < 0) goto fail;
+    if (get_flat(oidx, &b[5], 1, 8, n, "idx") < 0) goto fail;
+    if (get_flat(ot, &b[6], 1, 8, n, "t") < 0) goto fail;
+    const int32_t *tri = b[0].view.buf;
+    const char *obase = b[1].view.buf, *dbase = b[2].view.buf;
+    const Py_ssize_t os0 = b[1].view.strides[0], os1 = b[1].view.strides[1];
+    const Py_ssize_t ds0 = b[2].view.strides[0], ds1 = b[2].view.strides[1];
+    const double *pack = b[3].view.buf, *cent = b[4].view.buf;
+    const Py_ssize_t ntri = b[3].view.len / 64;
+    int64_t *idx = b[5].view.buf;
+    double *tout = b[6].view.buf;
+    Py_ssize_t hits = 0;
+    int bad = b[4].view.len / 24 < ntri;
+    if (!bad) {
+        Py_BEGIN_ALLOW_THREADS
+        for (Py_ssize_t i = 0; i < n; i++) {
+            if (i + PREFETCH < n) {
+                const int32_t ta = tri[i + PREFETCH];
+                if (ta >= 0 && ta < ntri)
+                    __builtin_prefetch(pack + 8 * (Py_ssize_t)ta);
+            }
+            const int32_t t = tri[i];
+            idx[i] = t;
+            if (t < 0) {
+                tout[i] = Py_HUGE_VAL;
+                continue;
+            }
+            if (t >= ntri) {
+                bad = 1;
+                break;
+            }
+            hits++;
+            const double *p = pack + 8 * (Py_ssize_t)t; /* nx ny nz v0x v0y v0z - - */
+            const double *oi = (const double *)(obase + i * os0);
+            const double *di = (const double *)(dbase + i * ds0);
+            const Py_ssize_t o1 = os1 / 8, d1s = ds1 / 8;
+            const double x = oi[0], y = oi[o1], z = oi[2 * o1];
+            const double dx = di[0], dy = di[d1s], dz = di[2 * d1s];
+            /* einsum's order of three products: (a0b0 + a2b2) + a1b1 */
+            double denom = dx * p[0] + dz * p[2];
+            denom = denom + dy * p[1];
+            double num = (p[3] - x) * p[0] + (p[5] - z) * p[2];
+            num = num + (p[4] - y) * p[1];
+            double s;
+            if (fabs(denom) < 1e-12) { /* grazing: the centroid's distance along the ray */
+                const double *c = cent + 3 * (Py_ssize_t)t;
+                s = (c[0] - x) * dx + (c[2] - z) * dz;
+                s = s + (c[1] - y) * dy;
+            } else {
+                s = num / denom;
+            }
+            if (s < 0.0) /* np.maximum(t, 0): a NaN stays NaN */
+                s = 0.0;
+            tout[i] = s;
+        }
+        Py_END_ALLOW_THREADS
+    }
+    release(b, 7);
+    if (bad) {
+        PyErr_SetString(PyExc_IndexError, "triangle index out of range");
+        return NULL;
+    }
+    return PyLong_FromSsize_t(hits);
+fail:
+    release(b, 7);
+    return NULL;
+}
+
+static PyObject *k_surface(PyObject *self, PyObject *args) {
+    PyObject *otri, *ot, *oo, *od, *orows, *ocoef_t, *ohours, *op, *onf, *ocosd, *ocoef;
+    Py_ssize_t n_tri;
+    if (!PyArg_ParseTuple(args, "OOOOOOOnOOOO", &otri, &ot, &oo, &od, &orows, &ocoef_t, &ohours,
+                          &n_tri, &op, &onf, &ocosd, &ocoef))
+        return NULL;
+    Buf b[11] = {{{0}}};
+    if (get_flat(otri, &b[0], 0, 8, 0, "tri") < 0) goto fail;
+    const Py_ssize_t n = b[0].view.len / 8;
+    if (get_flat(ot, &b[1], 0, 8, n, "t") < 0) goto fail;
+    if (get_n3(oo, &b[2], n, "o") < 0) goto fail;
+    if (get_n3(od, &b[3], n, "d") < 0) goto fail;
+    if (get_flat(orows, &b[4], 0, 8, 8 * n_tri, "rows") < 0) goto fail;
+    if (get_flat(ocoef_t, &b[5], 0, 8, 0, "coef_t") < 0) goto fail;
+    const int has_hours = ohours != Py_None;
+    if (has_hours && get_flat(ohours, &b[6], 0, 8, n, "hours") < 0) goto fail;
+    if (get_flat(op, &b[7], 1, 8, 3 * n, "p") < 0) goto fail;
+    if (get_flat(onf, &b[8], 1, 8, 3 * n, "nf") < 0) goto fail;
+    if (get_flat(ocosd, &b[9], 1, 8, n, "cosd") < 0) goto fail;
+    if (get_flat(ocoef, &b[10], 1, 8, 4 * n, "coef") < 0) goto fail;
+    const int64_t *tri = b[0].view.buf;
+    const double *tt = b[1].view.buf;
+    const char *obase = b[2].view.buf, *dbase = b[3].view.buf;
+    const Py_ssize_t os0 = b[2].view.strides[0], o1 = b[2].view.strides[1] / 8;
+    const Py_ssize_t ds0 = b[3].view.strides[0], d1s = b[3].view.strides[1] / 8;
+    const double *rows = b[4].view.buf, *coef_t = b[5].view.buf;
+    const Py_ssize_t ncols = b[5].view.len / 32;
+    const int64_t *hours = has_hours ? b[6].view.buf : NULL;
+    double *p = b[7].view.buf, *nf = b[8].view.buf, *cosd = b[9].view.buf,
+           *coef = b[10].view.buf;
+    int bad = 0;
+    Py_BEGIN_ALLOW_THREADS
+    for (Py_ssize_t i = 0; i < n; i++) {
+        if (i + PREFETCH < n) { /* later rays' triangle row and coefficients */
+            const int64_t ta = tri[i + PREFETCH];
+            const int64_t ca = has_hours ? hours[i + PREFETCH] * (int64_t)n_tri + ta : ta;
+            if (ta >= 0 && ta < n_tri && ca >= 0 && ca < ncols) {
+                __builtin_prefetch(rows + 8 * ta);
+                for (int e = 0; e < 4; e++)
+                    __builtin_prefetch(coef_t + e * ncols + ca);
+            }
+        }
+        const int64_t t = tri[i];
+        const int64_t col = has_hours ? hours[i] * (int64_t)n_tri + t : t;
+        if (t < 0 || t >= n_tri || col < 0 || col >= ncols) {
+            bad = 1;
+            break;
+        }
+        const double *r = rows + 8 * t;
+        const double *oi = (const double *)(obase + i * os0);
+        const double *di = (const double *)(dbase + i * ds0);
+        const double dx = di[0], dy = di[d1s], dz = di[2 * d1s];
+        const double s = tt[i];
+        p[3 * i] = s * dx + oi[0];
+        p[3 * i + 1] = s * dy + oi[o1];
+        p[3 * i + 2] = s * dz + oi[2 * o1];
+        double c = dx * r[0] + dz * r[2]; /* einsum's order: (a0b0 + a2b2) + a1b1 */
+        c = c + dy * r[1];
+        cosd[i] = c;
+        if (c < 0) {
+            nf[3 * i] = r[0];
+            nf[3 * i + 1] = r[1];
+            nf[3 * i + 2] = r[2];
+        } else {
+            nf[3 * i] = -r[0];
+            nf[3 * i + 1] = -r[1];
+            nf[3 * i + 2] = -r[2];
+        }
+        coef[i] = coef_t[col];
+        coef[n + i] = coef_t[ncols + col];
+        coef[2 * n + i] = coef_t[2 * ncols + col];
+        coef[3 * n + i] = coef_t[3 * ncols + col];
+    }
+    Py_END_ALLOW_THREADS
+    release(b, 11);
+    if (bad) {
+        PyErr_SetString(PyExc_IndexError, "triangle or hour index out of range");
+        return NULL;
+    }
+    Py_RETURN_NONE;
+fail:
+    release(b, 11);
+    return NULL;
+}
+
 static PyObject *k_frame(PyObject *self, PyObject *args) {
     PyObject *oo, *oframe, *oo32;
     if (!PyArg_ParseTuple(args, "OOO", &oo, &oframe, &oo32))
@@ -325,6 +513,10 @@ static PyMethodDef methods[] = {
      "Shadow rays past the surfaces they crossed: transmittance, compaction, next origins."},
     {"roulette", k_roulette, METH_VARARGS,
      "Russian roulette on the faint shadow rays going on, survivors compacted."},
+    {"distances", k_distances, METH_VARARGS,
+     "First hits: triangle (int64) and float64 plane distance per ray (inf: a miss)."},
+    {"surface", k_surface, METH_VARARGS,
+     "Hit points, facing normals, cosines and event coefficients of the paths' rays."},
     {"frame", k_frame, METH_VARARGS, "Origins (3, n) float64 to Embree's float32 frame (n, 3)."},
     {NULL, NULL, 0, NULL}};
 

@@ -295,15 +295,25 @@ class _Tracer:
                     hour = hour[hi]
                 if len(alive) == 0:
                     break
-            p = t[:, None] * d
-            p += o
-            ng = geo.normals.take(tri, axis=0)
-            cosd = np.einsum("ij,ij->i", d, ng)
-            front = cosd < 0
-            nf = np.where(front[:, None], ng, -ng)  # normal on the side the ray came from
-            # diffuse R, diffuse T, specular T, mirror (a copy, (4, k): one row per event)
-            coef = (self.tri_coef_t.take(tri, axis=1) if hour is None else
-                    self.tri_coefs_flat_t.take(hour * self.n_tri + tri, axis=1))
+            k_mod = kernel() if self.tri_pack is not None else None
+            if k_mod is not None and tri.dtype == np.int64:
+                # the same numbers in one pass (radtree.engines.numpy.kernel)
+                n_a = len(alive)
+                p, nf, cosd, coef = (np.empty((n_a, 3)), np.empty((n_a, 3)), np.empty(n_a),
+                                     np.empty((4, n_a)))
+                k_mod.surface(tri, t, o, d, self.tri_pack, self.tri_coef_t if hour is None
+                              else self.tri_coefs_flat_t, None if hour is None else
+                              np.asarray(hour, np.int64), self.n_tri, p, nf, cosd, coef)
+            else:
+                p = t[:, None] * d
+                p += o
+                ng = geo.normals.take(tri, axis=0)
+                cosd = np.einsum("ij,ij->i", d, ng)
+                front = cosd < 0
+                nf = np.where(front[:, None], ng, -ng)  # normal on the side the ray came from
+                # diffuse R, diffuse T, specular T, mirror (a copy, (4, k): one row per event)
+                coef = (self.tri_coef_t.take(tri, axis=1) if hour is None else
+                        self.tri_coefs_flat_t.take(hour * self.n_tri + tri, axis=1))
             rd, td = coef[0], coef[1]
 
             # next-event estimation towards the sun

@@ -17,6 +17,8 @@ from __future__ import annotations
 import os
 from types import ModuleType
 
+import numpy as np
+
 CHOICES = ("auto", "c", "numpy")
 
 _loaded: tuple[ModuleType | None, str] | None = None
@@ -69,3 +71,16 @@ def describe() -> str:
     if mod is None:
         return f"shadow-ray kernel numpy (the C kernel is {why})"
     return "shadow-ray kernel c (radtree.engines.numpy._kernel)"
+
+
+def triangle_rows(normals: np.ndarray, v0: np.ndarray) -> np.ndarray:
+    """The kernel's per-triangle rows (n, 8), zeroed, with the normal in columns 0–2 and the
+    first vertex in 3–5 (columns 6–7 for the caller): one 64-byte row a triangle, starting on
+    a 64-byte boundary (one cache line a lookup)."""
+    n = len(normals)
+    raw = np.zeros(8 * n + 8)
+    skip = (-raw.ctypes.data % 64) // 8
+    rows = raw[skip:skip + 8 * n].reshape(n, 8)
+    rows[:, 0:3] = normals
+    rows[:, 3:6] = v0
+    return rows

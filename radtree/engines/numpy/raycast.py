@@ -20,7 +20,7 @@ from typing import Protocol
 
 import numpy as np
 
-from radtree.engines.numpy.kernel import kernel
+from radtree.engines.numpy.kernel import kernel, triangle_rows
 
 BACKENDS = ("embree", "numpy-bvh")
 
@@ -97,6 +97,7 @@ class EmbreeCaster:
         self._v0 = np.ascontiguousarray(tris[:, 0])
         self._centroids = tris.mean(axis=1)
         self._normals = _unit_normals(tris)
+        self._rows = triangle_rows(self._normals, self._v0)  # the C kernel's distances
         self.workers = max(1, int(workers))
         self.chunk = chunk
         self._pool = ThreadPoolExecutor(self.workers) if self.workers > 1 else None
@@ -177,6 +178,12 @@ class EmbreeCaster:
         return self._query(origins_t, directions)
 
     def _chunk(self, o: np.ndarray, d: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        k = kernel()
+        if k is not None and o.dtype == np.float64 and d.dtype == np.float64:
+            tri = self._query(o.T, d)
+            idx, t = np.empty(len(o), np.int64), np.empty(len(o))
+            k.distances(tri, o, d, self._rows, self._centroids, idx, t)  # plane_distance's
+            return idx, t
         idx = self._query(o.T, d).astype(np.int64)
         t = np.full(len(o), np.inf)
         hit = (idx >= 0).nonzero()[0]

@@ -15,7 +15,7 @@ from typing import Any, Protocol
 import numpy as np
 
 from radtree.engines.numpy.geometry import Geometry, Optics, glass_coefficients
-from radtree.engines.numpy.kernel import kernel
+from radtree.engines.numpy.kernel import kernel, triangle_rows
 from radtree.engines.numpy.lockstep import Draws
 from radtree.engines.numpy.raycast import EmbreeCaster, RayCaster, hit_triangles, plane_distance
 
@@ -145,14 +145,9 @@ def kernel_tables(normals: np.ndarray, v0: np.ndarray, ts: np.ndarray, sun_cos: 
     """The C kernel's per-triangle rows (n, 8): normal, first vertex, specular transmittance
     and the cosine sun · normal of the first hour state — what a crossing needs, in one
     64-byte row (one cache line where the allocation allows)."""
-    n = len(normals)
-    raw = np.zeros(8 * n + 8)
-    skip = (-raw.ctypes.data % 64) // 8  # a row starts on a 64-byte boundary
-    pack = raw[skip:skip + 8 * n].reshape(n, 8)
-    pack[:, 0:3] = normals
-    pack[:, 3:6] = v0
+    pack = triangle_rows(normals, v0)
     pack[:, 6] = ts
-    pack[:, 7] = sun_cos[:n]
+    pack[:, 7] = sun_cos[:len(pack)]
     return pack
 
 
