@@ -17,8 +17,11 @@ Noise: rtrace runs with ``-u-`` (the same octree and options give the same numbe
 crown is traced once per ``-ad`` of ``--ads`` / ``--explicit-ads`` — values that give
 different ambient divisions (Radiance rounds -ad to n_θ × n_φ strata: 2047 and 2048 trace
 alike, and above ≈ 25 000 the BSDF crown's numbers stop changing) — and the table gives the
-mean over them with the standard deviation of one run (sd) per hour. ``--segments``: the
-BSDF shell's ``tree.dome.segments`` (rings = segments / 4; the slat dome does not use it).
+mean over them with the standard deviation of one run (sd) per hour. One BSDF run scatters by
+2–4 % per hour (3–4 % at 10:30), so 4 runs leave ≈ ±2 % and a 5 % test needs ≈ 24 (session
+13: 8 runs read 10:30 +5.6 ± 1.6 %, 24 runs +4.1 ± 0.7 %). ``--segments``: the BSDF shell's
+``tree.bsdf.segments`` (rings = segments / 4; 0: the project's, default 192; the slat dome
+does not use it).
 Run it on a copy of the example (``--project``) when others use its build folder.
 """
 
@@ -93,10 +96,13 @@ def main() -> None:
                          "horizontal angle from the façade normal, each with its own traced "
                          "row (0: the project's)")
     ap.add_argument("--segments", type=int, default=0,
-                    help="tree.dome.segments of the BSDF shell (rings = segments / 4; 0: the "
-                         "project's, 48 — 192 read 3 %% higher at every hour, no closer)")
-    ap.add_argument("--ads", type=ads, default=[8192, 12000, 16384, 24000],
-                    help="rtrace -ad of the BSDF crown, one run each")
+                    help="tree.bsdf.segments: the BSDF shell's segments around (rings = "
+                         "segments / 4; 0: the project's)")
+    ap.add_argument("--ads", type=ads, default=[8192, 12000, 16384, 24000, 9000, 10000, 14000,
+                                                20000, 6000, 6900, 7800, 8700, 9600, 10500,
+                                                11400, 12300, 13200, 15000, 15900, 16800,
+                                                17700, 18600, 19500, 21000],
+                    help="rtrace -ad of the BSDF crown, one run each (24: see the module text)")
     ap.add_argument("--explicit-ads", type=ads, default=[2048, 1810, 1963, 2290, 2463],
                     help="rtrace -ad of the explicit slats, one run each")
     ap.add_argument("--curvature", default="traced", choices=("traced", "rings", "planar"),
@@ -112,7 +118,7 @@ def main() -> None:
     bs = replace(sc, name=f"{sc.name}-bsdf", switches={
         **sc.switches, "tree.representation": "bsdf", "bsdf.samples": args.samples,
         "bsdf.bands": args.bands, "bsdf.curvature": args.curvature,
-        **({"dome.segments": args.segments} if args.segments else {}),
+        **({"bsdf.segments": args.segments} if args.segments else {}),
         **({"bsdf.sectors": args.sectors} if args.sectors else {})})
     t0 = time.perf_counter()
     bands = scenario_xmls(project, bs, progress=print)

@@ -105,9 +105,14 @@ def test_branch_slab_cover_and_config_keys():
     with pytest.raises(ConfigError, match="tree.bsdf.tiles.*odd"):
         CrownBsdf(tiles=4)
     assert check_key("bsdf.sectors", 5)[0].name == "tree.bsdf.sectors"
-    assert CrownBsdf().sectors == 1
+    # the dome's defaults: 5 sectors on a 48-ring shell (the setting that holds every hour of
+    # the Mendoza dome within 5 % of the slats)
+    assert (CrownBsdf().sectors, CrownBsdf().segments) == (5, 192)
+    assert check_key("bsdf.segments", 96)[0].name == "tree.bsdf.segments"
     with pytest.raises(ConfigError, match="tree.bsdf.sectors"):
         CrownBsdf(sectors=0)
+    with pytest.raises(ConfigError, match="tree.bsdf.segments"):
+        CrownBsdf(segments=3)
     proj = load_project(MENDOZA)
     with pytest.raises(ConfigError, match="model 'perforated'.*louvers"):
         leaf_on_sample(proj, proj.scenario("C"))
@@ -132,7 +137,8 @@ def test_bsdf_crown_scene_and_in_process_engines_refuse_it(tmp_path):
     proj_dir = copy_project(tmp_path / "p", hours=["12:30"])
     xml = plates(tmp_path / "x")
     text = (proj_dir / "radtree.toml").read_text().replace(
-        '[tree.dome]', f'representation = "bsdf"\n\n[tree.bsdf]\nxml = "{xml}"\n\n[tree.dome]')
+        '[tree.dome]', f'representation = "bsdf"\n\n[tree.bsdf]\nxml = "{xml}"\nsectors = 1\n'
+        'segments = 0\n\n[tree.dome]')
     (proj_dir / "radtree.toml").write_text(text)
     proj = load_project(proj_dir)
     from radtree.engines.numpy.interface import NumpyEngine

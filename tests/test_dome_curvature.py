@@ -216,7 +216,8 @@ def test_scenario_xml_of_the_dome_carries_the_traced_row(tmp_path):
 
     proj_dir = copy_project(tmp_path / "p", hours=["12:30"])
     text = (proj_dir / "radtree.toml").read_text().replace(
-        "[tree.dome]", 'representation = "bsdf"\n\n[tree.bsdf]\nsamples = 20\nbands = 1\n\n'
+        "[tree.dome]", 'representation = "bsdf"\n\n[tree.bsdf]\nsamples = 20\nbands = 1\n'
+        'sectors = 1\n\n'
         "[tree.dome]")
     (proj_dir / "radtree.toml").write_text(text)
     p = load_project(proj_dir)

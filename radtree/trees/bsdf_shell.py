@@ -163,7 +163,7 @@ def build_bsdf_crown(tree: Tree, sensors: Sensors, street: Street, frame: Facade
     notes: list[str] = []
     if form == "dome":
         spec = dome_spec(tree, sensors, street, source)
-        verts, faces = spec.shell(max(3, spec.segments // 4))
+        verts, faces = spec.shell(max(3, (tree.bsdf.segments or spec.segments) // 4))
         verts = frame.to_world(verts)
         centre = frame.to_world(spec.centre[None, :])[0]
         for name, mat, fs in dome_bands(verts, inward(verts, faces, centre), centre, bands,
