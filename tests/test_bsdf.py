@@ -171,3 +171,33 @@ def test_bsdf_crown_scene_and_in_process_engines_refuse_it(tmp_path):
         f"void BSDF crown_bsdf_b1_low\n6 0 {xml.resolve()} 0 0 -1 .\n0\n0\n")
     with pytest.raises(EngineError, match="Radiance only"):
         trace_hours(proj, proj.scenario("B"), NumpyEngine(), grids=["facade"], built=built)
+
+
+@needs_radiance
+def test_dome_bsdf_shell_takes_its_own_segments(tmp_path):
+    """tree.bsdf.segments meshes the dome's BSDF shell (rings = segments / 4; 0: the dome's
+    tree.dome.segments, 48 → 12 rings): 192 segments give 16 × the facets of 48 (a hemisphere
+    mesh of n rings has ∝ n² triangles) and a surface within 1 % of the hemisphere's 2πr²,
+    closer than the coarse shell's."""
+    from radtree.pipeline.assemble import make_scene
+
+    proj_dir = copy_project(tmp_path / "p", hours=["12:30"])
+    xml = plates(tmp_path / "x")
+    base = (proj_dir / "radtree.toml").read_text()
+    shells = {}
+    for segments in (0, 192):
+        (proj_dir / "radtree.toml").write_text(base.replace(
+            "[tree.dome]", f'representation = "bsdf"\n\n[tree.bsdf]\nxml = "{xml}"\n'
+            f"sectors = 1\nsegments = {segments}\n\n[tree.dome]"))
+        proj = load_project(proj_dir)
+        built = make_scene(proj, proj.scenario("B"), dense_grid=False)
+        shells[segments] = np.concatenate([m.triangles for m in built.scene.meshes
+                                           if m.material.startswith("crown_bsdf")])
+        r = proj.tree.dome.radius_m
+    assert proj.tree.dome.segments == 48
+    assert len(shells[192]) == pytest.approx(16 * len(shells[0]), rel=0.1)
+    areas = {k: 0.5 * np.linalg.norm(np.cross(t[:, 1] - t[:, 0], t[:, 2] - t[:, 0]),
+                                     axis=1).sum() for k, t in shells.items()}
+    hemi = 2 * math.pi * r**2
+    assert abs(areas[192] / hemi - 1) < abs(areas[0] / hemi - 1)
+    assert areas[192] == pytest.approx(hemi, rel=0.01)
