@@ -271,3 +271,41 @@ def test_surface_equals_the_path_loop_arithmetic(states):
     assert np.array_equal(p, ref_p) and np.array_equal(cosd, ref_cos)
     assert np.array_equal(nf, ref_nf) and np.array_equal(coef, ref_coef)
     assert np.any(ref_cos < 0) and np.any(ref_cos > 0)
+
+
+@needs_kernel
+@pytest.mark.parametrize("case", ["sun", "disc", "hours"])
+def test_nee_equals_the_path_loop_arithmetic(case):
+    """``nee`` against the path loop's NumPy lines: cosines by einsum, the weights
+    ``where(cs > 0, rd cs, −td cs) / π`` (× each hour's direct normal lux), the rays with
+    f > 0 and their shadow-ray origins ``nf · (ε sign cs) + p``."""
+    import math
+
+    k_mod = kernel._load()[0]
+    rng = np.random.default_rng(12)
+    n = 6000
+    nf = rng.normal(size=(n, 3))
+    nf /= np.linalg.norm(nf, axis=1)[:, None]
+    p = rng.normal(scale=5.0, size=(n, 3))
+    coef = rng.random((4, n)) * (rng.random((4, n)) < 0.8)
+    rd, td = coef[0], coef[1]
+    sun = np.array([0.3, -0.5, 0.81])
+    sun /= np.linalg.norm(sun)
+    sd = (np.broadcast_to(sun, (n, 3)) if case == "sun" else
+          sun + rng.normal(scale=0.01, size=(n, 3)))
+    hour = rng.integers(0, 3, n) if case == "hours" else None
+    dnis = np.array([70000.0, 0.0, 31000.5])
+    eps = 1.6e-4
+    f, ni, so = np.empty(n), np.empty(n, np.int64), np.empty((n, 3))
+    m = k_mod.nee(nf, sd, rd, td, dnis if hour is not None else None, hour, eps, p, f, ni, so)
+    cs = np.einsum("ij,ij->i", nf, sd)
+    ref_f = np.where(cs > 0, rd * cs, -td * cs) / math.pi
+    if hour is not None:
+        ref_f *= dnis[hour]
+    ref_ni = (ref_f > 0).nonzero()[0]
+    ref_so = nf.take(ref_ni, axis=0)
+    ref_so *= (eps * np.sign(cs[ref_ni]))[:, None]
+    ref_so += p.take(ref_ni, axis=0)
+    assert np.array_equal(f, ref_f) and m == len(ref_ni) > 0
+    assert np.array_equal(ni[:m], ref_ni) and np.array_equal(so[:m], ref_so)
+    assert np.any(cs[ref_ni] < 0) and np.any(cs[ref_ni] > 0)

@@ -37,13 +37,22 @@
  *       where the paths' rays hit (engine._Tracer.paths): p = o + t d, cosd = d · n (einsum's
  *       order), nf = n or −n facing the ray (n where cosd < 0), coef (4, k) = the triangle's
  *       column of coef_t (4, N) — column hours[i] · n_tri + tri[i] when hours is given.
+ *   nee(nf, sd, rd, td, dnis, hours, eps, p, f, ni, so) -> m
+ *       next-event estimation set-up of the path loop: cs = nf · sd (einsum's order), f =
+ *       (rd cs if cs > 0 else −td cs) / π (× dnis[hours[i]] when hours is given), and for the
+ *       m rays with f > 0, in order: their index ni and the shadow-ray origin
+ *       so = nf · (ε sign cs) + p.
  *   frame(o, frame, o32) -> None
  *       o (3, n), any strides -> o32 (n, 3): float32(o), - origin in float64, × scale,
  *       rounded to float32 (EmbreeCaster._query's conversion).
  */
 #define PY_SSIZE_T_CLEAN
+#define _USE_MATH_DEFINES
 #include <Python.h>
 #include <math.h>
+#ifndef M_PI
+#define M_PI 3.14159265358979323846
+#endif
 #include <stdint.h>
 #include <string.h>
 
@@ -480,6 +489,76 @@ fail:
     return NULL;
 }
 
+static PyObject *k_nee(PyObject *self, PyObject *args) {
+    PyObject *onf, *osd, *ord, *otd, *odnis, *ohours, *op, *of, *oni, *oso;
+    double eps;
+    if (!PyArg_ParseTuple(args, "OOOOOOdOOOO", &onf, &osd, &ord, &otd, &odnis, &ohours, &eps,
+                          &op, &of, &oni, &oso))
+        return NULL;
+    Buf b[10] = {{{0}}};
+    if (get_flat(ord, &b[2], 0, 8, 0, "rd") < 0) goto fail;
+    const Py_ssize_t n = b[2].view.len / 8;
+    if (get_n3(onf, &b[0], n, "nf") < 0) goto fail;
+    if (get_n3(osd, &b[1], n, "sd") < 0) goto fail;
+    if (get_flat(otd, &b[3], 0, 8, n, "td") < 0) goto fail;
+    const int has_hours = ohours != Py_None;
+    if (has_hours && get_flat(odnis, &b[4], 0, 8, 1, "dnis") < 0) goto fail;
+    if (has_hours && get_flat(ohours, &b[5], 0, 8, n, "hours") < 0) goto fail;
+    if (get_n3(op, &b[6], n, "p") < 0) goto fail;
+    if (get_flat(of, &b[7], 1, 8, n, "f") < 0) goto fail;
+    if (get_flat(oni, &b[8], 1, 8, n, "ni") < 0) goto fail;
+    if (get_flat(oso, &b[9], 1, 8, 3 * n, "so") < 0) goto fail;
+    const char *nfb = b[0].view.buf, *sdb = b[1].view.buf, *pb = b[6].view.buf;
+    const Py_ssize_t nf0 = b[0].view.strides[0], nf1 = b[0].view.strides[1] / 8;
+    const Py_ssize_t sd0 = b[1].view.strides[0], sd1 = b[1].view.strides[1] / 8;
+    const Py_ssize_t p0 = b[6].view.strides[0], p1 = b[6].view.strides[1] / 8;
+    const double *rd = b[2].view.buf, *td = b[3].view.buf;
+    const double *dnis = has_hours ? b[4].view.buf : NULL;
+    const Py_ssize_t ndnis = has_hours ? b[4].view.len / 8 : 0;
+    const int64_t *hours = has_hours ? b[5].view.buf : NULL;
+    double *f = b[7].view.buf, *so = b[9].view.buf;
+    int64_t *ni = b[8].view.buf;
+    Py_ssize_t m = 0;
+    int bad = 0;
+    Py_BEGIN_ALLOW_THREADS
+    for (Py_ssize_t i = 0; i < n; i++) {
+        const double *a = (const double *)(nfb + i * nf0);
+        const double *c = (const double *)(sdb + i * sd0);
+        const double ax = a[0], ay = a[nf1], az = a[2 * nf1];
+        double cs = ax * c[0] + az * c[2 * sd1]; /* einsum's order: (a0b0 + a2b2) + a1b1 */
+        cs = cs + ay * c[sd1];
+        double fi = (cs > 0 ? rd[i] * cs : -td[i] * cs) / M_PI;
+        if (has_hours) {
+            const int64_t h = hours[i];
+            if (h < 0 || h >= ndnis) {
+                bad = 1;
+                break;
+            }
+            fi = fi * dnis[h];
+        }
+        f[i] = fi;
+        if (!(fi > 0))
+            continue;
+        /* eps · sign(cs): f > 0 needs cs != 0 */
+        const double e = eps * (cs > 0 ? 1.0 : cs < 0 ? -1.0 : cs);
+        const double *pi = (const double *)(pb + i * p0);
+        so[3 * m] = ax * e + pi[0];
+        so[3 * m + 1] = ay * e + pi[p1];
+        so[3 * m + 2] = az * e + pi[2 * p1];
+        ni[m++] = i;
+    }
+    Py_END_ALLOW_THREADS
+    release(b, 10);
+    if (bad) {
+        PyErr_SetString(PyExc_IndexError, "hour index out of range");
+        return NULL;
+    }
+    return PyLong_FromSsize_t(m);
+fail:
+    release(b, 10);
+    return NULL;
+}
+
 static PyObject *k_frame(PyObject *self, PyObject *args) {
     PyObject *oo, *oframe, *oo32;
     if (!PyArg_ParseTuple(args, "OOO", &oo, &oframe, &oo32))
@@ -517,6 +596,8 @@ static PyMethodDef methods[] = {
      "First hits: triangle (int64) and float64 plane distance per ray (inf: a miss)."},
     {"surface", k_surface, METH_VARARGS,
      "Hit points, facing normals, cosines and event coefficients of the paths' rays."},
+    {"nee", k_nee, METH_VARARGS,
+     "Next-event estimation set-up: sun cosines, weights, shadow-ray origins."},
     {"frame", k_frame, METH_VARARGS, "Origins (3, n) float64 to Embree's float32 frame (n, 3)."},
     {NULL, NULL, 0, NULL}};
 

@@ -321,15 +321,24 @@ class _Tracer:
                 rng.at(bounce, 0)
                 sd = (self.sun_directions(len(alive), rng) if hour is None
                       else self.suns.take(hour, axis=0))
-                cs = np.einsum("ij,ij->i", nf, sd)
-                f = np.where(cs > 0, rd * cs, -td * cs) / math.pi
-                if hour is not None:
-                    f *= self.dnis[hour]   # 0 where that hour's sun is off
-                ni = (f > 0).nonzero()[0]
+                if k_mod is not None:  # the same numbers in one pass
+                    n_a = len(alive)
+                    f, ni, so = np.empty(n_a), np.empty(n_a, np.int64), np.empty((n_a, 3))
+                    m = k_mod.nee(nf, sd, rd, td, self.dnis if hour is not None else None,
+                                  None if hour is None else np.asarray(hour, np.int64), eps,
+                                  p, f, ni, so)
+                    ni, so = ni[:m], so[:m]
+                else:
+                    cs = np.einsum("ij,ij->i", nf, sd)
+                    f = np.where(cs > 0, rd * cs, -td * cs) / math.pi
+                    if hour is not None:
+                        f *= self.dnis[hour]   # 0 where that hour's sun is off
+                    ni = (f > 0).nonzero()[0]
+                    if len(ni):
+                        so = nf.take(ni, axis=0)
+                        so *= (eps * np.sign(cs[ni]))[:, None]
+                        so += p.take(ni, axis=0)
                 if len(ni):
-                    so = nf.take(ni, axis=0)
-                    so *= (eps * np.sign(cs[ni]))[:, None]
-                    so += p.take(ni, axis=0)
                     vis = self.shadow(so, _rows(sd, ni), rng, (bounce, 1), parallel,
                                       None if self.opts.sun_disc else
                                       0 if hour is None else hour[ni])
