@@ -478,3 +478,29 @@ def test_species_phenology_weighs_leafed_and_bare_hour_by_hour(tiny_project):
     noon = wea.hour == 12.5
     assert int(res.in_leaf[noon].sum()) == 93 + 128
     assert "phenology of Morus alba" in " ".join(res.notes)
+
+
+@needs_radiance
+def test_reflected_sun_sampling_from_the_command_line(tiny_project, tmp_path):
+    """--sun-ad / --sun-lw reach the reflected-sun rcontrib run (recorded in annual_meta.json)
+    and leave the sky run's settings alone; a weight outside (0, 1) is refused by name."""
+    import json
+    import shutil
+
+    from click.testing import CliRunner
+
+    from radtree.cli.annual import annual_command
+
+    proj = tmp_path / "proj"
+    shutil.copytree(tiny_project, proj, ignore=shutil.ignore_patterns("results"))
+    res = CliRunner().invoke(annual_command, [str(proj), "--no-figures", "-j", "1",
+                                              "--sun-ad", "96", "--sun-lw", "0.002"])
+    assert res.exit_code == 0, res.output
+    assert "-ad 96 -lw 0.002 (reflected sun)" in res.output
+    meta = json.loads((proj / "results" / "annual" / "annual_meta.json").read_text())
+    rc = meta["rcontrib"]
+    assert (rc["sun_ad"], rc["sun_lw"]) == (96, 0.002)
+    assert (rc["ad"], rc["lw"]) == (64, 0.001)          # the project's [engine], untouched
+    bad = CliRunner().invoke(annual_command, [str(proj), "--sun-lw", "1.5"])
+    assert isinstance(bad.exception, ConfigError)
+    assert "--sun-lw must be between 0 and 1" in str(bad.exception)

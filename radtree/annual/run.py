@@ -133,6 +133,9 @@ class AnnualOptions:
         parse_occupancy(self.occupancy)
         if self.nproc < 1:
             raise ConfigError("processes must be ≥ 1")
+        for name, value in (("--lw", self.lw), ("--sun-lw", self.sun_lw)):
+            if value is not None and not 0 < value < 1:
+                raise ConfigError(f"{name} must be between 0 and 1 (a ray weight), got {value:g}")
 
 
 @dataclass
