@@ -53,12 +53,7 @@ import radtree.annual.metrics as metrics
 from radtree.annual.branches import BranchParams, build_leaf_off
 from radtree.annual.coefficients import CoefficientRunner, TraceParams
 from radtree.annual.phenology import Phenology, crown_year, phenology_of
-from radtree.annual.schedule import (
-    DEFAULT_OCCUPANCY,
-    LeafSchedule,
-    occupied,
-    parse_occupancy,
-)
+from radtree.annual.schedule import DEFAULT_OCCUPANCY, LeafSchedule, occupied, parse_occupancy
 from radtree.annual.skymatrix import Suns, Wea, patch_count
 from radtree.annual.weather_year import YearInputs, annual_weather
 from radtree.config import Project, Scenario, effective_project
