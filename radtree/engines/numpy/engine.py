@@ -43,8 +43,9 @@ Rays are processed in batches of at most ``batch_paths`` paths (arrays of that l
 first-hit query per bounce plus the shadow queries), never a Python loop per ray. With
 ``engine.workers`` > 1 a batch is split into that many contiguous parts (of at least
 ``min_part_paths``) traced in parallel threads, each running its own NumPy work and
-single-threaded Embree queries; the parts draw exactly the random numbers of the one-thread
-trace (:mod:`radtree.engines.numpy.lockstep`), so the numbers do not depend on ``workers``.
+single-threaded Embree queries. Each path draws from its own counter-based stream
+(:mod:`radtree.engines.numpy.streams`), so the parts never wait for each other and the numbers
+depend neither on ``workers`` nor on ``batch_paths``.
 """
 
 from __future__ import annotations
@@ -68,11 +69,11 @@ from radtree.engines.numpy.geometry import (
 )
 from radtree.engines.numpy.kernel import describe as kernel_describe
 from radtree.engines.numpy.kernel import kernel
-from radtree.engines.numpy.lockstep import Draws, LockstepRandom, SerialDraws
 from radtree.engines.numpy.raycast import embree_available
 from radtree.engines.numpy.sampling import cosine_hemisphere, cosine_rows, mirror, uniform_cone
 from radtree.engines.numpy.shadow import kernel_tables, transmittance
 from radtree.engines.numpy.shadow import rows as _rows
+from radtree.engines.numpy.streams import Draws, PathStreams, as_draws
 from radtree.light.sky import SkyState
 from radtree.light.sun import SUN_HALF_ANGLE_DEG
 
@@ -209,23 +210,25 @@ class _Tracer:
         return np.broadcast_to(self.sun, (k, 3))
 
     def shadow(self, origins: np.ndarray, dirs: np.ndarray,
-               rng: Draws | np.random.Generator | None = None, tag: tuple[int, ...] = (),
-               parallel: bool = True, hour: np.ndarray | int | None = None) -> np.ndarray:
+               rng: Draws | np.random.Generator | None = None, parallel: bool = True,
+               hour: np.ndarray | int | None = None) -> np.ndarray:
         """Transmittance towards the sun: 1 if free, product of specular passes, else 0.
 
         With ``rng``, faint shadow rays are continued by Russian roulette (unbiased); without,
-        the product is exact (the sensors' own direct sun). ``tag``: the program-order label
-        of the roulette draws when ``rng`` is a :class:`Draws` (layer appended); ``parallel``:
+        the product is exact (the sensors' own direct sun); ``rng``: one stream per shadow
+        ray (:class:`~radtree.engines.numpy.streams.Draws`, the layer crossed appended to its
+        place) or a plain ``Generator``; ``parallel``:
         whether the ray caster may split its queries over threads (not inside a part thread);
         ``hour``: the hour state(s) whose point sun ``dirs`` are (per-triangle tables of the
         cosines and offsets), None for other directions (a sampled sun disc).
         """
-        return transmittance(self, origins, dirs, rng, tag, parallel, hour)
+        return transmittance(self, origins, dirs, rng, parallel, hour)
 
     def sensor_sun(self, points: np.ndarray, normals: np.ndarray, dirs: np.ndarray | None = None,
-                   rng: np.random.Generator | None = None, state: int | None = None
+                   rng: Draws | np.random.Generator | None = None, state: int | None = None
                    ) -> np.ndarray:
         """Direct sun illuminance on sensors (shadow rays start exactly at the points);
+        ``rng``: the roulette's draws, one stream per point (None: the exact product);
         ``state``: the index of the hour state (several states in one tracer)."""
         k = len(points)
         out = np.zeros(k)
@@ -240,8 +243,9 @@ class _Tracer:
         cos = np.einsum("ij,ij->i", normals, dirs)
         need = cos > 0
         if need.any():
+            draws = None if rng is None else as_draws(rng).rows(np.flatnonzero(need), 0, 6)
             out[need] = dni * cos[need] * self.shadow(points[need],
-                                                      _rows(dirs, need), rng, hour=hour)
+                                                      _rows(dirs, need), draws, hour=hour)
         return out
 
     # -- paths
@@ -251,9 +255,9 @@ class _Tracer:
               orders: np.ndarray | None = None, hour: np.ndarray | None = None) -> np.ndarray:
         """Radiance (cd/m²) seen along one cosine-sampled direction from each sensor sample.
 
-        Every draw is labelled (``rng.at``) with its place in the program — (bounce, site) —
-        so that parts of a batch traced in separate threads (:meth:`paths_split`) draw the
-        numbers this method draws for them when it traces the whole batch. ``dirs``: the
+        ``rng``: the streams of these paths (:class:`~radtree.engines.numpy.streams.Draws`);
+        every draw is taken at its place in the program — (bounce, site) — from the streams of
+        the paths still alive, so a path's numbers do not depend on the others. ``dirs``: the
         first directions instead of the cosine samples about ``normals``; ``escapes(path,
         direction, throughput)`` is told of every path leaving the scene (the transfer of a
         layer, :mod:`radtree.engines.numpy.transfer`). ``orders`` (k, max_bounces): also adds
@@ -265,8 +269,7 @@ class _Tracer:
         acc = np.zeros(k)
         alive = np.arange(k)
         o = np.array(points, float)
-        rng.at(0, 4)
-        d = (cosine_hemisphere(np.asarray(normals, float), rng) if dirs is None
+        d = (cosine_hemisphere(np.asarray(normals, float), rng.rows(None, 0, 4)) if dirs is None
              else np.array(dirs, float))
         beta = np.ones(k)
         depth = np.ones(k, np.int64)
@@ -318,8 +321,7 @@ class _Tracer:
 
             # next-event estimation towards the sun
             if self.sun_on:
-                rng.at(bounce, 0)
-                sd = (self.sun_directions(len(alive), rng) if hour is None
+                sd = (self.sun_directions(len(alive), rng.rows(alive, bounce, 0)) if hour is None
                       else self.suns.take(hour, axis=0))
                 if k_mod is not None:  # the same numbers in one pass
                     n_a = len(alive)
@@ -339,7 +341,8 @@ class _Tracer:
                         so *= (eps * np.sign(cs[ni]))[:, None]
                         so += p.take(ni, axis=0)
                 if len(ni):
-                    vis = self.shadow(so, _rows(sd, ni), rng, (bounce, 1), parallel,
+                    vis = self.shadow(so, _rows(sd, ni), rng.rows(alive.take(ni), bounce, 1),
+                                      parallel,
                                       None if self.opts.sun_disc else
                                       0 if hour is None else hour[ni])
                     got = beta[ni] * (self.dni if hour is None else 1.0) * f[ni] * vis
@@ -360,13 +363,11 @@ class _Tracer:
             cum = _cumulative(coef)   # the last row: the total, summed in order
             total = cum[3]
             beta = beta * total
-            rng.at(bounce, 2)
-            u = rng.random(len(alive))
+            u = rng.rows(alive, bounce, 2).random(len(alive))
             low = beta < thr
             survive = (total > 0) & (~low | (u * thr < beta))
             beta = np.where(low, thr, beta)
-            rng.at(bounce, 3)
-            pick = rng.random(len(alive)) * total
+            pick = rng.rows(alive, bounce, 3).random(len(alive)) * total
             ev = _event(pick, cum)
 
             si = survive.nonzero()[0]
@@ -387,8 +388,7 @@ class _Tracer:
                 di = diffuse.nonzero()[0]
                 axis = np.empty((3, len(di)))  # ±n_f, one row per axis
                 np.multiply(nf.take(di, axis=0).T, np.where(diff_r[di], 1.0, -1.0), out=axis)
-                rng.at(bounce, 4)
-                new_d[di] = cosine_rows(axis, rng).T
+                new_d[di] = cosine_rows(axis, rng.rows(alive.take(di), bounce, 4)).T
             spec_t, mir = ev == 2, ev == 3
             if mir.any():
                 new_d[mir] = mirror(d[mir], nf[mir])
@@ -401,36 +401,33 @@ class _Tracer:
             nspec = nspec + (spec_t | mir)
         return acc
 
-    def paths_split(self, points: np.ndarray, normals: np.ndarray, rng: np.random.Generator,
+    def paths_split(self, points: np.ndarray, normals: np.ndarray, streams: PathStreams,
                     dirs: np.ndarray | None = None, orders: np.ndarray | None = None,
                     hour: np.ndarray | None = None) -> np.ndarray:
-        """:meth:`paths` of a batch, split into ``workers`` contiguous parts traced in parallel
-        threads (each part's NumPy work and Embree queries on its own core) drawing the very
-        numbers of the serial trace (:class:`~radtree.engines.numpy.lockstep.LockstepRandom`):
-        the results are identical to ``paths(points, normals, SerialDraws(rng), dirs=dirs)``.
-        ``dirs``: the paths' first directions (None: cosine samples drawn from ``rng``);
-        ``orders``, ``hour``: as :meth:`paths`."""
+        """:meth:`paths` of a batch, split into ``workers`` interleaved parts (part i: paths i,
+        i + parts, …; every part gets its share of each sensor's paths, so the parts take
+        about as long) traced in parallel threads, each part's NumPy work and Embree queries on
+        its own core. ``streams``: the batch's paths' streams; each part draws from its own
+        paths' streams, so the results are those of one thread, ``paths(points, normals,
+        streams, dirs=dirs)``, and the threads never wait for each other. ``dirs``: the paths'
+        first directions (None: cosine samples); ``orders``, ``hour``: as :meth:`paths`."""
         k = len(points)
         parts = min(self.workers, k // self.opts.min_part_paths)
         if parts <= 1:
-            return self.paths(points, normals, SerialDraws(rng), dirs=dirs, orders=orders,
-                              hour=hour)
-        bounds = np.linspace(0, k, parts + 1).astype(int)
-        shared = LockstepRandom(rng, parts)
-        out: list[np.ndarray | None] = [None] * parts
+            return self.paths(points, normals, streams, dirs=dirs, orders=orders, hour=hour)
+        acc = np.empty(k)
         errors: list[BaseException] = []
 
         def run(i: int) -> None:
             try:
-                s = slice(bounds[i], bounds[i + 1])
-                out[i] = self.paths(points[s], normals[s], shared.part(i), parallel=False,
+                s = slice(i, None, parts)  # views: ``orders[s]`` is added to in place
+                acc[s] = self.paths(points[s], normals[s],
+                                    streams.rows(np.arange(i, k, parts)), parallel=False,
                                     dirs=None if dirs is None else dirs[s],
                                     orders=None if orders is None else orders[s],
                                     hour=None if hour is None else hour[s])
             except BaseException as exc:  # re-raised in the calling thread
                 errors.append(exc)
-            finally:
-                shared.finish(i)
 
         threads = [threading.Thread(target=run, args=(i,), daemon=True) for i in range(parts)]
         for th in threads:
@@ -439,4 +436,4 @@ class _Tracer:
             th.join()
         if errors:
             raise errors[0]
-        return np.concatenate([o for o in out if o is not None])
+        return acc

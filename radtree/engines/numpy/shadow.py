@@ -16,8 +16,8 @@ import numpy as np
 
 from radtree.engines.numpy.geometry import Geometry, Optics, glass_coefficients
 from radtree.engines.numpy.kernel import kernel, triangle_rows
-from radtree.engines.numpy.lockstep import Draws
 from radtree.engines.numpy.raycast import EmbreeCaster, RayCaster, hit_triangles, plane_distance
+from radtree.engines.numpy.streams import Draws, as_draws
 
 SHADOW_ROULETTE = 0.02  # shadow-ray transmittance below which Russian roulette starts
 
@@ -75,8 +75,8 @@ def rows(d: np.ndarray, sel: np.ndarray | None) -> np.ndarray:
 
 
 def transmittance(tr: ShadowTracer, origins: np.ndarray, dirs: np.ndarray,
-                  rng: Draws | np.random.Generator | None = None, tag: tuple[int, ...] = (),
-                  parallel: bool = True, hour: np.ndarray | int | None = None) -> np.ndarray:
+                  rng: Draws | np.random.Generator | None = None, parallel: bool = True,
+                  hour: np.ndarray | int | None = None) -> np.ndarray:
     """Transmittance of shadow rays from ``origins`` (k, 3) along ``dirs`` (k, 3, or one
     broadcast row) for the tracer ``tr``: :meth:`_Tracer.shadow`."""
     if (hour is not None and tr.tri_pack is not None
@@ -84,10 +84,11 @@ def transmittance(tr: ShadowTracer, origins: np.ndarray, dirs: np.ndarray,
             and isinstance(tr.caster, EmbreeCaster)):
         k_mod = kernel()
         if k_mod is not None and (isinstance(hour, int) or np.asarray(dirs).strides[0] != 0):
-            return _transmittance_c(k_mod, tr, origins, dirs, rng, tag, parallel, hour)
+            return _transmittance_c(k_mod, tr, origins, dirs, rng, parallel, hour)
     k = len(origins)
     vis = np.ones(k)
     idx = np.arange(k)
+    draws = None if rng is None else as_draws(rng)
     # origins as rows of all rays, (3, k): the per-crossing arithmetic on long contiguous
     # rows (NumPy broadcasts over 3-wide rows several times slower)
     o = np.array(np.asarray(origins, float).T, order="C")
@@ -116,10 +117,10 @@ def transmittance(tr: ShadowTracer, origins: np.ndarray, dirs: np.ndarray,
         vis[ih] = v
         # Russian roulette on faint shadow rays (unbiased: survivors are promoted)
         faint = (v > 0) & (v < SHADOW_ROULETTE)
-        if rng is not None and faint.any():
-            if tag:
-                rng.at(*tag, layer)  # type: ignore[union-attr]
-            keep = rng.random(int(faint.sum())) * SHADOW_ROULETTE < v[faint]
+        if draws is not None and faint.any():
+            fi = faint.nonzero()[0]
+            keep = (draws.rows(ih.take(fi), layer).random(len(fi)) * SHADOW_ROULETTE
+                    < v.take(fi))
             v[faint] = np.where(keep, SHADOW_ROULETTE, 0.0)
             vis[ih] = v
         go = (v > 0).nonzero()[0]
@@ -152,8 +153,8 @@ def kernel_tables(normals: np.ndarray, v0: np.ndarray, ts: np.ndarray, sun_cos: 
 
 
 def _transmittance_c(k_mod: Any, tr: ShadowTracer, origins: np.ndarray, dirs: np.ndarray,
-                     rng: Draws | np.random.Generator | None, tag: tuple[int, ...],
-                     parallel: bool, hour: np.ndarray | int) -> np.ndarray:
+                     rng: Draws | np.random.Generator | None, parallel: bool,
+                     hour: np.ndarray | int) -> np.ndarray:
     """:func:`transmittance` towards the point sun through Embree with the C kernel: per
     crossing one Embree query and one pass (``cross``: transmittance products, the rays going
     on, their next origins and float32 copies in Embree's frame), and when some are faint
@@ -161,6 +162,7 @@ def _transmittance_c(k_mod: Any, tr: ShadowTracer, origins: np.ndarray, dirs: np
     numbers as the NumPy loop."""
     caster = tr.caster
     assert isinstance(caster, EmbreeCaster)
+    draws = None if rng is None else as_draws(rng)
     k = len(origins)
     vis = np.ones(k)
     idx = np.arange(k, dtype=np.int64)
@@ -184,11 +186,11 @@ def _transmittance_c(k_mod: Any, tr: ShadowTracer, origins: np.ndarray, dirs: np
                                         h0, hours, suns, eps, o, frame, o32)
         if n_hit == 0:
             return vis
-        if rng is not None and n_faint:
-            if tag:
-                rng.at(*tag, layer)  # type: ignore[union-attr]
-            m = k_mod.roulette(idx, vis, hours, o, o32, m, rng.random(n_faint),
-                               SHADOW_ROULETTE)
+        if draws is not None and n_faint:
+            going = idx[:m]
+            faint = going[vis.take(going) < SHADOW_ROULETTE]  # in order, as roulette takes them
+            m = k_mod.roulette(idx, vis, hours, o, o32, m,
+                               draws.rows(faint, layer).random(n_faint), SHADOW_ROULETTE)
         if m == 0:
             return vis
     vis[idx[:m]] = 0.0

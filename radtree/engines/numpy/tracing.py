@@ -22,6 +22,7 @@ from radtree.engines.numpy.engine import (
 )
 from radtree.engines.numpy.qmc import FirstDirections
 from radtree.engines.numpy.sampling import cosine_directions as cosine_from
+from radtree.engines.numpy.streams import PathStreams, stream_key
 from radtree.engines.numpy.tally import SensorTally
 from radtree.errors import EngineError
 from radtree.light.sky import SkyState
@@ -64,23 +65,26 @@ def _trace_grid(tracer: _Tracer, grid: SensorGrid, n_paths: int, rng: np.random.
     total = n_s * n_paths
     first = FirstDirections(n_s, n_paths, rng) if sampling == "sobol" else None
     tally = SensorTally(n_s, cols, first)
+    key = stream_key(rng)  # each path's stream: (key, path number) (engines.numpy.streams)
     batch = max(1, int(tracer.opts.batch_paths))
     for start in range(0, total, batch):
         pid = np.arange(start, min(total, start + batch))
         sensor = pid // n_paths
         x = np.zeros((len(pid), cols))
+        batch_streams = PathStreams(key, pid.astype(np.uint64))
         if tracer.max_bounces > 0:
             dirs = None
             if first is not None:
                 u = first.uniforms(pid)
                 dirs = cosine_from(u[:, 0], u[:, 1], nrm[sensor])
             orders = np.zeros((len(pid), cols)) if ladder else None
-            acc = tracer.paths_split(pts[sensor], nrm[sensor], rng, dirs, orders,
+            acc = tracer.paths_split(pts[sensor], nrm[sensor], batch_streams, dirs, orders,
                                      None if hour_of is None else hour_of[sensor])
             x += math.pi * (np.cumsum(orders, axis=1) if orders is not None else acc[:, None])
         if disc:
             x += tracer.sensor_sun(pts[sensor], nrm[sensor],
-                                   tracer.sun_directions(len(pid), rng), rng)[:, None]
+                                   tracer.sun_directions(len(pid), batch_streams.rows(None, 0, 5)),
+                                   batch_streams)[:, None]
         tally.add(pid, sensor, x)
     return _per_state(tally.results(direct), n_states)
 

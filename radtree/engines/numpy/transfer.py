@@ -20,8 +20,8 @@ import numpy as np
 from radtree.config import EngineParams
 from radtree.engines.numpy.engine import TraceOptions, _Tracer
 from radtree.engines.numpy.geometry import scene_geometry, scene_optics
-from radtree.engines.numpy.lockstep import SerialDraws
 from radtree.engines.numpy.scenes import sky_state
+from radtree.engines.numpy.streams import PathStreams, stream_key
 from radtree.errors import EngineError
 from radtree.scene import Scene
 
@@ -54,7 +54,7 @@ def trace_escapes(scene: Scene, origins: np.ndarray, directions: np.ndarray, *,
     geo = scene_geometry(scene, backend, workers)
     tracer = _Tracer(geo, scene_optics(scene, state, geo.material_names), state, params,
                      TraceOptions(backend=backend))
-    rng = np.random.default_rng(seed)
+    key = stream_key(np.random.default_rng(seed))
     paths: list[np.ndarray] = []
     dirs: list[np.ndarray] = []
     weights: list[np.ndarray] = []
@@ -66,7 +66,8 @@ def trace_escapes(scene: Scene, origins: np.ndarray, directions: np.ndarray, *,
             dirs.append(np.array(e, float))
             weights.append(np.array(w, float))
 
-        tracer.paths(o[s], d[s], SerialDraws(rng), dirs=d[s], escapes=record)
+        ids = np.arange(start, min(len(o), start + batch), dtype=np.uint64)
+        tracer.paths(o[s], d[s], PathStreams(key, ids), dirs=d[s], escapes=record)
     if not paths:
         return Escapes(np.zeros(0, np.int64), np.zeros((0, 3)), np.zeros(0), len(o))
     return Escapes(np.concatenate(paths), np.vstack(dirs), np.concatenate(weights), len(o))
