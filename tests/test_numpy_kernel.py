@@ -19,8 +19,9 @@ from radtree.engines.numpy import kernel, shadow, tracing
 from radtree.engines.numpy.engine import DEFAULT_OPTIONS, TraceOptions, describe
 from radtree.engines.numpy.raycast import EmbreeCaster, embree_available
 from radtree.engines.numpy.scenes import dome_slats, sky_state
+from radtree.engines.numpy.streams import PathStreams
 from radtree.optics import Plastic, Trans
-from radtree.scene import Scene, SensorGrid
+from radtree.scene import Scene, SensorGrid, quad
 
 built = kernel._load()[0] is not None
 needs_kernel = pytest.mark.skipif(not built or not embree_available(),
@@ -309,3 +310,32 @@ def test_nee_equals_the_path_loop_arithmetic(case):
     assert np.array_equal(f, ref_f) and m == len(ref_ni) > 0
     assert np.array_equal(ni[:m], ref_ni) and np.array_equal(so[:m], ref_so)
     assert np.any(cs[ref_ni] < 0) and np.any(cs[ref_ni] > 0)
+
+
+@needs_kernel
+def test_paths_take_strided_inputs(monkeypatch):
+    """A part of an interleaved batch split (every second path: strided points, normals, first
+    directions and hour states) traces as its contiguous copy — inside a closed box, where
+    every first ray hits and nothing is compacted before the first surface pass."""
+    monkeypatch.setenv("RADTREE_KERNEL", "c")
+    c = np.array([[-1.0, -1, -1], [1, -1, -1], [1, 1, -1], [-1, 1, -1],
+                  [-1, -1, 1], [1, -1, 1], [1, 1, 1], [-1, 1, 1]])
+    faces = [(0, 1, 2, 3), (4, 5, 6, 7), (0, 1, 5, 4), (1, 2, 6, 5), (2, 3, 7, 6), (3, 0, 4, 7)]
+    walls = [quad(f"w{i}", "wall", c[list(f)]) for i, f in enumerate(faces)]
+    grid = SensorGrid("g", np.zeros((1, 3)), np.array([[0.0, 0.0, 1.0]]))
+    _, hours = _scene(3)
+    scene = Scene(walls, {"wall": Plastic("wall", 0.5)}, {"g": grid})
+    tr, _ = tracing._tracer(scene, hours[0], EngineParams(rays=8, max_bounces=4), None,
+                            DEFAULT_OPTIONS, hours[1:])
+    rng = np.random.default_rng(4)
+    n = 4000
+    pts = rng.uniform(-0.5, 0.5, size=(n, 3))
+    nrm = np.tile([0.0, 0.0, 1.0], (n, 1))
+    dirs = rng.normal(size=(n, 3))
+    dirs /= np.linalg.norm(dirs, axis=1)[:, None]
+    hour = rng.integers(0, 3, n)
+    ids = np.arange(0, n, 2, dtype=np.uint64)
+    strided = tr.paths(pts[::2], nrm[::2], PathStreams(9, ids), dirs=dirs[::2], hour=hour[::2])
+    copied = tr.paths(pts[::2].copy(), nrm[::2].copy(), PathStreams(9, ids),
+                      dirs=dirs[::2].copy(), hour=hour[::2].copy())
+    assert np.array_equal(strided, copied)

@@ -274,6 +274,8 @@ class _Tracer:
         beta = np.ones(k)
         depth = np.ones(k, np.int64)
         nspec = np.zeros(k, np.int64)
+        if hour is not None:  # contiguous int64 (a part of an interleaved split is strided)
+            hour = np.ascontiguousarray(hour, dtype=np.int64)
         geo, eps = self.geo, self.eps
         thr = self.opts.roulette_weight
         bounce = 0
