@@ -83,6 +83,9 @@ __all__ = ["DEFAULT_OPTIONS", "ENGINE_NAME", "GLASS_INDEX", "Environment", "Geom
 ENGINE_NAME = "numpy"
 
 
+SPLIT_BLOCK = 256  # consecutive paths a part of a batch split takes in turn
+
+
 @dataclass(frozen=True)
 class TraceOptions:
     """Settings of the Monte Carlo engine that are not in :class:`EngineParams`."""
@@ -406,10 +409,12 @@ class _Tracer:
     def paths_split(self, points: np.ndarray, normals: np.ndarray, streams: PathStreams,
                     dirs: np.ndarray | None = None, orders: np.ndarray | None = None,
                     hour: np.ndarray | None = None) -> np.ndarray:
-        """:meth:`paths` of a batch, split into ``workers`` interleaved parts (part i: paths i,
-        i + parts, …; every part gets its share of each sensor's paths, so the parts take
-        about as long) traced in parallel threads, each part's NumPy work and Embree queries on
-        its own core. ``streams``: the batch's paths' streams; each part draws from its own
+        """:meth:`paths` of a batch, split into ``workers`` parts traced in parallel threads,
+        each part's NumPy work and Embree queries on its own core. The parts take blocks of
+        ``SPLIT_BLOCK`` consecutive paths in turn (part i: blocks i, i + parts, …), so every
+        part gets its share of each sensor and each block a whole stratum of the sensor's
+        Sobol' net (every second path alone would give one part the low and the other the high
+        zenith angles). ``streams``: the batch's paths' streams; each part draws from its own
         paths' streams, so the results are those of one thread, ``paths(points, normals,
         streams, dirs=dirs)``, and the threads never wait for each other. ``dirs``: the paths'
         first directions (None: cosine samples); ``orders``, ``hour``: as :meth:`paths`."""
@@ -417,17 +422,20 @@ class _Tracer:
         parts = min(self.workers, k // self.opts.min_part_paths)
         if parts <= 1:
             return self.paths(points, normals, streams, dirs=dirs, orders=orders, hour=hour)
+        block = np.arange(k) // SPLIT_BLOCK % parts
         acc = np.empty(k)
         errors: list[BaseException] = []
 
         def run(i: int) -> None:
             try:
-                s = slice(i, None, parts)  # views: ``orders[s]`` is added to in place
-                acc[s] = self.paths(points[s], normals[s],
-                                    streams.rows(np.arange(i, k, parts)), parallel=False,
-                                    dirs=None if dirs is None else dirs[s],
-                                    orders=None if orders is None else orders[s],
-                                    hour=None if hour is None else hour[s])
+                rows = (block == i).nonzero()[0]
+                own = None if orders is None else orders.take(rows, axis=0)
+                acc[rows] = self.paths(points.take(rows, axis=0), normals.take(rows, axis=0),
+                                       streams.rows(rows), parallel=False,
+                                       dirs=None if dirs is None else dirs.take(rows, axis=0),
+                                       orders=own, hour=None if hour is None else hour[rows])
+                if orders is not None:
+                    orders[rows] = own
             except BaseException as exc:  # re-raised in the calling thread
                 errors.append(exc)
 
