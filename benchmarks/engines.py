@@ -13,7 +13,8 @@ Prints (no timing assertions):
    embreex's ``EmbreeScene.run`` (the same float32 rays in trimesh's Embree frame, chunks of 65 536 over
    the same number of threads) and through the engine's ``EmbreeCaster.first_hit`` in one call
    (conversions and float64 distances included); the engine's rays/s over raw Embree's is the
-   throughput ratio (Mendoza scenarios B and F, 12:30, 1 and 2 threads); also Embree's own CPU
+   throughput ratio (Mendoza scenarios B and F, 12:30, 1 and 2 threads; and B's 7 hours in the
+   same batches, as ``radtree simulate`` traces a scenario); also Embree's own CPU
    time inside the engine (``EmbreeScene.run`` timed where the engine calls it) as a share of
    the engine's CPU time, and which shadow-ray kernel ran (``RADTREE_KERNEL``: c or numpy);
 4. when Radiance is available, the per-row relative difference NumPy − Radiance on the slat
@@ -227,32 +228,39 @@ def engine_vs_embree(quick: bool) -> None:
     print("\n== NumPy engine vs raw Embree on the same rays ==")
     from radtree.config import load_project
     from radtree.engines.numpy import trace_hour
+    from radtree.engines.numpy.tracing import trace_states
     from radtree.light.hours import hour_states
     from radtree.pipeline.assemble import make_scene
 
-    for name in ("B", "F"):
+    # one hour (trace_hour), and the project's 7 hours in the same batches as `radtree
+    # simulate` traces a scenario (Engine.trace_many → trace_states), B only
+    for name, n_hours in (("B", 1), ("F", 1), ("B", 7)):
         for workers in (1, 2):
             project = load_project(ROOT / "examples" / "mendoza-street", overrides={
-                "site.hours": ["12:30"], "sensors.dense_grid": False, "engine.workers": workers})
+                "sensors.dense_grid": False, "engine.workers": workers})
+            hours = ["12:30"] if n_hours == 1 else list(project.site.hours)[:n_hours]
             sc = project.scenario(name)
             built = make_scene(project, sc, dense_grid=False)
-            state = hour_states(project, sc, ["12:30"])[0]
+            states = hour_states(project, sc, hours)
             p = replace(project.engine, rays=1024 if quick else 4096, max_bounces=built.ab)
             geo = scene_geometry(built.scene, DEFAULT_OPTIONS.backend, workers)
             caster = geo.caster
             if not isinstance(caster, EmbreeCaster):
                 print("  embreex not installed: skipped")
                 return
-            trace_hour(built.scene, state, replace(p, rays=16), ["facade"])
-            o32, d32, calls = _recorded_queries(caster, trace_hour, built.scene, state, p,
-                                                ["facade"])
+            if n_hours == 1:
+                work, args = trace_hour, (built.scene, states[0], p, ["facade"])
+            else:
+                work, args = trace_states, (built.scene, states, p, ["facade"])
+            work(*args[:2], replace(p, rays=16), ["facade"])
+            o32, d32, calls = _recorded_queries(caster, work, *args)
             # the same rays in world coordinates, float64, for EmbreeCaster.first_hit
             o = o32.astype(np.float64) / caster.frame[3] + caster.frame[:3]
             d = d32.astype(np.float64)
             best = []
             for _ in range(2):  # best of 2 of each, measured back to back
                 c0, t0 = time.process_time(), time.perf_counter()
-                trace_hour(built.scene, state, p, ["facade"])
+                work(*args)
                 engine, engine_cpu = time.perf_counter() - t0, time.process_time() - c0
                 c0 = time.process_time()
                 raw = _replay_raw(caster, o32, d32, workers)
@@ -262,11 +270,11 @@ def engine_vs_embree(quick: bool) -> None:
                 first_hit = time.perf_counter() - t0
                 best.append((engine, raw, first_hit, engine_cpu, raw_cpu))
             engine, raw, first_hit, engine_cpu, raw_cpu = min(best)
-            inside, inside_cpu = _embree_inside(caster, trace_hour, built.scene, state, p,
-                                                ["facade"])
+            inside, inside_cpu = _embree_inside(caster, work, *args)
             from radtree.engines.numpy.kernel import name as kernel_name
             n = len(o)
-            print(f"  scenario {name}: {built.triangles} triangles, {workers} thread(s), "
+            print(f"  scenario {name}, {len(hours)} hour(s): {built.triangles} triangles, "
+                  f"{workers} thread(s), "
                   f"{n / 1e6:.2f} M queries in {calls} calls: engine {n / engine / 1e6:.2f} "
                   f"M rays/s ({engine:.2f} s, {engine_cpu:.2f} s CPU), raw Embree "
                   f"{n / raw / 1e6:.2f} M/s ({raw_cpu:.2f} s CPU), EmbreeCaster.first_hit "

@@ -75,3 +75,19 @@ def test_event_rows_equal_cumsum_and_count(seed):
     pick = rng.random(5000) * cum[3]
     expected = np.minimum((pick[:, None] >= np.cumsum(coef, axis=1)).sum(axis=1), 3)
     assert np.array_equal(_event(pick, cum), expected)
+
+
+def test_unit32_equals_trimesh_unitize():
+    """The float32 unit directions handed to Embree: ``raycast._unit32`` (no BLAS) gives
+    trimesh's ``unitize`` + float32 to the bit — rows over five decades, zero rows, a row."""
+    from trimesh.util import unitize
+
+    from radtree.engines.numpy.raycast import _unit32
+
+    rng = np.random.default_rng(12)
+    v = (rng.normal(size=(200_000, 3)) * 10.0 ** rng.uniform(-4, 1, (200_000, 3)))
+    v = v.astype(np.float32)
+    v[:5] = 0.0
+    v[5] = (1e-7, 0.0, 0.0)   # below trimesh's zero threshold once squared: left as it is
+    for d in (v, v[:1], np.broadcast_to(v[7], (50, 3))):
+        assert np.array_equal(_unit32(d), np.asarray(unitize(d), dtype=np.float32))
