@@ -176,11 +176,14 @@ def _transmittance_c(k_mod: Any, tr: ShadowTracer, origins: np.ndarray, dirs: np
     else:
         hours, h0, suns = None, int(hour), np.array(d[0], dtype=float)
     pack, sun_cos, n_tri, eps, frame = tr.tri_pack, tr.sun_cos, tr.n_tri, tr.eps, caster.frame
-    d32 = caster.directions32(d)  # one broadcast row for a point sun
+    # float32 unit rows for Embree: one broadcast row for a point sun; with several hour
+    # states each state's sun converted once and gathered per ray (``d`` holds those suns)
+    suns32 = None if hours is None else caster.directions32(tr.suns)
+    d32 = caster.directions32(d) if suns32 is None else suns32.take(hours, axis=0)
     m = k
     for layer in range(tr.opts.max_shadow_layers):
-        if hours is not None and layer:
-            d32 = caster.directions32(tr.suns.take(hours[:m], axis=0))
+        if suns32 is not None and layer:
+            d32 = suns32.take(hours[:m], axis=0)
         tri = caster.query_frame(o32[:m], d32[:m], parallel)
         n_hit, m, n_faint = k_mod.cross(tri, idx, vis, SHADOW_ROULETTE, pack, sun_cos, n_tri,
                                         h0, hours, suns, eps, o, frame, o32)
