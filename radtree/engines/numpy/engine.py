@@ -41,8 +41,9 @@ Light sources and physics, chosen to behave like Radiance:
 
 Rays are processed in batches of at most ``batch_paths`` paths (arrays of that length, one
 first-hit query per bounce plus the shadow queries), never a Python loop per ray. With
-``engine.workers`` > 1 a batch is split into that many contiguous parts (of at least
-``min_part_paths``) traced in parallel threads, each running its own NumPy work and
+``engine.workers`` > 1 a batch is split into that many parts (of at least ``min_part_paths``;
+blocks of ``SPLIT_BLOCK`` paths taken in turn) traced in parallel threads, each running its own
+NumPy work and
 single-threaded Embree queries. Each path draws from its own counter-based stream
 (:mod:`radtree.engines.numpy.streams`), so the parts never wait for each other and the numbers
 depend neither on ``workers`` nor on ``batch_paths``.
@@ -277,7 +278,7 @@ class _Tracer:
         beta = np.ones(k)
         depth = np.ones(k, np.int64)
         nspec = np.zeros(k, np.int64)
-        if hour is not None:  # contiguous int64 (a part of an interleaved split is strided)
+        if hour is not None:  # contiguous int64 (the C kernel's surface pass needs it)
             hour = np.ascontiguousarray(hour, dtype=np.int64)
         geo, eps = self.geo, self.eps
         thr = self.opts.roulette_weight
