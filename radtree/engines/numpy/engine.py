@@ -43,8 +43,7 @@ Rays are processed in batches of at most ``batch_paths`` paths (arrays of that l
 first-hit query per bounce plus the shadow queries), never a Python loop per ray. With
 ``engine.workers`` > 1 a batch is split into that many parts (of at least ``min_part_paths``;
 blocks of ``SPLIT_BLOCK`` paths taken in turn) traced in parallel threads, each running its own
-NumPy work and
-single-threaded Embree queries. Each path draws from its own counter-based stream
+NumPy work and single-threaded Embree queries. Each path draws from its own counter-based stream
 (:mod:`radtree.engines.numpy.streams`), so the parts never wait for each other and the numbers
 depend neither on ``workers`` nor on ``batch_paths``.
 """
