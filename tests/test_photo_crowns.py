@@ -40,6 +40,9 @@ def test_perforated_realisations_and_direct_sun(mendoza):
     subs = realisations_of(mendoza, sc)
     assert [s.name for s in subs] == ["C@1", "C@2"]
     assert [s.switches["perforated.seed"] for s in subs] == [5, 6]
+    # each crown an independent Monte Carlo sample too
+    assert [s.switches["engine.seed"] for s in subs] == [mendoza.engine.seed,
+                                                         mendoza.engine.seed + 1]
     rows = []
     for s in subs:
         built = make_scene(mendoza, s)

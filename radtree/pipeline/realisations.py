@@ -1,7 +1,8 @@
 """Crown realisations: a louvers crown with ``louvers.realisations`` N > 1 (a perforated crown
 with ``perforated.realisations`` N > 1: random gap patterns) is traced as N random crowns
-``<name>@1`` … ``<name>@N`` (seeds ``<table>.seed`` … + N − 1) and averaged back into
-``<name>``; ``lux_stderr`` becomes the standard error over the crowns."""
+``<name>@1`` … ``<name>@N`` (seeds ``<table>.seed`` … + N − 1, and engine seeds
+``engine.seed`` … + N − 1, so that each crown is also an independent Monte Carlo sample) and
+averaged back into ``<name>``; ``lux_stderr`` becomes the standard error over the crowns."""
 
 from __future__ import annotations
 
@@ -11,6 +12,7 @@ import numpy as np
 import pandas as pd
 
 from radtree.config import Project, Scenario
+from radtree.config.switches import effective_project
 from radtree.errors import ConfigError
 
 REALISATION_MARK = "@"   # "F@3": the third random crown of scenario F
@@ -40,9 +42,13 @@ def realisations_of(project: Project, sc: Scenario) -> list[Scenario]:
                           "patterns, but the crown's gaps come from a photo (one fixed pattern): "
                           "set perforated.realisations = 1 or remove the photo",
                           source=str(project.source), field="tree.perforated.realisations")
+    # each crown its own engine seed too: with one seed the crowns' paths share their random
+    # numbers (the first directions and, path by path, every later draw), which correlates
+    # their Monte Carlo errors and leaves part of the mean's error out of the spread
+    engine_seed = effective_project(project, sc).engine.seed
     return [replace(sc, name=f"{sc.name}{REALISATION_MARK}{k}",
                     switches={**sc.switches, f"{table}.seed": params.seed + k - 1,
-                              f"{table}.realisations": 1})
+                              f"{table}.realisations": 1, "engine.seed": engine_seed + k - 1})
             for k in range(1, n + 1)]
 
 
