@@ -177,8 +177,9 @@ class Louvers(Checked):
     vertical line crosses ``layers`` slats; ``"volume"`` — slat centres uniform at random in the
     crown, azimuths random, density such that a vertical line through the crown centre crosses
     ``crossings`` slats on average (0: use ``layers``), times ``cover_fraction``.
-    ``realisations``: how many random crowns (``seed``, ``seed`` + 1, …) ``simulate`` traces
-    and averages; the results' ``lux_stderr`` is then the standard error over them.
+    ``realisations``: how many random crowns (``seed``, ``seed`` + 1, …; each traced with
+    its own ``engine.seed`` + k − 1) ``simulate`` traces and averages; the results'
+    ``lux_stderr`` is then the standard error over them.
     """
 
     TABLE: ClassVar[str] = "tree.louvers"
