@@ -178,11 +178,11 @@ def _transmittance_c(k_mod: Any, tr: ShadowTracer, origins: np.ndarray, dirs: np
     pack, sun_cos, n_tri, eps, frame = tr.tri_pack, tr.sun_cos, tr.n_tri, tr.eps, caster.frame
     # float32 unit rows for Embree: one broadcast row for a point sun; with several hour
     # states each state's sun converted once and gathered per ray (``d`` holds those suns)
-    suns32 = None if hours is None else caster.directions32(tr.suns)
-    d32 = caster.directions32(d) if suns32 is None else suns32.take(hours, axis=0)
+    suns32 = caster.directions32(tr.suns) if hours is not None else np.empty((0, 3), np.float32)
+    d32 = caster.directions32(d) if hours is None else suns32.take(hours, axis=0)
     m = k
     for layer in range(tr.opts.max_shadow_layers):
-        if suns32 is not None and layer:
+        if hours is not None and layer:
             d32 = suns32.take(hours[:m], axis=0)
         tri = caster.query_frame(o32[:m], d32[:m], parallel)
         n_hit, m, n_faint = k_mod.cross(tri, idx, vis, SHADOW_ROULETTE, pack, sun_cos, n_tri,
