@@ -224,7 +224,7 @@ def _embree_inside(caster: EmbreeCaster, work: Any, *args: Any) -> tuple[float, 
         caster._embree = wrap
 
 
-def engine_vs_embree(quick: bool) -> None:
+def engine_vs_embree(quick: bool, repeats: int = 3) -> None:
     print("\n== NumPy engine vs raw Embree on the same rays ==")
     from radtree.config import load_project
     from radtree.engines.numpy import trace_hour
@@ -258,7 +258,7 @@ def engine_vs_embree(quick: bool) -> None:
             o = o32.astype(np.float64) / caster.frame[3] + caster.frame[:3]
             d = d32.astype(np.float64)
             best = []
-            for _ in range(2):  # best of 2 of each, measured back to back
+            for _ in range(max(1, repeats)):  # best of `repeats` each, back to back
                 c0, t0 = time.process_time(), time.perf_counter()
                 work(*args)
                 engine, engine_cpu = time.perf_counter() - t0, time.process_time() - c0
@@ -324,6 +324,8 @@ def main() -> None:
     ap.add_argument("--quick", action="store_true", help="smaller batches")
     ap.add_argument("--with-defaults", action="store_true",
                     help="also run Radiance with the project's -as 512 -aa 0.1 (minutes)")
+    ap.add_argument("--repeats", type=int, default=3,
+                    help="throughput: best of this many runs of engine and raw Embree (3)")
     ap.add_argument("--only", choices=["rays", "hour", "throughput", "radiance"],
                     help="run one section (1 rays, 2 hour, 3 throughput, 4 radiance)")
     args = ap.parse_args()
@@ -335,7 +337,7 @@ def main() -> None:
     if run & {"hour", "radiance"}:
         sc = engine_hour(args.quick) if "hour" in run else slat_scene(3000)
     if "throughput" in run:
-        engine_vs_embree(args.quick)
+        engine_vs_embree(args.quick, args.repeats)
     if "radiance" in run:
         engines_differ(sc, args.quick, args.with_defaults)
 
