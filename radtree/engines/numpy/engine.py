@@ -73,7 +73,13 @@ from radtree.engines.numpy.raycast import embree_available
 from radtree.engines.numpy.sampling import cosine_hemisphere, cosine_rows, mirror, uniform_cone
 from radtree.engines.numpy.shadow import kernel_tables, transmittance
 from radtree.engines.numpy.shadow import rows as _rows
-from radtree.engines.numpy.streams import Draws, PathStreams, as_draws
+from radtree.engines.numpy.streams import (
+    FIRST_DIRECTIONS,
+    SENSOR_SUN_ROULETTE,
+    Draws,
+    PathStreams,
+    as_draws,
+)
 from radtree.light.sky import SkyState
 from radtree.light.sun import SUN_HALF_ANGLE_DEG
 
@@ -246,7 +252,7 @@ class _Tracer:
         cos = np.einsum("ij,ij->i", normals, dirs)
         need = cos > 0
         if need.any():
-            draws = None if rng is None else as_draws(rng).rows(np.flatnonzero(need), 0, 6)
+            draws = None if rng is None else as_draws(rng).rows(np.flatnonzero(need), *SENSOR_SUN_ROULETTE)
             out[need] = dni * cos[need] * self.shadow(points[need],
                                                       _rows(dirs, need), draws, hour=hour)
         return out
@@ -272,7 +278,7 @@ class _Tracer:
         acc = np.zeros(k)
         alive = np.arange(k)
         o = np.array(points, float)
-        d = (cosine_hemisphere(np.asarray(normals, float), rng.rows(None, 0, 4)) if dirs is None
+        d = (cosine_hemisphere(np.asarray(normals, float), rng.rows(None, *FIRST_DIRECTIONS)) if dirs is None
              else np.array(dirs, float))
         beta = np.ones(k)
         depth = np.ones(k, np.int64)

@@ -26,6 +26,13 @@ _U_GOLDEN, _U_M1, _U_M2 = np.uint64(_GOLDEN), np.uint64(_M1), np.uint64(_M2)
 _S30, _S27, _S31, _S11 = np.uint64(30), np.uint64(27), np.uint64(31), np.uint64(11)
 _TO_UNIT = 1.0 / (1 << 53)
 
+# Places of the draws made outside the bounce loop (bounce 0); the loop's own are
+# (bounce ≥ 1, site 0–4), a shadow ray's roulette appends the layer crossed. Distinct places
+# give independent numbers, so no two sites may share one.
+FIRST_DIRECTIONS = (0, 4)      # cosine samples of the first directions (no Sobol' net given)
+SUN_DISC = (0, 5)              # a sensor's direction into the sampled sun disc
+SENSOR_SUN_ROULETTE = (0, 6)   # the roulette of a sensor's own shadow ray
+
 
 def mix64(x: int) -> int:
     """SplitMix64's finaliser of one 64-bit integer (a Python int)."""

@@ -22,7 +22,7 @@ from radtree.engines.numpy.engine import (
 )
 from radtree.engines.numpy.qmc import FirstDirections
 from radtree.engines.numpy.sampling import cosine_directions as cosine_from
-from radtree.engines.numpy.streams import PathStreams, stream_key
+from radtree.engines.numpy.streams import SUN_DISC, PathStreams, stream_key
 from radtree.engines.numpy.tally import SensorTally
 from radtree.errors import EngineError
 from radtree.light.sky import SkyState
@@ -83,7 +83,7 @@ def _trace_grid(tracer: _Tracer, grid: SensorGrid, n_paths: int, rng: np.random.
             x += math.pi * (np.cumsum(orders, axis=1) if orders is not None else acc[:, None])
         if disc:
             x += tracer.sensor_sun(pts[sensor], nrm[sensor],
-                                   tracer.sun_directions(len(pid), batch_streams.rows(None, 0, 5)),
+                                   tracer.sun_directions(len(pid), batch_streams.rows(None, *SUN_DISC)),
                                    batch_streams)[:, None]
         tally.add(pid, sensor, x)
     return _per_state(tally.results(direct), n_states)
