@@ -67,6 +67,29 @@ def test_pixel_solid_angles_sum_to_the_hemisphere(lens: str) -> None:
     assert pf.weight[cap].sum() == pytest.approx(2 * math.pi * (1 - math.cos(math.radians(40))), rel=2e-3)
 
 
+def test_pixel_field_is_shared_by_the_lens_axes() -> None:
+    """The field's angles are in the camera frame: an upward and a horizontal analysis of one
+    photo share one computation; a geometry with another north and mirror shares the lens's
+    part, and each field equals its geometry's own pixel-by-pixel directions."""
+    from radtree.hemi.geometry import clear_pixel_field_cache
+
+    mask, lens = CircularMask(450, 350, 340), get_lens("FC-E8")
+    up = FisheyeGeometry(900, 700, mask, lens)
+    side = FisheyeGeometry(900, 700, mask, lens, axis="horizontal")
+    turned = FisheyeGeometry(900, 700, mask, lens, axis="horizontal", north_deg=30.0,
+                             mirror=False)
+    clear_pixel_field_cache()
+    assert side.pixel_field() is up.pixel_field()
+    a, b = up.pixel_field(), turned.pixel_field()
+    assert b.zenith is a.zenith and b.weight is a.weight and b.valid is a.valid
+    for g, pf in ((up, a), (turned, b)):
+        y, x = np.nonzero(pf.valid)
+        zen, azi = g.to_direction(x + pf.cols.start + 0.5, y + pf.rows.start + 0.5)
+        np.testing.assert_allclose(pf.zenith[pf.valid], zen, atol=1e-4)
+        np.testing.assert_allclose(pf.azimuth[pf.valid], azi.astype(np.float32), atol=1e-3)
+    assert not np.allclose(a.azimuth[a.valid], b.azimuth[b.valid], atol=1.0)
+
+
 def test_full_frame_allows_the_circle_past_the_frame() -> None:
     mask = full_frame_mask(1200, 800)
     assert mask.radius == pytest.approx(0.5 * math.hypot(1200, 800))

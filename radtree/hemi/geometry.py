@@ -21,8 +21,9 @@ turns these angles into world vectors given the façade azimuth.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from functools import lru_cache
+from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -135,12 +136,27 @@ class FisheyeGeometry:
     def pixel_field(self, max_zenith: float = 90.0) -> PixelField:
         """Directions and solid angles of all pixel centres within ``max_zenith`` degrees.
 
-        Cached for the last few geometries (a batch of photos from one camera shares it); the
-        arrays are read-only.
+        Cached for the last few geometries (a batch of photos from one camera shares it, and
+        one photo's upward and horizontal analyses share the lens's part: the lens axis does
+        not enter these camera-frame angles, and north and mirror only turn the azimuths);
+        the arrays are read-only.
         """
-        return _pixel_field(self, float(max_zenith))
+        return _pixel_field(replace(self, axis="up"), float(max_zenith))
 
     def _compute_pixel_field(self, max_zenith: float) -> PixelField:
+        radial = _radial_field(replace(self, axis="up", north_deg=0.0, mirror=False),
+                               max_zenith)
+        rows, cols, valid, zenith, weight, alpha = radial
+        beta = alpha - self.north_deg
+        azimuth = np.full(valid.shape, np.nan, dtype=np.float32)
+        azimuth[valid] = np.mod(-beta if self.mirror else beta, 360.0)
+        azimuth.setflags(write=False)
+        return PixelField(rows, cols, valid, zenith, azimuth, weight)
+
+    def _compute_radial_field(self, max_zenith: float) -> tuple[Any, ...]:
+        """What the lens and mask alone give: the box, valid pixels, zenith (degrees),
+        solid angle (sr) and, on the valid pixels, the angle clockwise from image-up
+        (degrees, before north and mirror)."""
         rows, cols = self.bounds()
         y = np.arange(rows.start, rows.stop, dtype=np.float64) + 0.5
         x = np.arange(cols.start, cols.stop, dtype=np.float64) + 0.5
@@ -158,16 +174,14 @@ class FisheyeGeometry:
             r_in, z_in = r_in[ok], z_in[ok]
         dxb = np.broadcast_to(dx, rho.shape)[valid]
         dyb = np.broadcast_to(dy, rho.shape)[valid]
-        beta = np.degrees(np.arctan2(dxb, -dyb)) - self.north_deg
+        alpha = np.degrees(np.arctan2(dxb, -dyb))
         zenith = np.full(rho.shape, np.nan, dtype=np.float32)
-        azimuth = np.full(rho.shape, np.nan, dtype=np.float32)
         weight = np.zeros(rho.shape)
         zenith[valid] = z_in
-        azimuth[valid] = np.mod(-beta if self.mirror else beta, 360.0)
         weight[valid] = self.pixel_solid_angle(z_in, r_in)
-        for a in (valid, zenith, azimuth, weight):
+        for a in (valid, zenith, weight, alpha):
             a.setflags(write=False)
-        return PixelField(rows, cols, valid, zenith, azimuth, weight)
+        return rows, cols, valid, zenith, weight, alpha
 
     def pixel_solid_angle(
         self, zenith: NDArray[np.float64], rho: NDArray[np.float64]
@@ -199,6 +213,12 @@ def _pixel_field(geometry: FisheyeGeometry, max_zenith: float) -> PixelField:
     return geometry._compute_pixel_field(max_zenith)
 
 
+@lru_cache(maxsize=2)
+def _radial_field(geometry: FisheyeGeometry, max_zenith: float) -> tuple[Any, ...]:
+    return geometry._compute_radial_field(max_zenith)
+
+
 def clear_pixel_field_cache() -> None:
     """Forget cached pixel fields (frees memory; benchmarks use it to time a cold start)."""
     _pixel_field.cache_clear()
+    _radial_field.cache_clear()

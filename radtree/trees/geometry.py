@@ -120,19 +120,23 @@ def hemisphere_mesh(rings: int) -> tuple[np.ndarray, np.ndarray]:
     return v, f
 
 
-def clip_polygons(polys: np.ndarray, counts: np.ndarray, normal: np.ndarray, offset: float
-                  ) -> tuple[np.ndarray, np.ndarray]:
+def clip_polygons(polys: np.ndarray, counts: np.ndarray, normal: np.ndarray,
+                  offset: float | np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Keep the part of each convex planar polygon where normal·x ≥ offset (Sutherland–Hodgman,
-    all polygons at once). ``polys`` (n, K, 3) holds polygon i in its first ``counts[i]``
-    rows; returns the clipped polygons the same way (n, K', 3) with their counts. A result
-    of fewer than 3 corners counts 0 (dropped), so later clips leave it empty."""
-    n, k, _ = polys.shape
+    all polygons at once). ``polys`` (n, K, D) holds polygon i in its first ``counts[i]``
+    rows (D = 3, or 2 for polygons in a plane's own coordinates); ``offset`` is one number or
+    one per polygon (n,). Returns the clipped polygons the same way (n, K', D) with their
+    counts. A result of fewer than 3 corners counts 0 (dropped), so later clips leave it
+    empty."""
+    n, k, dim = polys.shape
     if n == 0:
         return polys, counts
     slot = np.arange(k)
     valid = slot[None, :] < counts[:, None]
     nxt = (slot[None, :] + 1) % np.maximum(counts, 1)[:, None]
-    d = polys @ normal - offset
+    off = np.asarray(offset, dtype=float)
+    with np.errstate(invalid="ignore"):   # rows beyond a polygon's count may hold NaN
+        d = polys @ normal - (off[:, None] if off.ndim else off)
     q = np.take_along_axis(polys, nxt[:, :, None], axis=1)
     dq = np.take_along_axis(d, nxt, axis=1)
     keep = valid & (d >= 0)
@@ -140,7 +144,7 @@ def clip_polygons(polys: np.ndarray, counts: np.ndarray, normal: np.ndarray, off
     with np.errstate(divide="ignore", invalid="ignore"):   # t is used where crossing only
         t = d / (d - dq)
         cut = polys + t[:, :, None] * (q - polys)
-    cand = np.stack([polys, cut], axis=2).reshape(n, 2 * k, 3)
+    cand = np.stack([polys, cut], axis=2).reshape(n, 2 * k, dim)
     use = np.stack([keep, crossing], axis=2).reshape(n, 2 * k)
     out_counts = use.sum(axis=1)
     order = np.argsort(~use, axis=1, kind="stable")[:, :max(int(out_counts.max()), 1)]
@@ -154,13 +158,22 @@ def polygons_to_mesh(polygons: list[np.ndarray]) -> tuple[np.ndarray, np.ndarray
     kept = [p for p in polygons if len(p) >= 3]
     if not kept:
         return np.zeros((0, 3)), np.zeros((0, 3), np.int64)
-    k = np.fromiter((len(p) for p in kept), np.int64, len(kept))
+    return flat_polygons_to_mesh(np.concatenate(kept),
+                                 np.fromiter((len(p) for p in kept), np.int64, len(kept)))
+
+
+def flat_polygons_to_mesh(points: np.ndarray, counts: np.ndarray
+                          ) -> tuple[np.ndarray, np.ndarray]:
+    """Convex planar polygons given one after another — ``points`` (sum(counts), 3), polygon i
+    the next ``counts[i]`` ≥ 3 rows — → the vertices (``points`` itself) and fan-triangulated
+    faces, as :func:`polygons_to_mesh`."""
+    k = np.asarray(counts, np.int64)
     offset = np.concatenate([[0], np.cumsum(k)[:-1]])
     n_tri = k - 2
     first = np.repeat(offset, n_tri)
     local = np.arange(int(n_tri.sum())) - np.repeat(np.cumsum(n_tri) - n_tri, n_tri) + 1
     faces = np.column_stack([first, first + local, first + local + 1])
-    return np.concatenate(kept), faces
+    return points, faces
 
 
 def quads_to_mesh(quads: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

@@ -60,7 +60,7 @@ from radtree.optics import Plastic, Trans
 from radtree.scene import Mesh
 from radtree.site.frame import FacadeFrame
 from radtree.trees.envelope import crown_row_spec, dome_notes, dome_spec, row_notes
-from radtree.trees.geometry import polygons_to_mesh, quads_to_mesh
+from radtree.trees.geometry import flat_polygons_to_mesh, polygons_to_mesh, quads_to_mesh
 from radtree.trees.louvers_dome import build_dome_louvers
 from radtree.trees.louvers_free import BRANCH_SLATS, build_free_louvers
 from radtree.trees.model import BARK_REFLECTANCE, LEAF, TRUNK, TreeModel
@@ -205,8 +205,9 @@ def build_louvers(tree: Tree, sensors: Sensors, street: Street, frame: FacadeFra
         if src is None:
             verts, faces = quads_to_mesh(quads)
         else:
-            pieces, photo_info, photo = dome_from_photo(quads, spec.centre, src, source)
-            verts, faces = polygons_to_mesh(pieces)
+            points, corners, photo_info, photo = dome_from_photo(quads, spec.centre, src,
+                                                                 source)
+            verts, faces = flat_polygons_to_mesh(points, corners)
             ginfo.update(photo_info)
         slats = len(quads)
         notes.extend(dome_notes(spec))

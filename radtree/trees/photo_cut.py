@@ -12,7 +12,8 @@ direction, and the part of every slat inside a sky cell is removed. So a directi
 sky cell passes every layer and a direction through a canopy cell meets every layer's slat —
 the layers' gaps line up along the lines from the photo point, as in the photo, up to one
 cell. The pieces kept are (rectangles of canopy cells: runs along a row, merged with the same
-runs in the rows above) ∩ slat: convex polygons (shapely), mapped back onto the slat's plane.
+runs in the rows above) ∩ slat: convex polygons (Sutherland–Hodgman), mapped back onto the
+slat's plane.
 """
 
 from __future__ import annotations
@@ -20,9 +21,9 @@ from __future__ import annotations
 from typing import Any
 
 import numpy as np
-import shapely
 
 from radtree.errors import ConfigError
+from radtree.trees.geometry import clip_polygons
 from radtree.trees.louvers_dome import DOME_FACES
 from radtree.trees.photo import (
     PhotoSource,
@@ -63,30 +64,47 @@ def _runs(grid: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndar
     """The True cells of ``grid`` as rectangles: runs of consecutive True cells along each row,
     runs with the same columns in consecutive rows merged into one — (first row, last row,
     start column, stop column) index arrays. They cover exactly the True cells."""
-    pad = np.zeros((grid.shape[0], grid.shape[1] + 2), np.int8)
-    pad[:, 1:-1] = grid
-    d = np.diff(pad, axis=1)
-    r, a = np.nonzero(d == 1)
-    _, b = np.nonzero(d == -1)
-    order = np.lexsort((r, b, a))
-    r, a, b = r[order], a[order], b[order]
+    last_row, last_col = grid.shape[0] - 1, grid.shape[1] - 1
+    _, r0, r1, a, b = _window_runs(grid, *(np.array([v]) for v in (0, last_row, 0, last_col)))
+    return r0, r1, a, b
+
+
+def _window_runs(grid: np.ndarray, i0: np.ndarray, i1: np.ndarray, j0: np.ndarray,
+                 j1: np.ndarray) -> tuple[np.ndarray, ...]:
+    """:func:`_runs` of many windows of ``grid`` at once (window w: rows i0[w]..i1[w], columns
+    j0[w]..j1[w], inclusive): (window, first row, last row, start column, stop column), rows
+    and columns counted from the window's corner, ordered by window, then start column, stop
+    column and first row."""
+    win, row, col = _window_cells(i0, i1, j0, j1)
+    val = grid[i0[win] + row, j0[win] + col]
+    prev = np.concatenate([[False], val[:-1]]) & (col > 0)
+    after = np.concatenate([val[1:], [False]]) & (col < (j1 - j0)[win])
+    start = np.flatnonzero(val & ~prev)
+    stop = np.flatnonzero(val & ~after)              # the run's last cell, in the same order
+    win, r, a, b = win[start], row[start], col[start], col[stop] + 1
+    order = np.lexsort((r, b, a, win))
+    win, r, a, b = win[order], r[order], a[order], b[order]
     new = np.ones(len(r), bool)
-    new[1:] = (a[1:] != a[:-1]) | (b[1:] != b[:-1]) | (r[1:] != r[:-1] + 1)
+    new[1:] = ((win[1:] != win[:-1]) | (a[1:] != a[:-1]) | (b[1:] != b[:-1])
+               | (r[1:] != r[:-1] + 1))
     first = np.flatnonzero(new)
     last = np.append(first[1:], len(r)) - 1
-    return r[first], r[last], a[first], b[first]
+    return win[first], r[first], r[last], a[first], b[first]
 
 
 def cut_slats(quads: np.ndarray, centre: np.ndarray, is_sky, cell: float = CELL
-              ) -> tuple[list[np.ndarray], dict[str, float]]:
+              ) -> tuple[np.ndarray, np.ndarray, dict[str, float]]:
     """Slat quads (k, 4, 3) around ``centre`` cut where ``is_sky`` (unit façade-frame
-    vectors → bool) is sky: the kept convex pieces (each an (m, 3) polygon) and counts."""
+    vectors → bool) is sky: the kept convex pieces one after another — points (m, 3) and
+    each piece's corner count (face by face: its whole slats, then the pieces of its cut
+    slats) — and counts."""
     rasters = _face_rasters(is_sky, cell)
     axes = np.array([f[0] for f in DOME_FACES])
     rel = quads - centre[None, None, :]
     cdir = rel.mean(axis=1)
     face_of = np.argmax(cdir @ axes.T, axis=1)
-    pieces: list[np.ndarray] = []
+    points: list[np.ndarray] = []
+    counts: list[np.ndarray] = []
     whole = removed = cut = 0
     for f, (A, P, Q, _a, _b) in enumerate(DOME_FACES):
         edges, canopy = rasters[f]
@@ -101,67 +119,86 @@ def cut_slats(quads: np.ndarray, centre: np.ndarray, is_sky, cell: float = CELL
         ix1 = np.clip(np.floor((X.max(axis=1) + EXTENT) / cell).astype(int), 0, n_cells - 1)
         iy0 = np.clip(np.floor((Y.min(axis=1) + EXTENT) / cell).astype(int), 0, n_cells - 1)
         iy1 = np.clip(np.floor((Y.max(axis=1) + EXTENT) / cell).astype(int), 0, n_cells - 1)
-        bx: list[np.ndarray] = []
-        owner: list[int] = []
-        slat_of: list[int] = []
-        for k, q in enumerate(sel):
-            sub = canopy[iy0[k]:iy1[k] + 1, ix0[k]:ix1[k] + 1]
-            if sub.all():
-                pieces.append(quads[q])
-                whole += 1
-                continue
-            if not sub.any():
-                removed += 1
-                continue
-            r0, r1, a, b = _runs(sub)
-            bx.append(np.column_stack([edges[ix0[k] + a], edges[iy0[k] + r0],
-                                       edges[ix0[k] + b], edges[iy0[k] + r1] + cell]))
-            owner.extend([int(q)] * len(r0))
-            slat_of.extend([k] * len(r0))
-        if not bx:
+        cells = (iy1 - iy0 + 1) * (ix1 - ix0 + 1)
+        win, row, col = _window_cells(iy0, iy1, ix0, ix1)
+        in_canopy = np.add.reduceat(canopy[iy0[win] + row, ix0[win] + col].astype(np.int64),
+                                    np.cumsum(cells) - cells)
+        is_whole = in_canopy == cells
+        is_cut = (in_canopy > 0) & ~is_whole
+        removed += int((in_canopy == 0).sum())
+        whole += int(is_whole.sum())
+        points.append(quads[sel[is_whole]].reshape(-1, 3))
+        counts.append(np.full(int(is_whole.sum()), 4, np.int64))
+        part = np.flatnonzero(is_cut)
+        if not len(part):
             continue
-        b4 = np.concatenate(bx)
-        boxes = shapely.box(b4[:, 0], b4[:, 1], b4[:, 2], b4[:, 3])
-        slat_polys = shapely.polygons(np.stack([X, Y], axis=2))
-        got = shapely.intersection(boxes, slat_polys[np.array(slat_of)])
-        own = np.array(owner)
-        keep = ~shapely.is_empty(got) & (shapely.area(got) > MIN_PIECE)
-        kept_by = set(own[keep].tolist())
-        removed += len(set(owner) - kept_by)
+        k, r0, r1, a, b = _window_runs(canopy, iy0[part], iy1[part], ix0[part], ix1[part])
+        of = part[k]
+        b4 = np.column_stack([edges[ix0[of] + a], edges[iy0[of] + r0],
+                              edges[ix0[of] + b], edges[iy0[of] + r1] + cell])
+        xy, n_xy = _clip_to_boxes(np.stack([X, Y], axis=2)[of], b4)
+        keep = (n_xy >= 3) & (_areas(xy, n_xy) > MIN_PIECE)
+        kept_by = np.unique(of[keep])
+        removed += len(np.unique(of)) - len(kept_by)
         cut += len(kept_by)
-        pieces.extend(_pieces_on_slats(got[keep], own[keep], rel, centre, A, P, Q))
+        xy, n_xy = xy[keep], n_xy[keep]
+        points.append(_on_slats(xy, n_xy, rel[sel[of[keep]]], centre, A, P, Q))
+        counts.append(n_xy)
     info = {"photo_slats_whole": float(whole), "photo_slats_removed": float(removed),
-            "photo_slats_cut": float(cut), "photo_pieces": float(len(pieces)),
+            "photo_slats_cut": float(cut), "photo_pieces": float(sum(len(c) for c in counts)),
             "photo_cell_gnomonic": cell}
-    return pieces, info
+    if not points:
+        return np.zeros((0, 3)), np.zeros(0, np.int64), info
+    return np.concatenate(points), np.concatenate(counts), info
 
 
-def _pieces_on_slats(got: np.ndarray, own: np.ndarray, rel: np.ndarray, centre: np.ndarray,
-                     A: np.ndarray, P: np.ndarray, Q: np.ndarray) -> list[np.ndarray]:
-    """The polygons of the kept intersections ``got`` (gnomonic X, Y of one face; multi-part
-    results split, parts that are not polygons or smaller than :data:`MIN_PIECE` dropped),
-    each mapped back onto the plane of its slat ``own`` (slat corners ``rel`` around
-    ``centre``): (m, 3) polygons in the order of ``got`` and its parts."""
-    parts, of = shapely.get_parts(got, return_index=True)
-    ok = (shapely.get_type_id(parts) == 3) & (shapely.area(parts) > MIN_PIECE)   # 3: Polygon
-    parts, of = parts[ok], of[ok]
-    if not len(parts):
-        return []
-    xy, ring = shapely.get_coordinates(shapely.get_exterior_ring(parts), return_index=True)
-    count = np.bincount(ring, minlength=len(parts))
-    last = np.cumsum(count) - 1
-    keep = np.ones(len(xy), bool)
-    keep[last] = False               # the closing vertex of each ring
-    xy, ring = xy[keep], ring[keep]
-    q = own[of]                      # the slat of each part
-    corners = rel[q]
+def _window_cells(i0: np.ndarray, i1: np.ndarray, j0: np.ndarray, j1: np.ndarray
+                  ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Every cell of the windows (rows i0..i1, columns j0..j1, inclusive), window after
+    window, row by row: its window, and its row and column counted from the window's corner."""
+    h, w = i1 - i0 + 1, j1 - j0 + 1
+    size = h * w
+    win = np.repeat(np.arange(len(h)), size)
+    row, col = np.divmod(np.arange(int(size.sum())) - np.repeat(np.cumsum(size) - size, size),
+                         w[win])
+    return win, row, col
+
+
+def _clip_to_boxes(polys: np.ndarray, boxes: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Convex polygons (n, 4, 2) each ∩ its box (n, 4: x0, y0, x1, y1), all at once: four
+    Sutherland–Hodgman clips; (n, K, 2) polygons (first ``counts[i]`` rows) and counts."""
+    out = polys
+    n = np.full(len(polys), polys.shape[1], np.int64)
+    for normal, offset in (((1.0, 0.0), boxes[:, 0]), ((0.0, 1.0), boxes[:, 1]),
+                           ((-1.0, 0.0), -boxes[:, 2]), ((0.0, -1.0), -boxes[:, 3])):
+        out, n = clip_polygons(out, n, np.array(normal), offset)
+    return out, n
+
+
+def _areas(xy: np.ndarray, counts: np.ndarray) -> np.ndarray:
+    """Shoelace areas of the polygons (n, K, 2) with ``counts`` corners (rows beyond unused)."""
+    slot = np.arange(xy.shape[1])
+    nxt = np.take_along_axis(xy, ((slot[None, :] + 1) % np.maximum(counts, 1)[:, None]
+                                  )[:, :, None], axis=1)
+    with np.errstate(invalid="ignore"):   # rows beyond a polygon's count may hold NaN
+        term = xy[:, :, 0] * nxt[:, :, 1] - nxt[:, :, 0] * xy[:, :, 1]
+    return 0.5 * np.abs(np.where(slot[None, :] < counts[:, None], term, 0.0).sum(axis=1))
+
+
+def _on_slats(xy: np.ndarray, counts: np.ndarray, corners: np.ndarray, centre: np.ndarray,
+              A: np.ndarray, P: np.ndarray, Q: np.ndarray) -> np.ndarray:
+    """Pieces in gnomonic X, Y of one face (n, K, 2; ``counts`` corners each) mapped back onto
+    the plane of their slats (``corners`` (n, 4, 3), relative to ``centre``): the points of
+    all pieces one after another (sum(counts), 3)."""
+    used = np.arange(xy.shape[1])[None, :] < counts[:, None]
+    flat = xy[used]
+    ring = np.repeat(np.arange(len(counts)), counts)
     m = np.cross(corners[:, 1] - corners[:, 0], corners[:, 3] - corners[:, 0])
     m /= np.linalg.norm(m, axis=1)[:, None]
     h = _dot(m, corners[:, 0])
-    dirs = A[None, :] + xy[:, :1] * P[None, :] + xy[:, 1:2] * Q[None, :]
+    dirs = A[None, :] + flat[:, :1] * P[None, :] + flat[:, 1:2] * Q[None, :]
     t = h[ring] / _dot(dirs, m[ring])
-    points = centre + t[:, None] * dirs
-    return np.split(points, np.cumsum(count - 1)[:-1])
+    return centre + t[:, None] * dirs
 
 
 def _dot(a: np.ndarray, b: np.ndarray) -> np.ndarray:
@@ -171,8 +208,9 @@ def _dot(a: np.ndarray, b: np.ndarray) -> np.ndarray:
 
 def dome_from_photo(quads: np.ndarray, centre: np.ndarray, src: PhotoSource,
                     source: str | None = None
-                    ) -> tuple[list[np.ndarray], dict[str, float], dict[str, Any]]:
-    """The dome's slats cut by the façade photo ``src``: pieces, counts, provenance."""
+                    ) -> tuple[np.ndarray, np.ndarray, dict[str, float], dict[str, Any]]:
+    """The dome's slats cut by the façade photo ``src``: the pieces' points and corner counts
+    (as :func:`cut_slats`), counts, provenance."""
     try:
         require_direction(src, "facade", "the louvers dome")
         if len(src.images) > 1:
@@ -182,7 +220,7 @@ def dome_from_photo(quads: np.ndarray, centre: np.ndarray, src: PhotoSource,
     except ConfigError as exc:
         raise with_source(exc, source) from None
     is_sky = facade_sky(result)
-    pieces, info = cut_slats(quads, centre, is_sky)
+    points, corners, info = cut_slats(quads, centre, is_sky)
     info["photo_openness"] = float(result.metrics.openness)
-    return pieces, info, provenance(src, [result], {
+    return points, corners, info, provenance(src, [result], {
         "slats_removed": info["photo_slats_removed"], "slats_cut": info["photo_slats_cut"]})
