@@ -3,7 +3,8 @@
 Each run is the command line in a fresh process on a copy of the example (pictures off unless
 ``--pictures``), with its own build cache (``RADTREE_CACHE_DIR`` in the temporary folder):
 a cold build into an empty folder and an empty cache, with 1 process and with the usable
-cores; a build into an empty folder with the crowns in the cache (what any build after the
+cores, and of the scenarios whose crowns come from no photo (the 14 folders of the issue); a
+build into an empty folder with the crowns in the cache (what any build after the
 first is: another project folder, ``--fresh``, a changed hour or sky); a second
 `radtree build` on the built folders (every folder current: kept) and a `--fresh` one (every
 folder rebuilt, crowns from the cache). CPU includes the spawned workers. The slowest folders
@@ -42,8 +43,12 @@ def main() -> None:
         extra = [] if args.pictures else ["--no-pictures"]
         cache = Path(tmp) / "cache"
         os.environ["RADTREE_CACHE_DIR"] = str(cache)
+        plain = _without_photo_crowns(proj)
         rows = []
-        for label, opts, clean in (("cold, empty cache, 1 process", ["--workers", "1"], 2),
+        for label, opts, clean in (*([(f"cold, the {len(plain)} scenarios without photo",
+                                       [a for name in plain for a in ("-s", name)], 2)]
+                                     if plain else []),
+                                   ("cold, empty cache, 1 process", ["--workers", "1"], 2),
                                    (f"cold, empty cache, {cores} processes", [], 2),
                                    ("empty folder, crowns cached", [], 1),
                                    ("again, folders current (kept)", [], 0),
@@ -71,6 +76,17 @@ def main() -> None:
         for total, b in sorted(facts, key=lambda t: -t[0])[:6]:
             print(f"  {b['scenario']:8s} {total:5.2f} s (geometry {b['seconds']['geometry']:.2f}, "
                   f"writing {b['seconds']['writing']:.2f}; {b['triangles']} triangles)")
+
+
+def _without_photo_crowns(proj: Path) -> list[str]:
+    """The project's scenarios whose crowns come from no photo (the folders the issue timed)."""
+    from radtree.config import load_project
+
+    project = load_project(proj)
+    if project.tree.photo is not None:
+        return []
+    return [sc.name for sc in project.scenarios
+            if not any(key.endswith(".photo") for key in sc.switches)]
 
 
 def _run(argv: list[str]) -> tuple[float, float, float]:
