@@ -171,9 +171,16 @@ def flat_polygons_to_mesh(points: np.ndarray, counts: np.ndarray
     offset = np.concatenate([[0], np.cumsum(k)[:-1]])
     n_tri = k - 2
     first = np.repeat(offset, n_tri)
-    local = np.arange(int(n_tri.sum())) - np.repeat(np.cumsum(n_tri) - n_tri, n_tri) + 1
+    local = ranks_within(n_tri) + 1
     faces = np.column_stack([first, first + local, first + local + 1])
     return points, faces
+
+
+def ranks_within(sizes: np.ndarray) -> np.ndarray:
+    """0, 1, …, sizes[0] − 1, 0, 1, …, sizes[1] − 1, …: each item's place in its group, for
+    groups of ``sizes`` items laid one after another."""
+    sizes = np.asarray(sizes, np.int64)
+    return np.arange(int(sizes.sum())) - np.repeat(np.cumsum(sizes) - sizes, sizes)
 
 
 def quads_to_mesh(quads: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

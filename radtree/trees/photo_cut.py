@@ -23,7 +23,7 @@ from typing import Any
 import numpy as np
 
 from radtree.errors import ConfigError
-from radtree.trees.geometry import clip_polygons
+from radtree.trees.geometry import clip_polygons, ranks_within
 from radtree.trees.louvers_dome import DOME_FACES
 from radtree.trees.photo import (
     PhotoSource,
@@ -76,9 +76,16 @@ def _window_runs(grid: np.ndarray, i0: np.ndarray, i1: np.ndarray, j0: np.ndarra
     and columns counted from the window's corner, ordered by window, then start column, stop
     column and first row."""
     win, row, col = _window_cells(i0, i1, j0, j1)
-    val = grid[i0[win] + row, j0[win] + col]
+    return _cell_runs(win, row, col, grid[i0[win] + row, j0[win] + col], (j1 - j0)[win])
+
+
+def _cell_runs(win: np.ndarray, row: np.ndarray, col: np.ndarray, val: np.ndarray,
+               last: np.ndarray) -> tuple[np.ndarray, ...]:
+    """:func:`_window_runs` of windows given cell by cell (as :func:`_window_cells` lists
+    them, whole windows only): each cell's window, row, column, value and its window's last
+    column."""
     prev = np.concatenate([[False], val[:-1]]) & (col > 0)
-    after = np.concatenate([val[1:], [False]]) & (col < (j1 - j0)[win])
+    after = np.concatenate([val[1:], [False]]) & (col < last)
     start = np.flatnonzero(val & ~prev)
     stop = np.flatnonzero(val & ~after)              # the run's last cell, in the same order
     win, r, a, b = win[start], row[start], col[start], col[stop] + 1
@@ -88,8 +95,8 @@ def _window_runs(grid: np.ndarray, i0: np.ndarray, i1: np.ndarray, j0: np.ndarra
     new[1:] = ((win[1:] != win[:-1]) | (a[1:] != a[:-1]) | (b[1:] != b[:-1])
                | (r[1:] != r[:-1] + 1))
     first = np.flatnonzero(new)
-    last = np.append(first[1:], len(r)) - 1
-    return win[first], r[first], r[last], a[first], b[first]
+    last_run = np.append(first[1:], len(r)) - 1
+    return win[first], r[first], r[last_run], a[first], b[first]
 
 
 def cut_slats(quads: np.ndarray, centre: np.ndarray, is_sky, cell: float = CELL
@@ -121,19 +128,18 @@ def cut_slats(quads: np.ndarray, centre: np.ndarray, is_sky, cell: float = CELL
         iy1 = np.clip(np.floor((Y.max(axis=1) + EXTENT) / cell).astype(int), 0, n_cells - 1)
         cells = (iy1 - iy0 + 1) * (ix1 - ix0 + 1)
         win, row, col = _window_cells(iy0, iy1, ix0, ix1)
-        in_canopy = np.add.reduceat(canopy[iy0[win] + row, ix0[win] + col].astype(np.int64),
-                                    np.cumsum(cells) - cells)
+        val = canopy[iy0[win] + row, ix0[win] + col]
+        in_canopy = np.add.reduceat(val.astype(np.int64), np.cumsum(cells) - cells)
         is_whole = in_canopy == cells
         is_cut = (in_canopy > 0) & ~is_whole
         removed += int((in_canopy == 0).sum())
         whole += int(is_whole.sum())
         points.append(quads[sel[is_whole]].reshape(-1, 3))
         counts.append(np.full(int(is_whole.sum()), 4, np.int64))
-        part = np.flatnonzero(is_cut)
-        if not len(part):
+        if not is_cut.any():
             continue
-        k, r0, r1, a, b = _window_runs(canopy, iy0[part], iy1[part], ix0[part], ix1[part])
-        of = part[k]
+        c = is_cut[win]                  # the cells of the cut slats' windows
+        of, r0, r1, a, b = _cell_runs(win[c], row[c], col[c], val[c], (ix1 - ix0)[win[c]])
         b4 = np.column_stack([edges[ix0[of] + a], edges[iy0[of] + r0],
                               edges[ix0[of] + b], edges[iy0[of] + r1] + cell])
         xy, n_xy = _clip_to_boxes(np.stack([X, Y], axis=2)[of], b4)
@@ -159,8 +165,7 @@ def _window_cells(i0: np.ndarray, i1: np.ndarray, j0: np.ndarray, j1: np.ndarray
     h, w = i1 - i0 + 1, j1 - j0 + 1
     size = h * w
     win = np.repeat(np.arange(len(h)), size)
-    row, col = np.divmod(np.arange(int(size.sum())) - np.repeat(np.cumsum(size) - size, size),
-                         w[win])
+    row, col = np.divmod(ranks_within(size), w[win])
     return win, row, col
 
 
