@@ -47,7 +47,10 @@ SKY_TEXT = ("# unit-radiance sky and ground: rcontrib bins it into Reinhart patc
 
 @dataclass(frozen=True)
 class TraceParams:
-    """rcontrib settings of the indirect runs (``-ab``, ``-ad``, ``-lw``) and processes."""
+    """rcontrib settings of the indirect runs (``-ab``, ``-ad``, ``-lw``) and processes.
+
+    The runs sample with ``-u-`` (Radiance's fixed-seed, correlated sampling; its default
+    ``-u+`` seeds from the clock), so one process gives the same coefficients every time."""
 
     ab: int
     ad: int
@@ -56,10 +59,10 @@ class TraceParams:
 
     def ambient(self, ab: int | None = None) -> list[str]:
         use_ab = self.ab if ab is None else ab
-        return ["-ab", str(use_ab), "-ad", str(self.ad), "-lw", f"{self.lw:g}", "-aa", "0"]
+        return ["-u-", "-ab", str(use_ab), "-ad", str(self.ad), "-lw", f"{self.lw:g}", "-aa", "0"]
 
     def key(self) -> str:
-        return f"ab{self.ab}_ad{self.ad}_lw{self.lw:g}"
+        return f"u-_ab{self.ab}_ad{self.ad}_lw{self.lw:g}"
 
 
 def scene_text(scene: Scene, ground_reflectance: float | None) -> str:
