@@ -8,6 +8,13 @@ import shutil
 from pathlib import Path
 
 import pytest
+from hypothesis import settings
+
+# Property tests draw the same examples every run (derandomize, no example database): a CI
+# run cannot fail on a draw no earlier run made. HYPOTHESIS_PROFILE=explore draws afresh.
+settings.register_profile("deterministic", derandomize=True, database=None)
+settings.register_profile("explore", derandomize=False)
+settings.load_profile(os.environ.get("HYPOTHESIS_PROFILE", "deterministic"))
 
 # The build cache (radtree.cache) is off in tests: a test that changes a crown builder would
 # otherwise be served another test's crown. tests/test_build_cache.py turns it on in tmp_path.
