@@ -31,7 +31,7 @@ from pathlib import Path
 import numpy as np
 
 from radtree.annual.skymatrix import patch_count
-from radtree.engines.radiance.binaries import run
+from radtree.engines.radiance.binaries import FIXED_SEED, run
 from radtree.engines.radiance.writer import mesh_to_radiance
 from radtree.errors import EngineError
 from radtree.fileio import atomic_path, write_text
@@ -49,8 +49,8 @@ SKY_TEXT = ("# unit-radiance sky and ground: rcontrib bins it into Reinhart patc
 class TraceParams:
     """rcontrib settings of the indirect runs (``-ab``, ``-ad``, ``-lw``) and processes.
 
-    The runs sample with ``-u-`` (Radiance's fixed-seed, correlated sampling; its default
-    ``-u+`` seeds from the clock), so one process gives the same coefficients every time."""
+    The runs sample with :data:`~radtree.engines.radiance.binaries.FIXED_SEED`, so one
+    process gives the same coefficients every time."""
 
     ab: int
     ad: int
@@ -59,7 +59,7 @@ class TraceParams:
 
     def ambient(self, ab: int | None = None) -> list[str]:
         use_ab = self.ab if ab is None else ab
-        return ["-u-", "-ab", str(use_ab), "-ad", str(self.ad), "-lw", f"{self.lw:g}", "-aa", "0"]
+        return [FIXED_SEED, "-ab", str(use_ab), "-ad", str(self.ad), "-lw", f"{self.lw:g}", "-aa", "0"]
 
     def key(self) -> str:
         return f"u-_ab{self.ab}_ad{self.ad}_lw{self.lw:g}"

@@ -18,6 +18,9 @@ from pathlib import Path
 from radtree.errors import EngineError
 
 REQUIRED = ("oconv", "rtrace", "gendaylit", "rcalc", "obj2mesh")   # obj2mesh: crowns (meshes.py)
+#: rtrace/rcontrib/rfluxmtx's fixed-seed sampling: the same octree and options give the same
+#: numbers in one process (Radiance's default ``-u+`` seeds its random numbers from the clock).
+FIXED_SEED = "-u-"
 
 
 @dataclass(frozen=True)

@@ -34,7 +34,7 @@ from pathlib import Path
 
 import numpy as np
 
-from radtree.engines.radiance.binaries import run
+from radtree.engines.radiance.binaries import FIXED_SEED, run
 from radtree.errors import EngineError
 from radtree.fileio import write_text
 from radtree.optics import KLEMS_FULL_RINGS, Material
@@ -67,9 +67,10 @@ class FluxSettings:
             raise ValueError(f"tensor_tree must be 0 or 4–6, got {self.tensor_tree}")
 
     def options(self) -> list[str]:
-        """rfluxmtx options: ``-u-`` (correlated sampling: the same system and options give
-        the same matrices), the ambient settings, ``-w-``, ``-n`` and ``-c``."""
-        return ["-u-", "-ab", str(self.ab), "-ad", str(self.ad), "-lw", f"{self.lw:g}", "-w-",
+        """rfluxmtx options: :data:`~radtree.engines.radiance.binaries.FIXED_SEED` (the same
+        system and options give the same matrices), the ambient settings, ``-w-``, ``-n`` and
+        ``-c``."""
+        return [FIXED_SEED, "-ab", str(self.ab), "-ad", str(self.ad), "-lw", f"{self.lw:g}", "-w-",
                 "-n", str(self.nproc), "-c", str(self.samples)]
 
 

@@ -25,7 +25,7 @@ from jinja2 import Template
 
 import radtree
 from radtree.config import EngineParams
-from radtree.engines.radiance.binaries import RadianceInstall
+from radtree.engines.radiance.binaries import FIXED_SEED, RadianceInstall
 from radtree.engines.radiance.meshes import (
     as_compiled_mesh,
     mesh_primitive_text,
@@ -78,13 +78,13 @@ def materials_text(materials: Mapping[str, Material], ground: str | None = None)
 
 
 def rtrace_options(params: EngineParams, ab: int) -> list[str]:
-    """rtrace options for illuminance: -I (irradiance at points), -h (no header), -u- (correlated
-    sampling: the same octree and options give the same numbers) and the ambient parameters.
+    """rtrace options for illuminance: -I (irradiance at points), -h (no header),
+    :data:`~radtree.engines.radiance.binaries.FIXED_SEED` and the ambient parameters.
     With a photon map (``pmap_photons``) rtrace computes one ambient bounce (final gathering)."""
     if PhotonMap.from_params(params) is not None:
         ab = FINAL_GATHER_AB
     return [
-        "-h", "-I", "-u-", "-ab", str(ab), "-ad", str(params.ad), "-as", str(params.as_),
+        "-h", "-I", FIXED_SEED, "-ab", str(ab), "-ad", str(params.ad), "-as", str(params.as_),
         "-ar", str(params.ar), "-aa", f"{params.aa:g}", "-lw", f"{params.lw:g}",
     ]
 
