@@ -8,6 +8,7 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from dataclasses import dataclass, field
+from datetime import tzinfo
 from pathlib import Path
 from typing import Any, ClassVar
 
@@ -27,6 +28,8 @@ _PHOTO = photo_fields()
 _CLUMPING = clumping_fields()
 REFLECTION_MODES = ("traced", "calculated")
 SKY_CHOICES = ("none", "perez")
+#: where the hours' direct normal and diffuse illuminance come from (:class:`Light`)
+WEATHER_CHOICES = ("clear-sky", "epw", "table")
 SAMPLING_CHOICES = ("sobol", "random")  # NumPy engine's first directions (engines/numpy/qmc)
 #: Presets of the louvers slat optics (the switch ``"louvers.reading"``): the study's reading
 #: (every layer fully covered, T 0.5 in the slat) and near-opaque leaves with open gaps.
@@ -47,16 +50,41 @@ def _fraction(default: float) -> Any:
 # ---------------------------------------------------------------- dataclasses
 @dataclass(frozen=True)
 class Site(Checked):
-    """Place and times: latitude north +, longitude east + (west negative), UTC offset hours."""
+    """Place and times: latitude north +, longitude east + (west negative), elevation m.
+
+    ``time_zone``: an IANA name (``"Europe/Madrid"``: daylight saving applied) or a fixed
+    offset (``"UTC+1"``); ``hours`` are local civil clock times on ``date``
+    (:mod:`radtree.config.timezone`). ``utc_offset_hours`` is the zone's *standard-time*
+    offset on ``date`` (the time base of EPW files), derived from ``time_zone``; a file may
+    give it instead of ``time_zone`` (a fixed offset).
+    """
 
     TABLE: ClassVar[str] = "site"
     name: str
     latitude: float = field(metadata=meta(-90, 90))
     longitude: float = field(metadata=meta(-180, 180))
     elevation_m: float = field(metadata=meta(-500, 9000))
-    utc_offset_hours: float = field(metadata=meta(-14, 14))
+    utc_offset_hours: float = field(metadata=meta(-14, 14, switch=False))
     date: str = field(metadata=meta(kind="date"))
     hours: tuple[str, ...] = field(metadata=meta(kind="times", switch=False))
+    time_zone: str = field(default="", metadata=meta(switch=False))
+
+    def check(self) -> None:
+        from radtree.config.timezone import fixed_name, parse_time_zone
+
+        if not self.time_zone:
+            object.__setattr__(self, "time_zone", fixed_name(self.utc_offset_hours))
+        try:
+            parse_time_zone(self.time_zone)
+        except ValueError as exc:
+            raise self.fail("time_zone", str(exc)) from None
+
+    @property
+    def tzinfo(self) -> tzinfo:
+        """The zone of the site's clock times (daylight saving applied for IANA names)."""
+        from radtree.config.timezone import parse_time_zone
+
+        return parse_time_zone(self.time_zone)
 
 
 @dataclass(frozen=True)
@@ -83,10 +111,15 @@ class Street(Checked):
 
 @dataclass(frozen=True)
 class Light(Checked):
-    """Sun and sky inputs: a DNI table (``time,direct_normal_lux``) or an EPW file.
+    """Sun and sky inputs: where each hour's direct normal and diffuse illuminance come from.
 
-    ``sky``: ``none`` = sun only (the study's set-up) or ``perez`` = clear-sky Perez sky of
-    ``diffuse_horizontal_lux`` (a stated substitute: the study gives no diffuse values).
+    ``weather``: ``clear-sky`` (no file: pvlib's Ineichen–Perez clear sky with pvlib's Linke
+    turbidity climatology at the site, Perez et al. 1990 luminous efficacy →
+    :mod:`radtree.light.clearsky`), ``epw`` (a weather file, ``epw``; checked against
+    ``[site]``) or ``table`` (a DNI table ``time,direct_normal_lux`` in lux, ``direct_normal``).
+    Left out: ``epw`` when an EPW is given, ``table`` when a DNI table is, else ``clear-sky``.
+    ``sky``: ``none`` = sun only, or ``perez`` = Perez sky of the hour's diffuse horizontal
+    illuminance (from the weather; a DNI table gives none, then ``diffuse_horizontal_lux``).
     """
 
     TABLE: ClassVar[str] = "light"
@@ -95,6 +128,25 @@ class Light(Checked):
     epw: Path | None = field(default=None, metadata=meta(switch=False))
     sky: str = field(default="none", metadata=meta(choices=SKY_CHOICES))
     diffuse_horizontal_lux: float = field(default=12000.0, metadata=meta(0.0, 150000.0))
+    weather: str = field(default="", metadata=meta(choices=("", ) + WEATHER_CHOICES,
+                                                   switch=False))
+
+    def check(self) -> None:
+        given = {"epw": self.epw is not None, "table": self.direct_normal_table is not None}
+        if given["epw"] and given["table"]:
+            raise self.fail("epw", "both an EPW and a DNI table (direct_normal) are given: "
+                            "keep one")
+        inferred = "epw" if given["epw"] else "table" if given["table"] else "clear-sky"
+        if not self.weather:
+            object.__setattr__(self, "weather", inferred)
+        elif self.weather == "clear-sky" and inferred != "clear-sky":
+            raise self.fail("weather", f"weather = 'clear-sky' needs no file, but "
+                            f"{'epw' if given['epw'] else 'direct_normal'} is given: delete "
+                            "one of the two")
+        elif self.weather in ("epw", "table") and not given[self.weather]:
+            key = "epw" if self.weather == "epw" else "direct_normal"
+            raise self.fail("weather", f"weather = {self.weather!r} needs {key} = \"…\" "
+                            "(or use weather = 'clear-sky')")
 
 
 @dataclass(frozen=True)

@@ -11,7 +11,7 @@ import functools
 import importlib.util
 import math
 from dataclasses import dataclass
-from datetime import datetime, timedelta, timezone
+from datetime import datetime, timedelta, timezone, tzinfo
 from functools import lru_cache
 from pathlib import Path
 from types import ModuleType
@@ -62,9 +62,12 @@ def compass_to_radiance_azimuth(azimuth_deg: float) -> float:
     return (a + 180.0) % 360.0 - 180.0
 
 
-def local_datetime(date: str, time: str, utc_offset_hours: float) -> datetime:
-    """A timezone-aware local clock datetime from ``YYYY-MM-DD`` and ``HH:MM``."""
-    tz = timezone(timedelta(hours=utc_offset_hours))
+def local_datetime(date: str, time: str, zone: float | tzinfo) -> datetime:
+    """A timezone-aware local civil clock datetime from ``YYYY-MM-DD`` and ``HH:MM``.
+
+    ``zone``: a fixed UTC offset in hours, or a tzinfo (an IANA zone: daylight saving
+    applied, e.g. 09:00 on 21 June in ``Europe/Madrid`` is UTC+2)."""
+    tz = zone if isinstance(zone, tzinfo) else timezone(timedelta(hours=zone))
     return datetime.fromisoformat(f"{date}T{time}").replace(tzinfo=tz)
 
 
