@@ -125,3 +125,16 @@ def angular_separation_deg(a: np.ndarray, b: np.ndarray) -> float:
     a = np.asarray(a, float) / np.linalg.norm(a)
     b = np.asarray(b, float) / np.linalg.norm(b)
     return math.degrees(math.acos(float(np.clip(np.dot(a, b), -1.0, 1.0))))
+
+
+def daylight_hours(latitude: float, longitude: float, elevation_m: float, zone: float | tzinfo,
+                   date: str, min_altitude_deg: float = 0.0, step_min: int = 60) -> list[str]:
+    """The local civil clock times ``HH:MM`` of ``date`` (every ``step_min`` minutes from
+    00:00) with the sun's centre (apparent, refraction included) above ``min_altitude_deg``."""
+    out = []
+    for m in range(0, 24 * 60, step_min):
+        t = f"{m // 60:02d}:{m % 60:02d}"
+        sun = sun_position(local_datetime(date, t, zone), latitude, longitude, elevation_m)
+        if sun.altitude_deg > min_altitude_deg:
+            out.append(t)
+    return out

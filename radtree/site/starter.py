@@ -45,6 +45,7 @@ from radtree.config.species import find_species
 from radtree.config.switches import TABLES, TREE_TABLES
 from radtree.errors import ConfigError
 from radtree.fileio import write_text
+from radtree.light.sun import daylight_hours
 from radtree.light.weather import read_epw
 from radtree.site.inventory import read_features
 
@@ -250,22 +251,6 @@ def site_facts(epw: Path | None, inputs: Inputs, where: Location | None = None
     return site, "; ".join(said)
 
 
-def daylight_hours(site: dict[str, Any], date: str, min_altitude_deg: float = 5.0
-                   ) -> list[str]:
-    """The whole clock hours of ``date`` with the sun at least ``min_altitude_deg`` high."""
-    from radtree.light.sun import local_datetime, sun_position
-
-    tz = parse_time_zone(site["time_zone"])
-    out = []
-    for h in range(24):
-        t = f"{h:02d}:00"
-        sun = sun_position(local_datetime(date, t, tz), site["latitude"], site["longitude"],
-                           site["elevation_m"])
-        if sun.altitude_deg >= min_altitude_deg:
-            out.append(t)
-    return out
-
-
 # ---------------------------------------------------------------- the document
 def _unit(name: str, kind: str, fraction: bool) -> str:
     if kind not in ("float", "int"):
@@ -358,7 +343,13 @@ def document(template: str, site: dict[str, Any], site_source: str, data: dict[s
     proj.add(tomlkit.comment('measured_rows = "data/…"   # per-row measured means; optional'))
     doc.add("project", proj)
     date = site.pop("date")
-    hours = daylight_hours(site, date)
+    args = (site["latitude"], site["longitude"], site["elevation_m"],
+            parse_time_zone(site["time_zone"]), date)
+    hours = daylight_hours(*args, min_altitude_deg=5.0) or daylight_hours(*args)
+    if not hours:
+        raise ConfigError(f"the sun stays below the horizon at every whole hour of {date} at "
+                          f"latitude {site['latitude']:g} (polar night): choose another "
+                          "--date")
     s = table(TABLES["site"], {**site, "date": date, "hours": hours},
               {"date": "local date of the hours",
                "hours": "local civil clock times (daylight saving applied with an IANA zone); "
