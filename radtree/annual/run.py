@@ -53,7 +53,13 @@ import radtree.annual.metrics as metrics
 from radtree.annual.branches import BranchParams, build_leaf_off
 from radtree.annual.coefficients import CoefficientRunner, TraceParams
 from radtree.annual.phenology import Phenology, crown_year, phenology_of
-from radtree.annual.schedule import DEFAULT_OCCUPANCY, LeafSchedule, occupied, parse_occupancy
+from radtree.annual.schedule import (
+    DEFAULT_OCCUPANCY,
+    LeafSchedule,
+    leaf_season,
+    occupied,
+    parse_occupancy,
+)
 from radtree.annual.skymatrix import Suns, Wea, patch_count
 from radtree.annual.weather_year import YearInputs, annual_weather
 from radtree.config import Project, Scenario, effective_project
@@ -89,7 +95,8 @@ MONTHLY_COLUMNS = ["grid", "tree", "month", "mean_lux", "mean_direct_lux", "leaf
 class AnnualOptions:
     """Settings of an annual run (None = from the project)."""
 
-    leaf: LeafSchedule = field(default_factory=LeafSchedule)
+    #: the leaf season; None: :func:`radtree.annual.schedule.leaf_season` of the project
+    leaf: LeafSchedule | None = None
     mf: int = 1
     sun_mf: int = 1
     occupancy: tuple[float, float] = DEFAULT_OCCUPANCY
@@ -300,11 +307,18 @@ def scene_year_lux(runner: CoefficientRunner, year: YearInputs, mf: int, sun_mf:
     return combine(c_sky, sky, c_dir, suns, c_ind, verts, weights, wea.n_hours)
 
 
+def with_season(project: Project, options: AnnualOptions) -> AnnualOptions:
+    """``options`` with its leaf season resolved (:func:`radtree.annual.schedule.leaf_season`)."""
+    if options.leaf is not None:
+        return options
+    return replace(options, leaf=leaf_season(project))
+
+
 def compute_annual(project: Project, options: AnnualOptions | None = None,
                    echo: Callable[[str], None] = print, progress: bool = False
                    ) -> AnnualResult:
     """Trace the three scenes and assemble 8760 hours of illuminance per sensor."""
-    options = options or AnnualOptions()
+    options = with_season(project, options or AnnualOptions())
     if options.method != "dc":
         raise ConfigError(f"compute_annual is the 'dc' method; for {options.method!r} use "
                           "radtree.annual.methods.compute")

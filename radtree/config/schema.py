@@ -6,6 +6,7 @@ as local clock ``HH:MM``. Bounds, choices and TOML names are field metadata (:fu
 
 from __future__ import annotations
 
+import re
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from datetime import tzinfo
@@ -289,6 +290,19 @@ class Tree(Checked):
     photo_zenith_deg: float = _PHOTO["photo_zenith_deg"]
     representation: str = field(default="explicit", metadata=meta(choices=REPRESENTATIONS))
     bsdf: CrownBsdf = field(default_factory=CrownBsdf)
+    #: the leaf season (``MM-DD``) of annual runs and exports, both or neither: when left out
+    #: it comes from the species' phenology and the site's hemisphere (radtree.annual.schedule)
+    leaf_on: str | None = field(default=None, metadata=meta(switch=False))
+    leaf_off: str | None = field(default=None, metadata=meta(switch=False))
+
+    def check(self) -> None:
+        if (self.leaf_on is None) != (self.leaf_off is None):
+            raise self.fail("leaf_on" if self.leaf_on is None else "leaf_off",
+                            "give both leaf_on and leaf_off (MM-DD), or neither")
+        for name in ("leaf_on", "leaf_off"):
+            v = getattr(self, name)
+            if v is not None and not re.match(r"^(0[1-9]|1[0-2])-(0[1-9]|[12]\d|3[01])$", v):
+                raise self.fail(name, f"got {v!r}, expected MM-DD such as '04-15'")
 
 
 @dataclass(frozen=True)
