@@ -25,7 +25,7 @@ import numpy as np
 from radtree.errors import ConfigError
 from radtree.optics import Plastic
 from radtree.scene import Mesh, SensorGrid, quad
-from radtree.site.inventory import InventoryTree, LocalFrame, number, read_features
+from radtree.site.inventory import InventoryTree, LocalFrame, check_spread, number, read_features
 
 PROBE_M = 0.5          # how far outside a face its "open ground" probe sits
 GROUND_MARGIN_M = 30.0  # the ground extends this far beyond buildings and trees
@@ -108,6 +108,11 @@ def read_buildings(path: Path, frame_crs: str, latitude: float, longitude: float
         wwr = number(f, "window_to_wall", src, lo=0.0, lo_open=False, hi=1.0, default=-1.0) \
             if "window_to_wall" in f.props else None
         out.append(Building(f.id, orient(poly, 1.0), h, rho, max(1, st), wwr))
+    raw = np.array([[float(v) for v in np.mean(np.asarray(f.coords[0], float)[:, :2], axis=0)]
+                    for f in feats]).reshape(-1, 2)
+    check_spread([b.id for b in out], raw, np.array([[b.polygon.centroid.x, b.polygon.centroid.y]
+                                                     for b in out]).reshape(-1, 2),
+                 frame, src, "building")
     for i, a in enumerate(out):
         for b in out[i + 1:]:
             if a.polygon.intersection(b.polygon).area > 0.01:   # type: ignore[attr-defined]

@@ -206,11 +206,8 @@ def site_facts(epw: Path | None, inputs: Inputs, where: Location | None = None
         raise ConfigError("radtree new needs the site: give --lat LAT --lon LON (degrees, "
                           "north and east positive) and --tz Area/City (e.g. --lat 40.42 "
                           "--lon -3.70 --tz Europe/Madrid), or an EPW, or geographic inputs")
-    if centre is not None and (abs(centre[0] - lon) > 0.5 or abs(centre[1] - lat) > 0.5):
-        raise ConfigError(f"the inputs' coordinates centre on latitude {centre[1]:.4f}, "
-                          f"longitude {centre[0]:.4f}, more than 0.5° from the site "
-                          f"({lat:g}, {lon:g}): check --lat/--lon (or longitude and latitude "
-                          "swapped in the inputs)")
+    # inputs far from the site: each feature is checked by the inventory readers
+    # (radtree.site.inventory.check_spread), naming the feature
     if w is not None and (abs(w.latitude - lat) > 0.5 or abs(w.longitude - lon) > 0.5):
         raise ConfigError(f"the EPW {epw} is for latitude {w.latitude}, longitude "
                           f"{w.longitude}, more than 0.5° from the site ({lat:g}, {lon:g}): "
