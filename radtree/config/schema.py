@@ -288,6 +288,7 @@ class Tree(Checked):
     photo_distance_m: float = _PHOTO["photo_distance_m"]
     photo_height_m: float = _PHOTO["photo_height_m"]
     photo_zenith_deg: float = _PHOTO["photo_zenith_deg"]
+    accept_poor_fit: bool = _PHOTO["accept_poor_fit"]
     representation: str = field(default="explicit", metadata=meta(choices=REPRESENTATIONS))
     bsdf: CrownBsdf = field(default_factory=CrownBsdf)
     #: the leaf season (``MM-DD``) of annual runs and exports, both or neither: when left out

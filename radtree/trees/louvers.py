@@ -239,7 +239,10 @@ def build_louvers(tree: Tree, sensors: Sensors, street: Street, frame: FacadeFra
             from radtree.trees.photo_fit import camera_point, fitted_louvers
 
             lv, fit, photo = fitted_louvers(lv, src, spec_r, camera_point(tree, sensors),
-                                            frame, source)
+                                            frame, source, tree.accept_poor_fit)
+            if fit.problems():
+                notes.append("POOR PHOTO FIT ACCEPTED ([tree] accept_poor_fit = true): "
+                             + "; ".join(fit.problems()) + ".")
             volume = True
             tilt = (f"leaf inclinations from Campbell's ellipsoidal distribution, x = "
                     f"{fit.x:.3g} (mean tilt {fit.mean_tilt_deg:.1f}°)" if fit.x is not None
