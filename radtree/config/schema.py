@@ -152,7 +152,7 @@ class Light(Checked):
 
 @dataclass(frozen=True)
 class Dome(Checked):
-    """Study form: hemisphere of ``radius_m`` centred on the sensor grid, flat side on the wall."""
+    """Dome form: a hemisphere of ``radius_m`` centred on the sensor grid, flat side on the wall."""
 
     TABLE: ClassVar[str] = "tree.dome"
     radius_m: float = _positive(4.0)

@@ -292,8 +292,8 @@ def build_louvers(tree: Tree, sensors: Sensors, street: Street, frame: FacadeFra
                      "(switch louvers.reading = \"gap\").")
     elif optics.reading == "gap":
         notes.append("Gap reading: leaves are near-opaque real leaves and each layer passes "
-                     "light mainly through its gaps (switch louvers.reading = \"study\" for the "
-                     "study's effective slat material).")
+                     "light mainly through its gaps (switch louvers.reading = \"study\" for an "
+                     "effective slat material: every layer covered, transmittance 0.5).")
     if volume:
         ab = recommended_volume_ab(lv)
         notes.append(f"Radiance: -ab {ab} (crossings + 2, capped at 6: light crossing many "
