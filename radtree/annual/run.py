@@ -479,7 +479,7 @@ def write_annual(result: AnnualResult, figures: bool = True) -> AnnualOutcome:
                     "description": result.weather.description},
         "scenarios": result.scenarios,
         "leaf_on": o.leaf.leaf_on, "leaf_off": o.leaf.leaf_off,
-        "leaf_days": o.leaf.leaf_days(),
+        "leaf_days": o.leaf.leaf_days(), "leaf_source": o.leaf.source,
         "occupancy": list(o.occupancy), "occupied_hours": int(result.occupied.sum()),
         "sky_mf": o.mf, "sun_mf": o.sun_mf, "method": o.method,
         "rcontrib": {"ab": result.trace.ab, "ad": result.trace.ad, "lw": result.trace.lw,

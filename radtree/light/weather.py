@@ -242,13 +242,8 @@ def find_weather(project, epw: Path | None = None, echo=None) -> WeatherSource:
             p = Path(cand)
             if not p.exists():
                 raise ConfigError(f"EPW file not found: {p}", field="light.epw")
+            check_epw_site(project, p)
             w = read_epw(p)
-            if not (_close(w.latitude, site.latitude, 0.5)
-                    and _close(w.longitude, site.longitude, 0.5)):
-                raise ConfigError(f"EPW {p} is for latitude {w.latitude}, longitude "
-                                  f"{w.longitude}, but the site is at {site.latitude}, "
-                                  f"{site.longitude}", source=str(project.source),
-                                  field="light.epw")
             return WeatherSource(p, w.generated, f"{p.name} ({why}"
                                  + (", GENERATED clear sky)" if w.generated else ")"))
     data = project.root / "data"
