@@ -102,10 +102,13 @@ def test_clip_writes_one_trees_points(tile: Path, tmp_path: Path) -> None:
     assert r.exit_code == 0, r.output
     pts = read_tile(out)
     seg = segment_tile(read_tile(tile))
-    assert len(pts) == seg.trees[0].points == int(r.output.split()[2])
-    # all within the highest crown's spheroid (x 15, y 22, radius 4)
+    assert len(pts) == int(r.output.split()[2])
+    assert np.sum(pts.classification != 2) == seg.trees[0].points
+    # crown points within the highest crown's spheroid (x 15, y 22, radius 4), its ground
+    # within the cells (0.5 m, diagonal 0.71 m) the crown's rim reaches
     d = np.hypot(pts.xyz[:, 0] - 500015.0, pts.xyz[:, 1] - 4000022.0)
-    assert d.max() < 4.3
+    assert d[pts.classification != 2].max() < 4.0
+    assert 4.0 < d.max() < 4.0 + 0.71
     r = CliRunner().invoke(main, ["lidar", "clip", str(tile), "--tree", "L999", "--out",
                                   str(tmp_path / "x.laz")])
     assert r.exit_code == 2 and "no tree 'L999' in this tile (its trees: L001, L002, L003)" \

@@ -117,7 +117,7 @@ def segment_command(tile: Path, out: Path, species: str, crs: str | None, **sett
               help="The point file to write (.laz or .las).")
 @_settings
 def clip_command(tile: Path, tree_id: str, out: Path, **settings) -> None:  # type: ignore[no-untyped-def]
-    """Write one tree's points (its crown's non-ground points) to a LAS/LAZ file.
+    """Write one tree's points (those in its crown's cells, ground included) to LAS/LAZ.
 
     The tile is segmented again with the same options as `radtree lidar segment`, so the
     same options give the same ids. The header (point format, scales, CRS) is the tile's.

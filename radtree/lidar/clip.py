@@ -1,7 +1,8 @@
 """Cut one tree's points out of a tile: ``radtree lidar clip TILE --tree ID --out tree.laz``.
 
 The tree is found by the same segmentation as ``radtree lidar segment`` (same settings, so the
-same ids); its points are the tile's non-ground points in the crown's cells, written with the
+same ids); its points are the tile's points in the crown's cells (its ground points
+included, so the file carries its own terrain for heights above ground), written with the
 tile's own header (point format, scales, offsets, CRS; laspy), as LAZ when ``out`` ends in
 ``.laz``. Written to a temporary name and moved into place.
 """

@@ -127,16 +127,19 @@ def tree_tops(chm: np.ndarray, cell: float, cfg: SegmentConfig) -> np.ndarray:
     return np.array(tops, np.int64)
 
 
-def crowns(chm: np.ndarray, tops: np.ndarray, cfg: SegmentConfig) -> np.ndarray:
-    """Crown labels 1…k of every cell (0: no crown) by marker-controlled watershed."""
+def crowns(chm: np.ndarray, tops: np.ndarray, cfg: SegmentConfig
+           ) -> tuple[np.ndarray, np.ndarray]:
+    """Labels 1…k of every cell (0: none) by marker-controlled watershed: the crowns (cells
+    ≥ ``crown_ratio`` × top) and the whole watershed regions (cells ≥ ``min_height_m``)."""
     from skimage.segmentation import watershed
 
     markers = np.zeros(chm.shape, np.int32)
     markers[tops[:, 0], tops[:, 1]] = np.arange(1, len(tops) + 1)
-    labels = watershed(-chm, markers, mask=chm >= cfg.min_height_m)
+    regions = np.asarray(watershed(-chm, markers, mask=chm >= cfg.min_height_m))
     top_h = np.concatenate([[0.0], chm[tops[:, 0], tops[:, 1]]])
-    labels[chm < cfg.crown_ratio * top_h[labels]] = 0
-    return np.asarray(labels)
+    labels = regions.copy()
+    labels[chm < cfg.crown_ratio * top_h[regions]] = 0
+    return labels, regions
 
 
 @dataclass(frozen=True)
@@ -165,11 +168,14 @@ class Segmentation:
     trees: list[DetectedTree]
     chm: Raster
     labels: np.ndarray
-    point_labels: np.ndarray   # crown label (0 = none) of every tile point
+    point_labels: np.ndarray   # watershed region (0 = none) of the cell of every tile point
     heights: np.ndarray        # heights above ground of every tile point
+    ground: np.ndarray         # which tile points are ground
 
     def tree_mask(self, tree_id: str) -> np.ndarray:
-        """The tile's points of crown ``tree_id`` (its non-ground points in the crown's cells)."""
+        """The tile's points in the watershed region of tree ``tree_id`` (the crown without
+        the ``crown_ratio`` cut, so low branches at its rim stay; ground points included: the
+        tree's own terrain, so its heights can be found again from the clipped file)."""
         ids = [t.id for t in self.trees]
         if tree_id not in ids:
             shown = ", ".join(ids[:8]) + (" …" if len(ids) > 8 else "")
@@ -209,11 +215,11 @@ def segment_tile(tile: Tile, cfg: SegmentConfig | None = None) -> Segmentation:
     if len(tops):   # ids by descending height, then x, y: stable for the same tile
         order = np.lexsort((tops[:, 1], tops[:, 0], -smooth[tops[:, 0], tops[:, 1]]))
         tops = tops[order]
-        labels = crowns(smooth, tops, cfg)
+        labels, regions = crowns(smooth, tops, cfg)
     else:
-        labels = np.zeros(smooth.shape, np.int32)
+        labels = regions = np.zeros(smooth.shape, np.int32)
     pi, pj = chm.index(xy)
-    point_labels = np.where(ground, 0, labels[pi, pj])
+    point_labels = regions[pi, pj]
     trees: list[DetectedTree] = []
     width = max(3, len(str(len(tops))))
     objects = ndimage.find_objects(labels)
@@ -224,7 +230,7 @@ def segment_tile(tile: Tile, cfg: SegmentConfig | None = None) -> Segmentation:
         mask = labels[sl] == k
         ii, jj = np.nonzero(mask)
         centre = chm.centre(ii + sl[0].start, jj + sl[1].start).mean(axis=0)
-        mine = point_labels == k
+        mine = (labels[pi, pj] == k) & ~ground
         h_pts = heights[mine]
         height = float(h_pts.max()) if len(h_pts) else float(raw.values[ti, tj])
         low = h_pts[h_pts >= cfg.min_height_m]
@@ -235,4 +241,4 @@ def segment_tile(tile: Tile, cfg: SegmentConfig | None = None) -> Segmentation:
             f"L{k:0{width}d}", float(top_xy[0]), float(top_xy[1]), float(centre[0]),
             float(centre[1]), height, 2.0 * math.sqrt(mask.sum() * cfg.cell_m**2 / math.pi),
             base, int(mine.sum()), _outline(mask, chm, sl[0].start, sl[1].start)))
-    return Segmentation(tile, cfg, trees, chm, labels, point_labels, heights)
+    return Segmentation(tile, cfg, trees, chm, labels, point_labels, heights, ground)
