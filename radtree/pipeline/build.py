@@ -42,12 +42,14 @@ from radtree.pipeline.realisations import (
 
 def hour_grids(project: Project, time_: str, available: list[str],
                wanted: list[str] | None, sc: Scenario | None = None) -> list[str]:
-    """Grids to trace at an hour: the dense façade map only at ``sensors.dense_hours``, and
+    """Grids to trace at an hour: the dense façade maps only at ``sensors.dense_hours``, and
     only in the first crown realisation (``F@1``) of a scenario with several."""
+    from radtree.sensor_grid import is_dense_grid
+
     use = [g for g in available if wanted is None or g in wanted]
     dense = project.sensors.dense_hours
     if (dense and time_ not in dense) or (sc is not None and is_later_realisation(sc.name)):
-        use = [g for g in use if g != "facade_map"]
+        use = [g for g in use if not is_dense_grid(g)]
     return use
 
 

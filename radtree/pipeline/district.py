@@ -16,7 +16,7 @@ from radtree.config import Project, Scenario, effective_project
 from radtree.errors import ConfigError, RadtreeError
 from radtree.optics import Material
 from radtree.scene import Scene
-from radtree.sensor_grid import facade_circle, facade_dense_grid
+from radtree.sensor_grid import street_grids
 from radtree.site.buildings import building_meshes, facade_grids, ground_mesh
 from radtree.site.district import load_district
 from radtree.site.frame import FacadeFrame
@@ -52,9 +52,8 @@ def district_scene(project: Project, scenario: Scenario, dense_grid: bool | None
         frame = FacadeFrame(azimuth_deg=project.street.facade_azimuth_deg)
         materials = dict(street_materials(project.street))
         meshes = street_meshes(project.street, frame)
-        grids = {"facade": facade_circle(project.sensors, frame)}
-        if project.sensors.dense_grid if dense_grid is None else dense_grid:
-            grids["facade_map"] = facade_dense_grid(project.sensors, frame)
+        grids = street_grids(project.sensors, frame, project.sensors.dense_grid
+                             if dense_grid is None else dense_grid)
         notes.append(f"street canyon {project.street.width_m:g} m wide with "
                      f"{len(inputs.trees)} inventory tree(s)")
     t0 = time.perf_counter()
