@@ -33,6 +33,7 @@ import pandas as pd
 from radtree.config import Project
 from radtree.errors import RadtreeError
 from radtree.fileio import atomic_path
+from radtree.pipeline.assemble import facade_frame
 from radtree.pipeline.results import read_results
 from radtree.site.frame import FacadeFrame
 
@@ -122,7 +123,7 @@ def whole_grid(summary: pd.DataFrame) -> pd.DataFrame:
     if rooms is None or rooms.nunique() <= 1:
         return summary
     out = []
-    for (scen, time), g in summary.groupby(["scenario", "time"], sort=False):
+    for _, g in summary.groupby(["scenario", "time"], sort=False):
         n = g["n_points"].to_numpy(float)
 
         def pooled(col: str, g: pd.DataFrame = g, n: np.ndarray = n) -> float:
@@ -250,7 +251,7 @@ def write_maps(project: Project, table: pd.DataFrame, out_dir: Path | None = Non
 
     out_dir = out_dir or office_dir(project)
     out_dir.mkdir(parents=True, exist_ok=True)
-    frame = FacadeFrame(azimuth_deg=project.street.facade_azimuth_deg)
+    frame = facade_frame(project)
     scen_order = list(dict.fromkeys(table["scenario"].astype(str)))
     written = []
     for grid, gt in table.groupby("grid", sort=False):

@@ -6,6 +6,7 @@ as local clock ``HH:MM``. Bounds, choices and TOML names are field metadata (:fu
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -43,6 +44,13 @@ def _positive(default: float) -> Any:
 
 def _fraction(default: float) -> Any:
     return field(default=default, metadata=meta(0.0, 1.0))
+
+
+def line_azimuth(line: tuple[tuple[float, float], tuple[float, float]]) -> float:
+    """Compass azimuth (degrees clockwise from north, 0–360) a façade along ``line`` looks
+    towards: to the right of x1 → x2 (x east, y north)."""
+    (x1, y1), (x2, y2) = line
+    return math.degrees(math.atan2(y2 - y1, -(x2 - x1))) % 360.0
 
 
 # ---------------------------------------------------------------- dataclasses
@@ -86,6 +94,18 @@ class Street(Checked):
     #: inventory, it is placed by radtree.site.placement
     facade_line: tuple[tuple[float, float], tuple[float, float]] | None = field(
         default=None, metadata=meta(kind="line", switch=False))
+
+    def check(self) -> None:
+        if self.facade_line is None:
+            return
+        az = line_azimuth(self.facade_line)
+        given = self.facade_azimuth_deg
+        if given != 0.0 and abs((given - az + 180.0) % 360.0 - 180.0) > 1.0:
+            raise self.fail("facade_azimuth_deg", f"got {given:g}°, but facade_line "
+                            f"{[list(p) for p in self.facade_line]} looks {az:.1f}° (to the "
+                            "right of its first point → second): leave facade_azimuth_deg "
+                            "out, or list the line's points the other way round")
+        object.__setattr__(self, "facade_azimuth_deg", az)   # the line's: one orientation
 
 
 @dataclass(frozen=True)

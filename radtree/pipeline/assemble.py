@@ -13,6 +13,7 @@ from radtree.pipeline.limits import check_triangles
 from radtree.scene import Scene
 from radtree.sensor_grid import street_grids
 from radtree.site.frame import FacadeFrame
+from radtree.site.placement import facade_frame as placed_frame
 from radtree.site.street import street_materials, street_meshes
 
 #: -ab of a scene without a crown model (direct + one interreflection)
@@ -34,8 +35,9 @@ class BuiltScene:
 
 
 def facade_frame(project: Project) -> FacadeFrame:
-    """The studied façade's local frame (x east, y north, z up; azimuth clockwise from north)."""
-    return FacadeFrame(azimuth_deg=project.street.facade_azimuth_deg)
+    """The studied façade's local frame (x east, y north, z up; azimuth clockwise from north),
+    placed by :func:`radtree.site.placement.facade_frame` (``[street] facade_line``, …)."""
+    return placed_frame(project)
 
 
 def scene_ab(project: Project, tree_ab: int | None) -> int:

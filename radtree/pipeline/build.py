@@ -53,6 +53,18 @@ def hour_grids(project: Project, time_: str, available: list[str],
     return use
 
 
+def echo_notes(name: str, notes: list[str], echo: Callable[[str], None]) -> None:
+    """Print the notes a user must see at build time: the crown–wall policy's clip note
+    (:mod:`radtree.trees.wall_policy`) and where an inventory's façade was placed
+    (:mod:`radtree.site.placement`)."""
+    from radtree.site.placement import NOTE_PREFIX as PLACED
+    from radtree.trees.wall_policy import NOTE_PREFIX as WALL
+
+    for note in notes:
+        if note.startswith((WALL, PLACED)):
+            echo(f"  {name}: {note}")
+
+
 def build_project(project: Project, scenarios: list[str] | None = None,
                   echo: Callable[[str], None] = print, progress: bool = True,
                   pictures: bool = True, fresh: bool = True,
@@ -90,6 +102,7 @@ def build_project(project: Project, scenarios: list[str] | None = None,
             if name in drawn:
                 painter.draw(build_root / name)
             echo(_built_line(built_facts, build_root / name))
+            echo_notes(name, built_facts["notes"], echo)
             if bar is not None:
                 bar.update(1)
 

@@ -137,7 +137,11 @@ class OfficeLayout:
     @property
     def sensed(self) -> list[tuple[str, int, int]]:
         """The sensed rooms: (name ``"STOREY-BAY"``, storey k, bay j), in ``rooms`` order."""
-        return [(n, *(int(v) for v in n.split("-"))) for n in self.office.room_names]
+        out = []
+        for name in self.office.room_names:
+            k, j = name.split("-")
+            out.append((name, int(k), int(j)))
+        return out
 
     def opening(self, j: int, k: int) -> tuple[float, float, float, float]:
         """(u0, u1, z0, z1) of the office's façade opening."""
