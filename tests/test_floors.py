@@ -3,6 +3,7 @@ the ground floor included; street sensors at several heights."""
 
 from __future__ import annotations
 
+import math
 import re
 import shutil
 from pathlib import Path
@@ -167,3 +168,191 @@ def test_one_validator_for_one_or_several_heights(tmp_path):
                          ("heights_m = []", "expected a non-empty list of numbers")):
         with pytest.raises(ConfigError, match=re.escape(msg)):
             load_project(street_copy(tmp_path / str(abs(hash(sensors))), sensors))
+
+
+# ---------------------------------------------------------------- where the façade stands
+def inventory_street(tmp: Path, trees: list[dict], crs: str | None, tree_extra: str = "",
+                     street_extra: str = "") -> Path:
+    """An inventory in the street template (no buildings): tests/test_district's project
+    with a 40 m street; ``tree_extra`` goes into [tree], ``street_extra`` into [street]."""
+    from tests.test_district import STREET, district
+
+    p = district(tmp, trees=trees, buildings=None, crs=crs,
+                 extra=STREET.replace("length_m = 40.0", "length_m = 40.0\n" + street_extra))
+    toml = p / "radtree.toml"
+    toml.write_text(toml.read_text().replace('form = "free"', 'form = "free"\n' + tree_extra))
+    return p
+
+
+def _lonlat_row():
+    """Two trees 10 m either side of the site origin (their centroid), in longitude/latitude."""
+    from tests.test_district import LAT, LON, point
+
+    dlon = 10.0 / (111320.0 * math.cos(math.radians(LAT)))
+    return [point("A", LON - dlon, LAT), point("B", LON + dlon, LAT)]
+
+
+def test_inventory_street_without_buildings_builds_behind_the_trees(tmp_path):
+    """The site origin is the trees' centroid: the façade used to pass through it ("tree
+    stands inside a building"); now it stands [tree.crown] trunk_distance_m (3 m) behind them."""
+    from radtree.pipeline.assemble import make_scene
+    from radtree.pipeline.build import build_project
+
+    proj = load_project(inventory_street(tmp_path / "auto", _lonlat_row(), crs=None))
+    said: list[str] = []
+    build_project(proj, echo=said.append, progress=False, pictures=False)
+    placed = [m for m in said if "Façade placed" in m]
+    assert len(placed) == 1 and "T: Façade placed 3 m ([tree.crown] trunk_distance_m) behind " \
+        "the trunk nearest to it, looking 0° (street.facade_azimuth_deg): to place it " \
+        "yourself, set [street] facade_line = [[20.00, -3.00], [-20.00, -3.00]]" in placed[0]
+    scene = make_scene(proj, proj.scenario("T")).scene
+    facade = next(m for m in scene.meshes if m.name == "facade")
+    # (transverse Mercator: trees on the origin's parallel 10 m out lie 5 µm north of it)
+    assert np.allclose(facade.vertices[:, 1], -3.0, atol=1e-4)
+    assert np.allclose(scene.grids["facade"].points[:, 1], -3.0 + 0.01, atol=1e-4)
+    # the same line written out places the façade identically (no note then)
+    line = "facade_line = [[20.0, -3.0], [-20.0, -3.0]]"
+    explicit = load_project(inventory_street(tmp_path / "line", _lonlat_row(), crs=None,
+                                             street_extra=line))
+    built = make_scene(explicit, explicit.scenario("T"))
+    same = next(m for m in built.scene.meshes if m.name == "facade")
+    np.testing.assert_allclose(same.vertices, facade.vertices, atol=1e-4)
+    assert not any("Façade placed" in n for n in built.notes)
+
+
+def test_facade_line_orients_the_facade(tmp_path):
+    """A line running north (x1 → x2 = 0,−20 → 0,20) puts a façade looking east (to its
+    right) through x = 0; a contradicting facade_azimuth_deg is refused naming both."""
+    from radtree.pipeline.assemble import facade_frame
+    from tests.test_district import point
+
+    trees = [point("A", 4.0, -5.0), point("B", 4.0, 5.0)]
+    p = load_project(inventory_street(tmp_path / "east", trees, crs="local",
+                                      street_extra="facade_line = [[0, -20], [0, 20]]"))
+    assert p.street.facade_azimuth_deg == pytest.approx(90.0)
+    f = facade_frame(p)
+    np.testing.assert_allclose(f.normal, [1.0, 0.0, 0.0], atol=1e-12)
+    np.testing.assert_allclose(f.to_local(np.array([4.0, 5.0, 0.0])), [-5.0, 4.0, 0.0],
+                               atol=1e-9)
+    bad = inventory_street(tmp_path / "bad", trees, crs="local", street_extra=(
+        "facade_line = [[0, -20], [0, 20]]\nfacade_azimuth_deg = 270"))
+    with pytest.raises(ConfigError, match=re.escape(
+            "field 'street.facade_azimuth_deg': got 270°, but facade_line [[0.0, -20.0], "
+            "[0.0, 20.0]] looks 90.0°")):
+        load_project(bad)
+
+
+def test_tree_behind_the_facade_names_the_fix(tmp_path):
+    from radtree.pipeline.build import build_project
+    from tests.test_district import point
+
+    p = load_project(inventory_street(tmp_path / "p", [point("A", 0.0, -2.0)], crs="local"))
+    with pytest.raises(ConfigError, match=re.escape(
+            "field 'feature 'A'': tree stands behind the studied façade (n = -2.00 m across a "
+            "20 m street): set [street] facade_line")):
+        build_project(p, echo=lambda _m: None, progress=False, pictures=False)
+
+
+# ---------------------------------------------------------------- one crown–wall policy
+def test_removed_fraction_is_the_clipped_volume():
+    """(1 − t)²(2 + t)/4 against a Monte Carlo of the clipped spheroid (independent)."""
+    from radtree.trees.envelope import CrownRowSpec
+    from radtree.trees.volume import clipped_volume
+    from radtree.trees.wall_policy import removed_fraction
+
+    assert removed_fraction(5.0, 0.0) == 0.5 and removed_fraction(5.0, 5.0) == 0.0
+    assert removed_fraction(5.0, -5.0) == 1.0
+    for a, b, d in ((5.0, 4.75, 2.985), (3.0, 2.5, 1.0), (2.0, 3.0, -0.5)):
+        spec = CrownRowSpec(centres=np.array([[0.0, d, 10.0]]), a=a, b=b, n_clip=0.0,
+                            strips=np.array([[-np.inf, np.inf]]), trunk_radius=0.2,
+                            trunk_top=9.0)
+        vol, se = clipped_volume(spec, samples=400_000, seed=2)
+        whole = 4.0 / 3.0 * math.pi * a * a * b
+        assert 1.0 - vol / whole == pytest.approx(removed_fraction(a, d), abs=4 * se / whole)
+
+
+ROW = """
+[tree.crown]
+count = 1
+trunk_distance_m = 3.5
+radius_m = 4.0
+vertical_radius_m = 2.5
+base_height_m = 3.0
+"""
+
+
+def _row_project(tmp: Path, policy: str) -> Path:
+    """The one-crown row of tests/test_district (hand-written), its crown radius 4 m: it
+    reaches the façade (trunk 3.5 m out)."""
+    from tests.test_district import DNI, REST, SITE, STREET
+
+    tmp.mkdir()
+    (tmp / "dni.csv").write_text(DNI)
+    (tmp / "radtree.toml").write_text(SITE + STREET + ROW + REST.replace(
+        'form = "free"', f'form = "free"\nwall_policy = "{policy}"'))
+    return tmp
+
+
+def test_row_crown_clip_note_and_refusal(tmp_path):
+    from radtree.pipeline.build import build_project
+    from radtree.trees.wall_policy import removed_fraction
+
+    said: list[str] = []
+    build_project(load_project(_row_project(tmp_path / "clip", "clip")), echo=said.append,
+                  progress=False, pictures=False)
+    pct = 100 * removed_fraction(4.0, 3.5 - 0.015)
+    assert f"{pct:.1f}" == "1.2"
+    assert '  T: Crown–wall policy "clip": crowns cut at the wall; crown volume removed: the ' \
+        "row's crown 1.2 % ([tree] wall_policy = \"refuse\" stops the build instead, with the " \
+        'fix)' in said
+    p = load_project(_row_project(tmp_path / "refuse", "refuse"))
+    with pytest.raises(ConfigError) as exc:
+        build_project(p, echo=lambda _m: None, progress=False, pictures=False)
+    assert str(exc.value).endswith(
+        "field 'tree.crown.radius_m': the row's crown (radius 4 m) reaches the façade: its trunk "
+        "stands 3.48 m from the wall's clip plane; [tree] wall_policy = \"refuse\": move the "
+        "trunk 0.52 m further from the wall ([tree.crown] trunk_distance_m), or reduce "
+        "[tree.crown] radius_m to 3.48 m — or set wall_policy = \"clip\"")
+    assert not (p.build_dir / "T").exists()
+
+
+def test_inventory_crown_clip_note_and_refusal(tmp_path):
+    """The same policy for an inventory tree in the canyon (crs local: façade through the
+    origin) and against a building: cut at the wall's clip plane, or refused with the fix."""
+    from radtree.pipeline.assemble import make_scene
+    from radtree.pipeline.build import build_project
+    from radtree.trees.wall_policy import removed_fraction
+    from tests.test_district import BUILDINGS, district, point
+
+    near = [point("N", 0.0, 2.0, crown_diameter_m=6.0)]   # radius 3 m, trunk 2 m out
+    p = load_project(inventory_street(tmp_path / "clip", near, crs="local"))
+    said: list[str] = []
+    build_project(p, echo=said.append, progress=False, pictures=False)
+    pct = 100 * removed_fraction(3.0, 2.0 - 0.015)
+    assert f"{pct:.1f}" == "7.6"
+    assert any("Crown–wall policy \"clip\": crowns cut at the wall; crown volume removed: "
+               "the crown of tree 'N' 7.6 %" in m for m in said)
+    leaves = [m for m in make_scene(p, p.scenario("T")).scene.meshes
+              if m.material.startswith("leaf")]
+    ys = np.concatenate([m.vertices[:, 1] for m in leaves])
+    assert ys.min() >= 0.015 - 1e-9 and ys.min() < 0.05      # cut at the plane, up to it
+
+    refuse = inventory_street(tmp_path / "refuse", near, crs="local",
+                              tree_extra='wall_policy = "refuse"')
+    with pytest.raises(ConfigError, match=re.escape(
+            "field 'feature 'N'': the crown of tree 'N' (radius 3 m) reaches the façade: its "
+            "trunk stands 1.99 m from the wall's clip plane; [tree] wall_policy = \"refuse\": "
+            "move the trunk 1.02 m further from the wall, or reduce the crown radius "
+            "(crown_diameter_m / 2) to 1.98 m")):
+        build_project(load_project(refuse), echo=lambda _m: None, progress=False,
+                      pictures=False)
+
+    # against building N1 (south wall at y = 10): the crown keeps y ≤ 10 − 0.015
+    q = load_project(district(tmp_path / "bldg", trees=[point("T4", -8, 8.0,
+                                                               crown_diameter_m=6.0)],
+                              buildings=BUILDINGS))
+    built = make_scene(q, q.scenario("T"))
+    assert any("removed: the crown of tree 'T4' 7.6 %" in n for n in built.notes)
+    ys = np.concatenate([m.vertices[:, 1] for m in built.scene.meshes
+                         if m.material.startswith("leaf")])
+    assert ys.max() <= 10.0 - 0.015 + 1e-9 and ys.max() > 10.0 - 0.05
