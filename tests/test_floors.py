@@ -356,3 +356,22 @@ def test_inventory_crown_clip_note_and_refusal(tmp_path):
     ys = np.concatenate([m.vertices[:, 1] for m in built.scene.meshes
                          if m.material.startswith("leaf")])
     assert ys.max() <= 10.0 - 0.015 + 1e-9 and ys.max() > 10.0 - 0.05
+
+
+def test_honeybee_crowns_follow_the_same_policy(tmp_path):
+    """A Honeybee model's crowns stand in the street frame's row: the same note and refusal."""
+    pytest.importorskip("honeybee.model")
+    from radtree.pipeline.assemble import make_scene
+    from tests.test_honeybee_model import CROWN, TOML, write_project
+
+    crown = CROWN.replace("radius_m = 2.5", "radius_m = 3.0")
+    p = load_project(write_project(tmp_path / "clip", toml=TOML + crown))
+    notes = make_scene(p, p.scenario("crown")).notes
+    assert any(n.startswith('Crown–wall policy "clip": crowns cut at the wall; crown volume '
+                            "removed: the row's crown 2.1 %") for n in notes)
+    q = load_project(write_project(tmp_path / "refuse", toml=TOML + crown.replace(
+        'form = "free"', 'form = "free"\nwall_policy = "refuse"')))
+    with pytest.raises(ConfigError, match=re.escape(
+            "move the trunk 0.52 m further from the wall ([tree.crown] trunk_distance_m), or "
+            "reduce [tree.crown] radius_m to 2.48 m")):
+        make_scene(q, q.scenario("crown"))
