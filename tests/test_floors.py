@@ -158,6 +158,16 @@ def test_street_with_three_sensor_heights(tmp_path):
     se = np.sqrt((a["lux_stderr"] ** 2).sum() / 64 + (b["lux_stderr"] ** 2).sum() / 64)
     assert abs(a["lux"].mean() - b["lux"].mean()) < 4 * se + 1e-9
     assert a["lux"].mean() > 10000
+    # the report reads the circle nearest sensors.height_m (5 m: 4.5 m) as its façade grid
+    from radtree.report.data import one_level_as_facade
+
+    notes: list[str] = []
+    as_report = one_level_as_facade(proj, t, notes)
+    assert as_report[as_report["grid"] == "facade"]["lux"].tolist() == a["lux"].tolist()
+    by = t[t["grid"] == "facade@7.5m"]["lux"].mean()
+    assert notes[0].startswith("façade sensors at 3 heights ([sensors] heights_m): the report's "
+                               "façade grid is the circle at 4.5 m (nearest sensors.height_m 5 m)")
+    assert f"storey 2 (7.5m) {by:,.0f} lx" in notes[0]
 
 
 def test_one_validator_for_one_or_several_heights(tmp_path):

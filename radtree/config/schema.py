@@ -281,7 +281,9 @@ class Sensors(Checked):
     storey) replaces ``height_m`` when given; each height is checked like ``height_m``. With
     two or more heights the grids are named ``facade@<h>m`` / ``facade_map@<h>m`` (``h`` as
     written, e.g. ``facade@4.5m``) and every sensor carries its ``storey``: the height's index
-    in the list (write the list from the ground up: storey 0 = the lowest)."""
+    in the list (write the list from the ground up: storey 0 = the lowest). ``height_m`` still
+    places what needs one point (the sensor dome, the crown photo's camera, the wall cap's
+    sensor point) and picks the circle the report compares (the nearest height)."""
 
     TABLE: ClassVar[str] = "sensors"
     height_m: float = _positive(5.0)
