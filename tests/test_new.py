@@ -94,8 +94,8 @@ def _inventory(tmp_path: Path) -> tuple[Path, Path]:
                         "crown_diameter_m": 8.0, "crown_base_m": 3.0}}
         for i, (lon, lat, sp) in enumerate([(-68.846, -32.889, "Morus alba"),
                                             (-68.845, -32.889, "morus_alba"),
-                                            (-68.844, -32.890, "Platanus × acerifolia"),
-                                            (-68.843, -32.890, "Ginkgo biloba")])]}
+                                            (-68.844, -32.889, "Platanus × acerifolia"),
+                                            (-68.843, -32.889, "Ginkgo biloba")])]}
     tp = tmp_path / "trees.geojson"
     tp.write_text(json.dumps(trees))
     cp = tmp_path / "trees.csv"
@@ -111,7 +111,7 @@ def test_inputs_summarised_per_species(tmp_path: Path) -> None:
                             "Ginkgo biloba: 1 (not in the species library)"]
     site, why = site_facts(None, info)
     assert (site["latitude"], site["longitude"], site["time_zone"]) == \
-        (-32.8895, -68.8445, "America/Argentina/Mendoza")
+        (-32.889, -68.8445, "America/Argentina/Mendoza")
     assert "looked up from the coordinates" in why and "elevation 0 m (ASSUMED" in why
     csv_info = read_inputs(cp, None, None)
     assert csv_info.lines() == ["2 trees — Melia azedarach: 2"]
@@ -165,7 +165,7 @@ def test_site_from_inputs_and_epw(tmp_path: Path) -> None:
     tp, _ = _inventory(tmp_path)
     site, why = site_facts(EPW, read_inputs(tp, None, None))
     assert (site["latitude"], site["longitude"], site["time_zone"],
-            site["elevation_m"]) == (-32.8895, -68.8445, "UTC-3", 750.0)
+            site["elevation_m"]) == (-32.889, -68.8445, "UTC-3", 750.0)
     assert why.startswith("latitude/longitude the centroid of the inputs' coordinates; time zone")
     far = tmp_path / "far.geojson"
     far.write_text(json.dumps({"type": "FeatureCollection", "features": [

@@ -26,6 +26,7 @@ commented ``# key = default`` lines to uncomment. The file is loaded with
 from __future__ import annotations
 
 import inspect
+import math
 from collections.abc import Callable
 from datetime import date as _date
 import json
@@ -117,9 +118,15 @@ def read_inputs(trees: Path | None, buildings: Path | None, honeybee: Path | Non
             feats, crs = read_features(path, "EPSG:4326", geometry, kind[0].upper())
         except ConfigError as exc:
             raise ConfigError(f"{path}: cannot read the {kind} ({exc})") from None
+        pts = [pt for f in feats for pt in _points(f.coords)]
         if crs.upper().endswith(("4326", "CRS84")):
-            for f in feats:
-                info.lonlat += _points(f.coords)
+            info.lonlat += pts
+        elif pts and crs != "local":    # a projected CRS: its coordinates as longitude/latitude
+            from pyproj import Transformer
+
+            t = Transformer.from_crs(crs, "EPSG:4326", always_xy=True)
+            lon, lat = t.transform([p[0] for p in pts], [p[1] for p in pts])
+            info.lonlat += list(zip(map(float, lon), map(float, lat)))
         if kind == "trees":
             info.trees = len(feats)
             info.species = Counter(str(f.props.get("species", "")).strip() or "(no species)"
@@ -133,6 +140,16 @@ def read_inputs(trees: Path | None, buildings: Path | None, honeybee: Path | Non
         except (OSError, ValueError, UnicodeDecodeError) as exc:
             raise ConfigError(f"{honeybee}: cannot read the Honeybee model ({exc})") from None
     return info
+
+
+def _east_west_span_m(inputs: Inputs) -> float:
+    """East–west extent of the inputs' coordinates (m; equirectangular, enough to size the
+    street along the default east–west façade); 0 without geographic inputs."""
+    if not inputs.lonlat:
+        return 0.0
+    lon = [p[0] for p in inputs.lonlat]
+    lat = sum(p[1] for p in inputs.lonlat) / len(inputs.lonlat)
+    return (max(lon) - min(lon)) * 111320.0 * math.cos(math.radians(lat))
 
 
 def _centroid(inputs: Inputs) -> tuple[float, float] | None:
@@ -366,7 +383,11 @@ def document(template: str, site: dict[str, Any], site_source: str, data: dict[s
             HONEYBEE_LINES if "honeybee" in data else []):
         s.add(tomlkit.comment(line))
     doc.add("site", s)
-    doc.add("street", table(TABLES["street"], {}))
+    span = _east_west_span_m(inputs)
+    street_len = TABLES["street"]().length_m
+    doc.add("street", table(TABLES["street"], {} if span + 40.0 <= street_len else {
+        "length_m": float(math.ceil((span + 40.0) / 10.0) * 10.0)},
+        {"length_m": "covers the inventory's trees along the façade, 20 m beyond each end"}))
     doc.add("light", table(TABLES["light"], light,
                            {"sky": "Perez sky of the weather's diffuse illuminance",
                             "weather": "clear-sky needs no file; epw = \"data/site.epw\" for "
