@@ -33,6 +33,8 @@ import pandas as pd
 from radtree.config import Project
 from radtree.errors import RadtreeError
 from radtree.fileio import atomic_path
+from radtree.office_rooms import fmt as _f
+from radtree.office_rooms import room_names, rooms_data, scenario_pair, whole_grid
 from radtree.pipeline.assemble import facade_frame
 from radtree.pipeline.results import read_results
 from radtree.site.frame import FacadeFrame
@@ -87,7 +89,7 @@ def summarise(table: pd.DataFrame) -> pd.DataFrame:
     if missing:
         raise RadtreeError(f"results table lacks column(s) {', '.join(sorted(missing))}")
     rooms = "room" in table.columns and bool(table["room"].notna().any())
-    table = table.assign(room=_room_names(table) if rooms else "")
+    table = table.assign(room=room_names(table) if rooms else "")
     rows = []
     order = list(dict.fromkeys(table["scenario"].astype(str)))
     for (scen, time, grid, room), g in table.groupby(["scenario", "time", "grid", "room"],
@@ -108,36 +110,6 @@ def summarise(table: pd.DataFrame) -> pd.DataFrame:
                           key=lambda c: c.map(rank) if c.name == "scenario" else
                           c.map(room_rank) if c.name == "room" else c)
     return out.reset_index(drop=True)
-
-
-def _room_names(table: pd.DataFrame) -> pd.Series:
-    """The ``room`` column as text, "" where a row has none."""
-    return table["room"].astype("string").fillna("").astype(str)
-
-
-def whole_grid(summary: pd.DataFrame) -> pd.DataFrame:
-    """One grid's summary rows pooled over its rooms, per scenario and hour: the rooms' cells
-    are equal-area cells, so means and area bands are point-count-weighted means, the minimum
-    and maximum the rooms' extremes, U₀ their min / the pooled mean. One room: unchanged."""
-    rooms = _room_names(summary) if "room" in summary.columns else None
-    if rooms is None or rooms.nunique() <= 1:
-        return summary
-    out = []
-    for _, g in summary.groupby(["scenario", "time"], sort=False):
-        n = g["n_points"].to_numpy(float)
-
-        def pooled(col: str, g: pd.DataFrame = g, n: np.ndarray = n) -> float:
-            return float(np.dot(g[col].to_numpy(float), n) / n.sum())
-
-        mean = pooled("mean_lux")
-        lo = float(g["min_lux"].min())
-        out.append({**g.iloc[0].to_dict(), "n_points": int(n.sum()), "mean_lux": mean,
-                    "min_lux": lo, "max_lux": float(g["max_lux"].max()),
-                    "uniformity": lo / mean if mean > 0 else math.nan,
-                    **{c: pooled(c) for c in ("pct_below_300", "pct_300_2000",
-                                              "pct_above_2000")},
-                    "storey": pd.NA, "room": "all"})
-    return pd.DataFrame(out, columns=summary.columns)
 
 
 def summary_path(project: Project) -> Path:
@@ -384,12 +356,6 @@ def _summary_for_report(project: Project) -> pd.DataFrame:
     return pd.read_csv(out, dtype={"time": str, "scenario": str, "grid": str})
 
 
-def _f(v: float, digits: int = 0) -> str:
-    if v is None or not np.isfinite(v):
-        return "–"
-    return f"{v:,.{digits}f}"
-
-
 #: The columns of a grid's office table per scenario: summary column, label, decimals.
 GRID_COLUMNS = [("mean_lux", "mean lx", 0), ("uniformity", "U₀ min/mean", 2),
                 ("pct_below_300", "% < 300", 0), ("pct_300_2000", "% 300–2000", 0),
@@ -400,11 +366,7 @@ def _grid_data(g: pd.DataFrame, scen_order: list[str]) -> dict[str, Any]:
     """One grid's consultant-style table: per hour (and the day mean) and scenario the mean,
     uniformity and area bands, and the with / without ratio when there is one of each."""
     times = sorted(g["time"].astype(str).unique())
-    scens = [s for s in scen_order if s in set(g["scenario"])]
-    tree_of = {s: str(g[g["scenario"] == s]["tree"].iloc[0]) for s in scens}
-    withs = [s for s in scens if tree_of[s] == "with"]
-    withouts = [s for s in scens if tree_of[s] == "without"]
-    pair = (withs[0], withouts[0]) if len(withs) == 1 and len(withouts) == 1 else None
+    scens, tree_of, pair = scenario_pair(g, scen_order)
     cols = GRID_COLUMNS
     rows = []
     idx = g.set_index(["scenario", "time"])
@@ -431,38 +393,6 @@ def _grid_data(g: pd.DataFrame, scen_order: list[str]) -> dict[str, Any]:
                      "cells": cells})
     return {"scenarios": [{"name": s, "tree": tree_of[s]} for s in scens],
             "columns": [c[1] for c in cols], "pair": pair is not None, "rows": rows}
-
-
-#: The per-room table of a grid: summary column (mean over the hours), label, decimals.
-ROOM_COLUMNS = [("mean_lux", "day mean lx", 0), ("pct_300_2000", "% 300–2000", 0)]
-
-
-def _rooms_data(g: pd.DataFrame, scen_order: list[str]) -> dict[str, Any] | None:
-    """Per sensed room (rows, in the summary's order) and scenario: the day's mean of the
-    hourly mean and of the useful band, and the with / without ratio when there is a pair
-    (None for one room)."""
-    rooms = [r for r in dict.fromkeys(_room_names(g)) if r]
-    if len(rooms) <= 1:
-        return None
-    scens = [s for s in scen_order if s in set(g["scenario"])]
-    tree_of = {s: str(g[g["scenario"] == s]["tree"].iloc[0]) for s in scens}
-    withs = [s for s in scens if tree_of[s] == "with"]
-    withouts = [s for s in scens if tree_of[s] == "without"]
-    pair = (withs[0], withouts[0]) if len(withs) == 1 and len(withouts) == 1 else None
-    day = g.groupby(["room", "scenario"])[[c for c, _, _ in ROOM_COLUMNS]].mean()
-    rows = []
-    for r in rooms:
-        cells = [{"text": _f(float(day.loc[(r, s), c]), d) if (r, s) in day.index else "–",
-                  "num": True} for s in scens for c, _, d in ROOM_COLUMNS]
-        if pair:
-            w, wo = (float(day.loc[(r, s), "mean_lux"]) if (r, s) in day.index else None
-                     for s in pair)
-            cells.append({"text": f"{100 * w / wo:.0f} %" if w is not None and wo else "–",
-                          "num": True})
-        storey = g[g["room"] == r]["storey"].iloc[0]
-        rows.append({"label": f"{r} (storey {storey})", "cells": cells})
-    return {"scenarios": [{"name": s, "tree": tree_of[s]} for s in scens],
-            "columns": [c[1] for c in ROOM_COLUMNS], "pair": pair is not None, "rows": rows}
 
 
 def _maps(project: Project, grid: str, times: list[str], prefix: str) -> list[dict[str, str]]:
@@ -518,7 +448,7 @@ def office_section_data(project: Project, image_prefix: str = "office/") -> dict
         times = sorted(g["time"].astype(str).unique())
         grids.append({
             "title": GRID_TITLES.get(str(grid), str(grid)),
-            **_grid_data(whole_grid(g), scen_order), "rooms": _rooms_data(g, scen_order),
+            **_grid_data(whole_grid(g), scen_order), "rooms": rooms_data(g, scen_order),
             "hourly_image": f"{image_prefix}{grid}_hourly.png",
             "maps": _maps(project, str(grid), times, image_prefix)})
     return {"description": description, "sky": sky, "grids": grids}

@@ -385,3 +385,20 @@ def test_honeybee_crowns_follow_the_same_policy(tmp_path):
             "move the trunk 0.52 m further from the wall ([tree.crown] trunk_distance_m), or "
             "reduce [tree.crown] radius_m to 2.48 m")):
         make_scene(q, q.scenario("crown"))
+
+
+def test_crown_reaching_both_facades_is_refused_under_either_policy(tmp_path):
+    from radtree.pipeline.build import build_project
+    from tests.test_district import point
+
+    folder = inventory_street(tmp_path / "p", [point("W", 0.0, 2.5, crown_diameter_m=6.0)],
+                              crs="local")
+    toml = folder / "radtree.toml"
+    toml.write_text(toml.read_text().replace("width_m = 20.0", "width_m = 5.0"))
+    with pytest.raises(ConfigError, match=re.escape(
+            "field 'feature 'W'': the crown of tree 'W' (radius 3 m) reaches two walls (the "
+            "façade and the opposite façade); a crown is clipped at one wall only: reduce its "
+            "radius to 2.48 m or move its trunk")):
+        build_project(load_project(folder), echo=lambda _m: None, progress=False,
+                      pictures=False)
+    assert not (folder / "build" / "T").exists()

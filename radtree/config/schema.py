@@ -20,7 +20,7 @@ from radtree.config.honeybee import HoneybeeSite
 from radtree.config.limits import Limits
 from radtree.config.params_hash import params_hashes, plain
 from radtree.config.photo import INCLINATION_DISTRIBUTIONS, photo_fields
-from radtree.config.spec import TIME_RE, Checked, meta
+from radtree.config.spec import TIME_RE, Checked, line_azimuth, meta
 from radtree.errors import ConfigError
 
 CROWN_MODELS = ("homogeneous", "perforated", "louvers", "none")
@@ -48,13 +48,6 @@ def _positive(default: float) -> Any:
 
 def _fraction(default: float) -> Any:
     return field(default=default, metadata=meta(0.0, 1.0))
-
-
-def line_azimuth(line: tuple[tuple[float, float], tuple[float, float]]) -> float:
-    """Compass azimuth (degrees clockwise from north, 0–360) a façade along ``line`` looks
-    towards: to the right of x1 → x2 (x east, y north)."""
-    (x1, y1), (x2, y2) = line
-    return math.degrees(math.atan2(y2 - y1, -(x2 - x1))) % 360.0
 
 
 # ---------------------------------------------------------------- dataclasses

@@ -197,6 +197,13 @@ def _line(value: Any) -> tuple[tuple[float, float], tuple[float, float]]:
     return ((float(x1), float(y1)), (float(x2), float(y2)))
 
 
+def line_azimuth(line: tuple[tuple[float, float], tuple[float, float]]) -> float:
+    """Compass azimuth (degrees clockwise from north, 0–360) a façade along ``line`` looks
+    towards: to the right of x1 → x2 (x east, y north)."""
+    (x1, y1), (x2, y2) = line
+    return math.degrees(math.atan2(y2 - y1, -(x2 - x1))) % 360.0
+
+
 def meta(lo: float | None = None, hi: float | None = None, *, lo_open: bool = False,
          hi_open: bool = False,
          choices: tuple[str, ...] | None = None, toml: str | None = None,

@@ -12,8 +12,8 @@ from radtree.errors import RadtreeError
 from radtree.pipeline.limits import check_triangles
 from radtree.scene import Scene
 from radtree.sensor_grid import street_grids
+from radtree.site.district import street_frame as placed_frame
 from radtree.site.frame import FacadeFrame
-from radtree.site.placement import facade_frame as placed_frame
 from radtree.site.street import street_materials, street_meshes
 
 #: -ab of a scene without a crown model (direct + one interreflection)
@@ -36,7 +36,7 @@ class BuiltScene:
 
 def facade_frame(project: Project) -> FacadeFrame:
     """The studied façade's local frame (x east, y north, z up; azimuth clockwise from north),
-    placed by :func:`radtree.site.placement.facade_frame` (``[street] facade_line``, …)."""
+    placed by :func:`radtree.site.district.street_frame` (``[street] facade_line``, …)."""
     return placed_frame(project)
 
 

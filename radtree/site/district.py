@@ -90,6 +90,21 @@ def load_district(project: Project) -> DistrictInputs:
     return out
 
 
+def street_frame(project: Project) -> FacadeFrame:
+    """The studied façade's frame of a street-template project (:mod:`radtree.site.placement`:
+    the ``facade_line``; an inventory without buildings: :func:`canyon_frame`; else through
+    the site origin, looking ``facade_azimuth_deg``)."""
+    st = project.street
+    if st.facade_line is not None:
+        return line_frame(st.facade_line)
+    d = project.district
+    if d is not None and d.trees is not None and d.buildings is None:
+        frame = load_district(project).street_frame
+        assert frame is not None
+        return frame
+    return FacadeFrame(azimuth_deg=st.facade_azimuth_deg)
+
+
 def reach_margin(project: Project) -> float:
     """How far beyond its radius a crown may be from a wall and still meet the wall's clip
     plane (m): an upper bound of the plane's distance from the wall (clearance, or the

@@ -20,7 +20,8 @@ origin (u = 0, n = 0: the middle of the façade's foot) and the way it looks com
 3. Otherwise the façade's foot passes through the site origin (the hand-written street).
 
 With buildings (``[site] buildings``) every selected building face is a façade of its own
-(:mod:`radtree.site.buildings`): nothing here applies.
+(:mod:`radtree.site.buildings`): nothing here applies. The choice among 1–3 is
+:func:`radtree.site.district.street_frame`.
 """
 
 from __future__ import annotations
@@ -30,7 +31,7 @@ from collections.abc import Sequence
 import numpy as np
 
 from radtree.config import Project
-from radtree.config.schema import line_azimuth
+from radtree.config.spec import line_azimuth
 from radtree.site.frame import FacadeFrame
 
 Line = tuple[tuple[float, float], tuple[float, float]]
@@ -72,18 +73,3 @@ def placement_note(project: Project, frame: FacadeFrame) -> str:
             f"{frame.azimuth_deg:g}° (street.facade_azimuth_deg): to place it yourself, set "
             f"[street] facade_line = [[{x1:.2f}, {y1:.2f}], [{x2:.2f}, {y2:.2f}]] (site frame, "
             "m; the façade looks to the right of the first point → the second)")
-
-
-def facade_frame(project: Project) -> FacadeFrame:
-    """The studied façade's frame of a street-template project (module text: 1–3)."""
-    st = project.street
-    if st.facade_line is not None:
-        return line_frame(st.facade_line)
-    d = project.district
-    if d is not None and d.trees is not None and d.buildings is None:
-        from radtree.site.district import load_district
-
-        frame = load_district(project).street_frame
-        assert frame is not None
-        return frame
-    return FacadeFrame(azimuth_deg=st.facade_azimuth_deg)

@@ -34,7 +34,9 @@ NOTE_PREFIX = "Crown–wall policy"
 def removed_fraction(radius_m: float, distance_m: float) -> float:
     """Fraction of a spheroid's volume (horizontal semi-axis ``radius_m``, any vertical one) on
     the far side of a vertical plane ``distance_m`` from its axis: the spherical cap fraction
-    (1 − t)²(2 + t)/4 with t = d/a (the vertical semi-axis scales cap and whole alike)."""
+    (1 − t)²(2 + t)/4 with t = d/a — the cap of height h = a − d has volume πh²(3a − h)/3
+    (spherical segment, e.g. Zwillinger, CRC Standard Mathematical Tables and Formulae, 31st
+    ed., §4.6); the vertical semi-axis scales cap and whole alike (an affine map)."""
     t = min(1.0, max(-1.0, distance_m / radius_m))
     return (1.0 - t) ** 2 * (2.0 + t) / 4.0
 
