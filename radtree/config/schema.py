@@ -237,6 +237,11 @@ class Tree(Checked):
     photo_zenith_deg: float = _PHOTO["photo_zenith_deg"]
     representation: str = field(default="explicit", metadata=meta(choices=REPRESENTATIONS))
     bsdf: CrownBsdf = field(default_factory=CrownBsdf)
+    #: one tree's points (LAS/LAZ with its ground): free louvers crowns filled voxel by voxel
+    #: with its plant area density (radtree.trees.points_crown); voxel size in m (None: 5
+    #: point spacings)
+    points: Path | None = field(default=None)
+    points_voxel_m: float | None = field(default=None, metadata=meta(0.05, 20.0))
 
 
 @dataclass(frozen=True)
