@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import json
 import math
+import re
 from pathlib import Path
 
 import numpy as np
@@ -78,21 +79,36 @@ def test_segment_cli_writes_inventory_new_reads(tile: Path, tmp_path: Path) -> N
     assert r.exit_code == 0, r.output
     assert r.output.startswith("3 trees (8.0–15.0 m high) from ")
     doc = json.loads(out.read_text())
-    assert doc["crs"]["properties"]["name"] == "EPSG:32633"
+    assert "crs" not in doc   # longitude/latitude (RFC 7946) from the tile's EPSG:32633
     p = doc["features"][0]["properties"]
     assert {"id", "species", "height_m", "crown_diameter_m", "crown_base_m", "points",
-            "crown_outline"} <= set(p)
+            "crown_outline", "top"} <= set(p)
     ring = np.array(p["crown_outline"])
     assert np.allclose(ring[0], ring[-1]) and len(ring) > 8
+    from pyproj import Transformer
+
+    lon, lat = Transformer.from_crs("EPSG:32633", "EPSG:4326", always_xy=True).transform(
+        500015.0, 4000022.0)   # the highest crown's trunk
+    assert p["top"] == pytest.approx([lon, lat], abs=3e-6)   # ≈ 0.3 m
     from radtree.site.inventory import read_trees
 
-    trees, _ = read_trees(out, "EPSG:4326", 36.1, 15.0)   # the site origin near the tile
+    trees, _ = read_trees(out, "EPSG:4326", lat, lon)   # the site origin at that trunk
     assert [t.id for t in trees] == ["L001", "L002", "L003"]
     assert trees[0].height_m == pytest.approx(15.0, abs=0.15)
+    assert math.hypot(trees[1].x - (10 - 15), trees[1].y - (10 - 22)) < 0.5   # 12 m crown
+    local = tmp_path / "local.geojson"
+    CliRunner().invoke(main, ["lidar", "segment", str(tile), "--out", str(local),
+                              "--species", "morus_alba", "--crs", "local"])
+    doc = json.loads(local.read_text())
+    assert doc["crs"]["properties"]["name"] == "local"
+    assert doc["features"][0]["geometry"]["coordinates"][0] == pytest.approx(500015, abs=0.5)
     project = tmp_path / "study"
     r = CliRunner().invoke(main, ["new", str(project), "--trees", str(out)])
     assert r.exit_code == 0, r.output
-    assert 'trees = "data/trees.geojson"' in (project / "radtree.toml").read_text()
+    text = (project / "radtree.toml").read_text()
+    assert 'trees = "data/trees.geojson"' in text
+    # the site from the trees' longitude/latitude, not the Mendoza fallback
+    assert re.search(r"^latitude = 36\.14\d* ", text, re.M), text[:2000]
 
 
 def test_clip_writes_one_trees_points(tile: Path, tmp_path: Path) -> None:

@@ -44,7 +44,7 @@ import numpy as np
 
 from radtree.config.spec import Checked, meta
 from radtree.errors import ConfigError
-from radtree.lidar.ground import GROUND_MODES, GroundFilter, heights_above_ground
+from radtree.lidar.ground import GROUND_MODES, NOT_TREES, GroundFilter, heights_above_ground
 from radtree.lidar.tile import Tile
 
 #: a clipped tree keeps the cells this far (m) around its crown that belong to no other tree
@@ -232,7 +232,9 @@ def segment_tile(tile: Tile, cfg: SegmentConfig | None = None) -> Segmentation:
     cfg = cfg or SegmentConfig()
     heights, ground = heights_above_ground(tile, cfg.ground, GroundFilter())
     xy = tile.xyz[:, :2]
-    raw = canopy_height_model(xy, heights, cfg.cell_m)
+    # buildings, noise, water, bridges (NOT_TREES) stand at the ground in the canopy model
+    canopy = np.where(np.isin(tile.classification, NOT_TREES), 0.0, heights)
+    raw = canopy_height_model(xy, canopy, cfg.cell_m)
     smooth = raw.values
     if cfg.close_m > 0:   # pits (beams that reached the ground through a crown) filled
         r = max(1, int(round(cfg.close_m / 2.0 / cfg.cell_m)))
@@ -248,6 +250,7 @@ def segment_tile(tile: Tile, cfg: SegmentConfig | None = None) -> Segmentation:
     else:
         labels = regions = np.zeros(smooth.shape, np.int32)
     pi, pj = chm.index(xy)
+    not_tree = np.isin(tile.classification, NOT_TREES)
     trees: list[DetectedTree] = []
     width = max(3, len(str(len(tops))))
     objects = ndimage.find_objects(labels)
@@ -258,7 +261,7 @@ def segment_tile(tile: Tile, cfg: SegmentConfig | None = None) -> Segmentation:
         mask = labels[sl] == k
         ii, jj = np.nonzero(mask)
         centre = chm.centre(ii + sl[0].start, jj + sl[1].start).mean(axis=0)
-        mine = (labels[pi, pj] == k) & ~ground
+        mine = (labels[pi, pj] == k) & ~ground & ~not_tree
         h_pts = heights[mine]
         height = float(h_pts.max()) if len(h_pts) else float(raw.values[ti, tj])
         low = h_pts[h_pts >= cfg.min_height_m]

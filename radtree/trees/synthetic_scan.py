@@ -85,8 +85,12 @@ def leaf_area_m2(polys: list[np.ndarray]) -> float:
 
 
 def scan_street(trees: list[StreetTree], scan: AlsScan, lv: Louvers = STREET_LOUVERS,
-                margin_m: float = 5.0) -> tuple[ScanPoints, dict[str, float], tuple]:
-    """Scan the street: the points, each tree's true leaf area (m²), the scanned rectangle."""
+                margin_m: float = 5.0,
+                extra: list[tuple[np.ndarray, np.ndarray, int]] | None = None,
+                area: tuple | None = None) -> tuple[ScanPoints, dict[str, float], tuple]:
+    """Scan the street: the points, each tree's true leaf area (m²), the scanned rectangle
+    (``area`` = (lo, hi), else the trees' extent plus ``margin_m``). ``extra``: more
+    meshes (vertices, faces, ASPRS class), e.g. buildings (class 6)."""
     polys_all: list[np.ndarray] = []
     areas: dict[str, float] = {}
     for i, t in enumerate(trees):
@@ -97,11 +101,15 @@ def scan_street(trees: list[StreetTree], scan: AlsScan, lv: Louvers = STREET_LOU
     xs = [t.x for t in trees]
     ys = [t.y for t in trees]
     r = max(t.crown_radius_m for t in trees) + margin_m
-    lo, hi = (min(xs) - r, min(ys) - r), (max(xs) + r, max(ys) + r)
-    gv, gf = ground_plane(lo, hi)
-    verts = np.vstack([v, gv])
-    faces = np.vstack([f, gf + len(v)])
-    cls = np.concatenate([np.full(len(f), HIGH_VEGETATION), np.full(len(gf), GROUND)])
+    lo, hi = area or ((min(xs) - r, min(ys) - r), (max(xs) + r, max(ys) + r))
+    parts = [(v, f, HIGH_VEGETATION), (*ground_plane(lo, hi), GROUND), *(extra or [])]
+    verts, faces, cls_l, off = [], [], [], 0
+    for pv, pf, pc in parts:
+        verts.append(np.asarray(pv, float))
+        faces.append(np.asarray(pf, np.int64) + off)
+        cls_l.append(np.full(len(pf), pc))
+        off += len(pv)
+    verts, faces, cls = np.vstack(verts), np.vstack(faces), np.concatenate(cls_l)
     return scan_als(verts, faces, cls, lo, hi, scan), areas, (lo, hi)
 
 
