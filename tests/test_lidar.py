@@ -196,3 +196,23 @@ def test_real_plot_detection_floor() -> None:
     assert d.found_fraction >= 0.80
     assert d.false_fraction <= 0.20
     assert d.median_height_error_m <= 1.0
+
+
+def test_example_tile_eight_trees_no_roofs() -> None:
+    """examples/lidar-street: the eight street trees, not the four roofs (class 6), at their
+    trunks (make_tile.py: x 0…30 m, y ±6 m from the street origin) and heights."""
+    import importlib.util
+
+    spec = importlib.util.spec_from_file_location(
+        "make_tile", ROOT / "examples/lidar-street/make_tile.py")
+    assert spec is not None and spec.loader is not None
+    make_tile = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(make_tile)
+    ORIGIN, trees = make_tile.ORIGIN, make_tile.trees
+
+    seg = segment_tile(read_tile(ROOT / "examples/lidar-street/data/street_tile.laz"))
+    assert len(seg.trees) == 8
+    for t in trees():
+        d = min(seg.trees, key=lambda s: math.hypot(s.x - ORIGIN[0] - t.x, s.y - ORIGIN[1] - t.y))
+        assert math.hypot(d.x - ORIGIN[0] - t.x, d.y - ORIGIN[1] - t.y) < 0.5
+        assert d.height_m == pytest.approx(t.height_m, abs=0.5)

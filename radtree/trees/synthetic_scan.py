@@ -103,14 +103,17 @@ def scan_street(trees: list[StreetTree], scan: AlsScan, lv: Louvers = STREET_LOU
     r = max(t.crown_radius_m for t in trees) + margin_m
     lo, hi = area or ((min(xs) - r, min(ys) - r), (max(xs) + r, max(ys) + r))
     parts = [(v, f, HIGH_VEGETATION), (*ground_plane(lo, hi), GROUND), *(extra or [])]
-    verts, faces, cls_l, off = [], [], [], 0
+    vs: list[np.ndarray] = []
+    fs: list[np.ndarray] = []
+    cs: list[np.ndarray] = []
+    off = 0
     for pv, pf, pc in parts:
-        verts.append(np.asarray(pv, float))
-        faces.append(np.asarray(pf, np.int64) + off)
-        cls_l.append(np.full(len(pf), pc))
+        vs.append(np.asarray(pv, float))
+        fs.append(np.asarray(pf, np.int64) + off)
+        cs.append(np.full(len(pf), pc))
         off += len(pv)
-    verts, faces, cls = np.vstack(verts), np.vstack(faces), np.concatenate(cls_l)
-    return scan_als(verts, faces, cls, lo, hi, scan), areas, (lo, hi)
+    return (scan_als(np.vstack(vs), np.vstack(fs), np.concatenate(cs), lo, hi, scan), areas,
+            (lo, hi))
 
 
 def write_scan(points: ScanPoints, out: str | Path, offset: tuple[float, float] = (0.0, 0.0),
