@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import json
 import math
+import re
 from pathlib import Path
 
 import numpy as np
@@ -78,21 +79,36 @@ def test_segment_cli_writes_inventory_new_reads(tile: Path, tmp_path: Path) -> N
     assert r.exit_code == 0, r.output
     assert r.output.startswith("3 trees (8.0–15.0 m high) from ")
     doc = json.loads(out.read_text())
-    assert doc["crs"]["properties"]["name"] == "EPSG:32633"
+    assert "crs" not in doc   # longitude/latitude (RFC 7946) from the tile's EPSG:32633
     p = doc["features"][0]["properties"]
     assert {"id", "species", "height_m", "crown_diameter_m", "crown_base_m", "points",
-            "crown_outline"} <= set(p)
+            "crown_outline", "top"} <= set(p)
     ring = np.array(p["crown_outline"])
     assert np.allclose(ring[0], ring[-1]) and len(ring) > 8
+    from pyproj import Transformer
+
+    lon, lat = Transformer.from_crs("EPSG:32633", "EPSG:4326", always_xy=True).transform(
+        500015.0, 4000022.0)   # the highest crown's trunk
+    assert p["top"] == pytest.approx([lon, lat], abs=3e-6)   # ≈ 0.3 m
     from radtree.site.inventory import read_trees
 
-    trees, _ = read_trees(out, "EPSG:4326", 36.1, 15.0)   # the site origin near the tile
+    trees, _ = read_trees(out, "EPSG:4326", lat, lon)   # the site origin at that trunk
     assert [t.id for t in trees] == ["L001", "L002", "L003"]
     assert trees[0].height_m == pytest.approx(15.0, abs=0.15)
+    assert math.hypot(trees[1].x - (10 - 15), trees[1].y - (10 - 22)) < 0.5   # 12 m crown
+    local = tmp_path / "local.geojson"
+    CliRunner().invoke(main, ["lidar", "segment", str(tile), "--out", str(local),
+                              "--species", "morus_alba", "--crs", "local"])
+    doc = json.loads(local.read_text())
+    assert doc["crs"]["properties"]["name"] == "local"
+    assert doc["features"][0]["geometry"]["coordinates"][0] == pytest.approx(500015, abs=0.5)
     project = tmp_path / "study"
     r = CliRunner().invoke(main, ["new", str(project), "--trees", str(out)])
     assert r.exit_code == 0, r.output
-    assert 'trees = "data/trees.geojson"' in (project / "radtree.toml").read_text()
+    text = (project / "radtree.toml").read_text()
+    assert 'trees = "data/trees.geojson"' in text
+    # the site from the trees' longitude/latitude, not the Mendoza fallback
+    assert re.search(r"^latitude = 36\.14\d* ", text, re.M), text[:2000]
 
 
 def test_clip_writes_one_trees_points(tile: Path, tmp_path: Path) -> None:
@@ -105,10 +121,10 @@ def test_clip_writes_one_trees_points(tile: Path, tmp_path: Path) -> None:
     assert len(pts) == int(r.output.split()[2])
     assert np.sum(pts.classification != 2) == seg.trees[0].points
     # crown points within the highest crown's spheroid (x 15, y 22, radius 4), its ground
-    # within the cells (0.5 m, diagonal 0.71 m) the crown's rim reaches
+    # within the cells (0.5 m, diagonal 0.71 m) 2 m (CLIP_MARGIN_M) around the crown
     d = np.hypot(pts.xyz[:, 0] - 500015.0, pts.xyz[:, 1] - 4000022.0)
     assert d[pts.classification != 2].max() < 4.0
-    assert 4.0 < d.max() < 4.0 + 0.71
+    assert 5.5 < d.max() < 4.0 + 2.0 + 0.71
     r = CliRunner().invoke(main, ["lidar", "clip", str(tile), "--tree", "L999", "--out",
                                   str(tmp_path / "x.laz")])
     assert r.exit_code == 2 and "no tree 'L999' in this tile (its trees: L001, L002, L003)" \
@@ -171,7 +187,7 @@ def test_lidar_help_teaches() -> None:
 
 @pytest.mark.skipif(REAL is None, reason="../shared/data/lidar not beside the repo")
 def test_real_plot_detection_floor() -> None:
-    """benchmarks/lidar.py prints the table: found 85.7 %, false 13.5 %, median height
+    """benchmarks/lidar.py prints the table: found 81.2 %, false 10.8 %, median height
     error 0.00 m at the defaults; the floor is the issue's targets."""
     from radtree.lidar.evaluate import detection
 
@@ -180,3 +196,23 @@ def test_real_plot_detection_floor() -> None:
     assert d.found_fraction >= 0.80
     assert d.false_fraction <= 0.20
     assert d.median_height_error_m <= 1.0
+
+
+def test_example_tile_eight_trees_no_roofs() -> None:
+    """examples/lidar-street: the eight street trees, not the four roofs (class 6), at their
+    trunks (make_tile.py: x 0…30 m, y ±6 m from the street origin) and heights."""
+    import importlib.util
+
+    spec = importlib.util.spec_from_file_location(
+        "make_tile", ROOT / "examples/lidar-street/make_tile.py")
+    assert spec is not None and spec.loader is not None
+    make_tile = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(make_tile)
+    ORIGIN, trees = make_tile.ORIGIN, make_tile.trees
+
+    seg = segment_tile(read_tile(ROOT / "examples/lidar-street/data/street_tile.laz"))
+    assert len(seg.trees) == 8
+    for t in trees():
+        d = min(seg.trees, key=lambda s: math.hypot(s.x - ORIGIN[0] - t.x, s.y - ORIGIN[1] - t.y))
+        assert math.hypot(d.x - ORIGIN[0] - t.x, d.y - ORIGIN[1] - t.y) < 0.5
+        assert d.height_m == pytest.approx(t.height_m, abs=0.5)

@@ -35,6 +35,10 @@ def _settings(f):  # type: ignore[no-untyped-def]
                      help="Tree-top window diameter ws = BASE + SLOPE × height (m): a top "
                           "is the highest cell within ws. Wider windows merge neighbours, "
                           "narrower ones split crowns."),
+        click.option("--prominence", "prominence_m", type=float, default=_D.prominence_m,
+                     show_default=True,
+                     help="A top must rise this far (m) above the saddle to any higher top: "
+                          "the bumps of one rough crown are not trees. 0 = off."),
         click.option("--crown-ratio", type=float, default=_D.crown_ratio, show_default=True,
                      help="A crown keeps the cells at least this fraction of its top's height."),
     ]
@@ -43,10 +47,11 @@ def _settings(f):  # type: ignore[no-untyped-def]
     return f
 
 
-def _config(ground, cell_m, smooth_m, min_height_m, window, crown_ratio):  # type: ignore[no-untyped-def]
+def _config(ground, cell_m, smooth_m, min_height_m, window, prominence_m, crown_ratio):  # type: ignore[no-untyped-def]
     return SegmentConfig(ground=ground, cell_m=cell_m, smooth_m=smooth_m,
                          min_height_m=min_height_m, window_base_m=window[0],
-                         window_slope=window[1], crown_ratio=crown_ratio)
+                         window_slope=window[1], prominence_m=prominence_m,
+                         crown_ratio=crown_ratio)
 
 
 @click.group("lidar", context_settings=CONTEXT)
@@ -83,7 +88,8 @@ def segment_command(tile: Path, out: Path, species: str, crs: str | None, **sett
     \b
     Steps: heights above ground (ground points: classification 2, or --ground) → canopy
     height model (highest point per --cell, smoothed by --smooth) → tree tops (local maxima
-    in a window widening with height, --window) → crowns (marker-controlled watershed from
+    in a window widening with height, --window, rising --prominence above their saddles)
+    → crowns (marker-controlled watershed from
     the tops, --crown-ratio) → per tree: position (the crown's area centroid), top, height_m,
     crown_diameter_m (equal-area circle), crown_base_m (5 % quantile of the crown's returns
     above --min-height: biased high, as ALS sees little under a crown), points, and the

@@ -319,6 +319,11 @@ class Tree(Checked):
     #: % per tree) or ``refuse`` (ConfigError with the trunk move or crown radius that fits);
     #: the same in row, inventory and Honeybee projects (radtree.trees.wall_policy)
     wall_policy: str = field(default="clip", metadata=meta(choices=WALL_POLICIES))
+    #: one tree's points (LAS/LAZ with its ground): free louvers crowns filled voxel by voxel
+    #: with its plant area density (radtree.trees.points_crown); voxel size in m (None: 5
+    #: point spacings)
+    points: Path | None = field(default=None)
+    points_voxel_m: float | None = field(default=None, metadata=meta(0.05, 20.0))
 
     def check(self) -> None:
         if (self.leaf_on is None) != (self.leaf_off is None):

@@ -10,6 +10,7 @@ tile's own header (point format, scales, offsets, CRS; laspy), as LAZ when ``out
 from __future__ import annotations
 
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -29,8 +30,7 @@ def write_subset(tile_path: str | Path, mask: np.ndarray, out: str | Path) -> Pa
     las = _las(Path(tile_path))
     sub = laspy.LasData(las.header)
     sub.points = las.points[np.asarray(mask)].copy()
-    with atomic_path(out) as tmp:
-        sub.write(str(tmp), do_compress=out.suffix.lower() == ".laz")
+    _write(sub, out)
     return out
 
 
@@ -58,8 +58,14 @@ def write_points(out: str | Path, xyz: np.ndarray, classification: np.ndarray,
     las.return_number = ones if return_number is None else np.asarray(return_number, np.uint8)
     las.number_of_returns = (ones if number_of_returns is None
                              else np.asarray(number_of_returns, np.uint8))
-    with atomic_path(out) as tmp:
-        las.write(str(tmp), do_compress=out.suffix.lower() == ".laz")
+    return _write(las, out)
+
+
+def _write(las: Any, out: Path) -> Path:
+    """Write ``las`` to ``out`` atomically, LAZ-compressed when ``out`` ends in ``.laz`` (a
+    stream: laspy takes the compression from a path's suffix, and the temporary's is not)."""
+    with atomic_path(out) as tmp, open(tmp, "wb") as fh:
+        las.write(fh, do_compress=out.suffix.lower() == ".laz")
     return out
 
 

@@ -14,6 +14,10 @@ Three ways to know the ground (``ground``):
 * ``"heights"``: z already holds heights above ground (a normalised tile).
 
 Units: metres. Heights below zero (ground noise) are kept as they are.
+
+Points that are not vegetation by their class — building 6, low noise 7, water 9, bridge deck
+17, high noise 18 (ASPRS LAS 1.4 R15 Table 17) — are left out of tree finding
+(:data:`NOT_TREES`); unclassified points (0, 1) and vegetation (3, 4, 5) are kept.
 """
 
 from __future__ import annotations
@@ -26,6 +30,7 @@ from radtree.errors import ConfigError
 from radtree.lidar.tile import GROUND_CLASS, Tile
 
 GROUND_MODES = ("class", "filter", "heights")
+NOT_TREES = (6, 7, 9, 17, 18)
 
 
 @dataclass(frozen=True)

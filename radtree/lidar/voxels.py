@@ -16,6 +16,8 @@ N(z_bottom) = ½ (a continuity correction, so its PAD is finite, an underestimat
 beam reached (N(z_top) = 0) gets PAD 0. Clumping inside a voxel is not modelled (random
 elements in each voxel).
 
+Points classed as buildings or noise (:data:`radtree.lidar.ground.NOT_TREES`) are left out.
+
 Wood: the points do not tell leaves from branches, so the density is *plant* area (leaves +
 wood, Chen & Black's "plant area index" sense): a leaf-on crown's wood counts as leaf area.
 Scans of leafless crowns give the wood alone.
@@ -35,7 +37,7 @@ from pathlib import Path
 import numpy as np
 
 from radtree.errors import ConfigError
-from radtree.lidar.ground import heights_above_ground
+from radtree.lidar.ground import NOT_TREES, heights_above_ground
 from radtree.lidar.tile import Tile, read_tile
 
 #: default voxel size in point spacings; finer than MIN_SPACINGS is refused (module text)
@@ -109,6 +111,8 @@ def tree_voxels(path: str | Path, g: float, size_m: float | None = None,
     if not 0.0 < g <= 1.0:
         raise ConfigError(f"projection G = {g:g}, expected 0 < G ≤ 1", source=tile.source)
     heights, _ = heights_above_ground(tile, ground)
+    keep = ~np.isin(tile.classification, NOT_TREES)   # roofs, noise: no beam of the crown
+    tile, heights = tile.subset(keep), heights[keep]
     veg = heights >= 0.5
     if veg.sum() < 2:
         raise ConfigError(f"the tree has {int(veg.sum())} point(s) 0.5 m or more above "

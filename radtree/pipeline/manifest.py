@@ -21,7 +21,8 @@ def input_files(project) -> dict[str, str]:
                    ("direct_normal", project.light.direct_normal_table),
                    ("epw", project.light.epw),
                    ("ground_reflectance", project.street.ground_reflectance_table),
-                   ("photo", project.tree.perforated.photo), ("tree_photo", project.tree.photo)):
+                   ("photo", project.tree.perforated.photo), ("tree_photo", project.tree.photo),
+                   ("tree_points", project.tree.points)):
         if p is not None:
             paths[key] = p
     return {k: f"{Path(v).name} sha256:{file_sha256(Path(v))}" for k, v in paths.items()

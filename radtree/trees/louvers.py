@@ -197,6 +197,11 @@ def build_louvers(tree: Tree, sensors: Sensors, street: Street, frame: FacadeFra
                           "its concentric slat shells; use arrangement = 'layers' or form "
                           "'free'", source=source, field="tree.louvers.arrangement")
     volume = form != "dome" and lv.arrangement == "volume"
+    from_points = tree.points is not None
+    if from_points and (form == "dome" or tree.photo is not None):
+        raise ConfigError("a crown from points is free-standing and fitted to no photo: use "
+                          "form = 'free' and no [tree] photo", source=source,
+                          field="tree.points")
     photo: dict | None = None
     if form == "dome":
         spec = dome_spec(tree, sensors, street, source)
@@ -256,7 +261,11 @@ def build_louvers(tree: Tree, sensors: Sensors, street: Street, frame: FacadeFra
                 f"(cells), {fit.ring_rms:.4f} (rings); the photo's LAI_eff "
                 f"{fit.lai_photo:.3f}, clumping {fit.clumping_photo:.3f} "
                 + _clumping_fit_text(fit) + _spread_text(fit.spread()))
-        if volume:
+        if from_points:
+            from radtree.trees.points_crown import build_points_louvers
+
+            polys, ginfo, _ = build_points_louvers(spec_r, tree, source)
+        elif volume:
             polys, ginfo = build_volume_louvers(spec_r, lv, source)
         else:
             polys, ginfo = build_free_louvers(spec_r, lv, source)
@@ -267,7 +276,12 @@ def build_louvers(tree: Tree, sensors: Sensors, street: Street, frame: FacadeFra
         meshes.append(Mesh("tree_trunks", TRUNK, frame.to_world(tv), tf))
         notes.extend(row_notes(spec_r, tree, sensors))
         ginfo["clip_plane_n_m"] = spec_r.n_clip
-    if volume:
+    if from_points:
+        from radtree.trees.points_crown import points_note
+
+        notes.append(points_note(tree, ginfo, slats))
+        volume = True   # slats through the volume: the volume crowns' optics and -ab
+    elif volume:
         notes.append(volume_note(lv, ginfo, slats, optics.t_specular))
     elif form != "dome":
         notes.append(
@@ -321,7 +335,7 @@ def build_louvers(tree: Tree, sensors: Sensors, street: Street, frame: FacadeFra
         "reading_gap": float(optics.reading == "gap"),
         "arrangement_volume": float(volume),
     }
-    if volume:
+    if volume and not from_points:
         # turbid-medium direct transmission along the vertical through a crown centre
         lam = ginfo["lambda_vertical"]
         for key in ("tau_crown_direct", "direct_transmission"):

@@ -1,0 +1,125 @@
+"""Louvers crowns filled voxel by voxel from a tree's point cloud (``[tree] points``).
+
+The points (LAS/LAZ of one tree with its ground points, e.g. from ``radtree lidar clip``)
+become a grid of plant area density (:mod:`radtree.lidar.voxels`: Beer–Lambert inversion along
+vertical beams; voxel size ``tree.points_voxel_m`` or 5 point spacings; the projection G of
+the slats' own leaf angles — ``louvers.inclination_deg`` or its ellipsoidal distribution, which
+the species fills — so inversion and crown use the same leaves; wood counted as leaf area).
+
+Every voxel of density PAD (m²/m³) and volume v³ receives PAD·v³ / s² slats of side s
+(``louvers.slat_size_m``; one-sided leaf area s² each; the fraction rounded up with a seeded
+draw), centres uniform in the voxel, normals at random azimuths and the louvers' inclination
+(fixed or drawn from the ellipsoidal distribution). So the crown's leaf area is the scan's,
+voxel by voxel; ``cover_fraction`` plays no part (the slats' optics do: the gap reading, with
+near-opaque real leaves, is the consistent one). The cloud is placed on every trunk of the
+row: its plant-area centroid on the trunk axis, its ground at the street (z = 0), its x along
+the façade (u) and y away from it (n). Slats are then clipped like the volume arrangement's
+(:mod:`radtree.trees.crown_clip`: trunk, wall-side plane, planes shared with neighbours).
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+import numpy as np
+
+from radtree.config import Louvers, Tree
+from radtree.errors import ConfigError
+from radtree.lidar.voxels import VoxelGrid, tree_voxels
+from radtree.trees.crown_clip import cut_to_share, touches_share, trunk_clash
+from radtree.trees.envelope import CrownRowSpec
+from radtree.trees.leaf_angles import draw_inclinations
+from radtree.trees.volume import MAX_VOLUME_SLATS, mean_cos, slat_edges
+
+
+def points_grid(tree: Tree, source: str | None = None) -> VoxelGrid:
+    """The plant area density grid of ``tree.points`` with the louvers' projection G."""
+    assert tree.points is not None
+    g = mean_cos(tree.louvers)
+    if g < 1e-6:
+        raise ConfigError("vertical slats (inclination 90°) intercept no vertical beam: the "
+                          "inversion is undefined", source=source,
+                          field="tree.louvers.inclination_deg")
+    return tree_voxels(tree.points, g, tree.points_voxel_m)
+
+
+def _corners(centres: np.ndarray, phi: np.ndarray, tilt: Any, s: float) -> np.ndarray:
+    e1, e2 = slat_edges(phi, tilt)
+    h1 = np.array([-0.5, 0.5, 0.5, -0.5]) * s
+    h2 = np.array([-0.5, -0.5, 0.5, 0.5]) * s
+    return (centres[:, None, :] + h1[None, :, None] * e1[:, None, :]
+            + h2[None, :, None] * e2[:, None, :])
+
+
+def voxel_slats(grid: VoxelGrid, lv: Louvers, rng: np.random.Generator,
+                origin: np.ndarray) -> tuple[np.ndarray, np.ndarray, Any]:
+    """Slat centres (k, 3), azimuths and inclinations of one crown: PAD·v³/s² per voxel
+    (module text); ``origin`` is where the grid's plant-area centroid stands (u, n, 0)."""
+    s, v = lv.slat_size_m, grid.size_m
+    expected = grid.pad * v**3 / (s * s)
+    n = np.floor(expected).astype(np.int64)
+    n += rng.random(expected.shape) < (expected - n)
+    idx = np.repeat(np.arange(n.size), n.ravel())
+    i, j, k = np.unravel_index(idx, n.shape)
+    cxy = grid.centroid_xy()
+    corner = np.column_stack([grid.x0 + i * v - cxy[0], grid.y0 + j * v - cxy[1], k * v])
+    centres = origin + corner + rng.random((len(idx), 3)) * v
+    phi = rng.uniform(0.0, 2.0 * math.pi, len(idx))
+    tilt: Any = math.radians(lv.inclination_deg)
+    if lv.inclination_distribution == "ellipsoidal":
+        tilt = draw_inclinations(rng, len(idx), lv.ellipsoid_x)
+    return centres, phi, tilt
+
+
+def build_points_louvers(spec: CrownRowSpec, tree: Tree, source: str | None = None
+                         ) -> tuple[list[np.ndarray], dict[str, float], VoxelGrid]:
+    """Slat polygons (local coordinates) of the row's crowns from ``tree.points``, geometry
+    info (voxel size, leaf area, its vertical profile) and the grid."""
+    lv = tree.louvers
+    grid = points_grid(tree, source)
+    per = grid.leaf_area_m2 / lv.slat_size_m**2
+    if per * spec.count > MAX_VOLUME_SLATS:
+        raise ConfigError(f"the crowns from {tree.points} would need {per * spec.count:.0f} "
+                          f"slats (limit {MAX_VOLUME_SLATS}): use larger slats "
+                          "(tree.louvers.slat_size_m)", source=source,
+                          field="tree.louvers.slat_size_m")
+    polys: list[np.ndarray] = []
+    cut = dropped = 0
+    for ti, child in enumerate(np.random.SeedSequence(lv.seed).spawn(spec.count)):
+        rng = np.random.default_rng(child)
+        c = spec.centres[ti]
+        lo, hi = spec.strips[ti]
+        centres, phi, tilt = voxel_slats(grid, lv, rng, np.array([c[0], c[1], 0.0]))
+        corners = _corners(centres, phi, tilt, lv.slat_size_m)
+        rho = np.hypot(centres[:, 0] - c[0], centres[:, 1] - c[1])
+        clash = trunk_clash(rho, corners[:, :, 2].min(axis=1), spec, lv.slat_size_m)
+        ok = touches_share(corners, spec, lo, hi) & ~clash
+        dropped += int(clash.sum())
+        kept, n_cut = cut_to_share(corners[ok], spec, lo, hi)
+        polys.extend(kept)
+        cut += n_cut
+    z, area = grid.profile()
+    info = {"points_voxel_m": grid.size_m, "points_spacing_m": grid.spacing_m,
+            "points_g_vertical": grid.g, "points_leaf_area_m2": grid.leaf_area_m2,
+            "points_height_m": float(len(z) * grid.size_m), "slats_cut": float(cut),
+            "slats_dropped": float(dropped), "slat_mean_area_m2": lv.slat_size_m**2}
+    for zk, ak in zip(z, area):
+        info[f"points_leaf_area_m2_z{zk:.2f}_{zk + grid.size_m:.2f}"] = float(ak)
+    return polys, info, grid
+
+
+def points_note(tree: Tree, info: dict[str, float], slats: int) -> str:
+    """What the points crown is, for the notes."""
+    z = [k for k in info if k.startswith("points_leaf_area_m2_z")]
+    top = sorted(z, key=lambda k: -info[k])[:3]
+    peak = ", ".join(f"{k.split('_z')[1].replace('_', '–')} m: {info[k]:.1f} m²" for k in top)
+    return (f"Crowns from the point cloud {tree.points.name if tree.points else ''}: plant area "
+            f"density on {info['points_voxel_m']:g} m voxels (mean point spacing "
+            f"{info['points_spacing_m']:.2f} m) by Beer–Lambert inversion along vertical beams "
+            f"(G = {info['points_g_vertical']:.3f} of the slats' leaf angles; wood counted as "
+            f"leaf area): {info['points_leaf_area_m2']:.1f} m² per crown, "
+            f"{info['points_height_m']:.1f} m high; densest layers {peak}. {slats} slats of "
+            f"{tree.louvers.slat_size_m:g} m fill it voxel by voxel "
+            f"({int(info['slats_cut'])} cut at the wall-side or shared planes, "
+            f"{int(info['slats_dropped'])} dropped at the trunks).")
