@@ -140,6 +140,13 @@ class AnnualOptions:
                 raise ConfigError(f"{name} must be between 0 and 1 (a ray weight), got {value:g}")
 
 
+    @property
+    def season(self) -> LeafSchedule:
+        """The resolved leaf season (:func:`with_season`)."""
+        if self.leaf is None:
+            raise ValueError("the leaf season is not resolved: call with_season first")
+        return self.leaf
+
 @dataclass
 class AnnualResult:
     """Hourly illuminance of the year and what produced it."""
@@ -381,11 +388,11 @@ def compute_annual(project: Project, options: AnnualOptions | None = None,
             bar.close()
 
     phen = phenology_of(project, options.species_phenology)
-    in_leaf, fraction, weight = crown_year(total, direct, grids, wea, options.leaf, phen)
+    in_leaf, fraction, weight = crown_year(total, direct, grids, wea, options.season, phen)
     occ = occupied(wea.hour, options.occupancy)
     grid_geo = {g: {"points": scenes["leaf_on"].grids[g].points,
                     "normals": scenes["leaf_on"].grids[g].normals} for g in grids}
-    notes.append(f"Crown {options.leaf.describe() if phen is None else phen.describe()}.")
+    notes.append(f"Crown {options.season.describe() if phen is None else phen.describe()}.")
     notes += METHOD_NOTES
     timing["total_s"] = time.perf_counter() - t0
     return AnnualResult(project=project, options=options, weather=weather, wea=wea,
@@ -478,8 +485,8 @@ def write_annual(result: AnnualResult, figures: bool = True) -> AnnualOutcome:
         "weather": {"path": str(result.weather.path), "generated": result.weather.generated,
                     "description": result.weather.description},
         "scenarios": result.scenarios,
-        "leaf_on": o.leaf.leaf_on, "leaf_off": o.leaf.leaf_off,
-        "leaf_days": o.leaf.leaf_days(), "leaf_source": o.leaf.source,
+        "leaf_on": o.season.leaf_on, "leaf_off": o.season.leaf_off,
+        "leaf_days": o.season.leaf_days(), "leaf_source": o.season.source,
         "occupancy": list(o.occupancy), "occupied_hours": int(result.occupied.sum()),
         "sky_mf": o.mf, "sun_mf": o.sun_mf, "method": o.method,
         "rcontrib": {"ab": result.trace.ab, "ad": result.trace.ad, "lw": result.trace.lw,

@@ -467,10 +467,10 @@ def compute_annual_3phase(project: Project, options: AnnualOptions,
             total[variant][g], direct[variant][g] = tot[start:start + n], dire[start:start + n]
             start += n
     phen = phenology_of(project, options.species_phenology)
-    in_leaf, fraction, weight = crown_year(total, direct, grids, wea, options.leaf, phen)
+    in_leaf, fraction, weight = crown_year(total, direct, grids, wea, options.season, phen)
     grid_geo = {g: {"points": bare.grids[g].points, "normals": bare.grids[g].normals}
                 for g in grids}
-    notes.append(f"Crown {options.leaf.describe() if phen is None else phen.describe()}.")
+    notes.append(f"Crown {options.season.describe() if phen is None else phen.describe()}.")
     notes.append(f"Method: three-phase (V·T·D·s with dctimestep; {len(tp.groups)} shell facet "
                  "groups; the crown BSDFs leaf-on and leaf-off); direct and reflected sun as "
                  f"the default method, {SUN_NOTES[options.sun_crown]}.")

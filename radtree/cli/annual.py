@@ -82,7 +82,7 @@ def annual_command(project: Path, leaf_on: str | None, leaf_off: str | None, mf:
         sun_lw=sun_lw, nproc=processes,
         with_scenario=with_scenario, without_scenario=without_scenario, epw=epw,
         species_phenology=not use_dates, method=method, sun_crown=sun_crown)
-    click.echo(f"annual: {proj.name}; leaf season {options.leaf.describe()}")
+    click.echo(f"annual: {proj.name}; leaf season {options.season.describe()}")
     out = run_annual(proj, options, echo=click.echo, progress=True,
                      figures=not no_figures)
     from radtree.annual.report import grid_summary

@@ -20,7 +20,6 @@ from radtree.config.honeybee import read_honeybee
 from radtree.config.schema import Project, Scenario, Site, Street, parse_time
 from radtree.config.spec import SchemaError, Spec, spec_for, spec_of, toml_name
 from radtree.config.species import find_species, tree_defaults, unknown_species_message
-from radtree.config.timezone import site_time_zone, standard_offset_hours
 from radtree.config.switches import (
     FIELD,
     TABLES,
@@ -30,6 +29,7 @@ from radtree.config.switches import (
     lookup_key,
     table_keys,
 )
+from radtree.config.timezone import site_time_zone, standard_offset_hours
 from radtree.errors import ConfigError
 
 TOP_TABLES = ("project", "site", "street", "light", "tree", "sensors", "engine", "office",

@@ -6,7 +6,6 @@ as local clock ``HH:MM``. Bounds, choices and TOML names are field metadata (:fu
 
 from __future__ import annotations
 
-import math
 import re
 from collections.abc import Callable
 from dataclasses import dataclass, field

@@ -23,7 +23,7 @@ the season, the bare branches of :func:`radtree.annual.branches.build_leaf_off` 
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from datetime import date, datetime, timedelta, timezone
+from datetime import datetime, timedelta, timezone
 
 import numpy as np
 import trimesh

@@ -13,7 +13,6 @@ from __future__ import annotations
 import io
 import math
 from dataclasses import dataclass
-from datetime import date as _date
 from pathlib import Path
 
 import pandas as pd

@@ -110,8 +110,9 @@ def read_buildings(path: Path, frame_crs: str, latitude: float, longitude: float
         out.append(Building(f.id, orient(poly, 1.0), h, rho, max(1, st), wwr))
     raw = np.array([[float(v) for v in np.mean(np.asarray(f.coords[0], float)[:, :2], axis=0)]
                     for f in feats]).reshape(-1, 2)
-    check_spread([b.id for b in out], raw, np.array([[b.polygon.centroid.x, b.polygon.centroid.y]
-                                                     for b in out]).reshape(-1, 2),
+    check_spread([b.id for b in out], raw,
+                 np.array([list(b.polygon.centroid.coords)[0]  # type: ignore[attr-defined]
+                           for b in out]).reshape(-1, 2),
                  frame, src, "building")
     for i, a in enumerate(out):
         for b in out[i + 1:]:

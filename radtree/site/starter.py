@@ -26,24 +26,24 @@ commented ``# key = default`` lines to uncomment. The file is loaded with
 from __future__ import annotations
 
 import inspect
-import math
-from collections.abc import Callable
-from datetime import date as _date
 import json
+import math
 import shutil
 import textwrap
 from collections import Counter
+from collections.abc import Callable
 from dataclasses import MISSING, dataclass, field, fields
+from datetime import date as _date
 from pathlib import Path
 from typing import Any
 
 import tomlkit
 
 from radtree.config import Project, Scenario, load_project
-from radtree.config.timezone import fixed_name, parse_time_zone, standard_offset_hours
 from radtree.config.spec import spec_of, toml_name
 from radtree.config.species import find_species
 from radtree.config.switches import TABLES, TREE_TABLES
+from radtree.config.timezone import fixed_name, parse_time_zone, standard_offset_hours
 from radtree.errors import ConfigError
 from radtree.fileio import write_text
 from radtree.light.sun import daylight_hours
