@@ -50,11 +50,13 @@ import numpy as np
 import pandas as pd
 
 import radtree.annual.metrics as metrics
+import radtree.annual.standards as standards
 from radtree.annual.branches import BranchParams, build_leaf_off
 from radtree.annual.coefficients import CoefficientRunner, TraceParams
 from radtree.annual.phenology import Phenology, crown_year, phenology_of
 from radtree.annual.schedule import DEFAULT_OCCUPANCY, LeafSchedule, occupied, parse_occupancy
 from radtree.annual.skymatrix import Suns, Wea, patch_count
+from radtree.annual.standards import SUNLIGHT_DATE, check_sunlight_date
 from radtree.annual.weather_year import YearInputs, annual_weather
 from radtree.config import Project, Scenario, effective_project
 from radtree.errors import ConfigError
@@ -115,6 +117,8 @@ class AnnualOptions:
     #: default method's sun runs — hourly direct sun and reflected sun — on its leaf-on /
     #: bare-branch scenes) or "bsdf" (both on the BSDF-crown scene)
     sun_crown: str = "explicit"
+    #: EN 17037 exposure to sunlight: the date (MM-DD, 1 February – 21 March)
+    sunlight_date: str = SUNLIGHT_DATE
 
     def __post_init__(self) -> None:
         if self.method not in METHODS:
@@ -126,6 +130,7 @@ class AnnualOptions:
             raise ConfigError(f"sky subdivision must be ≥ 1 (got --mf {self.mf}, "
                               f"sun MF {self.sun_mf})")
         parse_occupancy(self.occupancy)
+        check_sunlight_date(self.sunlight_date)
         if self.nproc < 1:
             raise ConfigError("processes must be ≥ 1")
         for name, value in (("--lw", self.lw), ("--sun-lw", self.sun_lw)):
@@ -156,6 +161,9 @@ class AnnualResult:
     leaf_fraction: np.ndarray | None = None
     leaf_weight: np.ndarray | None = None
     phenology: Phenology | None = None
+    #: EN 17037 exposure to sunlight: "with"/"without" → grid → hours of sun per sensor on
+    #: ``options.sunlight_date`` (:mod:`radtree.annual.standards`), None when not computed
+    sunlight: dict[str, dict[str, np.ndarray]] | None = None
 
 
 # ---------------------------------------------------------------- scene choice
@@ -373,13 +381,48 @@ def compute_annual(project: Project, options: AnnualOptions | None = None,
                     "normals": scenes["leaf_on"].grids[g].normals} for g in grids}
     notes.append(f"Crown {options.leaf.describe() if phen is None else phen.describe()}.")
     notes += METHOD_NOTES
+    ts = time.perf_counter()
+    sun = annual_sunlight(project, scenes, grids, options.sunlight_date, in_leaf, wea)
+    timing["sunlight_s"] = time.perf_counter() - ts
     timing["total_s"] = time.perf_counter() - t0
     return AnnualResult(project=project, options=options, weather=weather, wea=wea,
                         grids=grid_geo, total=total, direct=direct, in_leaf=in_leaf,
                         occupied=occ, scenarios={"with": with_sc.name,
                                                  "without": without_sc.name},
                         trace=trace, sun_trace=sun_trace, ground_reflectance=rho, notes=notes, timing=timing,
-                        leaf_fraction=fraction, leaf_weight=weight, phenology=phen)
+                        leaf_fraction=fraction, leaf_weight=weight, phenology=phen,
+                        sunlight=sun)
+
+
+def annual_sunlight(project: Project, scenes: dict[str, Scene], grids: list[str], date: str,
+                    in_leaf: np.ndarray, wea: Wea) -> dict[str, dict[str, np.ndarray]]:
+    """Hours of possible sun per sensor on ``date`` (EN 17037 exposure to sunlight), with the
+    crown of that day (leafed when ``in_leaf`` at its noon hour, else bare) and without trees,
+    traced at ``-ab 0`` by the seeded engine (:func:`radtree.annual.standards.sun_hours`)."""
+    from radtree.engines.registry import seeded_engine
+
+    site = project.site
+    month, day = (int(x) for x in date.split("-"))
+    noon = np.flatnonzero((wea.month == month) & (wea.day == day) & (wea.hour >= 12))
+    leafed = bool(in_leaf[noon[0]]) if len(noon) else True
+    times, alt, az = standards.sun_steps(site.latitude, site.longitude, site.utc_offset_hours,
+                                         int(str(site.date)[:4]), date)
+    eng = seeded_engine()
+    params = replace(project.engine, rays=1)
+    out: dict[str, dict[str, np.ndarray]] = {}
+    for tree, variant in (("with", "leaf_on" if leafed else "leaf_off"),
+                          ("without", "without")):
+        scene = scenes[variant]
+
+        def trace(states: list, scene: Scene = scene) -> list[dict[str, np.ndarray]]:
+            plan = eng.prepare(scene, states, params, 0)
+            got = eng.trace_many(plan, [s.label for s in states], grids)
+            return [{g: r[g].lux for g in grids} for r in got]
+
+        out[tree] = standards.sun_hours(trace, {g: (scene.grids[g].points,
+                                                    scene.grids[g].normals) for g in grids},
+                                        times, alt, az)
+    return out
 
 
 # ---------------------------------------------------------------- tables
@@ -480,6 +523,9 @@ def write_annual(result: AnnualResult, figures: bool = True) -> AnnualOutcome:
         meta["phenology"] = {"species": result.phenology.species.key,
                              "latitude": result.phenology.latitude_deg,
                              "describe": result.phenology.describe()}
+    standards.write_standards(result.project, standards.standards_table(
+        result.scenarios, list(result.grids), result.total, result.direct, result.wea.dhi,
+        result.occupied, result.sunlight, o.sunlight_date))
     mp = write_text(res / "annual" / "annual_meta.json", json.dumps(meta, indent=2,
                                                                      default=str))
     figs: list[Path] = []
