@@ -413,15 +413,9 @@ def annual_sunlight(project: Project, scenes: dict[str, Scene], grids: list[str]
     for tree, variant in (("with", "leaf_on" if leafed else "leaf_off"),
                           ("without", "without")):
         scene = scenes[variant]
-
-        def trace(states: list, scene: Scene = scene) -> list[dict[str, np.ndarray]]:
-            plan = eng.prepare(scene, states, params, 0)
-            got = eng.trace_many(plan, [s.label for s in states], grids)
-            return [{g: r[g].lux for g in grids} for r in got]
-
-        out[tree] = standards.sun_hours(trace, {g: (scene.grids[g].points,
-                                                    scene.grids[g].normals) for g in grids},
-                                        times, alt, az)
+        out[tree] = standards.sun_hours(standards.direct_tracer(eng, scene, params, grids),
+                                        {g: (scene.grids[g].points, scene.grids[g].normals)
+                                         for g in grids}, times, alt, az)
     return out
 
 

@@ -46,6 +46,7 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 from datetime import datetime, timedelta, timezone
 
 import numpy as np
@@ -54,6 +55,12 @@ import pandas as pd
 import radtree.annual.metrics as metrics
 from radtree.annual.schedule import parse_month_day
 from radtree.errors import ConfigError
+
+if TYPE_CHECKING:
+    from radtree.config import EngineParams
+    from radtree.engines.base import Engine
+    from radtree.light.sky import SkyState
+    from radtree.scene import Scene
 
 COLUMNS = ["scenario", "target", "metric", "value", "unit", "definition"]
 DAYLIGHT_HOURS = 4380         # half of the 8 760 hours (ClimateStudio's daylight hours)
@@ -190,7 +197,7 @@ def sun_steps(latitude: float, longitude: float, utc_offset_hours: float, year: 
     return [t.to_pydatetime() for t in times[up]], alt[up], az[up]
 
 
-def sun_hours(trace: Callable[[list], list[dict[str, np.ndarray]]], grids: dict[str, tuple],
+def sun_hours(trace: Callable[[list[SkyState]], list[dict[str, np.ndarray]]], grids: dict[str, tuple],
               times: list[datetime], altitude: np.ndarray, azimuth: np.ndarray,
               step_min: float = SUNLIGHT_STEP_MIN, chunk: int = 16) -> dict[str, np.ndarray]:
     """Hours of sun per sensor: Σ over the steps of (step length) × the share of a unit beam
@@ -213,6 +220,18 @@ def sun_hours(trace: Callable[[list], list[dict[str, np.ndarray]]], grids: dict[
                 share = np.where(cos > 1e-9, res[g] / np.where(cos > 1e-9, cos, 1.0), 0.0)
                 out[g] += np.clip(share, 0.0, 1.0) * step_min / 60.0
     return out
+
+
+def direct_tracer(engine: Engine, scene: Scene, params: EngineParams, grids: list[str]
+                  ) -> Callable[[list[SkyState]], list[dict[str, np.ndarray]]]:
+    """``trace(states)`` for :func:`sun_hours`: the direct illuminance per grid of each state,
+    traced by ``engine`` at ``-ab 0`` (the sun alone, exact transmittance through crowns)."""
+    def trace(states: list[SkyState]) -> list[dict[str, np.ndarray]]:
+        plan = engine.prepare(scene, states, params, 0)
+        got = engine.trace_many(plan, [s.label for s in states], grids)
+        return [{g: r[g].lux for g in grids} for r in got]
+
+    return trace
 
 
 def standards_table(scenarios: dict[str, str], grids: list[str],
