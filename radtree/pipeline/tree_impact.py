@@ -108,13 +108,14 @@ def tree_impact(project: Project, engine: Engine, scenarios: list[Scenario],
                 and not is_later_realisation(sc.name) and built[sc.name][0].scene.owners()]
     if not with_ids or not has_baseline(project):
         return None
-    eng: Engine | None = engine
+    eng = engine
     if not engine.attributes_trees:
-        eng = attributing_engine()
-        if eng is None:
+        other = attributing_engine()
+        if other is None:
             echo(f"  tree impact: the {engine.name} engine does not attribute light to trees "
                  f"and no engine here does; {FILE} not written")
             return None
+        eng = other
         echo(f"  tree impact: the {engine.name} engine does not attribute light to trees; "
              f"attributed by the {eng.name} engine (same scene, hours and sampling settings)")
     frames = [scenario_impact(project, sc, *built[sc.name], eng, grids) for sc in with_ids]
