@@ -56,11 +56,22 @@ def test_attribution_leaves_the_traced_numbers_alone_and_adds_up():
     # the tree-less trace is the engine's trace of the scene without the trees' faces
     bare = trace_hour(scene.without_owners(), STATE, PARAMS)["facade"]
     np.testing.assert_allclose(att.without.lux, bare.lux, rtol=1e-12)
-    # a path that crosses no crown changes nothing: every lux of the change has its tree
+    # a path that crosses no crown's box changes nothing
     assert np.all(att.unattributed == 0.0)
-    np.testing.assert_allclose(att.removed.sum(axis=0), att.without.lux - att.with_trees.lux,
-                               rtol=1e-9, atol=1e-6)
     assert att.owners == ["t1", "t2"]
+    # each tree's light is what the engine's trace without that tree alone gives back, on the
+    # same paths (those that cross both crowns' boxes traced again with the tree skipped, by
+    # other ray casters: Embree's float32 frame differs, so a rare path grazing an edge goes
+    # another way — a few sensors of 9 may differ by one path's worth, none by more)
+    for i, name in enumerate(att.owners):
+        alone = trace_hour(scene.without_owners({name}), STATE, PARAMS)["facade"]
+        want = alone.lux - ref.lux
+        same = np.isclose(att.removed[i], want, rtol=1e-9, atol=1e-6)
+        assert same.sum() >= 8, (name, att.removed[i] - want)
+        np.testing.assert_allclose(att.removed[i], want, rtol=0.05, atol=5.0)
+    # the joint part: light both crowns take (either would), given to neither
+    joint = (att.without.lux - att.with_trees.lux) - att.removed.sum(axis=0)
+    assert joint.max() > 0
     # the west sensors lose most to t1 (in front of them), the east ones to t2
     assert att.removed[0, 0] > 3 * att.removed[1, 0]
     assert att.removed[1, -1] > 3 * att.removed[0, -1]
@@ -81,7 +92,9 @@ def test_target_rows_give_facade_means_and_shares():
     rows = target_rows("trees", "12:00", "facade", scene.grids["facade"].labels, att)
     assert list(rows.columns) == COLUMNS
     assert list(rows["tree"]) == ["t1", "t2"]
-    assert rows["share"].sum() == pytest.approx(1.0, abs=1e-12)
+    change = (att.without.lux - att.with_trees.lux).mean()
+    np.testing.assert_allclose(rows["share"], rows["lux_removed"] / change, rtol=1e-12)
+    assert 0.5 < rows["share"].sum() <= 1.0   # the rest: light both crowns take
     assert rows["lux_removed"].iloc[0] == pytest.approx(att.removed[0].mean())
     assert rows["lux_removed_stderr"].iloc[0] == pytest.approx(
         np.sqrt((att.stderr[0] ** 2).sum()) / 9)
