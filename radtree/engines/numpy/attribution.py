@@ -12,7 +12,7 @@ path until it meets a face that one scene has and the other has not.
    every attributed tree (``without``, :meth:`radtree.scene.Scene.without_owners`), at one
    origin offset ε (the with-trees scene's).
 2. While both are traced, each ray of a path — every segment up to the surface it reaches
-   (∞ when it escapes) and every shadow ray that reaches the sun — is tested against each
+   (∞ when it escapes) and every shadow ray towards the sun (whole) — is tested against each
    tree's bounding box (its leaves' and trunk's faces). A path whose rays cross no box meets
    no tree: its two traces are the same path (``unattributed`` checks it: 0 exactly), and a
    tree whose box neither trace of a path crosses changes nothing on it.

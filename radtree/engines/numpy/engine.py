@@ -278,7 +278,7 @@ class _Tracer:
         index when the tracer holds several hour states (:func:`trace_states`).
         ``segments(path, origin, direction, reach)`` is told of every ray in path order — each
         path's segment (``reach`` its length, ∞ when it escapes), then its shadow ray towards
-        the sun (``reach`` ∞ when it passes, 0 when blocked) — without changing a number
+        the sun (``reach`` ∞, blocked or not) — without changing a number
         (the tree attribution, :mod:`radtree.engines.numpy.attribution`)."""
         k = len(points)
         acc = np.zeros(k)
@@ -365,8 +365,7 @@ class _Tracer:
                                       None if self.opts.sun_disc else
                                       0 if hour is None else hour[ni])
                     if segments is not None:
-                        segments(alive.take(ni), so, _rows(sd, ni),
-                                 np.where(vis > 0, np.inf, 0.0))
+                        segments(alive.take(ni), so, _rows(sd, ni), np.full(len(ni), np.inf))
                     got = beta[ni] * (self.dni if hour is None else 1.0) * f[ni] * vis
                     an = alive[ni]
                     acc[an] += got
