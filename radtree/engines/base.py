@@ -47,11 +47,12 @@ class TreeAttribution:
     attributes it while tracing (:attr:`Engine.attributes_trees`).
 
     ``owners``: the trees (:attr:`radtree.scene.Mesh.owners`); ``removed`` (trees, sensors):
-    the illuminance each tree removes (lux; positive = less light with the tree), ``stderr``
-    its Monte Carlo standard error; ``with_trees`` / ``without``: the sensors traced with every
-    tree and without the attributed ones (the same paths); ``unattributed`` (sensors): the part
-    of ``without − with_trees`` no tree was given (0 up to rounding for an exact attribution).
-    The engine's module states the method and how overlapping crowns share."""
+    the illuminance each tree takes (lux; positive = less light with the tree): what removing
+    that tree alone gives back; ``stderr`` its Monte Carlo standard error; ``with_trees`` /
+    ``without``: the sensors traced with every tree and without the attributed ones (the same
+    paths); ``unattributed`` (sensors): change found on paths that meet no tree (0 for an
+    exact attribution). ``without − with_trees − Σ removed`` is the light the trees take
+    jointly (overlapping crowns). The engine's module states the method."""
 
     owners: list[str]
     removed: np.ndarray

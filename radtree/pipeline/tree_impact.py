@@ -4,7 +4,7 @@ Written by ``radtree simulate`` when the project has a with/without-trees pair �
 without trees (model ``none``: the template's ``open``, the district's ``bare``) beside
 scenarios whose trees have ids (inventory trees: their ``id``; :attr:`radtree.scene.Mesh.owners`).
 For every such scenario and hour the engine traces the scene with and without its trees on the
-same paths and gives each path's difference to the tree it crossed first
+same paths and gives each tree what removing it alone gives back
 (:mod:`radtree.engines.numpy.attribution` states the method and how overlapping crowns share).
 An engine that cannot attribute (:attr:`radtree.engines.base.Engine.attributes_trees` False,
 e.g. Radiance) hands the attribution to the first registered engine that can, and says so.
@@ -13,11 +13,14 @@ Columns (one row per scenario × hour × tree × target where the tree changes t
 
 * ``scenario``, ``time`` (HH:MM), ``tree`` (the tree's id), ``target`` (the façade id of a
   district sensor, else the grid — an office room), ``grid``;
-* ``lux_removed`` — the mean over the target's sensors of the illuminance the tree removes
-  (lux; positive = less light with the tree, negative = its leaves add light);
+* ``lux_removed`` — the mean over the target's sensors of the illuminance the tree takes:
+  what felling that tree alone gives back (lux; positive = less light with the tree, negative
+  = its leaves add light);
 * ``lux_removed_stderr`` — its Monte Carlo standard error (sensors independent);
-* ``share`` — ``lux_removed`` over the target's whole change (mean ``without − with``, the
-  same paths) at that hour: the trees' shares of a target add up to 1.
+* ``share`` — ``lux_removed`` over the target's whole change (mean ``without − with`` over
+  all the trees, the same paths) at that hour. The shares of a target add up to 1 when no two
+  crowns take the same light; the remainder (1 − Σ share) is the light several crowns take
+  jointly (any one of them would block it), which removing one tree does not give back.
 """
 
 from __future__ import annotations
@@ -143,8 +146,9 @@ def removal_check(engine: Engine, scene: Scene, state: SkyState, params: EngineP
     hour ``state``, the attributed ``lux_removed`` beside the change when that tree alone is
     removed and the scene re-traced (``removal``: the engine's trace without the tree minus
     its trace with all trees, on paired paths of another seed, ``removal_seed``, so the two
-    estimates are independent), their standard errors and the difference in standard errors
-    ``z``."""
+    estimates are independent), their standard errors, the difference in standard errors
+    ``z`` and ``same_seed``: the removal traced with the attribution's own seed minus the
+    attributed light (0 when the attribution is exactly the removal, path for path)."""
     full = engine.attribute_trees(scene, state, params, ab, grids)
     rows = pd.concat([target_rows("", state.time, g, scene.grids[g].labels, a)
                       for g, a in full.items()], ignore_index=True)
@@ -159,9 +163,14 @@ def removal_check(engine: Engine, scene: Scene, state: SkyState, params: EngineP
         hit = again[again["target"] == r.target]
         rem, rem_se = ((float(hit["lux_removed"].iloc[0]), float(hit["lux_removed_stderr"]
                         .iloc[0])) if len(hit) else (0.0, 0.0))
+        twin = engine.attribute_trees(scene, state, params, ab, [r.grid], {str(r.tree)})[r.grid]
+        tw = target_rows("", state.time, r.grid, scene.grids[r.grid].labels, twin)
+        tw = tw[tw["target"] == r.target]
+        same = (float(tw["lux_removed"].iloc[0]) if len(tw) else 0.0) - r.lux_removed
         se = float(np.hypot(r.lux_removed_stderr, rem_se))
         out.append({"time": state.time, "tree": r.tree, "target": r.target, "grid": r.grid,
                     "attributed": r.lux_removed, "attributed_se": r.lux_removed_stderr,
                     "removal": rem, "removal_se": rem_se,
-                    "z": (r.lux_removed - rem) / se if se > 0 else np.nan})
+                    "z": (r.lux_removed - rem) / se if se > 0 else np.nan,
+                    "same_seed": same})
     return pd.DataFrame(out)
