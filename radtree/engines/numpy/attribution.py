@@ -118,6 +118,9 @@ class _SkipOne:
     passed through and the query resumed behind it). Triangles: the tree-less scene's, then
     the crowns' (offset by ``n_open``)."""
 
+    name = "skip-one"
+    rays_cast = 0
+
     def __init__(self, bare: RayCaster, crowns: _Crowns, n_open: int, skip: int, eps: float):
         self.bare, self.crowns, self.n_open, self.skip, self.eps = bare, crowns, n_open, skip, eps
 
@@ -247,9 +250,9 @@ def _attribute_grid(hour: _Hour, grid: SensorGrid, n_paths: int, rng: np.random.
     removed[met_sun[one].argmax(axis=1), np.flatnonzero(one)] = gone[one]
     unattributed = np.where(count == 0, gone, 0.0)
     later: dict[int, list[np.ndarray]] = {}   # tree → sensors whose sun crosses several boxes
-    for s in np.flatnonzero(count > 1):
-        for i in np.flatnonzero(met_sun[s]):
-            later.setdefault(int(i), []).append(np.array([s]))
+    for sensor_ in np.flatnonzero(count > 1):
+        for tree_ in np.flatnonzero(met_sun[sensor_]):
+            later.setdefault(int(tree_), []).append(np.array([sensor_]))
     if with_t.max_bounces <= 0:
         _direct_without_one(hour, later, pts, nrm, direct_w, removed)
         return TreeAttribution(names, removed, np.zeros((n_own, n_s)),
@@ -309,20 +312,18 @@ def _attribute_grid(hour: _Hour, grid: SensorGrid, n_paths: int, rng: np.random.
         if (k > 1).any():
             several.append((pid[k > 1], acc_w[k > 1], met[k > 1]))
     # the paths that cross several trees' boxes, traced again without each of those trees
-    for i in sorted({int(i) for _, _, m in several for i in np.flatnonzero(m.any(axis=0))}
-                    | set(later)):
-        tracer = hour.without(i)
+    crossed = {int(t) for _, _, m in several for t in np.flatnonzero(m.any(axis=0))}
+    for tree in sorted(crossed):
+        tracer = hour.without(tree)
         for pid, acc_w, m in several:
-            sel = m[:, i]
+            sel = m[:, tree]
             if not sel.any():
                 continue
             p = pid[sel]
             acc_i = tracer.paths(pts[p // n_paths], nrm[p // n_paths],
                                  PathStreams(key, p.astype(np.uint64)), dirs=directions(p))
-            add(np.full(len(p), i), p, math.pi * (acc_i - acc_w[sel]))
-        if i in later:
-            s = np.concatenate(later[i])
-            removed[i, s] += tracer.sensor_sun(pts[s], nrm[s]) - direct_w[s]
+            add(np.full(len(p), tree), p, math.pi * (acc_i - acc_w[sel]))
+    _direct_without_one(hour, later, pts, nrm, direct_w, removed)
     per = sums.reshape(n_own, n_s, r)
     cnt = counts.reshape(n_s, r)
     n = cnt.sum(axis=1)
