@@ -111,3 +111,19 @@ def test_inventory_crowns_name_their_trees():
         == len(scene.instances)
     assert fewer.owners() == owners[1:]
     assert attributing_engine() is not None and attributing_engine().attributes_trees
+
+
+def test_row_crowns_are_numbered():
+    from radtree.pipeline.assemble import make_scene
+
+    project = load_project(EXAMPLES / "mendoza-street")
+    scene = make_scene(project, project.scenario("F"), dense_grid=False).scene
+    assert scene.owners() == ["C1", "C2", "C3"]
+    leaves, trunks = scene.mesh("tree_leaves"), scene.mesh("tree_trunks")
+    assert leaves.owners is not None and (leaves.owners != "").all()
+    # each crown's leaves gather around its own place in the row, C2 between C1 and C3
+    c = leaves.vertices[leaves.faces].mean(axis=1)
+    m1, m2, m3 = (c[leaves.owners == k].mean(axis=0) for k in ("C1", "C2", "C3"))
+    d12, d23, d13 = (float(np.linalg.norm(a - b)) for a, b in ((m1, m2), (m2, m3), (m1, m3)))
+    assert min(d12, d23) > 2.0 and d13 > max(d12, d23)
+    assert list(np.unique(trunks.owners, return_counts=True)[1]) == [32, 32, 32]
