@@ -56,8 +56,7 @@ from radtree.annual.coefficients import CoefficientRunner, TraceParams
 from radtree.annual.phenology import Phenology, crown_year, phenology_of
 from radtree.annual.schedule import DEFAULT_OCCUPANCY, LeafSchedule, occupied, parse_occupancy
 from radtree.annual.skymatrix import Suns, Wea, patch_count
-from radtree.annual.standards import SUNLIGHT_DATE, check_sunlight_date
-from radtree.annual.weather_year import YearInputs, annual_weather
+from radtree.annual.weather_year import YearInputs, annual_ground_reflectance, annual_weather
 from radtree.config import Project, Scenario, effective_project
 from radtree.errors import ConfigError
 from radtree.fileio import atomic_path, write_text
@@ -118,7 +117,7 @@ class AnnualOptions:
     #: bare-branch scenes) or "bsdf" (both on the BSDF-crown scene)
     sun_crown: str = "explicit"
     #: EN 17037 exposure to sunlight: the date (MM-DD, 1 February – 21 March)
-    sunlight_date: str = SUNLIGHT_DATE
+    sunlight_date: str = standards.SUNLIGHT_DATE
 
     def __post_init__(self) -> None:
         if self.method not in METHODS:
@@ -130,7 +129,7 @@ class AnnualOptions:
             raise ConfigError(f"sky subdivision must be ≥ 1 (got --mf {self.mf}, "
                               f"sun MF {self.sun_mf})")
         parse_occupancy(self.occupancy)
-        check_sunlight_date(self.sunlight_date)
+        standards.check_sunlight_date(self.sunlight_date)
         if self.nproc < 1:
             raise ConfigError("processes must be ≥ 1")
         for name, value in (("--lw", self.lw), ("--sun-lw", self.sun_lw)):
@@ -161,8 +160,7 @@ class AnnualResult:
     leaf_fraction: np.ndarray | None = None
     leaf_weight: np.ndarray | None = None
     phenology: Phenology | None = None
-    #: EN 17037 exposure to sunlight: "with"/"without" → grid → hours of sun per sensor on
-    #: ``options.sunlight_date`` (:mod:`radtree.annual.standards`), None when not computed
+    #: EN 17037 sunlight: "with"/"without" → grid → hours of sun per sensor (standards.py)
     sunlight: dict[str, dict[str, np.ndarray]] | None = None
 
 
@@ -215,18 +213,6 @@ def choose_scenarios(project: Project, options: AnnualOptions
     notes.append("The annual sky comes from the weather file (Perez sky + sun every hour); "
                  "a scenario's own sky setting applies to the point-in-time runs only.")
     return with_sc, without_sc, notes
-
-
-def annual_ground_reflectance(project: Project) -> float:
-    """The street's reflectance for a whole year: the constant, or the mean of the
-    sun-angle table (coefficients need one fixed material)."""
-    table = project.street.ground_reflectance_table
-    if table is None:
-        return float(project.street.ground_reflectance)
-    from radtree.light.tables import ground_reflectance_table
-
-    df = ground_reflectance_table(table)
-    return float(df["reflectance"].mean())
 
 
 def annual_scenes(project: Project, with_sc: Scenario, without_sc: Scenario,
@@ -381,9 +367,7 @@ def compute_annual(project: Project, options: AnnualOptions | None = None,
                     "normals": scenes["leaf_on"].grids[g].normals} for g in grids}
     notes.append(f"Crown {options.leaf.describe() if phen is None else phen.describe()}.")
     notes += METHOD_NOTES
-    ts = time.perf_counter()
-    sun = annual_sunlight(project, scenes, grids, options.sunlight_date, in_leaf, wea)
-    timing["sunlight_s"] = time.perf_counter() - ts
+    sun = standards.annual_sunlight(project, scenes, grids, options.sunlight_date, in_leaf, wea)
     timing["total_s"] = time.perf_counter() - t0
     return AnnualResult(project=project, options=options, weather=weather, wea=wea,
                         grids=grid_geo, total=total, direct=direct, in_leaf=in_leaf,
@@ -392,31 +376,6 @@ def compute_annual(project: Project, options: AnnualOptions | None = None,
                         trace=trace, sun_trace=sun_trace, ground_reflectance=rho, notes=notes, timing=timing,
                         leaf_fraction=fraction, leaf_weight=weight, phenology=phen,
                         sunlight=sun)
-
-
-def annual_sunlight(project: Project, scenes: dict[str, Scene], grids: list[str], date: str,
-                    in_leaf: np.ndarray, wea: Wea) -> dict[str, dict[str, np.ndarray]]:
-    """Hours of possible sun per sensor on ``date`` (EN 17037 exposure to sunlight), with the
-    crown of that day (leafed when ``in_leaf`` at its noon hour, else bare) and without trees,
-    traced at ``-ab 0`` by the seeded engine (:func:`radtree.annual.standards.sun_hours`)."""
-    from radtree.engines.registry import seeded_engine
-
-    site = project.site
-    month, day = (int(x) for x in date.split("-"))
-    noon = np.flatnonzero((wea.month == month) & (wea.day == day) & (wea.hour >= 12))
-    leafed = bool(in_leaf[noon[0]]) if len(noon) else True
-    times, alt, az = standards.sun_steps(site.latitude, site.longitude, site.utc_offset_hours,
-                                         int(str(site.date)[:4]), date)
-    eng = seeded_engine()
-    params = replace(project.engine, rays=1)
-    out: dict[str, dict[str, np.ndarray]] = {}
-    for tree, variant in (("with", "leaf_on" if leafed else "leaf_off"),
-                          ("without", "without")):
-        scene = scenes[variant]
-        out[tree] = standards.sun_hours(standards.direct_tracer(eng, scene, params, grids),
-                                        {g: (scene.grids[g].points, scene.grids[g].normals)
-                                         for g in grids}, times, alt, az)
-    return out
 
 
 # ---------------------------------------------------------------- tables
@@ -517,9 +476,9 @@ def write_annual(result: AnnualResult, figures: bool = True) -> AnnualOutcome:
         meta["phenology"] = {"species": result.phenology.species.key,
                              "latitude": result.phenology.latitude_deg,
                              "describe": result.phenology.describe()}
-    standards.write_standards(result.project, standards.standards_table(
+    standards.write_standards(project, standards.standards_table(
         result.scenarios, list(result.grids), result.total, result.direct, result.wea.dhi,
-        result.occupied, result.sunlight, o.sunlight_date))
+        result.occupied, result.sunlight, result.options.sunlight_date))
     mp = write_text(res / "annual" / "annual_meta.json", json.dumps(meta, indent=2,
                                                                      default=str))
     figs: list[Path] = []

@@ -45,7 +45,7 @@ No blinds are operated.
 from __future__ import annotations
 
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from datetime import datetime, timedelta, timezone
 from typing import TYPE_CHECKING
 
@@ -57,7 +57,10 @@ from radtree.annual.schedule import parse_month_day
 from radtree.errors import ConfigError
 
 if TYPE_CHECKING:
-    from radtree.config import EngineParams
+    from pathlib import Path
+
+    from radtree.annual.skymatrix import Wea
+    from radtree.config import EngineParams, Project
     from radtree.engines.base import Engine
     from radtree.light.sky import SkyState
     from radtree.scene import Scene
@@ -255,7 +258,7 @@ def standards_table(scenarios: dict[str, str], grids: list[str],
     return pd.DataFrame(rows, columns=COLUMNS)
 
 
-def write_standards(project, table: pd.DataFrame):  # type: ignore[no-untyped-def]
+def write_standards(project: Project, table: pd.DataFrame) -> Path:
     """Write ``results/annual/standards.csv`` (atomically); returns its path."""
     from radtree.fileio import atomic_path
 
@@ -264,3 +267,30 @@ def write_standards(project, table: pd.DataFrame):  # type: ignore[no-untyped-de
     with atomic_path(path) as tmp:
         table.to_csv(tmp, index=False, float_format="%.6g")
     return path
+
+
+def annual_sunlight(project: Project, scenes: dict[str, Scene], grids: list[str], date: str,
+                    in_leaf: np.ndarray, wea: Wea) -> dict[str, dict[str, np.ndarray]]:
+    """Hours of possible sun per sensor on ``date`` (EN 17037 exposure to sunlight), with the
+    crown of that day (leafed when ``in_leaf`` at its noon hour, else bare) and without trees,
+    traced at ``-ab 0`` by the seeded engine (:func:`sun_hours`)."""
+    from radtree.engines.registry import seeded_engine
+
+    site = project.site
+    month, day = (int(x) for x in date.split("-"))
+    noon = np.flatnonzero((wea.month == month) & (wea.day == day) & (wea.hour >= 12))
+    leafed = bool(in_leaf[noon[0]]) if len(noon) else True
+    times, alt, az = sun_steps(site.latitude, site.longitude, site.utc_offset_hours,
+                               int(str(site.date)[:4]), date)
+    eng = seeded_engine()
+    params = replace(project.engine, rays=1)
+    out: dict[str, dict[str, np.ndarray]] = {}
+    for tree, variant in (("with", "leaf_on" if leafed else "leaf_off"),
+                          ("without", "without")):
+        scene = scenes[variant]
+        out[tree] = sun_hours(direct_tracer(eng, scene, params, grids),
+                              {g: (scene.grids[g].points, scene.grids[g].normals)
+                               for g in grids}, times, alt, az)
+    return out
+
+
