@@ -2,17 +2,21 @@
 
 Reads only the tidy results table ``PROJECT/results/illuminance.csv`` and writes
 
-* ``PROJECT/results/summary.csv`` — one row per scenario × hour × grid: ``scenario, model,
-  tree, time, grid, n_points, mean_lux, min_lux, max_lux, uniformity, pct_below_300,
-  pct_300_2000, pct_above_2000``. ``tree`` is ``without`` when the scenario's model is
-  ``none``, else ``with``. Uniformity is min/mean. The office grids are equal-area grids
+* ``PROJECT/results/summary.csv`` — one row per scenario × hour × grid × room: ``scenario,
+  model, tree, time, grid, n_points, mean_lux, min_lux, max_lux, uniformity, pct_below_300,
+  pct_300_2000, pct_above_2000, storey, room`` (``room`` ``"STOREY-BAY"``, storey 0 = the
+  ground floor, :mod:`radtree.site.office`; both empty for a table without rooms). ``tree`` is
+  ``without`` when the scenario's model is ``none``, else ``with``. Uniformity is min/mean. The office grids are equal-area grids
   (every point the centre of an equal cell), so the percentage of points in a band is the
   percentage of grid area: below 300 lx, 300–2000 lx (both bounds included: the "useful"
   band), above 2000 lx.
 * ``PROJECT/report/office/<grid>_<HHMM>.png`` — false-colour maps of each grid and hour, one
   panel per scenario side by side (with and without the tree), on a **logarithmic** colour
-  scale shared by all hours and scenarios of the grid, lux legend, cell values written in.
-* ``PROJECT/report/office/<grid>_hourly.png`` — the hourly mean and the area bands.
+  scale shared by all hours and scenarios of the grid, lux legend, cell values written in. A
+  grid that is not one plane (work planes of several storeys) is drawn per storey,
+  ``<grid>_s<STOREY>_<HHMM>.png``; a façade grid over several rooms is one elevation.
+* ``PROJECT/report/office/<grid>_hourly.png`` — the hourly mean and the area bands of the
+  whole grid (every sensed room: the rooms' equal-area cells pooled).
 
 :func:`office_section_data` gives the report's office section (tables + maps) as plain data.
 """
@@ -29,6 +33,7 @@ import pandas as pd
 from radtree.config import Project
 from radtree.errors import RadtreeError
 from radtree.fileio import atomic_path
+from radtree.pipeline.assemble import facade_frame
 from radtree.pipeline.results import read_results
 from radtree.site.frame import FacadeFrame
 
@@ -36,7 +41,7 @@ LOW_LUX = 300.0
 HIGH_LUX = 2000.0
 SUMMARY_COLUMNS = [
     "scenario", "model", "tree", "time", "grid", "n_points", "mean_lux", "min_lux", "max_lux",
-    "uniformity", "pct_below_300", "pct_300_2000", "pct_above_2000",
+    "uniformity", "pct_below_300", "pct_300_2000", "pct_above_2000", "storey", "room",
 ]
 GRID_TITLES = {"facade": "Façade (outside the glazing, vertical)",
                "workplane": "Work plane (horizontal)"}
@@ -76,25 +81,63 @@ def tree_label(model: str) -> str:
 
 
 def summarise(table: pd.DataFrame) -> pd.DataFrame:
-    """The per scenario × hour × grid summary of a results table (see module doc)."""
+    """The per scenario × hour × grid × room summary of a results table (see module doc)."""
     need = {"scenario", "model", "time", "grid", "lux"}
     missing = need - set(table.columns)
     if missing:
         raise RadtreeError(f"results table lacks column(s) {', '.join(sorted(missing))}")
+    rooms = "room" in table.columns and bool(table["room"].notna().any())
+    table = table.assign(room=_room_names(table) if rooms else "")
     rows = []
     order = list(dict.fromkeys(table["scenario"].astype(str)))
-    for (scen, time, grid), g in table.groupby(["scenario", "time", "grid"], sort=False):
+    for (scen, time, grid, room), g in table.groupby(["scenario", "time", "grid", "room"],
+                                                     sort=False):
         models = g["model"].astype(str).unique()
         model = models[0]
         stats = grid_statistics(g["lux"].to_numpy(float))
+        storey = int(g["storey"].iloc[0]) if room and "storey" in g.columns else None
         rows.append({"scenario": str(scen), "model": model, "tree": tree_label(model),
-                     "time": str(time), "grid": str(grid), **stats})
+                     "time": str(time), "grid": str(grid), **stats, "storey": storey,
+                     "room": room})
     out = pd.DataFrame(rows, columns=SUMMARY_COLUMNS)
     out["n_points"] = out["n_points"].astype(int)
+    out["storey"] = out["storey"].astype("Int64")
     rank = {s: i for i, s in enumerate(order)}
-    out = out.sort_values(["grid", "time", "scenario"],
-                          key=lambda c: c.map(rank) if c.name == "scenario" else c)
+    room_rank = {r: i for i, r in enumerate(dict.fromkeys(table["room"]))}
+    out = out.sort_values(["grid", "room", "time", "scenario"],
+                          key=lambda c: c.map(rank) if c.name == "scenario" else
+                          c.map(room_rank) if c.name == "room" else c)
     return out.reset_index(drop=True)
+
+
+def _room_names(table: pd.DataFrame) -> pd.Series:
+    """The ``room`` column as text, "" where a row has none."""
+    return table["room"].astype("string").fillna("").astype(str)
+
+
+def whole_grid(summary: pd.DataFrame) -> pd.DataFrame:
+    """One grid's summary rows pooled over its rooms, per scenario and hour: the rooms' cells
+    are equal-area cells, so means and area bands are point-count-weighted means, the minimum
+    and maximum the rooms' extremes, U₀ their min / the pooled mean. One room: unchanged."""
+    rooms = _room_names(summary) if "room" in summary.columns else None
+    if rooms is None or rooms.nunique() <= 1:
+        return summary
+    out = []
+    for _, g in summary.groupby(["scenario", "time"], sort=False):
+        n = g["n_points"].to_numpy(float)
+
+        def pooled(col: str, g: pd.DataFrame = g, n: np.ndarray = n) -> float:
+            return float(np.dot(g[col].to_numpy(float), n) / n.sum())
+
+        mean = pooled("mean_lux")
+        lo = float(g["min_lux"].min())
+        out.append({**g.iloc[0].to_dict(), "n_points": int(n.sum()), "mean_lux": mean,
+                    "min_lux": lo, "max_lux": float(g["max_lux"].max()),
+                    "uniformity": lo / mean if mean > 0 else math.nan,
+                    **{c: pooled(c) for c in ("pct_below_300", "pct_300_2000",
+                                              "pct_above_2000")},
+                    "storey": pd.NA, "room": "all"})
+    return pd.DataFrame(out, columns=summary.columns)
 
 
 def summary_path(project: Project) -> Path:
@@ -180,8 +223,20 @@ def _time_label(t: str) -> str:
     return str(t).replace(":", "")
 
 
-def map_filename(grid: str, time: str) -> str:
-    return f"{grid}_{_time_label(time)}.png"
+def map_filename(grid: str, time: str, storey: int | None = None) -> str:
+    """``<grid>_<HHMM>.png``, or ``<grid>_s<storey>_<HHMM>.png`` for one storey's part."""
+    part = "" if storey is None else f"_s{storey}"
+    return f"{grid}{part}_{_time_label(time)}.png"
+
+
+def _map_parts(gt: pd.DataFrame, frame: FacadeFrame) -> list[tuple[int | None, pd.DataFrame]]:
+    """A grid's rows as drawn: whole when its points lie in one plane (one room, or a façade
+    over several rooms), else one part per storey (work planes of several storeys)."""
+    local = frame.to_local(gt[["x", "y", "z"]].to_numpy(float))
+    planar = float(np.ptp(local, axis=0).min()) < 1e-6
+    if planar or "storey" not in gt.columns or gt["storey"].nunique() <= 1:
+        return [(None, gt)]
+    return [(int(k), part) for k, part in gt.groupby("storey", sort=True)]
 
 
 def write_maps(project: Project, table: pd.DataFrame, out_dir: Path | None = None
@@ -196,7 +251,7 @@ def write_maps(project: Project, table: pd.DataFrame, out_dir: Path | None = Non
 
     out_dir = out_dir or office_dir(project)
     out_dir.mkdir(parents=True, exist_ok=True)
-    frame = FacadeFrame(azimuth_deg=project.street.facade_azimuth_deg)
+    frame = facade_frame(project)
     scen_order = list(dict.fromkeys(table["scenario"].astype(str)))
     written = []
     for grid, gt in table.groupby("grid", sort=False):
@@ -204,7 +259,8 @@ def write_maps(project: Project, table: pd.DataFrame, out_dir: Path | None = Non
         norm = LogNorm(vmin=lo, vmax=hi)
         ticks = [v for v in (1, 2, 5, 10, 20, 50, 100, 200, 300, 500, 1000, 2000, 5000, 10000,
                              20000, 50000, 100000, 200000) if lo <= v <= hi]
-        for time, ht in gt.groupby("time", sort=True):
+        for (time, storey, ht) in [(t, k, p) for t, tt in gt.groupby("time", sort=True)
+                                   for k, p in _map_parts(tt, frame)]:
             scens = [s for s in scen_order if s in set(ht["scenario"].astype(str))]
             a0, b0, *_ = _plane_axes(frame.to_local(ht[["x", "y", "z"]].to_numpy(float)))
             ratio = (np.ptp(a0) + 0.5) / (np.ptp(b0) + 0.5)     # panel width / height
@@ -244,8 +300,9 @@ def write_maps(project: Project, table: pd.DataFrame, out_dir: Path | None = Non
             cb.ax.yaxis.set_minor_locator(NullLocator())
             cb.ax.set_yticklabels([f"{t:,}" for t in ticks], fontsize=7)
             title = GRID_TITLES.get(str(grid), str(grid))
-            fig.suptitle(f"{title} — {time} local — {project.site.date}", fontsize=10)
-            path = out_dir / map_filename(str(grid), str(time))
+            where = "" if storey is None else f" — storey {storey}"
+            fig.suptitle(f"{title}{where} — {time} local — {project.site.date}", fontsize=10)
+            path = out_dir / map_filename(str(grid), str(time), storey)
             with atomic_path(path) as tmp:
                 fig.savefig(tmp, format="png", dpi=110)
             plt.close(fig)
@@ -268,6 +325,7 @@ def write_hourly_charts(project: Project, summary: pd.DataFrame, out_dir: Path |
     plain = FuncFormatter(lambda v, _pos: f"{v:,.0f}")
     scen_order = list(dict.fromkeys(summary["scenario"].astype(str)))
     for grid, g in summary.groupby("grid", sort=False):
+        g = whole_grid(g)
         times = sorted(g["time"].astype(str).unique())
         fig, (ax1, ax2) = plt.subplots(1, 2, figsize=(10, 3.6), constrained_layout=True)
         width = 0.8 / max(1, len(scen_order))
@@ -375,6 +433,55 @@ def _grid_data(g: pd.DataFrame, scen_order: list[str]) -> dict[str, Any]:
             "columns": [c[1] for c in cols], "pair": pair is not None, "rows": rows}
 
 
+#: The per-room table of a grid: summary column (mean over the hours), label, decimals.
+ROOM_COLUMNS = [("mean_lux", "day mean lx", 0), ("pct_300_2000", "% 300–2000", 0)]
+
+
+def _rooms_data(g: pd.DataFrame, scen_order: list[str]) -> dict[str, Any] | None:
+    """Per sensed room (rows, in the summary's order) and scenario: the day's mean of the
+    hourly mean and of the useful band, and the with / without ratio when there is a pair
+    (None for one room)."""
+    rooms = [r for r in dict.fromkeys(_room_names(g)) if r]
+    if len(rooms) <= 1:
+        return None
+    scens = [s for s in scen_order if s in set(g["scenario"])]
+    tree_of = {s: str(g[g["scenario"] == s]["tree"].iloc[0]) for s in scens}
+    withs = [s for s in scens if tree_of[s] == "with"]
+    withouts = [s for s in scens if tree_of[s] == "without"]
+    pair = (withs[0], withouts[0]) if len(withs) == 1 and len(withouts) == 1 else None
+    day = g.groupby(["room", "scenario"])[[c for c, _, _ in ROOM_COLUMNS]].mean()
+    rows = []
+    for r in rooms:
+        cells = [{"text": _f(float(day.loc[(r, s), c]), d) if (r, s) in day.index else "–",
+                  "num": True} for s in scens for c, _, d in ROOM_COLUMNS]
+        if pair:
+            w, wo = (float(day.loc[(r, s), "mean_lux"]) if (r, s) in day.index else None
+                     for s in pair)
+            cells.append({"text": f"{100 * w / wo:.0f} %" if w is not None and wo else "–",
+                          "num": True})
+        storey = g[g["room"] == r]["storey"].iloc[0]
+        rows.append({"label": f"{r} (storey {storey})", "cells": cells})
+    return {"scenarios": [{"name": s, "tree": tree_of[s]} for s in scens],
+            "columns": [c[1] for c in ROOM_COLUMNS], "pair": pair is not None, "rows": rows}
+
+
+def _maps(project: Project, grid: str, times: list[str], prefix: str) -> list[dict[str, str]]:
+    """The grid's map images per hour as written (whole, or per storey)."""
+    folder = office_dir(project)
+    out = []
+    for t in times:
+        whole = map_filename(grid, t)
+        parts = sorted(folder.glob(f"{grid}_s*_{_time_label(t)}.png"),
+                       key=lambda p: int(p.name[len(grid) + 2:].split("_")[0]))
+        if (folder / whole).exists() or not parts:
+            out.append({"src": prefix + whole, "time": t})
+        else:
+            out += [{"src": prefix + p.name,
+                     "time": f"{t}, storey {p.name[len(grid) + 2:].split('_')[0]}"}
+                    for p in parts]
+    return out
+
+
 def office_section_data(project: Project, image_prefix: str = "office/") -> dict[str, Any]:
     """The report's office section as the data ``templates/sections/office.html.j2`` renders:
     per grid a consultant-style table (hour × scenario: mean lux, uniformity and the area bands
@@ -389,12 +496,13 @@ def office_section_data(project: Project, image_prefix: str = "office/") -> dict
         from radtree.site.office import office_layout
 
         lay = office_layout(project)
-        room = lay.central_room
+        floors = ", ".join(f"{n} (floor {lay.floor_z(k):g} m)" for n, k, _ in lay.sensed)
         description = (
             f"{o.bays} × {o.storeys} offices ({o.width_m:g} m wide, "
             f"{lay.room_height:g} m high, {o.depth_m:g} m deep) behind the façade, "
             f"glazing Tn {o.glazing_transmittance:g} with {100 * o.frame_fraction:g} % "
-            f"frame; results in the central office (floor {room.z0:g} m above the street). "
+            f"frame; results in {len(lay.sensed)} office(s), named STOREY-BAY (storey 0 = "
+            f"ground floor, bay 0 = leftmost seen from the street): {floors}. "
             f"Façade grid: {o.facade_grid_spacing_m:g} m cells just outside the glazing, "
             f"facing the street. Work plane: {o.workplane_height_m:g} m above the floor, "
             f"{o.grid_spacing_m:g} m cells, {o.wall_offset_m:g} m from the walls. "
@@ -409,8 +517,8 @@ def office_section_data(project: Project, image_prefix: str = "office/") -> dict
     for grid, g in summary.groupby("grid", sort=False):
         times = sorted(g["time"].astype(str).unique())
         grids.append({
-            "title": GRID_TITLES.get(str(grid), str(grid)), **_grid_data(g, scen_order),
+            "title": GRID_TITLES.get(str(grid), str(grid)),
+            **_grid_data(whole_grid(g), scen_order), "rooms": _rooms_data(g, scen_order),
             "hourly_image": f"{image_prefix}{grid}_hourly.png",
-            "maps": [{"src": image_prefix + map_filename(str(grid), t), "time": t}
-                     for t in times]})
+            "maps": _maps(project, str(grid), times, image_prefix)})
     return {"description": description, "sky": sky, "grids": grids}

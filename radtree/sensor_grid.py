@@ -1,11 +1,16 @@
 """Sensor grids on the façade: the study's 8-point circle and a dense grid around it.
 
 Points sit ``offset_m`` off the wall, normals point out of the wall (towards the street).
+With several heights (``[sensors] heights_m``, one per storey) each height has its own circle
+and map, named ``facade@<h>m`` / ``facade_map@<h>m`` (:func:`level_name`), every sensor
+labelled with its ``storey`` (the height's index in the list); one height keeps the plain
+names ``facade`` / ``facade_map`` and no label (:func:`street_grids`).
 """
 
 from __future__ import annotations
 
 import math
+from dataclasses import replace
 
 import numpy as np
 
@@ -55,6 +60,42 @@ def facade_dense_grid(sensors: Sensors, frame: FacadeFrame, name: str = DENSE_GR
     rows = [f"z={zz:.2f}" for zz in Z.ravel()]
     normals = np.tile(frame.normal, (U.size, 1))
     return SensorGrid(name, frame.to_world(local), normals, rows)
+
+
+#: joins a grid's name and its sensor height (``facade@4.5m``)
+LEVEL_MARK = "@"
+
+
+def level_name(grid: str, height_m: float) -> str:
+    """``<grid>@<h>m`` with the height as written (``%g``): ``facade@4.5m``."""
+    return f"{grid}{LEVEL_MARK}{height_m:g}m"
+
+
+def is_dense_grid(name: str) -> bool:
+    """Whether ``name`` is a dense façade map (``facade_map`` or ``facade_map@<h>m``)."""
+    return name == DENSE_GRID or name.startswith(DENSE_GRID + LEVEL_MARK)
+
+
+def street_grids(sensors: Sensors, frame: FacadeFrame, dense: bool) -> dict[str, SensorGrid]:
+    """The street's façade grids: per sensor height its circle (and, when ``dense``, its dense
+    map) — see the module text for names and the ``storey`` label."""
+    levels = sensors.levels
+    if len(levels) == 1:
+        at = replace(sensors, height_m=levels[0], heights_m=None)
+        grids = {"facade": facade_circle(at, frame)}
+        if dense:
+            grids[DENSE_GRID] = facade_dense_grid(at, frame)
+        return grids
+    out: dict[str, SensorGrid] = {}
+    for k, h in enumerate(levels):
+        at = replace(sensors, height_m=h, heights_m=None)
+        made = [facade_circle(at, frame, level_name("facade", h))]
+        if dense:
+            made.append(facade_dense_grid(at, frame, level_name(DENSE_GRID, h)))
+        for g in made:
+            g.labels = {"storey": [k] * len(g)}
+            out[g.name] = g
+    return out
 
 
 def point_grid(points, orientation: str, frame: FacadeFrame, name: str,

@@ -318,6 +318,8 @@ ground_reflectance = 0.15
 epw = "{epw}"
 
 [tree]
+leaf_on = "10-15"
+leaf_off = "06-01"
 form = "free"
 
 [tree.crown]

@@ -114,8 +114,19 @@ def test_tree_inside_building(tmp_path):
 
 
 def test_crown_through_wall(tmp_path):
-    msg = _fails(tmp_path, trees=[point("T4", -8, 8.0, crown_diameter_m=6.0)])
-    assert "feature 'T4'" in msg and "through a wall of building 'N1'" in msg
+    """Under ``[tree] wall_policy = "refuse"`` (the default clips: tests/test_floors.py)."""
+    from radtree.pipeline.build import build_project
+
+    p = district(tmp_path, trees=[point("T4", -8, 8.0, crown_diameter_m=6.0)])
+    toml = p / "radtree.toml"
+    toml.write_text(toml.read_text().replace('form = "free"', 'form = "free"\n'
+                                             'wall_policy = "refuse"'))
+    with pytest.raises(ConfigError) as exc:
+        build_project(load_project(p), echo=lambda _m: None, progress=False, pictures=False)
+    assert not (tmp_path / "build" / "T").exists()       # nothing half-written
+    msg = str(exc.value)
+    assert "feature 'T4'" in msg and "reaches a wall of building 'N1'" in msg
+    assert "move the trunk 1.02 m further from the wall, or reduce the crown radius" in msg
 
 
 def test_missing_height(tmp_path):

@@ -33,6 +33,8 @@ hours = ["13:30"]
 [light]
 direct_normal = "dni.csv"
 [tree]
+leaf_on = "10-15"
+leaf_off = "06-01"
 form = "free"
 [tree.crown]
 count = 1

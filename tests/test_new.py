@@ -17,7 +17,7 @@ from radtree.config import Crown, Louvers, Sensors, Street, load_project
 from radtree.config.spec import spec_of, toml_name
 from radtree.config.switches import TABLES
 from radtree.errors import ConfigError
-from radtree.site.starter import new_project, read_inputs, site_facts
+from radtree.site.starter import Location, new_project, read_inputs, site_facts
 from tests.conftest import ROOT
 
 EPW = ROOT / "examples" / "office-block" / "data" / "mendoza_generated.epw"
@@ -35,8 +35,9 @@ def test_new_from_an_epw_then_build(tmp_path: Path) -> None:
     folder = tmp_path / "proj"
     res = CliRunner().invoke(main, ["new", str(folder), "--epw", str(EPW)])
     assert res.exit_code == 0, res.output
-    assert ("site: latitude -32.89, longitude -68.83, UTC-3 h, elevation 750 m — from the "
-            "EPW mendoza_generated.epw (pvlib)") in res.output
+    assert ("site: latitude -32.89, longitude -68.83, time zone UTC-3, elevation 750 m"
+            in res.output)
+    assert "SITE NOT GIVEN ON THE COMMAND LINE — latitude/longitude from the EPW" in res.output
     assert (folder / "data" / EPW.name).read_bytes() == EPW.read_bytes()
     text = (folder / "radtree.toml").read_text()
     # every field of every table, with its unit and default
@@ -50,29 +51,40 @@ def test_new_from_an_epw_then_build(tmp_path: Path) -> None:
                     (table, f.name)
     assert "# width_m = 20.0   # m; a number > 0; default 20.0" in text
     assert "# reflectance = 0.11   # fraction; a number ≥ 0 and ≤ 1; default 0.11" in text
-    assert 'species = "morus_alba"' in text
+    assert 'species = "platanus_x_acerifolia"' in text
+    assert 'weather = "epw"' in text
     # loads to the schema's defaults, the species filling the leaf optics
     p = load_project(folder)
     assert (p.site.latitude, p.site.longitude, p.site.utc_offset_hours) == (-32.89, -68.83, -3)
     assert p.street == Street() and p.tree.crown == Crown() and p.sensors == Sensors()
-    assert p.tree.louvers.transmittance == 0.53 and p.tree.louvers.layers == Louvers().layers
+    assert p.tree.louvers.layers == Louvers().layers
+    # hours: every whole hour with the sun ≥ 5° high on the southern summer solstice
+    assert p.site.date == "2024-12-21" and p.site.hours[0] == "07:00" \
+        and p.site.hours[-1] == "20:00"
     # … and build accepts it as written
     res = CliRunner().invoke(main, ["build", str(folder), "-s", "trees", "--no-pictures"])
     assert res.exit_code == 0, res.output
-    mats = (folder / "build" / "trees" / "materials.rad").read_text()
-    assert "void trans leaf\n0\n0\n7 0.64 0.64 0.64 0 0 0.8281 0.9057\n" in mats
+    assert "void trans leaf" in (folder / "build" / "trees" / "materials.rad").read_text()
     assert (folder / "build" / "trees" / "Makefile").is_file()
 
 
-def test_new_office_template_without_epw_generates_a_labelled_year(tmp_path: Path) -> None:
-    out = new_project(tmp_path / "o", template="office")
-    assert out.generated_epw and out.site["latitude"] == -32.89
+def test_new_office_template_without_epw_is_clear_sky(tmp_path: Path) -> None:
+    out = new_project(tmp_path / "o", template="office",
+                      where=Location(40.42, -3.70, "Europe/Madrid", 667.0))
+    assert out.weather == "clear-sky" and out.site["latitude"] == 40.42
     text = out.path.read_text()
     assert "# bays = 3   # an integer ≥ 1 and ≤ 21; default 3" in _section(text, "office")
     p = load_project(out.path)
-    assert p.office is not None and p.light.epw == tmp_path / "o" / "data" / \
-        "generated_clear_sky.epw"
-    assert "GENERATED" in p.light.epw.read_text().splitlines()[5]
+    assert p.office is not None and p.light.epw is None and p.light.weather == "clear-sky"
+    assert not (tmp_path / "o" / "data" / "generated_clear_sky.epw").exists()
+    assert p.site.time_zone == "Europe/Madrid" and p.site.utc_offset_hours == 1.0
+
+
+def test_new_needs_a_site(tmp_path: Path) -> None:
+    res = CliRunner().invoke(main, ["new", str(tmp_path / "x")])
+    assert res.exit_code == 2
+    assert "radtree new needs the site: give --lat LAT --lon LON" in res.output
+    assert not (tmp_path / "x").exists()
 
 
 def _inventory(tmp_path: Path) -> tuple[Path, Path]:
@@ -82,8 +94,8 @@ def _inventory(tmp_path: Path) -> tuple[Path, Path]:
                         "crown_diameter_m": 8.0, "crown_base_m": 3.0}}
         for i, (lon, lat, sp) in enumerate([(-68.846, -32.889, "Morus alba"),
                                             (-68.845, -32.889, "morus_alba"),
-                                            (-68.844, -32.890, "Platanus × acerifolia"),
-                                            (-68.843, -32.890, "Ginkgo biloba")])]}
+                                            (-68.844, -32.889, "Platanus × acerifolia"),
+                                            (-68.843, -32.889, "Ginkgo biloba")])]}
     tp = tmp_path / "trees.geojson"
     tp.write_text(json.dumps(trees))
     cp = tmp_path / "trees.csv"
@@ -98,9 +110,9 @@ def test_inputs_summarised_per_species(tmp_path: Path) -> None:
     assert info.lines() == ["4 trees — Morus alba: 1; morus_alba: 1; Platanus × acerifolia: 1; "
                             "Ginkgo biloba: 1 (not in the species library)"]
     site, why = site_facts(None, info)
-    assert (site["latitude"], site["longitude"], site["utc_offset_hours"]) == \
-        (-32.8895, -68.8445, -5.0)
-    assert "ESTIMATED" in why
+    assert (site["latitude"], site["longitude"], site["time_zone"]) == \
+        (-32.889, -68.8445, "America/Argentina/Mendoza")
+    assert "looked up from the coordinates" in why and "elevation 0 m (ASSUMED" in why
     csv_info = read_inputs(cp, None, None)
     assert csv_info.lines() == ["2 trees — Melia azedarach: 2"]
     assert site_facts(None, csv_info)[0]["latitude"] == -32.85
@@ -125,6 +137,7 @@ def test_new_with_a_tree_inventory(tmp_path: Path) -> None:
         data = tomllib.loads((folder / "radtree.toml").read_text())
         assert data["site"]["trees"] == "data/trees.geojson"
         assert data["tree"]["species"] == "morus_alba"
+        assert data["site"]["time_zone"] == "UTC-3"
     else:              # this reader does not know [site] trees yet: refused, nothing kept
         assert res.exit_code == 2, res.output
         assert "field 'site.trees': unknown field" in res.output
@@ -135,6 +148,10 @@ def test_new_refuses_to_overwrite_and_bad_requests(tmp_path: Path) -> None:
     new_project(tmp_path / "a", epw=EPW)
     with pytest.raises(ConfigError, match="exists already"):
         new_project(tmp_path / "a", epw=EPW)
+    with pytest.raises(ConfigError, match="give both --lat and --lon"):
+        Location(latitude=40.0)
+    with pytest.raises(ConfigError, match="'Europe/Madird': not a known IANA time zone"):
+        Location(40.0, -3.7, "Europe/Madird")
     with pytest.raises(ConfigError, match="district template needs --trees"):
         new_project(tmp_path / "b", template="district")
     assert not (tmp_path / "b").exists()
@@ -147,12 +164,16 @@ def test_new_refuses_to_overwrite_and_bad_requests(tmp_path: Path) -> None:
 def test_site_from_inputs_and_epw(tmp_path: Path) -> None:
     tp, _ = _inventory(tmp_path)
     site, why = site_facts(EPW, read_inputs(tp, None, None))
-    assert (site["latitude"], site["longitude"], site["utc_offset_hours"],
-            site["elevation_m"]) == (-32.8895, -68.8445, -3.0, 750.0)
-    assert why.startswith("latitude/longitude the centroid of the inputs; time zone")
+    assert (site["latitude"], site["longitude"], site["time_zone"],
+            site["elevation_m"]) == (-32.889, -68.8445, "UTC-3", 750.0)
+    assert why.startswith("latitude/longitude the centroid of the inputs' coordinates; time zone")
     far = tmp_path / "far.geojson"
     far.write_text(json.dumps({"type": "FeatureCollection", "features": [
         {"type": "Feature", "geometry": {"type": "Point", "coordinates": [2.35, 48.85]},
          "properties": {"species": "tilia_cordata"}}]}))
-    with pytest.raises(ConfigError, match="more than 0.5° from the inputs' centre"):
+    with pytest.raises(ConfigError, match="the EPW .* is for latitude -32.89, longitude -68.83, "
+                       "more than 0.5° from the site"):
         site_facts(EPW, read_inputs(far, None, None))
+    with pytest.raises(ConfigError, match="standard time UTC-3 h, but the time zone "
+                       "Europe/Madrid has standard time UTC\\+1 h"):
+        site_facts(EPW, read_inputs(tp, None, None), Location(time_zone="Europe/Madrid"))

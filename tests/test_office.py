@@ -66,7 +66,7 @@ def test_grids_counts_normals_and_inside_the_central_office(project):
     meshes, materials, grids, notes = office_parts(project, frame)
     assert set(grids) == {"facade", "workplane"}
     lay = office_layout(project)
-    room = lay.central_room
+    room = lay.room(1, 1)
     o = project.office
 
     fg = grids["facade"]
@@ -91,7 +91,8 @@ def test_grids_counts_normals_and_inside_the_central_office(project):
     assert loc[:, 1].min() - room.n0 >= o.wall_offset_m - 1e-9
     # equal-area cells: evenly spaced, symmetric about the room's axis
     assert np.allclose(np.unique(np.round(loc[:, 0], 6)), [-0.75, -0.25, 0.25, 0.75])
-    assert any("central office" in n for n in notes)
+    assert any("results read in 1 office(s)" in n and ": 1-1;" in n for n in notes)
+    assert set(fg.labels["room"]) == {"1-1"} and set(wg.labels["storey"]) == {1}
 
 
 def test_facade_with_openings_and_materials(project):
@@ -129,7 +130,8 @@ def test_facade_with_openings_and_materials(project):
 @pytest.mark.parametrize("changes", [
     {},
     {"window_sill_m": 0.9, "window_head_m": 2.2, "storey_height_m": 3.0, "frame_fraction": 0.2},
-    {"bays": 1, "storeys": 1, "frame_fraction": 0.0},
+    {"bays": 1, "storeys": 1, "frame_fraction": 0.0, "rooms": "all"},
+    {"bays": 4, "storeys": 2, "rooms": "all"},
 ])
 def test_rooms_are_closed(project, changes):
     """Rays from random points inside every office, in random directions, all stay inside."""
@@ -371,7 +373,7 @@ def test_unglazed_opening_under_uniform_sky_matches_view_factor(project):
     meshes = [m for m in meshes if m.name != "office_glazing"]
     materials = {**materials, "facade_paint": Plastic("facade_paint", 0.0)}
     lay = office_layout(proj)
-    room = lay.central_room
+    room = lay.room(1, 1)
     wp = room.z0 + proj.office.workplane_height_m
     depths = np.array([0.75, 1.5, 3.0, 5.0])
     offsets = np.array([0.0, 0.0, 0.0, 0.8])                   # along u from the centre

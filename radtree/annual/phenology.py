@@ -79,8 +79,14 @@ class Phenology:
 
 
 def phenology_of(project: Project, enabled: bool = True) -> Phenology | None:
-    """The species phenology of an annual run: with ``[tree] species`` unless not ``enabled``."""
+    """The species phenology of an annual run: with ``[tree] species`` unless not ``enabled``
+    or the site lies between the tropics (then the dates of
+    :func:`radtree.annual.schedule.leaf_season` apply)."""
     if project.tree.species is None or not enabled:
+        return None
+    from radtree.annual.schedule import TROPIC_DEG
+
+    if abs(project.site.latitude) < TROPIC_DEG:   # no temperate ramps: the leaf season's dates
         return None
     return Phenology.of(project.tree.species, project.site.latitude)
 

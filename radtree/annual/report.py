@@ -127,6 +127,16 @@ def _heatmap_grid(project: Project, data: dict, meta: dict, grid: str, out: Path
     return _save(fig, out)
 
 
+def season_text(meta: dict) -> str:
+    """How the crown's season was set, from the run's record (never a default sentence)."""
+    if "phenology" in meta:
+        ph = meta["phenology"]
+        return ph.get("describe") or f"in leaf by the phenology of {ph.get('species')}"
+    return (f"in leaf from {meta['leaf_on']} to {meta['leaf_off']} (MM-DD, "
+            f"{meta['leaf_days']} days; {meta.get('leaf_source', 'dates given')}), bare "
+            "branches otherwise")
+
+
 def _monthly_grid(monthly: pd.DataFrame, grid: str, out: Path) -> Path:
     fig = _figure(7.0, 3.6)
     ax = fig.subplots()
@@ -230,6 +240,7 @@ def annual_section_data(project: Project) -> dict[str, Any]:
         "occupancy": f"{meta['occupancy'][0]:g}–{meta['occupancy'][1]:g}",
         "occupied_hours": meta["occupied_hours"], "leaf_on": meta["leaf_on"],
         "leaf_off": meta["leaf_off"], "leaf_days": meta["leaf_days"],
+        "season": season_text(meta),
         "scenarios": meta["scenarios"], "rows": rows, "months": list(MONTHS),
         "monthly": months, "figures": figures, "notes": [str(n) for n in meta.get("notes", [])],
         "timing": timing,

@@ -54,7 +54,13 @@ import radtree.annual.standards as standards
 from radtree.annual.branches import BranchParams, build_leaf_off
 from radtree.annual.coefficients import CoefficientRunner, TraceParams
 from radtree.annual.phenology import Phenology, crown_year, phenology_of
-from radtree.annual.schedule import DEFAULT_OCCUPANCY, LeafSchedule, occupied, parse_occupancy
+from radtree.annual.schedule import (
+    DEFAULT_OCCUPANCY,
+    LeafSchedule,
+    leaf_season,
+    occupied,
+    parse_occupancy,
+)
 from radtree.annual.skymatrix import Suns, Wea, patch_count
 from radtree.annual.weather_year import YearInputs, annual_ground_reflectance, annual_weather
 from radtree.config import Project, Scenario, effective_project
@@ -90,7 +96,8 @@ MONTHLY_COLUMNS = ["grid", "tree", "month", "mean_lux", "mean_direct_lux", "leaf
 class AnnualOptions:
     """Settings of an annual run (None = from the project)."""
 
-    leaf: LeafSchedule = field(default_factory=LeafSchedule)
+    #: the leaf season; None: :func:`radtree.annual.schedule.leaf_season` of the project
+    leaf: LeafSchedule | None = None
     mf: int = 1
     sun_mf: int = 1
     occupancy: tuple[float, float] = DEFAULT_OCCUPANCY
@@ -294,11 +301,18 @@ def scene_year_lux(runner: CoefficientRunner, year: YearInputs, mf: int, sun_mf:
     return combine(c_sky, sky, c_dir, suns, c_ind, verts, weights, wea.n_hours)
 
 
+def with_season(project: Project, options: AnnualOptions) -> AnnualOptions:
+    """``options`` with its leaf season resolved (:func:`radtree.annual.schedule.leaf_season`)."""
+    if options.leaf is not None:
+        return options
+    return replace(options, leaf=leaf_season(project))
+
+
 def compute_annual(project: Project, options: AnnualOptions | None = None,
                    echo: Callable[[str], None] = print, progress: bool = False
                    ) -> AnnualResult:
     """Trace the three scenes and assemble 8760 hours of illuminance per sensor."""
-    options = options or AnnualOptions()
+    options = with_season(project, options or AnnualOptions())
     if options.method != "dc":
         raise ConfigError(f"compute_annual is the 'dc' method; for {options.method!r} use "
                           "radtree.annual.methods.compute")
@@ -461,7 +475,7 @@ def write_annual(result: AnnualResult, figures: bool = True) -> AnnualOutcome:
                     "description": result.weather.description},
         "scenarios": result.scenarios,
         "leaf_on": o.leaf.leaf_on, "leaf_off": o.leaf.leaf_off,
-        "leaf_days": o.leaf.leaf_days(),
+        "leaf_days": o.leaf.leaf_days(), "leaf_source": o.leaf.source,
         "occupancy": list(o.occupancy), "occupied_hours": int(result.occupied.sum()),
         "sky_mf": o.mf, "sun_mf": o.sun_mf, "method": o.method,
         "rcontrib": {"ab": result.trace.ab, "ad": result.trace.ad, "lw": result.trace.lw,

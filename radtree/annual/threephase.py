@@ -77,6 +77,7 @@ from radtree.annual.run import (
     annual_scenes,
     choose_scenarios,
     scene_year_lux,
+    with_season,
 )
 from radtree.annual.schedule import occupied
 from radtree.annual.skymatrix import (
@@ -390,6 +391,7 @@ def compute_annual_3phase(project: Project, options: AnnualOptions,
     """The annual run of :func:`radtree.annual.run.compute_annual` by the three-phase method
     (module text); the same :class:`AnnualResult`, variants ``leaf_on``/``leaf_off`` from the
     crown BSDFs, ``without`` as the default method."""
+    options = with_season(project, options)
     timing: dict[str, float] = {}
     t0 = time.perf_counter()
     with_sc, without_sc, notes = choose_scenarios(project, options)

@@ -39,6 +39,7 @@ COMMANDS = {
     "method": "radtree.cli.method:method_command",
     "export": "radtree.cli.export:export_command",
     "cache": "radtree.cli.cache:cache_command",
+    "lidar": "radtree.cli.lidar:lidar_command",
 }
 
 

@@ -6,22 +6,19 @@ from pathlib import Path
 
 import click
 
-from radtree.annual.schedule import (
-    DEFAULT_LEAF_OFF,
-    DEFAULT_LEAF_ON,
-    LeafSchedule,
-    parse_occupancy,
-)
+from radtree.annual.schedule import leaf_season, parse_occupancy
 from radtree.cli.options import CONTEXT, writes
 
 
 @click.command("annual", context_settings=CONTEXT)
 @writes("results")
 @click.argument("project", type=click.Path(exists=True, path_type=Path))
-@click.option("--leaf-on", default=DEFAULT_LEAF_ON, show_default=True, metavar="MM-DD",
-              help="First day the crown is in leaf (Morus alba in Mendoza: an assumption).")
-@click.option("--leaf-off", default=DEFAULT_LEAF_OFF, show_default=True, metavar="MM-DD",
-              help="First day the crown is bare (branches only).")
+@click.option("--leaf-on", metavar="MM-DD",
+              help="First day the crown is in leaf. Default: [tree] leaf_on, else the "
+                   "species' phenology in the site's hemisphere (between the tropics the "
+                   "species must be evergreen or the dates given).")
+@click.option("--leaf-off", metavar="MM-DD",
+              help="First day the crown is bare (branches only); with --leaf-on.")
 @click.option("--mf", default=1, show_default=True, type=click.IntRange(1, 8),
               help="Reinhart sky subdivision (1 = 145 patches + ground).")
 @click.option("--sun-mf", default=1, show_default=True, type=click.IntRange(1, 8),
@@ -59,7 +56,8 @@ from radtree.cli.options import CONTEXT, writes
                    "slats, as the dc method does) or through the BSDF crown.")
 @click.option("--sunlight-date", default="03-21", show_default=True, metavar="MM-DD",
               help="EN 17037 exposure to sunlight: the date (1 February – 21 March).")
-def annual_command(project: Path, leaf_on: str, leaf_off: str, mf: int, sun_mf: int,
+def annual_command(project: Path, leaf_on: str | None, leaf_off: str | None, mf: int,
+                   sun_mf: int,
                    occupancy: str, epw: Path | None, with_scenario: str | None,
                    without_scenario: str | None, ab: int | None, ad: int | None,
                    lw: float | None, processes: int, no_figures: bool,
@@ -82,13 +80,13 @@ def annual_command(project: Path, leaf_on: str, leaf_off: str, mf: int, sun_mf: 
 
     proj = load_project(project)
     options = AnnualOptions(
-        leaf=LeafSchedule(leaf_on, leaf_off), mf=mf, sun_mf=sun_mf,
+        leaf=leaf_season(proj, leaf_on, leaf_off), mf=mf, sun_mf=sun_mf,
         occupancy=parse_occupancy(occupancy), ab=ab, ad=ad, lw=lw, sun_ad=sun_ad,
         sun_lw=sun_lw, nproc=processes,
         with_scenario=with_scenario, without_scenario=without_scenario, epw=epw,
         species_phenology=not use_dates, method=method, sun_crown=sun_crown,
         sunlight_date=sunlight_date)
-    click.echo(f"annual: {proj.name}")
+    click.echo(f"annual: {proj.name}; leaf season {options.leaf.describe()}")
     out = run_annual(proj, options, echo=click.echo, progress=True,
                      figures=not no_figures)
     from radtree.annual.report import grid_summary

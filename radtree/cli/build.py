@@ -37,9 +37,11 @@ def build_command(project: str, scenarios: tuple[str, ...], no_pictures: bool, f
     """
     from radtree.config import load_project
     from radtree.pipeline.build import build_project
+    from radtree.pipeline.inputs import check_inputs
 
     t = time.perf_counter()
     p = load_project(project)
+    check_inputs(p)
     click.echo(f"building {p.name} ({len(p.scenarios)} scenarios, {len(p.site.hours)} hours)")
     build_project(p, list(scenarios) or None, echo=click.echo, pictures=not no_pictures,
                   fresh=fresh, workers=workers)

@@ -69,6 +69,11 @@ def simulate_command(project: str, scenarios: tuple[str, ...], engine: str,
         click.echo("building façade means (lux):")
         click.echo(out.table.groupby(["scenario", "time"])["lux"].mean().unstack("time")
                    .round(0).to_string())
+    elif out.table["grid"].astype(str).str.startswith("facade@").any():   # [sensors] heights_m
+        click.echo("façade sensor means per height (lux):")
+        levels = out.table[out.table["grid"].astype(str).str.startswith("facade@")]
+        click.echo(levels.groupby(["scenario", "grid"], sort=False)["lux"].mean()
+                   .unstack("grid").round(0).to_string())
     else:
         click.echo("façade sensor means (lux):")
         click.echo(facade_means(out.table).round(0).to_string())

@@ -23,7 +23,10 @@ Keys of the ``[site]`` table (read here, hooked into :mod:`radtree.config.reader
   are built in place), ``"never"`` (every crown in place).
 
 The street canyon generator (``[street]``) stays for the simple case; with ``trees`` but no
-``buildings`` the inventory's crowns stand in that canyon instead of the ``[tree.crown]`` row.
+``buildings`` the inventory's crowns stand in that canyon instead of the ``[tree.crown]`` row,
+its façade where ``[street] facade_line`` says, else placed behind the trees
+(:mod:`radtree.site.placement`). A crown reaching a wall follows ``[tree] wall_policy``
+(:mod:`radtree.trees.wall_policy`).
 """
 
 from __future__ import annotations

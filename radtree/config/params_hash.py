@@ -65,6 +65,14 @@ def _project_payload(project: Any) -> dict[str, Any]:
     for key, default in (("representation", "explicit"), ("bsdf", plain(type(project.tree.bsdf)()))):
         if payload["tree"].get(key) == default:   # BSDF settings unused: hashes unchanged
             payload["tree"].pop(key, None)
+    from radtree.config.timezone import fixed_name
+
+    if payload["site"].get("time_zone") == fixed_name(project.site.utc_offset_hours):
+        payload["site"].pop("time_zone", None)   # a fixed offset: as before time zones
+    if payload["light"].get("weather") in ("table", "epw"):
+        payload["light"].pop("weather", None)    # inferred from the file: as before
+    for key in ("leaf_on", "leaf_off", "accept_poor_fit"):   # change no traced hour
+        payload["tree"].pop(key, None)
     if project.district is not None:   # inventory inputs: relative path + content (_file_key)
         payload["district"] = d["district"]
     return payload

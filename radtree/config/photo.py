@@ -43,6 +43,9 @@ def photo_fields() -> dict[str, Any]:
         "photo_distance_m": field(default=3.0, metadata=meta(0.0, lo_open=True)),
         "photo_height_m": field(default=1.5, metadata=meta(0.0)),
         "photo_zenith_deg": field(default=90.0, metadata=meta(10.0, 90.0)),
+        # build a crown whose fit to the photo is poor (ring RMS > 0.05 or a parameter at
+        # its bound) instead of stopping; the report says so on its first page
+        "accept_poor_fit": field(default=False),
     }
 
 
@@ -62,7 +65,7 @@ def photo_of(tree: Any) -> tuple[Path | None, str, tuple[float, float, float] | 
 ADDED_DEFAULTS: dict[str, dict[str, Any]] = {
     "": {"photo": None, "lens": "equidistant", "mask": None, "photo_direction": "facade",
          "photo_x_m": 2.0, "photo_distance_m": 3.0, "photo_height_m": 1.5,
-         "photo_zenith_deg": 90.0},
+         "photo_zenith_deg": 90.0, "accept_poor_fit": False},
     "perforated": {"seed": 1, "realisations": 1},
     "louvers": {"inclination_distribution": "fixed", "ellipsoid_x": 1.0, **CLUMPING_DEFAULTS},
 }

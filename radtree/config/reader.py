@@ -9,7 +9,7 @@ paths are resolved against the project folder.
 from __future__ import annotations
 
 import re
-from dataclasses import fields
+from dataclasses import fields, replace
 from pathlib import Path
 from typing import Any
 
@@ -20,6 +20,7 @@ from radtree.config.honeybee import read_honeybee
 from radtree.config.schema import Project, Scenario, Site, Street, parse_time
 from radtree.config.spec import SchemaError, Spec, spec_for, spec_of, toml_name
 from radtree.config.species import find_species, tree_defaults, unknown_species_message
+from radtree.config.timezone import site_time_zone, standard_offset_hours
 from radtree.config.switches import (
     FIELD,
     TABLES,
@@ -181,11 +182,19 @@ def parse_project(data: dict, path: Path) -> Project:
     hours = tuple(parse_time(h, f"site.hours[{i}]", src) for i, h in enumerate(hours_raw))
     if len(set(hours)) != len(hours):
         raise s.error("hours", "hours repeat")
+    lat = s.value("latitude", spec_for(Site, "latitude"), required=True)
+    # left out: the summer solstice of the site's hemisphere
+    date = s.value("date", spec_for(Site, "date"), "2024-06-21" if lat >= 0 else "2024-12-21")
+    zone, _fixed = site_time_zone(
+        s.value("time_zone", Spec("str", optional=True), None),
+        s.value("utc_offset_hours", replace(spec_for(Site, "utc_offset_hours"), optional=True),
+                None), source=src)
     site = _table(s, "site", base, hours=hours, name=s.value("name", Spec("str"), name),
                   elevation_m=s.value("elevation_m", spec_for(Site, "elevation_m"), 0.0),
-                  date=s.value("date", spec_for(Site, "date"), "2024-12-22"),
+                  date=date, time_zone=zone,
+                  utc_offset_hours=standard_offset_hours(zone, date),
                   **{k: s.value(k, spec_for(Site, k), required=True)
-                     for k in ("latitude", "longitude", "utc_offset_hours")})
+                     for k in ("latitude", "longitude")})
 
     st = top.sub("street")
     g = st.raw("ground_reflectance")
@@ -197,9 +206,6 @@ def parse_project(data: dict, path: Path) -> Project:
 
     li = top.sub("light")
     light = _table(li, "light", base)
-    if light.direct_normal_table is None and light.epw is None:
-        raise li.error("direct_normal", "missing: give a DNI table (time,direct_normal_lux) "
-                       "or an 'epw' weather file")
 
     tr = top.sub("tree")
     filled = species_fill(tr)

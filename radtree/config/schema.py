@@ -6,8 +6,11 @@ as local clock ``HH:MM``. Bounds, choices and TOML names are field metadata (:fu
 
 from __future__ import annotations
 
+import math
+import re
 from collections.abc import Callable
 from dataclasses import dataclass, field
+from datetime import tzinfo
 from pathlib import Path
 from typing import Any, ClassVar
 
@@ -27,6 +30,9 @@ _PHOTO = photo_fields()
 _CLUMPING = clumping_fields()
 REFLECTION_MODES = ("traced", "calculated")
 SKY_CHOICES = ("none", "perez")
+#: where the hours' direct normal and diffuse illuminance come from (:class:`Light`)
+WEATHER_CHOICES = ("clear-sky", "epw", "table")
+WALL_POLICIES = ("clip", "refuse")    # a crown reaching a wall (radtree.trees.wall_policy)
 SAMPLING_CHOICES = ("sobol", "random")  # NumPy engine's first directions (engines/numpy/qmc)
 #: Presets of the louvers slat optics (the switch ``"louvers.reading"``): the study's reading
 #: (every layer fully covered, T 0.5 in the slat) and near-opaque leaves with open gaps.
@@ -44,19 +50,51 @@ def _fraction(default: float) -> Any:
     return field(default=default, metadata=meta(0.0, 1.0))
 
 
+def line_azimuth(line: tuple[tuple[float, float], tuple[float, float]]) -> float:
+    """Compass azimuth (degrees clockwise from north, 0–360) a façade along ``line`` looks
+    towards: to the right of x1 → x2 (x east, y north)."""
+    (x1, y1), (x2, y2) = line
+    return math.degrees(math.atan2(y2 - y1, -(x2 - x1))) % 360.0
+
+
 # ---------------------------------------------------------------- dataclasses
 @dataclass(frozen=True)
 class Site(Checked):
-    """Place and times: latitude north +, longitude east + (west negative), UTC offset hours."""
+    """Place and times: latitude north +, longitude east + (west negative), elevation m.
+
+    ``time_zone``: an IANA name (``"Europe/Madrid"``: daylight saving applied) or a fixed
+    offset (``"UTC+1"``); ``hours`` are local civil clock times on ``date``
+    (:mod:`radtree.config.timezone`). ``utc_offset_hours`` is the zone's *standard-time*
+    offset on ``date`` (the time base of EPW files), derived from ``time_zone``; a file may
+    give it instead of ``time_zone`` (a fixed offset).
+    """
 
     TABLE: ClassVar[str] = "site"
     name: str
     latitude: float = field(metadata=meta(-90, 90))
     longitude: float = field(metadata=meta(-180, 180))
     elevation_m: float = field(metadata=meta(-500, 9000))
-    utc_offset_hours: float = field(metadata=meta(-14, 14))
+    utc_offset_hours: float = field(metadata=meta(-14, 14, switch=False))
     date: str = field(metadata=meta(kind="date"))
     hours: tuple[str, ...] = field(metadata=meta(kind="times", switch=False))
+    time_zone: str = field(default="", metadata=meta(switch=False))
+
+    def check(self) -> None:
+        from radtree.config.timezone import fixed_name, parse_time_zone
+
+        if not self.time_zone:
+            object.__setattr__(self, "time_zone", fixed_name(self.utc_offset_hours))
+        try:
+            parse_time_zone(self.time_zone)
+        except ValueError as exc:
+            raise self.fail("time_zone", str(exc)) from None
+
+    @property
+    def tzinfo(self) -> tzinfo:
+        """The zone of the site's clock times (daylight saving applied for IANA names)."""
+        from radtree.config.timezone import parse_time_zone
+
+        return parse_time_zone(self.time_zone)
 
 
 @dataclass(frozen=True)
@@ -79,14 +117,37 @@ class Street(Checked):
     opposite_reflectance: float = _fraction(0.35)
     ground_reflectance: float = field(default=0.15, metadata=meta(0.0, 1.0, path_ok=True))
     ground_reflectance_table: Path | None = field(default=None, metadata=meta(kind="-"))
+    #: where the studied façade stands, [[x1, y1], [x2, y2]] in the site frame (m, x east,
+    #: y north; the façade looks to the right of x1 → x2, radtree.site.placement); None: the
+    #: façade plane passes through the site origin (hand-written projects) or, with an
+    #: inventory, it is placed by radtree.site.placement
+    facade_line: tuple[tuple[float, float], tuple[float, float]] | None = field(
+        default=None, metadata=meta(kind="line", switch=False))
+
+    def check(self) -> None:
+        if self.facade_line is None:
+            return
+        az = line_azimuth(self.facade_line)
+        given = self.facade_azimuth_deg
+        if given != 0.0 and abs((given - az + 180.0) % 360.0 - 180.0) > 1.0:
+            raise self.fail("facade_azimuth_deg", f"got {given:g}°, but facade_line "
+                            f"{[list(p) for p in self.facade_line]} looks {az:.1f}° (to the "
+                            "right of its first point → second): leave facade_azimuth_deg "
+                            "out, or list the line's points the other way round")
+        object.__setattr__(self, "facade_azimuth_deg", az)   # the line's: one orientation
 
 
 @dataclass(frozen=True)
 class Light(Checked):
-    """Sun and sky inputs: a DNI table (``time,direct_normal_lux``) or an EPW file.
+    """Sun and sky inputs: where each hour's direct normal and diffuse illuminance come from.
 
-    ``sky``: ``none`` = sun only (the study's set-up) or ``perez`` = clear-sky Perez sky of
-    ``diffuse_horizontal_lux`` (a stated substitute: the study gives no diffuse values).
+    ``weather``: ``clear-sky`` (no file: pvlib's Ineichen–Perez clear sky with pvlib's Linke
+    turbidity climatology at the site, Perez et al. 1990 luminous efficacy →
+    :mod:`radtree.light.clearsky`), ``epw`` (a weather file, ``epw``; checked against
+    ``[site]``) or ``table`` (a DNI table ``time,direct_normal_lux`` in lux, ``direct_normal``).
+    Left out: ``epw`` when an EPW is given, ``table`` when a DNI table is, else ``clear-sky``.
+    ``sky``: ``none`` = sun only, or ``perez`` = Perez sky of the hour's diffuse horizontal
+    illuminance (from the weather; a DNI table gives none, then ``diffuse_horizontal_lux``).
     """
 
     TABLE: ClassVar[str] = "light"
@@ -95,11 +156,30 @@ class Light(Checked):
     epw: Path | None = field(default=None, metadata=meta(switch=False))
     sky: str = field(default="none", metadata=meta(choices=SKY_CHOICES))
     diffuse_horizontal_lux: float = field(default=12000.0, metadata=meta(0.0, 150000.0))
+    weather: str = field(default="", metadata=meta(choices=("", ) + WEATHER_CHOICES,
+                                                   switch=False))
+
+    def check(self) -> None:
+        given = {"epw": self.epw is not None, "table": self.direct_normal_table is not None}
+        if given["epw"] and given["table"]:
+            raise self.fail("epw", "both an EPW and a DNI table (direct_normal) are given: "
+                            "keep one")
+        inferred = "epw" if given["epw"] else "table" if given["table"] else "clear-sky"
+        if not self.weather:
+            object.__setattr__(self, "weather", inferred)
+        elif self.weather == "clear-sky" and inferred != "clear-sky":
+            raise self.fail("weather", f"weather = 'clear-sky' needs no file, but "
+                            f"{'epw' if given['epw'] else 'direct_normal'} is given: delete "
+                            "one of the two")
+        elif self.weather in ("epw", "table") and not given[self.weather]:
+            key = "epw" if self.weather == "epw" else "direct_normal"
+            raise self.fail("weather", f"weather = {self.weather!r} needs {key} = \"…\" "
+                            "(or use weather = 'clear-sky')")
 
 
 @dataclass(frozen=True)
 class Dome(Checked):
-    """Study form: hemisphere of ``radius_m`` centred on the sensor grid, flat side on the wall."""
+    """Dome form: a hemisphere of ``radius_m`` centred on the sensor grid, flat side on the wall."""
 
     TABLE: ClassVar[str] = "tree.dome"
     radius_m: float = _positive(4.0)
@@ -235,8 +315,26 @@ class Tree(Checked):
     photo_distance_m: float = _PHOTO["photo_distance_m"]
     photo_height_m: float = _PHOTO["photo_height_m"]
     photo_zenith_deg: float = _PHOTO["photo_zenith_deg"]
+    accept_poor_fit: bool = _PHOTO["accept_poor_fit"]
     representation: str = field(default="explicit", metadata=meta(choices=REPRESENTATIONS))
     bsdf: CrownBsdf = field(default_factory=CrownBsdf)
+    #: the leaf season (``MM-DD``) of annual runs and exports, both or neither: when left out
+    #: it comes from the species' phenology and the site's hemisphere (radtree.annual.schedule)
+    leaf_on: str | None = field(default=None, metadata=meta(switch=False))
+    leaf_off: str | None = field(default=None, metadata=meta(switch=False))
+    #: a crown reaching a wall: ``clip`` it at the wall (a note gives the crown volume removed,
+    #: % per tree) or ``refuse`` (ConfigError with the trunk move or crown radius that fits);
+    #: the same in row, inventory and Honeybee projects (radtree.trees.wall_policy)
+    wall_policy: str = field(default="clip", metadata=meta(choices=WALL_POLICIES))
+
+    def check(self) -> None:
+        if (self.leaf_on is None) != (self.leaf_off is None):
+            raise self.fail("leaf_on" if self.leaf_on is None else "leaf_off",
+                            "give both leaf_on and leaf_off (MM-DD), or neither")
+        for name in ("leaf_on", "leaf_off"):
+            v = getattr(self, name)
+            if v is not None and not re.match(r"^(0[1-9]|1[0-2])-(0[1-9]|[12]\d|3[01])$", v):
+                raise self.fail(name, f"got {v!r}, expected MM-DD such as '04-15'")
 
 
 @dataclass(frozen=True)
@@ -244,7 +342,15 @@ class Sensors(Checked):
     """The façade sensor circle: ``count`` points at equal angle steps on a ``radius_m`` circle
     centred ``height_m`` above the street and ``offset_m`` off the wall, normal out of the wall.
     Rows by height: top third ``higher``, middle ``intermediate``, bottom ``lower``. The dense
-    façade map grid (``dense_*``) is traced at ``dense_hours`` only (empty = every hour)."""
+    façade map grid (``dense_*``) is traced at ``dense_hours`` only (empty = every hour).
+
+    ``heights_m`` (a list, e.g. ``[1.5, 4.5, 7.5]``: one circle, and one dense map, per
+    storey) replaces ``height_m`` when given; each height is checked like ``height_m``. With
+    two or more heights the grids are named ``facade@<h>m`` / ``facade_map@<h>m`` (``h`` as
+    written, e.g. ``facade@4.5m``) and every sensor carries its ``storey``: the height's index
+    in the list (write the list from the ground up: storey 0 = the lowest). ``height_m`` still
+    places what needs one point (the sensor dome, the crown photo's camera, the wall cap's
+    sensor point) and picks the circle the report compares (the nearest height)."""
 
     TABLE: ClassVar[str] = "sensors"
     height_m: float = _positive(5.0)
@@ -256,19 +362,33 @@ class Sensors(Checked):
     dense_size_m: float = _positive(6.0)
     dense_spacing_m: float = _positive(0.5)
     dense_hours: tuple[str, ...] = field(default=(), metadata=meta(kind="times", switch=False))
+    heights_m: tuple[float, ...] | None = field(default=None, metadata=meta(
+        0.0, lo_open=True, kind="numbers", switch=False))
+
+    def check(self) -> None:
+        if self.heights_m is not None and len(set(self.heights_m)) != len(self.heights_m):
+            raise self.fail("heights_m", f"got {list(self.heights_m)}: a height is given twice")
+
+    @property
+    def levels(self) -> tuple[float, ...]:
+        """The circles' centre heights above the street (m): ``heights_m``, else ``height_m``."""
+        return tuple(self.heights_m) if self.heights_m else (self.height_m,)
 
 
 @dataclass(frozen=True)
 class Office(Checked):
     """A block of offices in the studied façade (the building application, SPEC.md §5).
 
-    ``bays`` × ``storeys`` identical offices (both odd: a central office exists), each
-    ``width_m`` wide, ``height_m`` high (floor to ceiling) and ``depth_m`` deep, with a glazed
-    façade towards the street. Storey ``k`` (0 = ground) has its floor at ``ground_floor_m +
-    k·storey_height_m``. The glazing's measured normal transmittance ``glazing_transmittance``
-    becomes a Radiance ``glass`` transmissivity; ``frame_fraction`` of each façade opening is
-    opaque frame. Results are read in the central office. Work plane at
-    ``workplane_height_m``, grids at ``grid_spacing_m`` spacing, ``wall_offset_m`` from the walls.
+    ``bays`` × ``storeys`` identical offices (any counts, even too), each ``width_m`` wide,
+    ``height_m`` high (floor to ceiling) and ``depth_m`` deep, with a glazed façade towards
+    the street; the block is centred on ``sensors.x_m``. Storey ``k`` (0 = ground) has its
+    floor at ``ground_floor_m + k·storey_height_m``. The glazing's measured normal
+    transmittance ``glazing_transmittance`` becomes a Radiance ``glass`` transmissivity;
+    ``frame_fraction`` of each façade opening is opaque frame. Results are read in the
+    ``rooms``: ``"all"`` (default) or a list of ``"STOREY-BAY"`` names — storey 0 = the ground
+    floor (lowest), bay 0 = the leftmost office seen from the street (smallest u), e.g.
+    ``["0-1", "1-1"]``. Work plane at ``workplane_height_m``, grids at ``grid_spacing_m``
+    spacing, ``wall_offset_m`` from the walls.
     """
 
     TABLE: ClassVar[str] = "office"
@@ -290,13 +410,26 @@ class Office(Checked):
     grid_spacing_m: float = _positive(0.5)
     wall_offset_m: float = 0.5
     facade_grid_spacing_m: float = _positive(0.5)
+    rooms: str | tuple[str, ...] = field(default="all", metadata=meta(kind="rooms",
+                                                                       switch=False))
 
     def check(self) -> None:
-        if self.bays % 2 == 0 or self.storeys % 2 == 0:
-            raise self.fail("bays", "bays and storeys must be odd so that a central office exists")
+        for name in self.room_names:
+            k, j = (int(v) for v in name.split("-"))
+            if k >= self.storeys or j >= self.bays:
+                raise self.fail("rooms", f"got room {name!r}: the block has storeys 0–"
+                                f"{self.storeys - 1} and bays 0–{self.bays - 1} ('STOREY-BAY', "
+                                "storey 0 = ground floor)")
         if self.height_m > self.storey_height_m:
             raise self.fail("height_m", f"office height {self.height_m} m exceeds the storey "
                             f"height {self.storey_height_m} m")
+
+    @property
+    def room_names(self) -> tuple[str, ...]:
+        """The sensed rooms ``"STOREY-BAY"``, storey by storey from the ground, bay by bay."""
+        if self.rooms == "all":
+            return tuple(f"{k}-{j}" for k in range(self.storeys) for j in range(self.bays))
+        return tuple(self.rooms)
 
 
 @dataclass(frozen=True)

@@ -47,7 +47,9 @@ def _g(x: float) -> str:
 @dataclass(frozen=True)
 class Spec:
     """What one value may be. ``kind``: ``float`` | ``int`` | ``bool`` | ``str`` | ``path`` |
-    ``times`` (a list of ``HH:MM``) | ``date`` (``YYYY-MM-DD``) | ``mask`` ([cx, cy, r] px).
+    ``times`` (a list of ``HH:MM``) | ``date`` (``YYYY-MM-DD``) | ``mask`` ([cx, cy, r] px) |
+    ``numbers`` (a non-empty list of numbers, each within the bounds) | ``rooms`` (``"all"`` or
+    a list of ``"STOREY-BAY"`` names such as ``"0-1"``) | ``line`` ([[x1, y1], [x2, y2]], m).
     ``optional``: None is a value; ``path_ok``: a file path is accepted too (in the file)."""
 
     kind: str
@@ -63,7 +65,9 @@ class Spec:
         """What is expected, in words (for lists of keys and messages)."""
         words = {"float": "a number", "int": "an integer", "bool": "true or false",
                  "str": "text", "path": "a file path", "times": "a list of 'HH:MM' times",
-                 "date": "a date YYYY-MM-DD", "mask": "[centre_x, centre_y, radius] in pixels"}
+                 "date": "a date YYYY-MM-DD", "mask": "[centre_x, centre_y, radius] in pixels",
+                 "numbers": "a list of numbers", "rooms": "'all' or a list of 'STOREY-BAY' "
+                 "names such as '0-1'", "line": "[[x1, y1], [x2, y2]] in metres"}
         text = words[self.kind]
         if self.choices:
             text = "one of " + ", ".join(self.choices)
@@ -135,6 +139,15 @@ class Spec:
                 raise ValueError(f"expected [centre_x, centre_y, radius] in pixels, got "
                                  f"{show(value)}")
             return (float(value[0]), float(value[1]), float(value[2]))
+        if k == "numbers":
+            if not isinstance(value, list | tuple) or not value:
+                raise ValueError(f"expected a non-empty list of numbers, got {show(value)}")
+            return tuple(Spec("float", self.lo, self.hi, self.lo_open,
+                              hi_open=self.hi_open).check(v) for v in value)
+        if k == "rooms":
+            return _rooms(value)
+        if k == "line":
+            return _line(value)
         raise ValueError(f"cannot check a value of kind {k!r}")  # pragma: no cover
 
     def _path(self, value: Any) -> Any:
@@ -149,6 +162,39 @@ class Spec:
         if hi is not None and (value > hi or (self.hi_open and value >= hi)):
             raise ValueError(f"got {value}, expected {'<' if self.hi_open else '≤'} {_g(hi)}")
         return value
+
+
+ROOM_RE = re.compile(r"^(\d+)-(\d+)$")
+
+
+def _rooms(value: Any) -> Any:
+    """``"all"`` or a tuple of distinct ``"STOREY-BAY"`` names (ranges: the office's check)."""
+    if value == "all":
+        return value
+    if not isinstance(value, list | tuple) or not value:
+        raise ValueError(f"expected 'all' or a list of 'STOREY-BAY' names such as ['0-1', "
+                         f"'1-1'], got {show(value)}")
+    for v in value:
+        if not isinstance(v, str) or not ROOM_RE.match(v):
+            raise ValueError(f"got room {show(v)}, expected 'STOREY-BAY' such as '0-1' "
+                             "(storey 0 = ground floor, bay 0 = leftmost seen from the street)")
+    if len(set(value)) != len(value):
+        raise ValueError(f"got {show(list(value))}: a room is named twice")
+    return tuple(value)
+
+
+def _line(value: Any) -> tuple[tuple[float, float], tuple[float, float]]:
+    """Two distinct points [[x1, y1], [x2, y2]] (m)."""
+    ok = (isinstance(value, list | tuple) and len(value) == 2 and all(
+        isinstance(p, list | tuple) and len(p) == 2 and all(
+            isinstance(c, int | float) and not isinstance(c, bool) and math.isfinite(c)
+            for c in p) for p in value))
+    if not ok:
+        raise ValueError(f"expected [[x1, y1], [x2, y2]] in metres, got {show(value)}")
+    (x1, y1), (x2, y2) = value
+    if math.hypot(x2 - x1, y2 - y1) < 1e-6:
+        raise ValueError(f"got {show(value)}: the two points coincide")
+    return ((float(x1), float(y1)), (float(x2), float(y2)))
 
 
 def meta(lo: float | None = None, hi: float | None = None, *, lo_open: bool = False,

@@ -91,6 +91,9 @@ class Species:
     leaf_fall_start_doy: float
     leaf_fall_end_doy: float
     southern_shift_days: float = SOUTHERN_SHIFT_DAYS
+    #: between the tropics: "evergreen" (in leaf all year) or "" (not stated: the user gives
+    #: the leaf season); optional in the library files
+    tropical_phenology: str = ""
     sources: dict[str, str] = field(default_factory=dict, compare=False, hash=False)
     origin: str = field(default="", compare=False)   # the file it was read from
 
@@ -103,7 +106,7 @@ class Species:
             raise self._fail("key", f"got {self.key!r}: use lower-case letters, digits and _")
         for f in fields(self):
             if f.name in ("key", "name", "common_name", "leaf_angle_distribution",
-                          "crown_shape", "sources", "origin"):
+                          "crown_shape", "sources", "origin", "tropical_phenology"):
                 continue
             v = getattr(self, f.name)
             if isinstance(v, bool) or not isinstance(v, int | float) or math.isnan(v):
@@ -141,11 +144,15 @@ class Species:
             raise self._fail("leaf_out_doy", "expected 1 ≤ leaf_out_doy < full_leaf_doy ≤ "
                              "leaf_fall_start_doy < leaf_fall_end_doy ≤ 365 (northern "
                              f"hemisphere days of the year), got {days}")
+        if self.tropical_phenology not in ("", "evergreen"):
+            raise self._fail("tropical_phenology", f"got {self.tropical_phenology!r}, "
+                             "expected \"evergreen\" or leave it out")
         if not 0 <= self.southern_shift_days < DAYS:
             raise self._fail("southern_shift_days", f"got {self.southern_shift_days}, "
                              "expected 0 … 364")
         missing = [f.name for f in fields(self) if f.name not in (
-            "key", "name", "common_name", "sources", "origin", "southern_shift_days")
+            "key", "name", "common_name", "sources", "origin", "southern_shift_days",
+            "tropical_phenology")
             and f.name not in self.sources]
         if missing:
             raise self._fail(missing[0], "no source given (a citation or 'documented "
@@ -222,7 +229,7 @@ def parse_species(data: dict[str, Any], origin: str = "") -> Species:
         if f.name in ("sources", "origin"):
             continue
         if f.name not in data:
-            if f.name == "southern_shift_days":
+            if f.name in ("southern_shift_days", "tropical_phenology"):
                 continue
             raise ConfigError("missing", source=origin or None, field=f.name)
         raw = data[f.name]

@@ -300,7 +300,7 @@ class HourlyGroundReflectance(Effect):
         site = ctx.project.site
         values = []
         for h in site.hours:
-            sun = sun_position(local_datetime(site.date, h, site.utc_offset_hours),
+            sun = sun_position(local_datetime(site.date, h, site.tzinfo),
                                site.latitude, site.longitude, site.elevation_m)
             values.append(ground_reflectance_at(ctx.project, sun.altitude_deg))
         return round(float(sum(values) / len(values)), 4)

@@ -229,17 +229,11 @@ def year_schedules(project: Project, scenario: Scenario, frame: FacadeFrame, ray
 
 
 def default_leaf_schedule(project: Project, leaf_on: str | None, leaf_off: str | None):
-    """The leaf season: given dates, else the Mendoza mulberry dates of
-    :mod:`radtree.annual.schedule` (southern hemisphere), shifted by half a year north of the
-    equator (an assumption, stated in the export's notes)."""
-    from radtree.annual.schedule import DEFAULT_LEAF_OFF, DEFAULT_LEAF_ON, LeafSchedule
+    """The leaf season: the given dates, else the project's
+    (:func:`radtree.annual.schedule.leaf_season`: ``[tree] leaf_on/leaf_off`` or the species'
+    phenology in the site's hemisphere)."""
+    from radtree.annual.schedule import leaf_season
 
-    on, off = DEFAULT_LEAF_ON, DEFAULT_LEAF_OFF
-    if project.site.latitude >= 0:
-        on, off = (_shift_half_year(on), _shift_half_year(off))
-    return LeafSchedule(leaf_on or on, leaf_off or off)
+    return leaf_season(project, leaf_on, leaf_off)
 
 
-def _shift_half_year(mmdd: str) -> str:
-    d = date(2023, int(mmdd[:2]), int(mmdd[3:])) + timedelta(days=182)
-    return f"{d.month:02d}-{d.day:02d}"

@@ -48,41 +48,57 @@ _MISSING = {6: "99.9", 7: "99.9", 8: "999", 12: "9999", 19: "9999", 20: "999", 2
             30: "999", 31: "99", 32: "999", 33: "999", 34: "99"}
 
 
+def clear_sky_illuminance(times: pd.DatetimeIndex, latitude: float, longitude: float,
+                          elevation_m: float) -> pd.DataFrame:
+    """Clear-sky irradiance and illuminance at the time-zone-aware instants ``times``.
+
+    Columns: zenith (apparent, degrees), ghi, dni, dhi (W/m²), ghi_lux, dni_lux, dhi_lux (lux),
+    etrn (extraterrestrial normal irradiance, W/m²); zero with the sun below the horizon. The
+    model is the module text's: Ineichen–Perez with pvlib's Linke turbidity climatology, Perez
+    (1990) luminous efficacy for the direct and the diffuse part.
+    """
+    import pvlib
+
+    sp = pvlib.solarposition.get_solarposition(times, latitude, longitude, altitude=elevation_m)
+    am_rel = pvlib.atmosphere.get_relative_airmass(sp["apparent_zenith"])
+    am_abs = pvlib.atmosphere.get_absolute_airmass(am_rel,
+                                                   pvlib.atmosphere.alt2pres(elevation_m))
+    linke = pvlib.clearsky.lookup_linke_turbidity(times, latitude, longitude)
+    etrn = pvlib.irradiance.get_extra_radiation(times)
+    cs = pvlib.clearsky.ineichen(sp["apparent_zenith"], am_abs, linke, altitude=elevation_m,
+                                 dni_extra=etrn)
+    zen = sp["apparent_zenith"].to_numpy()
+    up = zen < 90.0
+    ghi = np.where(up, np.nan_to_num(cs["ghi"].to_numpy()), 0.0)
+    dni = np.where(up, np.nan_to_num(cs["dni"].to_numpy()), 0.0)
+    dhi = np.where(up, np.nan_to_num(cs["dhi"].to_numpy()), 0.0)
+    eff_dir, eff_dif = perez_efficacy(dni, dhi, zen, times.day_of_year.to_numpy())
+    dni_lux = dni * eff_dir
+    dhi_lux = dhi * eff_dif
+    ghi_lux = dhi_lux + dni_lux * np.cos(np.radians(np.clip(zen, 0, 90)))
+    return pd.DataFrame({"zenith": zen, "ghi": ghi, "dni": dni, "dhi": dhi,
+                         "ghi_lux": ghi_lux, "dni_lux": dni_lux, "dhi_lux": dhi_lux,
+                         "etrn": np.where(up, etrn.to_numpy(), 0.0)}, index=times)
+
+
 def clear_sky_year(latitude: float, longitude: float, elevation_m: float,
                    utc_offset_hours: float, year: int = YEAR) -> pd.DataFrame:
     """8760 hourly rows of the generated clear-sky year (columns: month, day, hour (EPW hour
     ending), zenith, ghi, dni, dhi (W/m²), ghi_lux, dni_lux, dhi_lux, etr, etrn)."""
-    import pvlib
-
     tz = timezone(timedelta(hours=utc_offset_hours))
     start = pd.Timestamp(year=year, month=1, day=1, hour=0, minute=30, tz=tz)
     mid = pd.date_range(start, periods=8760, freq="h")
     if len(mid) != 8760 or mid[-1].year != year:
         raise ConfigError(f"year {year} is not a 365-day year")
-    sp = pvlib.solarposition.get_solarposition(mid, latitude, longitude, altitude=elevation_m)
-    am_rel = pvlib.atmosphere.get_relative_airmass(sp["apparent_zenith"])
-    am_abs = pvlib.atmosphere.get_absolute_airmass(am_rel,
-                                                   pvlib.atmosphere.alt2pres(elevation_m))
-    linke = pvlib.clearsky.lookup_linke_turbidity(mid, latitude, longitude)
-    cs = pvlib.clearsky.ineichen(sp["apparent_zenith"], am_abs, linke, altitude=elevation_m,
-                                 dni_extra=pvlib.irradiance.get_extra_radiation(mid))
-    zen = sp["apparent_zenith"].to_numpy()
-    up = zen < 90.0
-    ghi = np.where(up, cs["ghi"].to_numpy(), 0.0)
-    dni = np.where(up, cs["dni"].to_numpy(), 0.0)
-    dhi = np.where(up, cs["dhi"].to_numpy(), 0.0)
-    doy = mid.day_of_year.to_numpy()
-    eff_dir, eff_dif = perez_efficacy(dni, dhi, zen, doy)
-    dni_lux = dni * eff_dir
-    dhi_lux = dhi * eff_dif
-    ghi_lux = dhi_lux + dni_lux * np.cos(np.radians(np.clip(zen, 0, 90)))
-    etrn = pvlib.irradiance.get_extra_radiation(mid).to_numpy()
-    etr = np.where(up, etrn * np.cos(np.radians(np.clip(zen, 0, 90))), 0.0)
-    return pd.DataFrame({
-        "month": mid.month, "day": mid.day, "hour": mid.hour + 1, "zenith": zen,
-        "ghi": ghi, "dni": dni, "dhi": dhi, "ghi_lux": ghi_lux, "dni_lux": dni_lux,
-        "dhi_lux": dhi_lux, "etr": etr, "etrn": np.where(up, etrn, 0.0),
-    })
+    cs = clear_sky_illuminance(mid, latitude, longitude, elevation_m)
+    zen = cs["zenith"].to_numpy()
+    etr = cs["etrn"].to_numpy() * np.cos(np.radians(np.clip(zen, 0, 90)))
+    out = cs.reset_index(drop=True)
+    out.insert(0, "hour", mid.hour + 1)
+    out.insert(0, "day", mid.day)
+    out.insert(0, "month", mid.month)
+    out["etr"] = etr
+    return out
 
 
 def epw_text(city: str, latitude: float, longitude: float, elevation_m: float,

@@ -1,7 +1,8 @@
 """The light of each hour of a project: sun position, DNI/DHI, ground reflectance → SkyState.
 
-Inputs: a DNI table (``time,direct_normal_lux`` in lux, '#' comments allowed,
-:mod:`radtree.light.tables`) or an EPW file (:mod:`radtree.light.weather`); the ground
+Inputs (``[light] weather``, :func:`radtree.light.weather.hour_weather`): the clear sky of the
+site at the hour (:mod:`radtree.light.clearsky`), an EPW file checked against ``[site]``, or a DNI
+table (``time,direct_normal_lux`` in lux, :mod:`radtree.light.tables`); the ground
 reflectance is a constant or a table ``angle_deg,reflectance`` against the sun altitude
 (interpolated, clamped at the ends, :func:`radtree.light.ground.ground_reflectance_at`).
 """
@@ -15,8 +16,7 @@ from radtree.errors import ConfigError
 from radtree.light.ground import ground_reflectance_at
 from radtree.light.sky import SkyState
 from radtree.light.sun import local_datetime, sun_position
-from radtree.light.tables import direct_normal_table
-from radtree.light.weather import epw_hour_illuminance
+from radtree.light.weather import hour_weather
 
 
 def hour_states(project: Project, scenario: Scenario | None = None,
@@ -35,21 +35,13 @@ def hour_states(project: Project, scenario: Scenario | None = None,
     if unknown:
         raise ConfigError(f"unknown hour(s) {', '.join(unknown)}; the project has "
                           f"{', '.join(site.hours)}", source=str(project.source), field="site.hours")
-    dhi: dict[str, float] = {}
-    if project.light.direct_normal_table is not None:
-        dni = direct_normal_table(project.light.direct_normal_table)
-    else:
-        both = epw_hour_illuminance(project, wanted)
-        dni = {h: v[0] for h, v in both.items()}
-        dhi = {h: v[1] for h, v in both.items()}
+    weather = hour_weather(project, wanted)
     sky = (scenario.sky if scenario is not None and scenario.sky else project.light.sky)
     calculated = scenario is not None and scenario.reflection == "calculated"
     states = []
     for h in wanted:
-        if h not in dni:
-            raise ConfigError(f"hour {h} has no direct normal illuminance in "
-                              f"{project.light.direct_normal_table}")
-        when = local_datetime(site.date, h, site.utc_offset_hours)
+        w = weather[h]
+        when = local_datetime(site.date, h, site.tzinfo)
         sun = sun_position(when, site.latitude, site.longitude, site.elevation_m)
         if not sun.above_horizon:
             raise ConfigError(f"at {h} on {site.date} the sun is below the horizon "
@@ -57,9 +49,10 @@ def hour_states(project: Project, scenario: Scenario | None = None,
                               source=str(project.source), field="site.hours")
         rho = ground_reflectance_at(project, sun.altitude_deg)
         st = SkyState(
-            time=h, datetime=when, sun=sun, direct_normal_lux=dni[h],
-            diffuse_horizontal_lux=(dhi.get(h, project.light.diffuse_horizontal_lux)
-                                    if sky == "perez" else 0.0),
+            time=h, datetime=when, sun=sun, direct_normal_lux=w.direct_normal_lux,
+            diffuse_horizontal_lux=((project.light.diffuse_horizontal_lux
+                                     if w.diffuse_horizontal_lux is None
+                                     else w.diffuse_horizontal_lux) if sky == "perez" else 0.0),
             sky_model=sky, ground_reflectance=rho, ground_glow=True,
         )
         if calculated:

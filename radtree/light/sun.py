@@ -11,7 +11,7 @@ import functools
 import importlib.util
 import math
 from dataclasses import dataclass
-from datetime import datetime, timedelta, timezone
+from datetime import datetime, timedelta, timezone, tzinfo
 from functools import lru_cache
 from pathlib import Path
 from types import ModuleType
@@ -62,9 +62,12 @@ def compass_to_radiance_azimuth(azimuth_deg: float) -> float:
     return (a + 180.0) % 360.0 - 180.0
 
 
-def local_datetime(date: str, time: str, utc_offset_hours: float) -> datetime:
-    """A timezone-aware local clock datetime from ``YYYY-MM-DD`` and ``HH:MM``."""
-    tz = timezone(timedelta(hours=utc_offset_hours))
+def local_datetime(date: str, time: str, zone: float | tzinfo) -> datetime:
+    """A timezone-aware local civil clock datetime from ``YYYY-MM-DD`` and ``HH:MM``.
+
+    ``zone``: a fixed UTC offset in hours, or a tzinfo (an IANA zone: daylight saving
+    applied, e.g. 09:00 on 21 June in ``Europe/Madrid`` is UTC+2)."""
+    tz = zone if isinstance(zone, tzinfo) else timezone(timedelta(hours=zone))
     return datetime.fromisoformat(f"{date}T{time}").replace(tzinfo=tz)
 
 
@@ -122,3 +125,16 @@ def angular_separation_deg(a: np.ndarray, b: np.ndarray) -> float:
     a = np.asarray(a, float) / np.linalg.norm(a)
     b = np.asarray(b, float) / np.linalg.norm(b)
     return math.degrees(math.acos(float(np.clip(np.dot(a, b), -1.0, 1.0))))
+
+
+def daylight_hours(latitude: float, longitude: float, elevation_m: float, zone: float | tzinfo,
+                   date: str, min_altitude_deg: float = 0.0, step_min: int = 60) -> list[str]:
+    """The local civil clock times ``HH:MM`` of ``date`` (every ``step_min`` minutes from
+    00:00) with the sun's centre (apparent, refraction included) above ``min_altitude_deg``."""
+    out = []
+    for m in range(0, 24 * 60, step_min):
+        t = f"{m // 60:02d}:{m % 60:02d}"
+        sun = sun_position(local_datetime(date, t, zone), latitude, longitude, elevation_m)
+        if sun.altitude_deg > min_altitude_deg:
+            out.append(t)
+    return out

@@ -101,19 +101,118 @@ def read_epw(path: Path) -> Epw:
                generated=generated)
 
 
-def epw_hour_illuminance(project, hours: list[str]) -> dict[str, tuple[float, float]]:
-    """(direct normal, diffuse horizontal) lux per clock time from the project's EPW file."""
-    data = read_epw(project.light.epw).illuminance()
-    d = _date.fromisoformat(project.site.date)
+def epw_location(path: Path) -> tuple[float, float, float, float]:
+    """(latitude, longitude, UTC offset h, elevation m) from an EPW's LOCATION line alone."""
+    try:
+        with open(path, encoding="utf-8", errors="replace") as fh:
+            first = fh.readline().rstrip("\r\n").split(",")
+    except OSError as exc:
+        raise ConfigError(f"cannot read EPW file {path}: {exc}") from exc
+    if first[0] != "LOCATION" or len(first) < 10:
+        raise ConfigError(f"{path} is not an EPW file (no LOCATION header line)")
+    try:
+        return float(first[6]), float(first[7]), float(first[8]), float(first[9])
+    except ValueError:
+        raise ConfigError(f"{path}: malformed LOCATION line (latitude, longitude, time zone, "
+                          f"elevation): {','.join(first[6:10])}") from None
+
+
+def check_epw_site(project, path: Path | None = None) -> None:
+    """The EPW is the site's: latitude and longitude within 0.5°, the same standard time
+    zone; else ConfigError naming both values and the fix."""
+    path = Path(path or project.light.epw)
+    if not path.exists():
+        raise ConfigError(f"EPW file not found: {path}", source=str(project.source),
+                          field="light.epw")
+    lat, lon, tz, elev = epw_location(path)
+    site = project.site
+    fix = ("use an EPW of the site (or [light] weather = \"clear-sky\", which needs no file), "
+           "or correct [site]")
+    if abs(lat - site.latitude) > 0.5 or abs(lon - site.longitude) > 0.5:
+        raise ConfigError(f"the EPW {path.name} is for latitude {lat:g}, longitude {lon:g}, but "
+                          f"[site] is at latitude {site.latitude:g}, longitude "
+                          f"{site.longitude:g} (more than 0.5° apart): {fix}",
+                          source=str(project.source), field="light.epw")
+    if abs(tz - site.utc_offset_hours) > 1e-6:
+        raise ConfigError(f"the EPW {path.name} is in standard time UTC{tz:+g} h, but [site] "
+                          f"time_zone {site.time_zone!r} has standard time "
+                          f"UTC{site.utc_offset_hours:+g} h: {fix}",
+                          source=str(project.source), field="light.epw")
+
+
+@dataclass(frozen=True)
+class HourWeather:
+    """The weather of one project hour: direct normal and diffuse horizontal illuminance
+    (lux; diffuse None when the source has none) and where they came from."""
+
+    direct_normal_lux: float
+    diffuse_horizontal_lux: float | None
+    source: str
+
+
+def _standard_clock(when) -> tuple[int, int, int, int]:
+    """(month, day, hour, minute) of aware ``when`` in its zone's standard time (no DST)."""
+    from datetime import timedelta
+
+    dst = when.dst() or timedelta(0)
+    std = when.replace(tzinfo=None) - dst
+    return std.month, std.day, std.hour, std.minute
+
+
+def epw_hour_illuminance(project, hours: list[str], path: Path | None = None,
+                         ) -> dict[str, tuple[float, float]]:
+    """(direct normal, diffuse horizontal) lux per civil clock time from the EPW file.
+
+    EPW rows are local standard time: a civil hour under daylight saving is read from the row
+    of its standard-time clock (09:00 CEST → 08:00 standard → the row ending at 08)."""
+    from radtree.light.sun import local_datetime
+
+    path = Path(path or project.light.epw)
+    data = read_epw(path).illuminance()
     out = {}
     for h in hours:
-        hh, mm = (int(x) for x in h.split(":"))
+        month, day, hh, mm = _standard_clock(local_datetime(project.site.date, h,
+                                                            project.site.tzinfo))
         ending = hh + 1 if mm > 0 else max(hh, 1)
-        key = (d.month, d.day, ending)
+        key = (month, day, ending)
         if key not in data:
-            raise ConfigError(f"EPW file {project.light.epw} has no row for {d} hour {ending}")
+            raise ConfigError(f"EPW file {path} has no row for {month:02d}-{day:02d} hour "
+                              f"{ending}")
         out[h] = data[key]
     return out
+
+
+def hour_weather(project, hours: list[str]) -> dict[str, HourWeather]:
+    """The weather of each civil clock time of ``hours`` on ``[site] date``, from the
+    project's source (``[light] weather``): clear sky at the instant, an EPW row (checked
+    against ``[site]``), or the DNI table."""
+    light = project.light
+    if light.weather == "table":
+        from radtree.light.tables import direct_normal_table
+
+        table = direct_normal_table(light.direct_normal_table)
+        name = Path(light.direct_normal_table).name
+        missing = [h for h in hours if h not in table]
+        if missing:
+            raise ConfigError(f"hour(s) {', '.join(missing)} have no direct normal "
+                              f"illuminance in {light.direct_normal_table}",
+                              source=str(project.source), field="light.direct_normal")
+        return {h: HourWeather(table[h], None, f"DNI table {name}") for h in hours}
+    if light.weather == "epw":
+        check_epw_site(project)
+        both = epw_hour_illuminance(project, hours)
+        name = Path(light.epw).name
+        return {h: HourWeather(v[0], v[1], f"EPW {name}") for h, v in both.items()}
+    from radtree.light.clearsky import clear_sky_illuminance
+    from radtree.light.sun import local_datetime
+
+    site = project.site
+    when = pd.DatetimeIndex([pd.Timestamp(local_datetime(site.date, h, site.tzinfo))
+                             .tz_convert("UTC") for h in hours])
+    cs = clear_sky_illuminance(when, site.latitude, site.longitude, site.elevation_m)
+    return {h: HourWeather(float(d), float(f), "clear sky (pvlib Ineichen-Perez, Linke "
+                           "turbidity climatology; Perez 1990 luminous efficacy)")
+            for h, d, f in zip(hours, cs["dni_lux"], cs["dhi_lux"])}
 
 
 # ---------------------------------------------------------------- the EPW of an annual run
@@ -143,13 +242,8 @@ def find_weather(project, epw: Path | None = None, echo=None) -> WeatherSource:
             p = Path(cand)
             if not p.exists():
                 raise ConfigError(f"EPW file not found: {p}", field="light.epw")
+            check_epw_site(project, p)
             w = read_epw(p)
-            if not (_close(w.latitude, site.latitude, 0.5)
-                    and _close(w.longitude, site.longitude, 0.5)):
-                raise ConfigError(f"EPW {p} is for latitude {w.latitude}, longitude "
-                                  f"{w.longitude}, but the site is at {site.latitude}, "
-                                  f"{site.longitude}", source=str(project.source),
-                                  field="light.epw")
             return WeatherSource(p, w.generated, f"{p.name} ({why}"
                                  + (", GENERATED clear sky)" if w.generated else ")"))
     data = project.root / "data"
@@ -170,3 +264,18 @@ def find_weather(project, epw: Path | None = None, echo=None) -> WeatherSource:
     write_generated_epw(out, site.name, site.latitude, site.longitude, site.elevation_m,
                         site.utc_offset_hours)
     return WeatherSource(out, True, f"{out.name} (GENERATED clear sky for the site)")
+
+
+def weather_record(project, hours: list[str] | None = None) -> list[dict]:
+    """The weather each hour was traced with, for the manifest and the report: time, source,
+    direct normal and diffuse horizontal illuminance (lux), the sky model."""
+    hours = list(project.site.hours) if hours is None else list(hours)
+    rows = []
+    for h, w in hour_weather(project, hours).items():
+        dhi = (project.light.diffuse_horizontal_lux if w.diffuse_horizontal_lux is None
+               else w.diffuse_horizontal_lux)
+        rows.append({"time": h, "date": project.site.date, "time_zone": project.site.time_zone,
+                     "source": w.source, "direct_normal_lux": round(w.direct_normal_lux, 1),
+                     "diffuse_horizontal_lux": round(dhi, 1) if project.light.sky == "perez"
+                     else 0.0, "sky": project.light.sky})
+    return rows

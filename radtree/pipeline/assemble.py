@@ -11,8 +11,9 @@ from radtree.config import Project, Scenario, effective_project
 from radtree.errors import RadtreeError
 from radtree.pipeline.limits import check_triangles
 from radtree.scene import Scene
-from radtree.sensor_grid import facade_circle, facade_dense_grid
+from radtree.sensor_grid import street_grids
 from radtree.site.frame import FacadeFrame
+from radtree.site.placement import facade_frame as placed_frame
 from radtree.site.street import street_materials, street_meshes
 
 #: -ab of a scene without a crown model (direct + one interreflection)
@@ -34,8 +35,9 @@ class BuiltScene:
 
 
 def facade_frame(project: Project) -> FacadeFrame:
-    """The studied façade's local frame (x east, y north, z up; azimuth clockwise from north)."""
-    return FacadeFrame(azimuth_deg=project.street.facade_azimuth_deg)
+    """The studied façade's local frame (x east, y north, z up; azimuth clockwise from north),
+    placed by :func:`radtree.site.placement.facade_frame` (``[street] facade_line``, …)."""
+    return placed_frame(project)
 
 
 def scene_ab(project: Project, tree_ab: int | None) -> int:
@@ -61,10 +63,8 @@ def make_scene(project: Project, scenario: Scenario, dense_grid: bool | None = N
     frame = facade_frame(project)
     materials: dict = dict(street_materials(project.street))
     meshes = street_meshes(project.street, frame)
-    grids = {"facade": facade_circle(project.sensors, frame)}
     use_dense = project.sensors.dense_grid if dense_grid is None else dense_grid
-    if use_dense:
-        grids["facade_map"] = facade_dense_grid(project.sensors, frame)
+    grids = street_grids(project.sensors, frame, use_dense)
     notes = [f"street canyon {project.street.width_m:g} m wide, façade looks "
              f"{project.street.facade_azimuth_deg:g}° (compass), façade ρ "
              f"{project.street.facade_reflectance:g}"]

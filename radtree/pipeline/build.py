@@ -42,13 +42,27 @@ from radtree.pipeline.realisations import (
 
 def hour_grids(project: Project, time_: str, available: list[str],
                wanted: list[str] | None, sc: Scenario | None = None) -> list[str]:
-    """Grids to trace at an hour: the dense façade map only at ``sensors.dense_hours``, and
+    """Grids to trace at an hour: the dense façade maps only at ``sensors.dense_hours``, and
     only in the first crown realisation (``F@1``) of a scenario with several."""
+    from radtree.sensor_grid import is_dense_grid
+
     use = [g for g in available if wanted is None or g in wanted]
     dense = project.sensors.dense_hours
     if (dense and time_ not in dense) or (sc is not None and is_later_realisation(sc.name)):
-        use = [g for g in use if g != "facade_map"]
+        use = [g for g in use if not is_dense_grid(g)]
     return use
+
+
+def echo_notes(name: str, notes: list[str], echo: Callable[[str], None]) -> None:
+    """Print the notes a user must see at build time: the crown–wall policy's clip note
+    (:mod:`radtree.trees.wall_policy`) and where an inventory's façade was placed
+    (:mod:`radtree.site.placement`)."""
+    from radtree.site.placement import NOTE_PREFIX as PLACED
+    from radtree.trees.wall_policy import NOTE_PREFIX as WALL
+
+    for note in notes:
+        if note.startswith((WALL, PLACED)):
+            echo(f"  {name}: {note}")
 
 
 def build_project(project: Project, scenarios: list[str] | None = None,
@@ -88,6 +102,7 @@ def build_project(project: Project, scenarios: list[str] | None = None,
             if name in drawn:
                 painter.draw(build_root / name)
             echo(_built_line(built_facts, build_root / name))
+            echo_notes(name, built_facts["notes"], echo)
             if bar is not None:
                 bar.update(1)
 

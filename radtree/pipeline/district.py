@@ -16,7 +16,7 @@ from radtree.config import Project, Scenario, effective_project
 from radtree.errors import ConfigError, RadtreeError
 from radtree.optics import Material
 from radtree.scene import Scene
-from radtree.sensor_grid import facade_circle, facade_dense_grid
+from radtree.sensor_grid import street_grids
 from radtree.site.buildings import building_meshes, facade_grids, ground_mesh
 from radtree.site.district import load_district
 from radtree.site.frame import FacadeFrame
@@ -32,11 +32,15 @@ def district_scene(project: Project, scenario: Scenario, dense_grid: bool | None
     d = project.district
     inputs = load_district(project)
     # species are checked for every scenario (also 'none'): nothing is built with a bad one
+    notes: list[str] = []
+    clips: dict = {}
     if inputs.trees:
-        from radtree.trees.district import species_of
+        from radtree.trees.district import species_of, wall_clips
 
         species_of(inputs.trees, str(d.trees))
-    notes: list[str] = []
+        # the crown–wall policy for every scenario (also 'none'): a refusal stops them all
+        clips, wall_notes = wall_clips(project, inputs.trees, inputs.walls, str(d.trees))
+        notes += wall_notes
     materials: dict[str, Material]
     if inputs.buildings:
         meshes, walls = building_meshes(inputs.buildings)
@@ -49,12 +53,13 @@ def district_scene(project: Project, scenario: Scenario, dense_grid: bool | None
                      f"every {d.facade_spacing_m:g} m, {d.window_height_m:g} m above each "
                      f"storey floor), {len(inputs.trees)} trees.")
     else:
-        frame = FacadeFrame(azimuth_deg=project.street.facade_azimuth_deg)
+        frame = inputs.street_frame or FacadeFrame(azimuth_deg=project.street.facade_azimuth_deg)
+        if inputs.placement:
+            notes.append(inputs.placement)
         materials = dict(street_materials(project.street))
         meshes = street_meshes(project.street, frame)
-        grids = {"facade": facade_circle(project.sensors, frame)}
-        if project.sensors.dense_grid if dense_grid is None else dense_grid:
-            grids["facade_map"] = facade_dense_grid(project.sensors, frame)
+        grids = street_grids(project.sensors, frame, project.sensors.dense_grid
+                             if dense_grid is None else dense_grid)
         notes.append(f"street canyon {project.street.width_m:g} m wide with "
                      f"{len(inputs.trees)} inventory tree(s)")
     t0 = time.perf_counter()
@@ -71,7 +76,7 @@ def district_scene(project: Project, scenario: Scenario, dense_grid: bool | None
 
         tr, _ = apply_switches(project.tree, scenario.switches, source=str(project.source),
                                root=project.root)
-        tree = inventory_crowns(project, inputs.trees, tr, d.instancing)
+        tree = inventory_crowns(project, inputs.trees, tr, d.instancing, clips)
         clash = set(tree.materials) & set(materials)
         if clash:
             raise RadtreeError(f"crown materials clash with the buildings': {clash}")

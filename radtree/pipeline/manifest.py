@@ -9,6 +9,7 @@ from typing import Any
 
 import radtree
 from radtree.fileio import file_sha256
+from radtree.light.weather import weather_record
 
 __all__ = ["file_sha256", "input_files", "manifest"]
 
@@ -44,6 +45,7 @@ def manifest(project, extra: dict[str, Any] | None = None,
         "seeds": {"engine": project.engine.seed, "louvers": project.tree.louvers.seed},
         "inputs": input_files(project),
         "params_hash": project.params_hashes(project.scenarios),
+        "weather": weather_record(project),
     })
     if extra:
         d.update(extra)

@@ -57,7 +57,7 @@ def check_part(part: Path, scenario: str, time: str, params_hash: str
         return None, "was changed after it was written (sha256 differs from its manifest)"
     try:
         rows = pd.read_csv(part, dtype={"scenario": str, "time": str, "params_hash": str,
-                                       "building": str, "facade": str})
+                                       "building": str, "facade": str, "room": str})
     except (OSError, ValueError) as exc:
         return None, f"cannot be read ({exc})"
     missing = [c for c in REQUIRED_COLUMNS if c not in rows.columns]

@@ -29,13 +29,16 @@ RESULT_COLUMNS = [
     "scenario", "model", "datetime", "time", "grid", "sensor", "row", "x", "y", "z",
     "lux", "lux_stderr", "engine", "params_hash",
 ]
-#: optional per-sensor columns of inventory projects (sensor grids' ``labels``): the building
-#: id, the façade ``BUILDING:FACE`` and the storey (0 = ground); absent in other tables
-OPTIONAL_COLUMNS = ("building", "facade", "storey")
+#: optional per-sensor columns (sensor grids' ``labels``): the building id and the façade
+#: ``BUILDING:FACE`` (inventory projects), the storey (0 = ground; inventory façades, office
+#: rooms, a street's sensor heights) and the office ``room`` ``"STOREY-BAY"``
+#: (:mod:`radtree.site.office`); absent in tables whose grids carry none
+OPTIONAL_COLUMNS = ("building", "facade", "storey", "room")
 #: what a table must have to be read back
 REQUIRED_COLUMNS = ("scenario", "model", "time", "grid", "sensor", "row", "lux")
 _DTYPES = {"scenario": str, "time": str, "row": str, "grid": str, "params_hash": str,
-           "engine": str, "model": str, "reflection": str, "building": str, "facade": str}
+           "engine": str, "model": str, "reflection": str, "building": str, "facade": str,
+           "room": str}
 
 
 def results_path(project: Project) -> Path:

@@ -27,7 +27,13 @@ from radtree.light.hours import hour_states
 from radtree.light.sky import SkyState
 from radtree.lock import PUBLISH_NAME, folder_lock
 from radtree.pipeline.assemble import BuiltScene
-from radtree.pipeline.build import built_scene, ensure_built, hour_grids, progress_bar
+from radtree.pipeline.build import (
+    built_scene,
+    echo_notes,
+    ensure_built,
+    hour_grids,
+    progress_bar,
+)
 from radtree.pipeline.limits import check_memory
 from radtree.pipeline.manifest import manifest
 from radtree.pipeline.parts import check_part, write_part
@@ -139,6 +145,8 @@ def prepare_scenario(project: Project, sc: Scenario, engine: Engine,
     states = hour_states(project, sc, hours)
     seconds = time.perf_counter() - t0
     built = built_scene(project, sc)
+    if not engine.uses_build_folder:   # a build folder's notes are printed when it is built
+        echo_notes(sc.name, built.notes, echo)
     scene = built.scene
     if scene.instances and not engine.instancing:
         extra = scene.instanced_triangles()

@@ -333,6 +333,32 @@ def _map_time(results: pd.DataFrame, measured: pd.DataFrame | None,
                "scenarios; no measurements)")
 
 
+def one_level_as_facade(project: Project, results: pd.DataFrame, notes: list[str]
+                        ) -> pd.DataFrame:
+    """A street with sensors at several heights (``facade@<h>m``, :mod:`radtree.sensor_grid`):
+    the circle (and map) nearest ``sensors.height_m`` becomes the ``facade`` grid the core
+    sections read, and a note gives every storey's mean over the hours per scenario."""
+    from radtree.sensor_grid import LEVEL_MARK, level_name
+
+    grid = results["grid"].astype(str)
+    levels = project.sensors.levels
+    if len(levels) < 2 or not grid.str.startswith(FACADE_GRID + LEVEL_MARK).any():
+        return results
+    h = min(levels, key=lambda v: (abs(v - project.sensors.height_m), v))
+    means = (results[grid.str.startswith(FACADE_GRID + LEVEL_MARK)]
+             .groupby(["scenario", "storey", "grid"])["lux"].mean())
+    per = "; ".join(f"{scen} " + ", ".join(f"storey {int(k)} ({g.split(LEVEL_MARK)[1]}) "
+                                           f"{v:,.0f} lx" for (_, k, g), v in sub.items())
+                    for scen, sub in means.groupby(level=0, sort=False))
+    notes.append(f"façade sensors at {len(levels)} heights ([sensors] heights_m): the report's "
+                 f"façade grid is the circle at {h:g} m (nearest sensors.height_m "
+                 f"{project.sensors.height_m:g} m); mean over the hours per storey: {per}")
+    out = results.copy()
+    out.loc[grid == level_name(FACADE_GRID, h), "grid"] = FACADE_GRID
+    out.loc[grid == level_name(MAP_GRID, h), "grid"] = MAP_GRID
+    return out
+
+
 def collect(project: Project, echo: Callable[[str], None] = print) -> ReportData:
     """Read the results layout and compute every table the report shows."""
     notes: list[str] = []
@@ -341,6 +367,7 @@ def collect(project: Project, echo: Callable[[str], None] = print) -> ReportData
         from radtree.report.sections.facades import as_one_facade_grid
 
         results = as_one_facade_grid(results)
+    results = one_level_as_facade(project, results, notes)
     if results[results["grid"].astype(str) == FACADE_GRID].empty:
         raise RadtreeError(f"{results_path(project)}: no rows for the façade sensor grid "
                            f"'{FACADE_GRID}'")

@@ -25,7 +25,7 @@ import numpy as np
 from radtree.errors import ConfigError
 from radtree.optics import Plastic
 from radtree.scene import Mesh, SensorGrid, quad
-from radtree.site.inventory import InventoryTree, LocalFrame, number, read_features
+from radtree.site.inventory import InventoryTree, LocalFrame, check_spread, number, read_features
 
 PROBE_M = 0.5          # how far outside a face its "open ground" probe sits
 GROUND_MARGIN_M = 30.0  # the ground extends this far beyond buildings and trees
@@ -108,6 +108,11 @@ def read_buildings(path: Path, frame_crs: str, latitude: float, longitude: float
         wwr = number(f, "window_to_wall", src, lo=0.0, lo_open=False, hi=1.0, default=-1.0) \
             if "window_to_wall" in f.props else None
         out.append(Building(f.id, orient(poly, 1.0), h, rho, max(1, st), wwr))
+    raw = np.array([[float(v) for v in np.mean(np.asarray(f.coords[0], float)[:, :2], axis=0)]
+                    for f in feats]).reshape(-1, 2)
+    check_spread([b.id for b in out], raw, np.array([[b.polygon.centroid.x, b.polygon.centroid.y]
+                                                     for b in out]).reshape(-1, 2),
+                 frame, src, "building")
     for i, a in enumerate(out):
         for b in out[i + 1:]:
             if a.polygon.intersection(b.polygon).area > 0.01:   # type: ignore[attr-defined]
@@ -235,12 +240,27 @@ def ground_mesh(buildings: list[Building], trees: list[InventoryTree]) -> Mesh:
                                                [hi[0], hi[1], 0], [lo[0], hi[1], 0]]))
 
 
-def check_trees_against_buildings(trees: list[InventoryTree], buildings: list[Building],
-                                  source: str) -> None:
-    """A trunk inside a footprint, or a crown below the roof reaching into one, is an error
-    naming the tree's feature id."""
-    from shapely.geometry import Point
+@dataclass(frozen=True)
+class WallContact:
+    """A wall near a crown: its name, the wall's nearest point to the trunk (x, y m), the
+    unit normal from the wall towards the trunk, and the trunk axis' distance to the wall (m)."""
 
+    wall: str
+    point: np.ndarray
+    normal: np.ndarray
+    distance_m: float
+
+
+def check_trees_against_buildings(trees: list[InventoryTree], buildings: list[Building],
+                                  source: str, margin: float = 0.0
+                                  ) -> dict[str, list[WallContact]]:
+    """A trunk inside a footprint is an error naming the tree's feature id. Returns, per tree,
+    the buildings whose walls below the roof its crown comes within ``margin`` m of (the
+    crown–wall policy, :mod:`radtree.trees.wall_policy`, decides what is done)."""
+    from shapely.geometry import Point
+    from shapely.ops import nearest_points
+
+    out: dict[str, list[WallContact]] = {}
     for t in trees:
         p = Point(t.x, t.y)
         for b in buildings:
@@ -250,8 +270,10 @@ def check_trees_against_buildings(trees: list[InventoryTree], buildings: list[Bu
                                   field=f"feature {t.id!r}")
             if t.crown_base_m < b.height_m:
                 gap = poly.exterior.distance(p)   # type: ignore[attr-defined]
-                if gap < t.crown_radius_m:
-                    raise ConfigError(
-                        f"crown (radius {t.crown_radius_m:g} m, base {t.crown_base_m:g} m) "
-                        f"reaches through a wall of building {b.id!r} ({gap:.2f} m from the "
-                        "trunk)", source=source, field=f"feature {t.id!r}")
+                if gap < t.crown_radius_m + margin:
+                    q = nearest_points(poly.exterior, p)[0]   # type: ignore[attr-defined]
+                    foot = np.array([q.x, q.y])
+                    normal = (np.array([t.x, t.y]) - foot) / max(gap, 1e-12)
+                    out.setdefault(t.id, []).append(WallContact(
+                        f"a wall of building {b.id!r}", foot, normal, float(gap)))
+    return out

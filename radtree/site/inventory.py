@@ -29,6 +29,14 @@ from radtree.errors import ConfigError
 TREE_REQUIRED = ("species", "height_m", "crown_diameter_m", "crown_base_m")
 
 
+#: a feature farther than this from the median of the others is refused
+MAX_FROM_REST_M = 5000.0
+#: features spread over more than this (bounding-box diagonal) are refused
+MAX_SPREAD_M = 10000.0
+#: a feature farther than this from the site origin ([site] latitude/longitude) is refused
+MAX_FROM_SITE_M = 10000.0
+
+
 @dataclass(frozen=True)
 class LocalFrame:
     """Source CRS ↔ local metric frame at the site origin (x east, y north, metres)."""
@@ -206,6 +214,7 @@ def read_trees(path: Path, frame_crs: str, latitude: float, longitude: float
     frame = LocalFrame(crs, latitude, longitude)
     pts = np.array([[float(c) for c in f.coords[:2]] for f in feats])
     xs, ys = frame.to_local(pts[:, 0], pts[:, 1])
+    check_spread([f.id for f in feats], pts, np.column_stack([xs, ys]), frame, src, "tree")
     trees = []
     for f, x, y in zip(feats, xs, ys):
         where = f"feature {f.id!r}"
@@ -224,3 +233,56 @@ def read_trees(path: Path, frame_crs: str, latitude: float, longitude: float
             (str(f.props["photo"]) if f.props.get("photo") else None),
             None if td < 0 else td))
     return trees, frame
+
+
+def _geographic(crs: str) -> bool:
+    return crs.upper().endswith(("4326", "CRS84"))
+
+
+def check_spread(ids: list[str], raw: np.ndarray, local: np.ndarray, frame: LocalFrame,
+                 src: str, kind: str) -> None:
+    """Geographic sanity of features at ``raw`` (source CRS, (n, 2)) and ``local`` (metres
+    from the site origin): none farther than :data:`MAX_FROM_REST_M` from the median of all,
+    a bounding box within :data:`MAX_SPREAD_M` (diagonal), none farther than
+    :data:`MAX_FROM_SITE_M` from the site; else ConfigError naming the feature and the
+    likely cause (e.g. longitude and latitude swapped)."""
+    if len(local) == 0:
+        return
+    local = np.where(np.isfinite(local), local, 1e12)
+    here = f"latitude {frame.latitude:g}, longitude {frame.longitude:g}"
+    rest = np.hypot(*(local - np.median(local, axis=0)).T)
+    site = np.hypot(local[:, 0], local[:, 1])
+    # the outlier: far from the rest; of equals (two features), the one farther from the site
+    i = int(np.argmax(rest + 1e-6 * site))
+    if rest[i] > MAX_FROM_REST_M:
+        raise ConfigError(
+            f"{kind} at {raw[i, 0]:g}, {raw[i, 1]:g} lies {rest[i] / 1000.0:,.1f} km from the "
+            f"other {kind}s (at most {MAX_FROM_REST_M / 1000:g} km accepted): "
+            f"{_likely_cause(raw[i], frame)}", source=src, field=f"feature {ids[i]!r}")
+    span = float(np.hypot(*np.ptp(local, axis=0)))
+    if span > MAX_SPREAD_M:
+        raise ConfigError(
+            f"the {kind}s spread over {span / 1000:.1f} km (bounding-box diagonal; at most "
+            f"{MAX_SPREAD_M / 1000:g} km accepted): split the inventory into districts, or "
+            "check the coordinates of this one, the farthest from the rest",
+            source=src, field=f"feature {ids[i]!r}")
+    j = int(np.argmax(site))
+    if site[j] > MAX_FROM_SITE_M:
+        raise ConfigError(
+            f"{kind} at {raw[j, 0]:g}, {raw[j, 1]:g} lies {site[j] / 1000.0:,.1f} km from the "
+            f"site ({here}; at most {MAX_FROM_SITE_M / 1000:g} km accepted): "
+            f"{_likely_cause(raw[j], frame)}", source=src, field=f"feature {ids[j]!r}")
+
+
+def _likely_cause(xy: np.ndarray, frame: LocalFrame) -> str:
+    if _geographic(frame.crs):
+        sx, sy = frame.to_local(np.array([xy[1]]), np.array([xy[0]]))
+        if np.hypot(sx[0], sy[0]) <= MAX_FROM_SITE_M:
+            return ("longitude and latitude swapped? (GeoJSON and CSV x/lon columns come "
+                    "first as longitude) — swap them")
+        return ("check its coordinates (longitude first, degrees), [site] crs, and [site] "
+                "latitude/longitude")
+    if frame.crs == "local":
+        return "[site] crs = \"local\" expects metres from the site origin: check the numbers"
+    return (f"check its coordinates against [site] crs = {frame.crs!r} (a projected CRS in "
+            "metres?) and [site] latitude/longitude")

@@ -1,12 +1,18 @@
 """The office block of the building application (SPEC.md §5): rooms behind the studied façade.
 
-``bays`` × ``storeys`` identical offices (default 3 × 3 in elevation) sit behind the façade
-plane n = 0 of the street canyon, in the façade frame (u along the façade, n towards the
-street, z up). Each office is ``width_m`` wide (along u), ``depth_m`` deep (n from −depth to 0)
-and ``height_m`` high, with a glazed opening over its full width between ``window_sill_m`` and
-``window_head_m`` above its floor. Storey k (0 = lowest) has its floor at
-``ground_floor_m + k·storey_height_m``. The central bay is centred on u = ``sensors.x_m`` (where
-the crown row is centred), so the tree stands in front of the central office.
+``bays`` × ``storeys`` identical offices (default 3 × 3 in elevation; any counts, even ones
+too) sit behind the façade plane n = 0 of the street canyon, in the façade frame (u along the
+façade, n towards the street, z up). Each office is ``width_m`` wide (along u), ``depth_m``
+deep (n from −depth to 0) and ``height_m`` high, with a glazed opening over its full width
+between ``window_sill_m`` and ``window_head_m`` above its floor. Storey k (0 = the ground
+floor, the lowest) has its floor at ``ground_floor_m + k·storey_height_m``. The block is
+centred on u = ``sensors.x_m`` (where the crown row is centred): with an odd number of bays
+the tree stands in front of the central bay, with an even number in front of the partition
+between the two middle bays.
+
+Rooms are named ``"STOREY-BAY"``: ``"0-1"`` is the ground-floor office of bay 1, bays counted
+from 0 at the left end of the block seen from the street (smallest u). ``[office] rooms``
+selects the sensed rooms: ``"all"`` (the default) or a list such as ``["0-1", "1-1"]``.
 
 Geometry, all in one closed set of surfaces (rooms are closed except through the glazing):
 
@@ -30,22 +36,25 @@ Geometry, all in one closed set of surfaces (rooms are closed except through the
   so floor and ceiling never coincide (coincident surfaces of different materials are
   ambiguous for a ray tracer); the notes say so.
 
-Sensor grids, in the **central** office only (equal-area grids: every point is the centre of
-an equal cell, so "% of points" is "% of area"):
+Sensor grids, in every sensed room (equal-area grids: every point is the centre of an equal
+cell, so "% of points" is "% of area"); each grid holds the sensed rooms one after the other
+(in the order of ``rooms``; ``"all"``: storey by storey from the ground, bay by bay from the
+left) and every sensor carries its ``storey`` (int) and ``room`` (``"STOREY-BAY"``), columns
+of the results table:
 
-* ``facade`` — vertical, on the outside of the central office's façade (opening and frame),
+* ``facade`` — vertical, on the outside of each sensed office's façade (opening and frame),
   ``sensors.offset_m`` (1 cm) out, normals +n (out of the façade), cells of
   ``facade_grid_spacing_m`` over the office's width × height; rows are labelled by height above
   the street, ``z=4.00``.
-* ``workplane`` — horizontal at ``workplane_height_m`` above the central office's floor,
+* ``workplane`` — horizontal at ``workplane_height_m`` above each sensed office's floor,
   normals up, cells of ``grid_spacing_m`` over the floor area inset ``wall_offset_m`` from every
   wall (the band next to the walls is excluded, as in LM-83 / EN 17037 practice); rows are
   labelled by depth behind the façade, ``d=0.75``.
 
-Heights: with 2.5 m storeys, ``ground_floor_m`` = 1.25 m puts the central storey's floor at
-3.75 m and the centre of its façade grid at 5.0 m — the height of the study's measured
-sensors; ``examples/office-block`` sets it so. (``Office()``'s own default, 2.5 m, puts the
-central façade centre at 6.25 m.)
+Heights: with 2.5 m storeys, ``ground_floor_m`` = 1.25 m puts storey 1's floor at 3.75 m and
+the centre of its façade grid at 5.0 m — the height of the study's measured sensors;
+``examples/office-block`` sets it so and senses the central office ``"1-1"`` only.
+(``Office()``'s own default, 2.5 m, puts storey 1's façade centre at 6.25 m.)
 """
 
 from __future__ import annotations
@@ -109,17 +118,12 @@ class OfficeLayout:
     panes: int
     facade_offset: float
 
-    @property
-    def central_bay(self) -> int:
-        return self.office.bays // 2
-
-    @property
-    def central_storey(self) -> int:
-        return self.office.storeys // 2
-
     def bay_u(self, j: int) -> tuple[float, float]:
+        """(u0, u1) of bay j (0 = the leftmost seen from the street); the block is centred on
+        ``centre_u`` (for odd counts (bays − 1)/2 is a whole number: the central bay's
+        formula as before)."""
         w = self.office.width_m
-        u0 = self.centre_u + (j - self.central_bay) * w - w / 2.0
+        u0 = self.centre_u + (j - (self.office.bays - 1) / 2) * w - w / 2.0
         return u0, u0 + w
 
     def floor_z(self, k: int) -> float:
@@ -131,8 +135,13 @@ class OfficeLayout:
         return Box(u0, u1, -self.office.depth_m, 0.0, z0, z0 + self.room_height)
 
     @property
-    def central_room(self) -> Box:
-        return self.room(self.central_bay, self.central_storey)
+    def sensed(self) -> list[tuple[str, int, int]]:
+        """The sensed rooms: (name ``"STOREY-BAY"``, storey k, bay j), in ``rooms`` order."""
+        out = []
+        for name in self.office.room_names:
+            k, j = name.split("-")
+            out.append((name, int(k), int(j)))
+        return out
 
     def opening(self, j: int, k: int) -> tuple[float, float, float, float]:
         """(u0, u1, z0, z1) of the office's façade opening."""
@@ -344,32 +353,48 @@ def _cell_centres(a: float, b: float, spacing: float) -> np.ndarray:
     return a + step * (np.arange(n) + 0.5)
 
 
+def _room_labels(rooms: list[tuple[str, int, int]], sizes: list[int]) -> dict[str, list]:
+    return {"storey": [k for (_, k, _), m in zip(rooms, sizes) for _ in range(m)],
+            "room": [n for (n, _, _), m in zip(rooms, sizes) for _ in range(m)]}
+
+
 def facade_grid(layout: OfficeLayout, frame: FacadeFrame, name: str = "facade") -> SensorGrid:
-    """Vertical grid on the outside of the central office's façade, normals out (+n)."""
-    room = layout.central_room
-    us = _cell_centres(room.u0, room.u1, layout.office.facade_grid_spacing_m)
-    zs = _cell_centres(room.z0, room.z1, layout.office.facade_grid_spacing_m)
-    Z, U = np.meshgrid(zs[::-1], us, indexing="ij")          # top row first
-    local = np.column_stack([U.ravel(), np.full(U.size, layout.facade_offset), Z.ravel()])
-    rows = [f"z={z:.2f}" for z in Z.ravel()]
-    normals = np.tile(frame.normal, (U.size, 1))
-    return SensorGrid(name, frame.to_world(local), normals, rows)
+    """Vertical grid on the outside of every sensed office's façade, normals out (+n)."""
+    local, rows, sizes = [], [], []
+    for _, k, j in layout.sensed:
+        room = layout.room(j, k)
+        us = _cell_centres(room.u0, room.u1, layout.office.facade_grid_spacing_m)
+        zs = _cell_centres(room.z0, room.z1, layout.office.facade_grid_spacing_m)
+        Z, U = np.meshgrid(zs[::-1], us, indexing="ij")          # top row first
+        local.append(np.column_stack([U.ravel(), np.full(U.size, layout.facade_offset),
+                                      Z.ravel()]))
+        rows += [f"z={z:.2f}" for z in Z.ravel()]
+        sizes.append(U.size)
+    pts = np.vstack(local)
+    normals = np.tile(frame.normal, (len(pts), 1))
+    return SensorGrid(name, frame.to_world(pts), normals, rows,
+                      _room_labels(layout.sensed, sizes))
 
 
 def workplane_grid(layout: OfficeLayout, frame: FacadeFrame,
                    name: str = "workplane") -> SensorGrid:
-    """Horizontal grid at the work-plane height in the central office, normals up."""
+    """Horizontal grid at the work-plane height in every sensed office, normals up."""
     o = layout.office
-    room = layout.central_room
     off = o.wall_offset_m
-    us = _cell_centres(room.u0 + off, room.u1 - off, o.grid_spacing_m)
-    ns = _cell_centres(room.n0 + off, room.n1 - off, o.grid_spacing_m)[::-1]  # façade first
-    N, U = np.meshgrid(ns, us, indexing="ij")
-    z = room.z0 + o.workplane_height_m
-    local = np.column_stack([U.ravel(), N.ravel(), np.full(U.size, z)])
-    rows = [f"d={-n:.2f}" for n in N.ravel()]
-    normals = np.tile([0.0, 0.0, 1.0], (U.size, 1))
-    return SensorGrid(name, frame.to_world(local), normals, rows)
+    local, rows, sizes = [], [], []
+    for _, k, j in layout.sensed:
+        room = layout.room(j, k)
+        us = _cell_centres(room.u0 + off, room.u1 - off, o.grid_spacing_m)
+        ns = _cell_centres(room.n0 + off, room.n1 - off, o.grid_spacing_m)[::-1]  # façade first
+        N, U = np.meshgrid(ns, us, indexing="ij")
+        z = room.z0 + o.workplane_height_m
+        local.append(np.column_stack([U.ravel(), N.ravel(), np.full(U.size, z)]))
+        rows += [f"d={-n:.2f}" for n in N.ravel()]
+        sizes.append(U.size)
+    pts = np.vstack(local)
+    normals = np.tile([0.0, 0.0, 1.0], (len(pts), 1))
+    return SensorGrid(name, frame.to_world(pts), normals, rows,
+                      _room_labels(layout.sensed, sizes))
 
 
 # ---------------------------------------------------------------- entry point
@@ -382,17 +407,18 @@ def office_parts(project: Project, frame: FacadeFrame
                            project.street.building_height_m)
     materials = office_materials(o)
     grids = {"facade": facade_grid(layout, frame), "workplane": workplane_grid(layout, frame)}
-    room = layout.central_room
     glass = materials["glazing"]
     assert isinstance(glass, Glass)
     n_tri = sum(m.n_triangles for m in meshes)
     fg, wg = grids["facade"], grids["workplane"]
     floors = ", ".join(f"{layout.floor_z(k):g}" for k in range(o.storeys))
+    sensed = ", ".join(n for n, _, _ in layout.sensed)
     notes = [
         f"office block: {o.bays} bays × {o.storeys} storeys of offices {o.width_m:g} m wide × "
         f"{layout.room_height:g} m high × {o.depth_m:g} m deep behind the façade; floors at "
-        f"{floors} m (storey {o.storey_height_m:g} m); results read in the central office "
-        f"(floor {room.z0:g} m, u {room.u0:g}…{room.u1:g} m); {n_tri} triangles",
+        f"{floors} m (storey {o.storey_height_m:g} m); results read in "
+        f"{len(layout.sensed)} office(s) 'STOREY-BAY' (storey 0 = ground floor, bay 0 = "
+        f"leftmost seen from the street): {sensed}; {n_tri} triangles",
         f"openings over the full office width from {layout.sill:g} to {layout.head:g} m above "
         f"the floor, glazing flush with the façade (no reveal): Radiance glass, measured Tn "
         f"{o.glazing_transmittance:g} → transmissivity {glass.transmissivity:.4f}; frame and "
@@ -401,9 +427,11 @@ def office_parts(project: Project, frame: FacadeFrame
         f"inside: floor ρ {o.floor_reflectance:g}, walls ρ {o.wall_reflectance:g}, ceiling ρ "
         f"{o.ceiling_reflectance:g} (Lambertian); façade wall around the openings: "
         f"{FACADE_MATERIAL}",
-        f"grids: façade {len(fg)} points ({o.facade_grid_spacing_m:g} m cells over the central "
-        f"office's façade, {layout.facade_offset:g} m out, centre at "
-        f"{0.5 * (room.z0 + room.z1):.2f} m); work plane {len(wg)} points "
+        f"grids: façade {len(fg)} points ({o.facade_grid_spacing_m:g} m cells over each sensed "
+        f"office's façade, {layout.facade_offset:g} m out, centres at "
+        + ", ".join(f"{layout.floor_z(k) + 0.5 * layout.room_height:.2f}"
+                    for k in sorted({k for _, k, _ in layout.sensed}))
+        + f" m); work plane {len(wg)} points "
         f"({o.grid_spacing_m:g} m cells at {o.workplane_height_m:g} m, {o.wall_offset_m:g} m "
         "from the walls)",
     ]

@@ -6,11 +6,12 @@
   footprints) → ``[site] buildings``; ``--honeybee`` (HBJSON) → ``[site] honeybee``. They are
   read with plain ``json``/``csv`` only to summarise them (trees per species, buildings,
   rooms); their full validation belongs to the readers of those keys.
-* ``--epw``: the site's latitude, longitude, time zone and elevation from the weather file
-  (``pvlib`` through :func:`radtree.light.weather.read_epw`) and ``[light] epw``. Without it
-  the site comes from the inputs' coordinates (longitude/latitude; time zone estimated as
-  round(longitude / 15) h, said so) or is the Mendoza reference site, and a clear-sky year is
-  generated into ``data/generated_clear_sky.epw`` (labelled GENERATED).
+* ``--lat/--lon`` (degrees), ``--tz Area/City`` or ``--utc ±H``, ``--elevation``, ``--date``:
+  the site (:class:`Location`). What is left out comes from the inputs' coordinates, then the
+  EPW (``--epw``: ``[light] epw``, checked against the site), the time zone from the
+  coordinates (timezonefinder's offline IANA boundaries); every source is printed. Without an
+  EPW the weather is ``[light] weather = "clear-sky"`` (pvlib's clear sky of the site and date,
+  no file).
 * ``--template street|office|district``: the street canyon with free-standing crowns; the
   same with the office block (``[office]``); the inventory district (default when buildings
   are given).
@@ -25,6 +26,9 @@ commented ``# key = default`` lines to uncomment. The file is loaded with
 from __future__ import annotations
 
 import inspect
+import math
+from collections.abc import Callable
+from datetime import date as _date
 import json
 import shutil
 import textwrap
@@ -35,23 +39,20 @@ from typing import Any
 
 import tomlkit
 
-from radtree.config import Scenario, load_project
+from radtree.config import Project, Scenario, load_project
+from radtree.config.timezone import fixed_name, parse_time_zone, standard_offset_hours
 from radtree.config.spec import spec_of, toml_name
 from radtree.config.species import find_species
 from radtree.config.switches import TABLES, TREE_TABLES
 from radtree.errors import ConfigError
 from radtree.fileio import write_text
-from radtree.light.clearsky import write_generated_epw
+from radtree.light.sun import daylight_hours
 from radtree.light.weather import read_epw
 from radtree.site.inventory import read_features
 
 TEMPLATES = ("street", "office", "district")
-#: the site without an EPW or geographic inputs: the reference study (SPEC.md §1)
-MENDOZA = {"name": "Mendoza, Argentina (reference site)", "latitude": -32.89,
-           "longitude": -68.83, "elevation_m": 750.0, "utc_offset_hours": -3.0}
-HOURS = ["10:30", "11:30", "12:30", "13:30", "14:30", "15:30", "16:30"]
-GENERATED_EPW = "generated_clear_sky.epw"
-DEFAULT_SPECIES = "morus_alba"
+#: the species of a project whose inputs name none from the library: a common street tree
+DEFAULT_SPECIES = "platanus_x_acerifolia"
 _UNITS = (("_m", "m"), ("_deg", "degrees"), ("_lux", "lx"), ("_hours", "h"))
 _WRAP = 96
 TABLES_SCENARIO = Scenario
@@ -117,9 +118,15 @@ def read_inputs(trees: Path | None, buildings: Path | None, honeybee: Path | Non
             feats, crs = read_features(path, "EPSG:4326", geometry, kind[0].upper())
         except ConfigError as exc:
             raise ConfigError(f"{path}: cannot read the {kind} ({exc})") from None
+        pts = [pt for f in feats for pt in _points(f.coords)]
         if crs.upper().endswith(("4326", "CRS84")):
-            for f in feats:
-                info.lonlat += _points(f.coords)
+            info.lonlat += pts
+        elif pts and crs != "local":    # a projected CRS: its coordinates as longitude/latitude
+            from pyproj import Transformer
+
+            t = Transformer.from_crs(crs, "EPSG:4326", always_xy=True)
+            lon, lat = t.transform([p[0] for p in pts], [p[1] for p in pts])
+            info.lonlat += list(zip(map(float, lon), map(float, lat)))
         if kind == "trees":
             info.trees = len(feats)
             info.species = Counter(str(f.props.get("species", "")).strip() or "(no species)"
@@ -135,6 +142,16 @@ def read_inputs(trees: Path | None, buildings: Path | None, honeybee: Path | Non
     return info
 
 
+def _east_west_span_m(inputs: Inputs) -> float:
+    """East–west extent of the inputs' coordinates (m; equirectangular, enough to size the
+    street along the default east–west façade); 0 without geographic inputs."""
+    if not inputs.lonlat:
+        return 0.0
+    lon = [p[0] for p in inputs.lonlat]
+    lat = sum(p[1] for p in inputs.lonlat) / len(inputs.lonlat)
+    return (max(lon) - min(lon)) * 111320.0 * math.cos(math.radians(lat))
+
+
 def _centroid(inputs: Inputs) -> tuple[float, float] | None:
     if not inputs.lonlat:
         return None
@@ -143,33 +160,109 @@ def _centroid(inputs: Inputs) -> tuple[float, float] | None:
     return (lon, lat) if -180 <= lon <= 180 and -90 <= lat <= 90 else None
 
 
-def site_facts(epw: Path | None, inputs: Inputs) -> tuple[dict[str, Any], str]:
-    """The ``[site]`` place and where it came from: latitude/longitude from the inputs'
-    longitude/latitude centroid (the site origin of their local frame) or else the EPW; time
-    zone and elevation from the EPW, else estimated; else the Mendoza reference site."""
+@dataclass(frozen=True)
+class Location:
+    """Where the user says the site is (``radtree new --lat --lon --tz|--utc --elevation
+    --date``); every field optional: what is left out comes from the EPW or the inputs."""
+
+    latitude: float | None = None
+    longitude: float | None = None
+    time_zone: str | None = None
+    elevation_m: float | None = None
+    date: str | None = None
+
+    def __post_init__(self) -> None:
+        if (self.latitude is None) != (self.longitude is None):
+            raise ConfigError("give both --lat and --lon (degrees; latitude north +, longitude "
+                              "east +, west negative)")
+        if self.latitude is not None and not -90 <= self.latitude <= 90:
+            raise ConfigError(f"--lat {self.latitude:g}: expected −90 … 90 degrees (north +)")
+        if self.longitude is not None and not -180 <= self.longitude <= 180:
+            raise ConfigError(f"--lon {self.longitude:g}: expected −180 … 180 degrees (east +)")
+        if self.time_zone is not None:
+            try:
+                parse_time_zone(self.time_zone)
+            except ValueError as exc:
+                raise ConfigError(f"--tz/--utc: {exc}") from None
+        if self.date is not None:
+            try:
+                _date.fromisoformat(self.date)
+            except ValueError:
+                raise ConfigError(f"--date {self.date!r}: expected YYYY-MM-DD") from None
+
+
+def zone_at(latitude: float, longitude: float) -> str | None:
+    """The IANA time zone at a point (``timezonefinder``, offline boundary data), or None at
+    sea / where it finds none."""
+    from timezonefinder import TimezoneFinder
+
+    return TimezoneFinder().timezone_at(lng=longitude, lat=latitude)
+
+
+def site_facts(epw: Path | None, inputs: Inputs, where: Location | None = None
+               ) -> tuple[dict[str, Any], str]:
+    """The ``[site]`` place and where it came from, in order: ``--lat/--lon`` (``where``); the
+    inputs' longitude/latitude centroid (the site origin of their local frame); the EPW. The
+    time zone: ``--tz/--utc``, else the EPW's standard offset, else the IANA zone at the point
+    (timezonefinder). Elevation: ``--elevation``, else the EPW's, else 0 m (said so). Without
+    any of them: ConfigError asking for ``--lat/--lon``."""
+    where = where or Location()
     centre = _centroid(inputs)
-    if epw is not None:
-        w = read_epw(epw)
-        site = {"name": w.path.stem.replace("_", " "), "latitude": round(w.latitude, 4),
-                "longitude": round(w.longitude, 4), "elevation_m": float(w.elevation_m),
-                "utc_offset_hours": float(w.utc_offset_hours)}
-        why = f"from the EPW {epw.name} (pvlib)"
-        if centre is not None:
-            if abs(centre[0] - w.longitude) > 0.5 or abs(centre[1] - w.latitude) > 0.5:
-                raise ConfigError(f"the EPW {epw} is for latitude {w.latitude}, longitude "
-                                  f"{w.longitude}, more than 0.5° from the inputs' centre "
-                                  f"({centre[1]:.4f}, {centre[0]:.4f})")
-            site.update(latitude=round(centre[1], 5), longitude=round(centre[0], 5))
-            why = (f"latitude/longitude the centroid of the inputs; time zone and elevation "
-                   f"from the EPW {epw.name} (pvlib)")
-        return site, why
-    if centre is not None:
-        return ({"name": "site of the inputs", "latitude": round(centre[1], 5),
-                 "longitude": round(centre[0], 5), "elevation_m": 0.0,
-                 "utc_offset_hours": float(round(centre[0] / 15.0))},
-                "the centroid of the inputs' longitude/latitude; time zone ESTIMATED as "
-                "round(longitude / 15) h and elevation 0 m: check both")
-    return dict(MENDOZA), "the Mendoza reference site (no EPW, no geographic inputs): edit it"
+    w = read_epw(epw) if epw is not None else None
+    said: list[str] = []
+    if where.latitude is not None:
+        lat, lon = float(where.latitude), float(where.longitude)  # type: ignore[arg-type]
+        said.append("latitude/longitude from --lat/--lon")
+    elif centre is not None:
+        lat, lon = centre[1], centre[0]
+        said.append("latitude/longitude the centroid of the inputs' coordinates")
+    elif w is not None:
+        lat, lon = w.latitude, w.longitude
+        said.append(f"latitude/longitude from the EPW {epw.name}")  # type: ignore[union-attr]
+    else:
+        raise ConfigError("radtree new needs the site: give --lat LAT --lon LON (degrees, "
+                          "north and east positive) and --tz Area/City (e.g. --lat 40.42 "
+                          "--lon -3.70 --tz Europe/Madrid), or an EPW, or geographic inputs")
+    # inputs far from the site: each feature is checked by the inventory readers
+    # (radtree.site.inventory.check_spread), naming the feature
+    if w is not None and (abs(w.latitude - lat) > 0.5 or abs(w.longitude - lon) > 0.5):
+        raise ConfigError(f"the EPW {epw} is for latitude {w.latitude}, longitude "
+                          f"{w.longitude}, more than 0.5° from the site ({lat:g}, {lon:g}): "
+                          "give the site's EPW, or leave --epw out (clear-sky weather)")
+    if where.time_zone is not None:
+        zone = where.time_zone
+        said.append("time zone from --tz/--utc")
+    elif w is not None:
+        zone = fixed_name(w.utc_offset_hours)
+        said.append(f"time zone the EPW's standard time {zone} (no daylight saving: give --tz "
+                    "Area/City for clock times with daylight saving)")
+    else:
+        found = zone_at(lat, lon)
+        if found is None:
+            raise ConfigError(f"no time zone known at latitude {lat:g}, longitude {lon:g}: "
+                              "give --tz Area/City or --utc ±H")
+        zone = found
+        said.append(f"time zone {zone} looked up from the coordinates (timezonefinder)")
+    if w is not None and abs(standard_offset_hours(zone) - w.utc_offset_hours) > 1e-6:
+        raise ConfigError(f"the EPW {epw} is in standard time UTC{w.utc_offset_hours:+g} h, "
+                          f"but the time zone {zone} has standard time "
+                          f"UTC{standard_offset_hours(zone):+g} h: give the site's EPW or "
+                          "the right --tz")
+    if where.elevation_m is not None:
+        elevation = float(where.elevation_m)
+        said.append("elevation from --elevation")
+    elif w is not None:
+        elevation = float(w.elevation_m)
+        said.append("elevation from the EPW")
+    else:
+        elevation = 0.0
+        said.append("elevation 0 m (ASSUMED: give --elevation)")
+    name = (w.path.stem.replace("_", " ") if w is not None and where.latitude is None
+            else f"site at {abs(lat):.4f}°{'N' if lat >= 0 else 'S'} "
+                 f"{abs(lon):.4f}°{'E' if lon >= 0 else 'W'}")
+    site = {"name": name, "latitude": round(lat, 5), "longitude": round(lon, 5),
+            "elevation_m": elevation, "time_zone": zone}
+    return site, "; ".join(said)
 
 
 # ---------------------------------------------------------------- the document
@@ -263,10 +356,20 @@ def document(template: str, site: dict[str, Any], site_source: str, data: dict[s
                              "optional"))
     proj.add(tomlkit.comment('measured_rows = "data/…"   # per-row measured means; optional'))
     doc.add("project", proj)
-    date = "2024-12-22" if site["latitude"] < 0 else "2024-06-21"
-    s = table(TABLES["site"], {**site, "date": date, "hours": HOURS},
-              {"date": "the summer solstice of the site's hemisphere",
-               "hours": "the reference study's seven hours"})
+    date = site.pop("date")
+    args = (site["latitude"], site["longitude"], site["elevation_m"],
+            parse_time_zone(site["time_zone"]), date)
+    hours = daylight_hours(*args, min_altitude_deg=5.0) or daylight_hours(*args)
+    if not hours:
+        raise ConfigError(f"the sun stays below the horizon at every whole hour of {date} at "
+                          f"latitude {site['latitude']:g} (polar night): choose another "
+                          "--date")
+    s = table(TABLES["site"], {**site, "date": date, "hours": hours},
+              {"date": "local date of the hours",
+               "hours": "local civil clock times (daylight saving applied with an IANA zone); "
+                        "written: the whole hours with the sun ≥ 5° high on the date",
+               "time_zone": "IANA name (daylight saving applied) or a fixed offset 'UTC+1'",
+               "utc_offset_hours": "derived from time_zone; give it instead for a fixed offset"})
     data_notes = {"trees": "tree inventory: points with species, height_m, crown_diameter_m, "
                            "crown_base_m", "buildings": "footprints with height_m",
                   "honeybee": "a Honeybee model (HBJSON)"}
@@ -280,9 +383,15 @@ def document(template: str, site: dict[str, Any], site_source: str, data: dict[s
             HONEYBEE_LINES if "honeybee" in data else []):
         s.add(tomlkit.comment(line))
     doc.add("site", s)
-    doc.add("street", table(TABLES["street"], {}))
+    span = _east_west_span_m(inputs)
+    street_len = TABLES["street"]().length_m
+    doc.add("street", table(TABLES["street"], {} if span + 40.0 <= street_len else {
+        "length_m": float(math.ceil((span + 40.0) / 10.0) * 10.0)},
+        {"length_m": "covers the inventory's trees along the façade, 20 m beyond each end"}))
     doc.add("light", table(TABLES["light"], light,
-                           {"sky": "Perez sky from the EPW's diffuse illuminance"}))
+                           {"sky": "Perez sky of the weather's diffuse illuminance",
+                            "weather": "clear-sky needs no file; epw = \"data/site.epw\" for "
+                                       "measured or typical-year weather"}))
     tree = table(TABLES["tree"], {"form": "free", "species": species},
                  {"species": "fills leaf optics, tilt and permeability left out below"})
     for sub in TREE_TABLES:
@@ -313,7 +422,7 @@ class NewProject:
     site_source: str
     template: str
     copied: list[Path]
-    generated_epw: bool
+    weather: str
 
 
 def _copy(src: Path, data_dir: Path, made: list[Path]) -> str:
@@ -328,8 +437,10 @@ def _copy(src: Path, data_dir: Path, made: list[Path]) -> str:
 
 def new_project(folder: Path, trees: Path | None = None, buildings: Path | None = None,
                 honeybee: Path | None = None, epw: Path | None = None,
-                template: str | None = None) -> NewProject:
-    """Write ``folder/radtree.toml`` (+ ``data/``) and check it loads; see the module text."""
+                template: str | None = None, where: Location | None = None,
+                validate: Callable[[Project], None] | None = None) -> NewProject:
+    """Write ``folder/radtree.toml`` (+ ``data/``), load it and run ``validate`` on it (the
+    build's input checks) before it is moved into place; see the module text."""
     folder = Path(folder)
     template = template or ("district" if buildings is not None else "street")
     if template not in TEMPLATES:
@@ -346,7 +457,9 @@ def new_project(folder: Path, trees: Path | None = None, buildings: Path | None 
     if target.exists():
         raise ConfigError(f"{target} exists already: radtree new does not overwrite a project")
     inputs = read_inputs(trees, buildings, honeybee)
-    site, site_source = site_facts(epw, inputs)
+    site, site_source = site_facts(epw, inputs, where)
+    site["date"] = (where.date if where is not None and where.date
+                    else "2024-06-21" if site["latitude"] >= 0 else "2024-12-21")
     known = [s for s, _ in inputs.species.most_common() if find_species(s)]
     species = find_species(known[0]).key if known else DEFAULT_SPECIES  # type: ignore[union-attr]
     made_folder = not folder.exists()
@@ -359,21 +472,17 @@ def new_project(folder: Path, trees: Path | None = None, buildings: Path | None 
         data = {key: _copy(Path(p), data_dir, made) for key, p in
                 (("trees", trees), ("buildings", buildings), ("honeybee", honeybee))
                 if p is not None}
-        if epw is not None:
-            light = {"epw": _copy(Path(epw), data_dir, made), "sky": "perez"}
-        else:
-            out = data_dir / GENERATED_EPW
-            write_generated_epw(out, site["name"], site["latitude"], site["longitude"],
-                                site["elevation_m"], site["utc_offset_hours"])
-            made.append(out)
-            light = {"epw": f"data/{GENERATED_EPW}", "sky": "perez"}
+        light: dict[str, Any] = ({"weather": "epw", "epw": _copy(Path(epw), data_dir, made),
+                                  "sky": "perez"} if epw is not None
+                                 else {"weather": "clear-sky", "sky": "perez"})
         doc = document(template, site, site_source, data, light, inputs, species)
         write_text(tmp, tomlkit.dumps(doc))
         try:
-            load_project(tmp)                   # what build will read, as written
+            project = load_project(tmp)         # what build will read, as written
+            if validate is not None:
+                validate(project)               # and the build's checks of the inputs
         except ConfigError as exc:
-            raise ConfigError(f"the project written for {target} does not load, nothing was "
-                              f"kept: {exc}") from None
+            raise ConfigError(f"{exc} — nothing was written to {folder}") from None
         tmp.replace(target)
     except BaseException:
         tmp.unlink(missing_ok=True)
@@ -384,4 +493,4 @@ def new_project(folder: Path, trees: Path | None = None, buildings: Path | None 
         if made_folder and folder.exists() and not any(folder.iterdir()):
             folder.rmdir()
         raise
-    return NewProject(target, inputs, site, site_source, template, made, epw is None)
+    return NewProject(target, inputs, site, site_source, template, made, light["weather"])

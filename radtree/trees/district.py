@@ -37,14 +37,17 @@ from radtree.config import Louvers, Project, Tree
 from radtree.errors import ConfigError
 from radtree.optics import Plastic, Trans
 from radtree.scene import Instance, Mesh
+from radtree.site.buildings import WallContact
+from radtree.site.frame import FacadeFrame
 from radtree.site.inventory import InventoryTree
-from radtree.trees.envelope import CrownRowSpec
+from radtree.trees.envelope import CrownRowSpec, clip_plane
 from radtree.trees.geometry import polygons_to_mesh
 from radtree.trees.louvers import LouverOptics, check_louvers
 from radtree.trees.louvers_free import build_free_louvers
 from radtree.trees.model import BARK_REFLECTANCE, TRUNK, TreeModel
 from radtree.trees.species import Species, known_species, load_species, species_tree
 from radtree.trees.volume import build_volume_louvers, recommended_volume_ab
+from radtree.trees.wall_policy import WallReach, apply_wall_policy, two_walls
 
 TREE_SEED_STEP = 7919
 PROTOTYPE_SEED_STEP = 104729
@@ -85,15 +88,63 @@ def _slats(spec: CrownRowSpec, lv: Louvers, source: str) -> list[np.ndarray]:
     return polys
 
 
+#: a clipped inventory crown: the wall it meets and the clip plane's distance from it (m)
+WallClip = tuple[WallContact, float]
+
+
+def wall_clips(project: Project, trees: list[InventoryTree],
+               walls: dict[str, list[WallContact]] | None, source: str
+               ) -> tuple[dict[str, WallClip], list[str]]:
+    """The crown–wall policy (:mod:`radtree.trees.wall_policy`) over an inventory: per tree
+    whose crown reaches a wall's clip plane, the wall and the plane's distance from it, and
+    the policy's notes; under ``refuse`` (or a crown reaching two walls, or a trunk at the clip
+    plane) the ConfigError naming the feature and the fix."""
+    n_clip = clip_plane(project.tree, project.sensors)
+    rt0 = project.tree.crown.trunk_diameter_m / 2.0
+    reaches, clips = [], {}
+    for t in trees:
+        hit = [c for c in (walls or {}).get(t.id, [])
+               if t.crown_radius_m > c.distance_m - n_clip]
+        if not hit:
+            continue
+        where = f"feature {t.id!r}"
+        if len(hit) > 1:
+            raise two_walls(f"the crown of tree {t.id!r}", [c.wall for c in hit],
+                            t.crown_radius_m, min(c.distance_m for c in hit) - n_clip, where,
+                            source)
+        c = hit[0]
+        rt = (t.trunk_diameter_m / 2.0) if t.trunk_diameter_m else rt0
+        if c.distance_m - n_clip <= rt:
+            raise ConfigError(f"the trunk (radius {rt:g} m) stands {c.distance_m:.2f} m from "
+                              f"{c.wall}, at its clip plane ({n_clip:g} m out): move the "
+                              f"trunk at least {n_clip + rt - c.distance_m + 0.01:.2f} m away",
+                              source=source, field=where)
+        reaches.append(WallReach(f"the crown of tree {t.id!r}", c.wall, t.crown_radius_m,
+                                 c.distance_m - n_clip, where,
+                                 "the crown radius (crown_diameter_m / 2)"))
+        clips[t.id] = (c, n_clip)
+    return clips, apply_wall_policy(project.tree.wall_policy, reaches, source)
+
+
+def _wall_frame(contact: WallContact) -> FacadeFrame:
+    """The wall's frame: origin at its nearest point to the trunk, n towards the trunk."""
+    nx, ny = (float(v) for v in contact.normal)
+    return FacadeFrame(azimuth_deg=math.degrees(math.atan2(nx, ny)),
+                       origin_x=float(contact.point[0]), origin_y=float(contact.point[1]))
+
+
 def yaw_of(tree_id: str) -> float:
     """A repeatable yaw (degrees) for an instanced crown, from the tree id."""
     return float(zlib.crc32(tree_id.encode()) % 3600) / 10.0
 
 
 def inventory_crowns(project: Project, trees: list[InventoryTree], tree: Tree,
-                     instancing: str = "auto") -> TreeModel:
+                     instancing: str = "auto", clips: dict[str, WallClip] | None = None
+                     ) -> TreeModel:
     """The crowns of every inventory tree (louvers model, free form) as one TreeModel;
-    ``tree``: the project's [tree] after the scenario's switches."""
+    ``tree``: the project's [tree] after the scenario's switches. A crown in ``clips``
+    (:func:`wall_clips`) is built in place in its wall's frame, cut at the clip plane."""
+    clips = clips or {}
     lv = tree.louvers
     source = str(project.source)
     species = species_of(trees, source)
@@ -120,10 +171,11 @@ def inventory_crowns(project: Project, trees: list[InventoryTree], tree: Tree,
             ab = max(ab, recommended_volume_ab(slv))
         else:
             ab = max(ab, slv.layers + 2)
-        shared = instancing == "auto" and len(group) > 1
+        free = [t for t in group if t.id not in clips]
+        shared = instancing == "auto" and len(free) > 1
         if shared:
-            a_ref = float(np.median([t.crown_radius_m for t in group]))
-            aspect = float(np.median([t.vertical_radius_m / t.crown_radius_m for t in group]))
+            a_ref = float(np.median([t.crown_radius_m for t in free]))
+            aspect = float(np.median([t.vertical_radius_m / t.crown_radius_m for t in free]))
             b_ref = a_ref * aspect
             rt_ref = default_rt
             pspec = single_spec(np.zeros(3), a_ref, b_ref, rt_ref, -b_ref + 0.5 * b_ref)
@@ -132,13 +184,13 @@ def inventory_crowns(project: Project, trees: list[InventoryTree], tree: Tree,
             name = f"crown_{key}_s{lv.seed}"
             prototypes[name] = [Mesh(f"{name}_leaves", mat, v, f)]
             dz = []
-            for t in group:
+            for t in free:
                 k = t.crown_radius_m / a_ref
                 b_eff = b_ref * k
                 instances.append(Instance(name, (t.x, t.y, t.crown_base_m + b_eff),
                                           yaw_of(t.id), k, owner=str(t.id)))
                 dz.append(t.crown_base_m + 2 * b_eff - t.height_m)
-            notes.append(f"{key}: {len(group)} trees share one crown (instanced; median "
+            notes.append(f"{key}: {len(free)} trees share one crown (instanced; median "
                          f"radius {a_ref:.2f} m, aspect b/a {aspect:.2f}, {len(f)} triangles); "
                          f"crown tops differ from the inventory heights by "
                          f"{min(dz):+.2f}…{max(dz):+.2f} m.")
@@ -146,18 +198,28 @@ def inventory_crowns(project: Project, trees: list[InventoryTree], tree: Tree,
         leaf_owners: list[np.ndarray] = []
         for t in group:
             a, b = t.crown_radius_m, t.vertical_radius_m
-            if shared:
+            placed = shared and t.id not in clips      # an instance of the shared crown
+            if placed:
                 b = (t.crown_radius_m / a_ref) * b_ref
             rt = (t.trunk_diameter_m / 2.0) if t.trunk_diameter_m else default_rt
             spec = single_spec(np.array([t.x, t.y, t.crown_base_m + b]), a, b, rt,
                                t.crown_base_m + 0.5 * b)
-            if not shared:
+            wf = None
+            if t.id in clips:                          # in the wall's frame, cut at the plane
+                contact, n_clip = clips[t.id]
+                wf = _wall_frame(contact)
+                u, n, _ = wf.to_local(np.array([t.x, t.y, 0.0]))
+                spec = replace(single_spec(np.array([u, n, t.crown_base_m + b]), a, b, rt,
+                                           t.crown_base_m + 0.5 * b), n_clip=n_clip)
+            if not placed:
                 seed = lv.seed + TREE_SEED_STEP * index[t.id]
-                mine = _slats(spec, replace(slv, seed=seed), source)
-                polys.extend(mine)
-                leaf_owners.append(np.full(sum(len(q) - 2 for q in mine if len(q) >= 3),
+                slats = _slats(spec, replace(slv, seed=seed), source)
+                polys.extend(slats if wf is None else [wf.to_world(p) for p in slats])
+                leaf_owners.append(np.full(sum(len(q) - 2 for q in slats if len(q) >= 3),
                                            str(t.id)))
             tv, tf = spec.trunks()
+            if wf is not None:
+                tv = wf.to_world(tv)
             trunks_v.append(tv)
             trunks_f.append(tf + off)
             trunk_owners.append(np.full(len(tf), str(t.id)))
@@ -165,9 +227,9 @@ def inventory_crowns(project: Project, trees: list[InventoryTree], tree: Tree,
         if polys:
             v, f = polygons_to_mesh(polys)
             leaves.append(Mesh(f"tree_leaves_{key}", mat, v, f, np.concatenate(leaf_owners)))
-            if not shared:
-                notes.append(f"{key}: {len(group)} crown(s) built in place ({len(f)} "
-                             "triangles).")
+            if len(free) < len(group) or not shared:
+                built = len(group) - (len(free) if shared else 0)
+                notes.append(f"{key}: {built} crown(s) built in place ({len(f)} triangles).")
         notes.append(f"{key} leaves: " + o.describe_slat() + f"; slats {slv.slat_size_m:g} m "
                      f"at {slv.inclination_deg:g}° (species leaf tilt), permeability "
                      f"{species[group[0].id].permeability_leaf_on:g}.")

@@ -33,6 +33,7 @@ import numpy as np
 from radtree.config import Sensors, Street, Tree
 from radtree.errors import ConfigError
 from radtree.trees.geometry import cylinder_mesh, hemisphere_mesh
+from radtree.trees.wall_policy import WallReach, apply_wall_policy
 
 CLIP_MARGIN_M = 0.005  # crown stops this far in front of the sensors when clearance is 0
 
@@ -200,6 +201,17 @@ def clip_plane(tree: Tree, sensors: Sensors) -> float:
     return max(tree.crown.clearance_m, sensors.offset_m + CLIP_MARGIN_M)
 
 
+def row_wall_reach(tree: Tree, sensors: Sensors) -> WallReach | None:
+    """The row's crowns reaching the façade (all alike), or None (:mod:`.wall_policy`)."""
+    cr = tree.crown
+    d = cr.trunk_distance_m - clip_plane(tree, sensors)
+    if cr.radius_m <= d:
+        return None
+    who = "the row's crown" if cr.count == 1 else f"each of the row's {cr.count} crowns"
+    return WallReach(who, "the façade", cr.radius_m, d, "tree.crown.radius_m",
+                     "[tree.crown] radius_m", "[tree.crown] trunk_distance_m")
+
+
 def crown_row_spec(tree: Tree, sensors: Sensors, street: Street, source: str | None = None
                    ) -> CrownRowSpec:
     """Validate and lay out the row of free-standing crowns."""
@@ -223,9 +235,15 @@ def crown_row_spec(tree: Tree, sensors: Sensors, street: Street, source: str | N
                   f"the trunk (axis {cr.trunk_distance_m:g} m, radius {rt:g} m) must stand in "
                   f"front of the crown's wall-side clip plane at n = {n_clip:g} m")
     if cr.trunk_distance_m + cr.radius_m >= street.width_m:
+        fit = math.floor((street.width_m - cr.trunk_distance_m) * 100.0 - 1e-6) / 100.0
         raise err("radius_m",
                   f"the crown reaches n = {cr.trunk_distance_m + cr.radius_m:g} m, beyond the "
-                  f"opposite façade at {street.width_m:g} m (street.width_m)")
+                  f"opposite façade at {street.width_m:g} m (street.width_m): reduce radius_m "
+                  f"below {street.width_m - cr.trunk_distance_m:g} m (e.g. {fit:.2f}) or widen "
+                  "the street")
+    reach = row_wall_reach(tree, sensors)
+    if reach is not None:
+        apply_wall_policy(tree.wall_policy, [reach], source)   # "refuse": its ConfigError
     if cr.count > 1 and cr.spacing_m <= 2.0 * rt:
         raise err("spacing_m", f"got {cr.spacing_m:g} m: trunks of diameter "
                                f"{cr.trunk_diameter_m:g} m would overlap")
@@ -273,6 +291,9 @@ def row_notes(spec: CrownRowSpec, tree: Tree, sensors: Sensors) -> list[str]:
         notes.append(f"Crowns reach the wall (clearance {cr.clearance_m:g} m): clipped at "
                      f"n = {spec.n_clip:g} m, 5 mm in front of the sensors "
                      f"({sensors.offset_m:g} m off the wall), so no sensor lies inside a crown.")
+    reach = row_wall_reach(tree, sensors)
+    if reach is not None:
+        notes += apply_wall_policy(tree.wall_policy, [reach], None)
     if np.isfinite(spec.strips).any():
         notes.append("Neighbouring crowns overlap; the row is one envelope (each crown keeps "
                      "the half of the overlap nearer its trunk).")

@@ -240,7 +240,10 @@ def build_louvers(tree: Tree, sensors: Sensors, street: Street, frame: FacadeFra
             from radtree.trees.photo_fit import camera_point, fitted_louvers
 
             lv, fit, photo = fitted_louvers(lv, src, spec_r, camera_point(tree, sensors),
-                                            frame, source)
+                                            frame, source, tree.accept_poor_fit)
+            if fit.problems():
+                notes.append("POOR PHOTO FIT ACCEPTED ([tree] accept_poor_fit = true): "
+                             + "; ".join(fit.problems()) + ".")
             volume = True
             tilt = (f"leaf inclinations from Campbell's ellipsoidal distribution, x = "
                     f"{fit.x:.3g} (mean tilt {fit.mean_tilt_deg:.1f}°)" if fit.x is not None
@@ -292,8 +295,8 @@ def build_louvers(tree: Tree, sensors: Sensors, street: Street, frame: FacadeFra
                      "(switch louvers.reading = \"gap\").")
     elif optics.reading == "gap":
         notes.append("Gap reading: leaves are near-opaque real leaves and each layer passes "
-                     "light mainly through its gaps (switch louvers.reading = \"study\" for the "
-                     "study's effective slat material).")
+                     "light mainly through its gaps (switch louvers.reading = \"study\" for an "
+                     "effective slat material: every layer covered, transmittance 0.5).")
     if volume:
         ab = recommended_volume_ab(lv)
         notes.append(f"Radiance: -ab {ab} (crossings + 2, capped at 6: light crossing many "

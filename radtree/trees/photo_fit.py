@@ -62,6 +62,15 @@ from radtree.trees.photo import PhotoSource, analyse_photo, provenance, with_sou
 CELL_SAMPLES = (6, 10)    # zenith × azimuth directions per ring × segment cell
 X_BOUNDS = (0.1, 10.0)
 U_BOUNDS = (1e-3, 20.0)
+#: a fit whose ring gap fractions miss the photo's by more than this (RMS) is refused
+#: (``[tree] accept_poor_fit`` overrides): a crown the photo does not describe
+MAX_RING_RMS = 0.05
+
+
+def _at_bound(v: float, bounds: tuple[float, float]) -> bool:
+    """Within 1 % (in log) of either bound."""
+    span = math.log(bounds[1] / bounds[0])
+    return min(abs(math.log(v / bounds[0])), abs(math.log(bounds[1] / v))) < 0.01 * span
 #: the clumping indices at which the model's Lang & Xiang clumping is computed (fit_omega)
 OMEGA_GRID = (1.0, 0.85, 0.7, 0.55, 0.4, 0.25)
 CLUSTER_REALISATIONS = 6   # crowns drawn per Ω (seeds 1001–1006) whose clumping_lx is averaged
@@ -90,6 +99,28 @@ class CrownFit:
     clumping_lx_model: float = math.nan   # the fitted crown's clumping_lx (cluster draws)
     clumping_curve: tuple[tuple[float, float], ...] = ()   # (Ω, model clumping_lx)
     clumping_lx_target: float = math.nan   # the photos' clumping_lx on the fit's grid
+    #: per zenith ring: (zenith from, to (degrees), photo gap fraction, model gap fraction)
+    rings: tuple[tuple[float, float, float, float], ...] = ()
+
+    def problems(self) -> list[str]:
+        """Why the fit is poor (empty when it is acceptable): ring RMS above
+        :data:`MAX_RING_RMS`, or a fitted parameter at its bound."""
+        out = []
+        if not self.ring_rms <= MAX_RING_RMS:
+            out.append(f"gap-fraction RMS over the zenith rings {self.ring_rms:.3f} > "
+                       f"{MAX_RING_RMS:g}")
+        if _at_bound(self.lad, U_BOUNDS):
+            out.append(f"leaf area density {self.lad:.3g} m²/m³ at its bound {U_BOUNDS}")
+        if self.x is not None and _at_bound(self.x, X_BOUNDS):
+            out.append(f"leaf angle parameter x = {self.x:.3g} (mean tilt "
+                       f"{self.mean_tilt_deg:.1f}°) at its bound {X_BOUNDS}")
+        return out
+
+    def ring_table(self) -> str:
+        """The rings, photo vs model, as text lines."""
+        head = "zenith °   photo gap  model gap"
+        return "\n".join([head] + [f"{a:4.0f}–{b:<4.0f}  {p:9.3f}  {m:9.3f}"
+                                   for a, b, p, m in self.rings])
 
     @property
     def mean_tilt_deg(self) -> float | None:
@@ -454,6 +485,11 @@ def fit_crown(src: PhotoSource, camera: np.ndarray, spec: CrownRowSpec, lv: Louv
              for p in paths]
     ring_d = [np.nanmean(mg, axis=1) - np.nanmean(t, axis=1) for mg, t in zip(model, targets)]
     ring_rms = float(np.sqrt(np.nanmean(np.concatenate(ring_d) ** 2)))
+    edges = results[0].table.grid.ring_edges
+    ring_rows = tuple((float(edges[k]), float(edges[k + 1]),
+                       float(np.nanmean([np.nanmean(t[k]) for t in targets])),
+                       float(np.nanmean([np.nanmean(mg[k]) for mg in model])))
+                      for k in range(len(edges) - 1))
     fitted_lv = replace(lv, inclination_distribution="ellipsoidal" if x is not None
                         else "fixed", ellipsoid_x=x if x is not None else lv.ellipsoid_x)
     from radtree.trees.volume import mean_cos
@@ -462,7 +498,8 @@ def fit_crown(src: PhotoSource, camera: np.ndarray, spec: CrownRowSpec, lv: Louv
     fit = CrownFit(lad, x, crossings, rms, ring_rms,
                    float(np.nanmean([r.metrics.lai_eff for r in results])),
                    float(np.nanmean([r.metrics.clumping_lx for r in results])), per,
-                   omega, lv.clumping_fit, _model_lx(curve, omega), curve, lx_target)
+                   omega, lv.clumping_fit, _model_lx(curve, omega), curve, lx_target,
+                   ring_rows)
     _CACHE[key] = (fit, results)
     return fit, results
 
@@ -476,20 +513,30 @@ def _model_lx(curve: tuple[tuple[float, float], ...], omega: float) -> float:
 
 
 def fitted_louvers(lv: Louvers, src: PhotoSource, spec: CrownRowSpec, camera: np.ndarray,
-                   frame: FacadeFrame, source: str | None = None
-                   ) -> tuple[Louvers, CrownFit, dict[str, Any]]:
+                   frame: FacadeFrame, source: str | None = None,
+                   accept_poor_fit: bool = False) -> tuple[Louvers, CrownFit, dict[str, Any]]:
     """The louvers table with the fitted density (``crossings``) and distribution, the fit
     and its provenance."""
     try:
         fit, results = fit_crown(src, camera, spec, lv, frame)
     except ConfigError as exc:
         raise with_source(exc, source) from None
+    problems = fit.problems()
+    if problems and not accept_poor_fit:
+        raise ConfigError(
+            f"the crown fitted to the photo {src.path.name} does not describe it: "
+            + "; ".join(problems) + ". Rings (photo vs fitted crown):\n" + fit.ring_table()
+            + "\nCheck the photo's lens, mask and camera point (tree.photo_x_m, "
+            "photo_distance_m, photo_height_m) and the crown table; or set [tree] "
+            "accept_poor_fit = true to build it anyway (the report then says so)",
+            source=source, field="tree.photo")
     new = replace(lv, arrangement="volume", crossings=float(np.clip(fit.crossings, 0.01, 60.0)),
                   clumping=float(np.clip(fit.clumping, 0.1, 1.0)),
                   inclination_distribution="ellipsoidal" if fit.x is not None else "fixed",
                   ellipsoid_x=fit.x if fit.x is not None else lv.ellipsoid_x)
     return new, fit, provenance(src, results, {**fit.as_dict(),
-                                               "camera_local_m": camera.tolist()})
+                                               "camera_local_m": camera.tolist(),
+                                               "poor_fit_accepted": problems})
 
 
 def camera_point(tree: Any, sensors: Sensors) -> np.ndarray:

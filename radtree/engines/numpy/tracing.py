@@ -27,7 +27,7 @@ from radtree.engines.numpy.tally import SensorTally
 from radtree.errors import EngineError
 from radtree.light.sky import SkyState
 from radtree.scene import Scene, SensorGrid
-from radtree.sensor_grid import DENSE_GRID
+from radtree.sensor_grid import is_dense_grid
 
 __all__ = ["grid_rays", "trace", "trace_bounce_ladder", "trace_hour", "trace_states"]
 
@@ -170,9 +170,9 @@ def trace_bounce_ladder(scene: Scene, state: SkyState, params: EngineParams,
 
 
 def grid_rays(params: EngineParams, grid: str) -> int:
-    """Paths per sensor of ``grid``: ``engine.dense_rays`` for the dense façade map when set,
+    """Paths per sensor of ``grid``: ``engine.dense_rays`` for the dense façade maps when set,
     else ``engine.rays``."""
-    if grid == DENSE_GRID and params.dense_rays is not None:
+    if is_dense_grid(grid) and params.dense_rays is not None:
         return int(params.dense_rays)
     return int(params.rays)
 

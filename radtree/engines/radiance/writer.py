@@ -39,7 +39,7 @@ from radtree.light.units import PHOTOPIC_RGB, WHITE_EFFICACY
 from radtree.optics import Hole, Material, Plastic, with_reflectance
 from radtree.resources import template_environment
 from radtree.scene import Mesh, Scene
-from radtree.sensor_grid import DENSE_GRID
+from radtree.sensor_grid import is_dense_grid
 
 
 def mesh_to_radiance(mesh: Mesh) -> str:
@@ -90,11 +90,13 @@ def rtrace_options(params: EngineParams, ab: int) -> list[str]:
 
 
 def grid_rtrace_options(params: EngineParams, ab: int, grids: list[str]) -> dict[str, list[str]]:
-    """rtrace options of the grids traced differently: the dense façade map with
-    ``-lw engine.dense_lw`` (when set and the map is in ``grids``)."""
-    if params.dense_lw is None or DENSE_GRID not in grids:
+    """rtrace options of the grids traced differently: the dense façade maps with
+    ``-lw engine.dense_lw`` (when set and a map is in ``grids``)."""
+    maps = [g for g in grids if is_dense_grid(g)]
+    if params.dense_lw is None or not maps:
         return {}
-    return {DENSE_GRID: rtrace_options(replace(params, lw=params.dense_lw), ab)}
+    options = rtrace_options(replace(params, lw=params.dense_lw), ab)
+    return {g: options for g in maps}
 
 
 @dataclass
