@@ -19,12 +19,16 @@ class Mesh:
 
     ``vertices`` (N, 3) float metres; ``faces`` (M, 3) int indices into ``vertices``. Triangles are
     two-sided for both engines (Radiance polygons are two-sided for plastic/trans/glass).
+    ``owners`` (M,) str, optional: the tree each face belongs to (an inventory tree's id, a
+    row crown's number; ``""`` = none) — what :meth:`Scene.without_owners` removes and what an
+    engine attributing light to trees names (:mod:`radtree.engines.numpy.attribution`).
     """
 
     name: str
     material: str
     vertices: np.ndarray
     faces: np.ndarray
+    owners: np.ndarray | None = None
 
     def __post_init__(self) -> None:
         self.vertices = np.asarray(self.vertices, dtype=float).reshape(-1, 3)
@@ -33,6 +37,10 @@ class Mesh:
             raise ValueError(f"mesh '{self.name}': face index outside its {len(self.vertices)} vertices")
         if not np.all(np.isfinite(self.vertices)):
             raise ValueError(f"mesh '{self.name}': vertices must be finite")
+        if self.owners is not None:
+            self.owners = np.asarray(self.owners, dtype=str).reshape(-1)
+            if len(self.owners) != len(self.faces):
+                raise ValueError(f"mesh '{self.name}': one owner per face is needed")
 
     @property
     def n_triangles(self) -> int:
@@ -56,7 +64,11 @@ class Mesh:
             offset += len(m.vertices)
         if not verts:
             return Mesh(name, material, np.zeros((0, 3)), np.zeros((0, 3), int))
-        return Mesh(name, material, np.vstack(verts), np.vstack(faces))
+        owners = None
+        if any(m.owners is not None for m in meshes):
+            owners = np.concatenate([m.owners if m.owners is not None
+                                     else np.full(m.n_triangles, "") for m in meshes])
+        return Mesh(name, material, np.vstack(verts), np.vstack(faces), owners)
 
 
 def quad(name: str, material: str, corners: np.ndarray) -> Mesh:
@@ -109,12 +121,14 @@ class SensorGrid:
 class Instance:
     """A placed copy of a prototype (a list of meshes in its own frame): rotated
     ``rotate_z_deg`` counter-clockwise about +z, scaled uniformly by ``scale``, then moved by
-    ``translate`` (m) — Radiance's ``-rz A -s S -t X Y Z`` order."""
+    ``translate`` (m) — Radiance's ``-rz A -s S -t X Y Z`` order. ``owner``: the tree the
+    copy is (as :attr:`Mesh.owners`), ``""`` = none."""
 
     prototype: str
     translate: tuple[float, float, float]
     rotate_z_deg: float = 0.0
     scale: float = 1.0
+    owner: str = ""
 
     def apply(self, v: np.ndarray) -> np.ndarray:
         a = np.radians(self.rotate_z_deg)
@@ -168,9 +182,48 @@ class Scene:
         for k, inst in enumerate(self.instances):
             for m in self.prototypes[inst.prototype]:
                 if not isinstance(self.materials[m.material], Hole):
+                    owners = (np.full(m.n_triangles, inst.owner) if inst.owner
+                              else m.owners)
                     out.append(Mesh(f"{m.name}@{k}", m.material, inst.apply(m.vertices),
-                                    m.faces))
+                                    m.faces, owners))
         return out
+
+    def owners(self) -> list[str]:
+        """The trees whose faces the scene holds (:attr:`Mesh.owners`, :attr:`Instance.owner`),
+        in order of first appearance."""
+        seen: dict[str, None] = {}
+        for inst in self.instances:
+            if inst.owner:
+                seen.setdefault(inst.owner)
+        for m in [*self.meshes, *(p for ms in self.prototypes.values() for p in ms)]:
+            if m.owners is not None:
+                seen.update(dict.fromkeys(str(o) for o in dict.fromkeys(m.owners.tolist()) if o))
+        return list(seen)
+
+    def without_owners(self, owners: set[str] | None = None) -> Scene:
+        """The same scene without the faces of ``owners`` (default: every owned face) — the
+        scene with those trees removed; grids, materials and notes shared."""
+        def gone(o: np.ndarray) -> np.ndarray:
+            return (o != "") if owners is None else np.isin(o, list(owners))
+
+        def keep(m: Mesh) -> Mesh | None:
+            if m.owners is None:
+                return m
+            k = ~gone(m.owners)
+            if k.all():
+                return m
+            if not k.any():
+                return None
+            return Mesh(m.name, m.material, m.vertices, m.faces[k], m.owners[k])
+
+        meshes = [k for k in (keep(m) for m in self.meshes) if k is not None]
+        protos = {n: [k for k in (keep(m) for m in ms) if k is not None]
+                  for n, ms in self.prototypes.items()}
+        insts = [i for i in self.instances
+                 if not (i.owner and (owners is None or i.owner in owners))]
+        used = {i.prototype for i in insts}
+        return Scene(meshes, self.materials, self.grids, list(self.notes), self.ground_material,
+                     {n: ms for n, ms in protos.items() if n in used}, insts)
 
     def mesh(self, name: str) -> Mesh:
         for m in self.meshes:

@@ -421,6 +421,19 @@ def test_annual_command_writes_the_interface(tiny_project):
     assert july.crown == "bare" and july.leaf_on_days == 0
     may = mo[(mo.tree == "with") & (mo.month == 5)].iloc[0]
     assert may.crown == "mixed" and may.leaf_on_days == 19
+    # the standards, with and without the tree, each with its definition
+    st = pd.read_csv(results / "annual" / "standards.csv")
+    assert list(st.columns) == ["scenario", "target", "metric", "value", "unit", "definition"]
+    assert len(set(st.scenario)) == 2 and set(st.target) == {"facade"}
+    assert {"en17037_provision_level", "en17037_sunlight_hours", "leed_sda_300_50",
+            "leed_ase_1000_250"} <= set(st.metric)
+    assert st.definition.notna().all()
+    import json
+
+    names = json.loads((results / "annual" / "annual_meta.json").read_text())["scenarios"]
+    for tree, scen in names.items():   # the LEED figures are annual_summary.csv's
+        sda = st[(st.scenario == scen) & (st.metric == "leed_sda_300_50")].value.iloc[0]
+        assert sda == pytest.approx(s[s.tree == tree].sda_300_50.iloc[0], abs=1e-3)
     from radtree.report.sections import Section, render_section
 
     html = render_section(Section("annual", annual_section_data(load_project(tiny_project))))

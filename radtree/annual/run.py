@@ -50,6 +50,7 @@ import numpy as np
 import pandas as pd
 
 import radtree.annual.metrics as metrics
+import radtree.annual.standards as standards
 from radtree.annual.branches import BranchParams, build_leaf_off
 from radtree.annual.coefficients import CoefficientRunner, TraceParams
 from radtree.annual.phenology import Phenology, crown_year, phenology_of
@@ -61,7 +62,7 @@ from radtree.annual.schedule import (
     parse_occupancy,
 )
 from radtree.annual.skymatrix import Suns, Wea, patch_count
-from radtree.annual.weather_year import YearInputs, annual_weather
+from radtree.annual.weather_year import YearInputs, annual_ground_reflectance, annual_weather
 from radtree.config import Project, Scenario, effective_project
 from radtree.errors import ConfigError
 from radtree.fileio import atomic_path, write_text
@@ -122,6 +123,8 @@ class AnnualOptions:
     #: default method's sun runs — hourly direct sun and reflected sun — on its leaf-on /
     #: bare-branch scenes) or "bsdf" (both on the BSDF-crown scene)
     sun_crown: str = "explicit"
+    #: EN 17037 exposure to sunlight: the date (MM-DD, 1 February – 21 March)
+    sunlight_date: str = standards.SUNLIGHT_DATE
 
     def __post_init__(self) -> None:
         if self.method not in METHODS:
@@ -133,6 +136,7 @@ class AnnualOptions:
             raise ConfigError(f"sky subdivision must be ≥ 1 (got --mf {self.mf}, "
                               f"sun MF {self.sun_mf})")
         parse_occupancy(self.occupancy)
+        standards.check_sunlight_date(self.sunlight_date)
         if self.nproc < 1:
             raise ConfigError("processes must be ≥ 1")
         for name, value in (("--lw", self.lw), ("--sun-lw", self.sun_lw)):
@@ -170,6 +174,8 @@ class AnnualResult:
     leaf_fraction: np.ndarray | None = None
     leaf_weight: np.ndarray | None = None
     phenology: Phenology | None = None
+    #: EN 17037 sunlight: "with"/"without" → grid → hours of sun per sensor (standards.py)
+    sunlight: dict[str, dict[str, np.ndarray]] | None = None
 
 
 # ---------------------------------------------------------------- scene choice
@@ -221,18 +227,6 @@ def choose_scenarios(project: Project, options: AnnualOptions
     notes.append("The annual sky comes from the weather file (Perez sky + sun every hour); "
                  "a scenario's own sky setting applies to the point-in-time runs only.")
     return with_sc, without_sc, notes
-
-
-def annual_ground_reflectance(project: Project) -> float:
-    """The street's reflectance for a whole year: the constant, or the mean of the
-    sun-angle table (coefficients need one fixed material)."""
-    table = project.street.ground_reflectance_table
-    if table is None:
-        return float(project.street.ground_reflectance)
-    from radtree.light.tables import ground_reflectance_table
-
-    df = ground_reflectance_table(table)
-    return float(df["reflectance"].mean())
 
 
 def annual_scenes(project: Project, with_sc: Scenario, without_sc: Scenario,
@@ -394,13 +388,15 @@ def compute_annual(project: Project, options: AnnualOptions | None = None,
                     "normals": scenes["leaf_on"].grids[g].normals} for g in grids}
     notes.append(f"Crown {options.season.describe() if phen is None else phen.describe()}.")
     notes += METHOD_NOTES
+    sun = standards.annual_sunlight(project, scenes, grids, options.sunlight_date, in_leaf, wea)
     timing["total_s"] = time.perf_counter() - t0
     return AnnualResult(project=project, options=options, weather=weather, wea=wea,
                         grids=grid_geo, total=total, direct=direct, in_leaf=in_leaf,
                         occupied=occ, scenarios={"with": with_sc.name,
                                                  "without": without_sc.name},
                         trace=trace, sun_trace=sun_trace, ground_reflectance=rho, notes=notes, timing=timing,
-                        leaf_fraction=fraction, leaf_weight=weight, phenology=phen)
+                        leaf_fraction=fraction, leaf_weight=weight, phenology=phen,
+                        sunlight=sun)
 
 
 # ---------------------------------------------------------------- tables
@@ -501,6 +497,9 @@ def write_annual(result: AnnualResult, figures: bool = True) -> AnnualOutcome:
         meta["phenology"] = {"species": result.phenology.species.key,
                              "latitude": result.phenology.latitude_deg,
                              "describe": result.phenology.describe()}
+    standards.write_standards(project, standards.standards_table(
+        result.scenarios, list(result.grids), result.total, result.direct, result.wea.dhi,
+        result.occupied, result.sunlight, result.options.sunlight_date))
     mp = write_text(res / "annual" / "annual_meta.json", json.dumps(meta, indent=2,
                                                                      default=str))
     figs: list[Path] = []

@@ -46,3 +46,15 @@ def annual_weather(project: Project, epw: Path | None, mf: int, sun_mf: int, rho
     need = np.unique(verts)
     need = need[need > 0]
     return weather, wea, sky, suns, verts, weights, need, reinhart_directions(sun_mf)
+
+
+def annual_ground_reflectance(project: Project) -> float:
+    """The street's reflectance for a whole year: the constant, or the mean of the
+    sun-angle table (coefficients need one fixed material)."""
+    table = project.street.ground_reflectance_table
+    if table is None:
+        return float(project.street.ground_reflectance)
+    from radtree.light.tables import ground_reflectance_table
+
+    df = ground_reflectance_table(table)
+    return float(df["reflectance"].mean())

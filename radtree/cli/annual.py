@@ -54,6 +54,8 @@ from radtree.cli.options import CONTEXT, writes
               show_default=True,
               help="3phase: the hourly sun traced through the explicit crown (its gaps and "
                    "slats, as the dc method does) or through the BSDF crown.")
+@click.option("--sunlight-date", default="03-21", show_default=True, metavar="MM-DD",
+              help="EN 17037 exposure to sunlight: the date (1 February – 21 March).")
 def annual_command(project: Path, leaf_on: str | None, leaf_off: str | None, mf: int,
                    sun_mf: int,
                    occupancy: str, epw: Path | None, with_scenario: str | None,
@@ -61,7 +63,7 @@ def annual_command(project: Path, leaf_on: str | None, leaf_off: str | None, mf:
                    lw: float | None, processes: int, no_figures: bool,
                    sun_ad: int | None = None, sun_lw: float | None = None,
                    use_dates: bool = False, method: str = "dc",
-                   sun_crown: str = "explicit") -> None:
+                   sun_crown: str = "explicit", sunlight_date: str = "03-21") -> None:
     """Annual daylight (8760 h) with a deciduous tree: UDI, DA, sDA, ASE, monthly means.
 
     The crown is in leaf from --leaf-on to --leaf-off; with ``[tree] species`` each hour
@@ -69,7 +71,8 @@ def annual_command(project: Path, leaf_on: str | None, leaf_off: str | None, mf:
     leaf-fall ramps; --dates keeps the switch).
 
     Writes PROJECT/results/annual.csv, annual_summary.csv, annual_monthly.csv and
-    results/annual/ (hourly arrays, coefficients, figures).
+    results/annual/ (hourly arrays, coefficients, figures, standards.csv: EN 17037 daylight
+    provision and exposure to sunlight, LEED v4.1 sDA/ASE, with and without trees).
     """
     from radtree.annual.methods import run as run_annual
     from radtree.annual.run import AnnualOptions
@@ -81,7 +84,8 @@ def annual_command(project: Path, leaf_on: str | None, leaf_off: str | None, mf:
         occupancy=parse_occupancy(occupancy), ab=ab, ad=ad, lw=lw, sun_ad=sun_ad,
         sun_lw=sun_lw, nproc=processes,
         with_scenario=with_scenario, without_scenario=without_scenario, epw=epw,
-        species_phenology=not use_dates, method=method, sun_crown=sun_crown)
+        species_phenology=not use_dates, method=method, sun_crown=sun_crown,
+        sunlight_date=sunlight_date)
     click.echo(f"annual: {proj.name}; leaf season {options.season.describe()}")
     out = run_annual(proj, options, echo=click.echo, progress=True,
                      figures=not no_figures)
@@ -95,6 +99,7 @@ def annual_command(project: Path, leaf_on: str | None, leaf_off: str | None, mf:
     if out.result.weather.generated:
         click.secho("  weather: GENERATED clear-sky year (not measured): "
                     f"{out.result.weather.path}", fg="yellow")
-    click.echo(f"→ {out.annual_csv}\n→ {out.summary_csv}\n→ {out.monthly_csv}")
+    click.echo(f"→ {out.annual_csv}\n→ {out.summary_csv}\n→ {out.monthly_csv}\n"
+               f"→ {out.annual_csv.parent / 'annual' / 'standards.csv'}")
     for f in out.figures:
         click.echo(f"→ {f}")

@@ -41,6 +41,27 @@ class GridResult:
                 raise ValueError("stderr must have the shape of lux")
 
 
+@dataclass
+class TreeAttribution:
+    """The light each tree takes from the sensors of one grid for one hour, as an engine
+    attributes it while tracing (:attr:`Engine.attributes_trees`).
+
+    ``owners``: the trees (:attr:`radtree.scene.Mesh.owners`); ``removed`` (trees, sensors):
+    the illuminance each tree takes (lux; positive = less light with the tree): what removing
+    that tree alone gives back; ``stderr`` its Monte Carlo standard error; ``with_trees`` /
+    ``without``: the sensors traced with every tree and without the attributed ones (the same
+    paths); ``unattributed`` (sensors): change found on paths that meet no tree (0 for an
+    exact attribution). ``without − with_trees − Σ removed`` is the light the trees take
+    jointly (overlapping crowns). The engine's module states the method."""
+
+    owners: list[str]
+    removed: np.ndarray
+    stderr: np.ndarray
+    with_trees: GridResult
+    without: GridResult
+    unattributed: np.ndarray
+
+
 class Engine(ABC):
     """An estimator of sensor illuminance behind one interface.
 
@@ -60,6 +81,8 @@ class Engine(ABC):
     #: :meth:`trace_ab_ladder` traces the whole ``-ab`` ladder at once (bounce orders tallied
     #: from one set of paths) rather than one trace per ``-ab``
     ladder_in_one_trace: ClassVar[bool] = False
+    #: :meth:`attribute_trees` attributes the light the trees remove to each tree while tracing
+    attributes_trees: ClassVar[bool] = False
 
     @classmethod
     @abstractmethod
@@ -130,6 +153,14 @@ class Engine(ABC):
             plan = self.prepare(scene, [state], params, ab, folder)
             out[ab] = self.trace(plan, state.label, grids)
         return out
+
+    def attribute_trees(self, scene: Scene, state: SkyState, params: EngineParams, ab: int,
+                        grids: list[str] | None = None, owners: set[str] | None = None,
+                        seed: int | None = None) -> dict[str, TreeAttribution]:
+        """Hour ``state`` of ``scene`` traced with and without the faces of ``owners`` (default
+        every tree, :meth:`radtree.scene.Scene.without_owners`), the difference attributed to
+        each tree, per grid (engines with ``attributes_trees``)."""
+        raise NotImplementedError(f"engine {self.name!r} does not attribute light to trees")
 
     def trace_once(self, scene: Scene, state: SkyState, params: EngineParams, ab: int,
                    grids: list[str] | None = None) -> dict[str, GridResult]:

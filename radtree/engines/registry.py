@@ -71,6 +71,16 @@ def seeded_engine() -> Engine:
     raise RadtreeError("no seeded engine available")
 
 
+def attributing_engine() -> Engine | None:
+    """The first available registered engine that attributes light to trees
+    (:attr:`Engine.attributes_trees`), or None."""
+    for name in ENGINES:
+        cls = engine_class(name)
+        if cls.attributes_trees and cls.available():
+            return cls()
+    return None
+
+
 def engine_named(name: str | None) -> Engine:
     """``get_engine(name)``, or the seeded engine when ``name`` is None."""
     return seeded_engine() if name is None else get_engine(name)

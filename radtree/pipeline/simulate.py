@@ -279,6 +279,8 @@ def simulate_project(project: Project, engine: str | Engine = "auto",
     if per_realisation is not None:
         merge_write(project.results_dir / "realisations.csv", per_realisation, parents)
     table = in_column_order(table, [s.name for s in project.scenarios])
+    impact = _tree_impact(project, eng, chosen, prepared, echo, grids,
+                          {j.scenario.name for j in todo})
     out = results_path(project)
     tdf = _timing_table(timing, eng.name)
     with folder_lock(project.results_dir, "radtree simulate", wait=True, name=PUBLISH_NAME,
@@ -290,6 +292,10 @@ def simulate_project(project: Project, engine: str | Engine = "auto",
 
             write_facades_geojson(project, pd.read_csv(out, dtype={"facade": str,
                                                                    "building": str}))
+        if impact is not None:
+            from radtree.pipeline.tree_impact import write_tree_impact
+
+            echo(f"  tree impact: {write_tree_impact(project, impact)}")
         _merge_timing(project.results_dir / "timing.csv", tdf)
         write_text(project.results_dir / "manifest.json", json.dumps(
             manifest(project, extra={"engine": eng.name, "scenarios": [s.name for s in chosen]}),
@@ -329,6 +335,19 @@ def _merge_timing(out: Path, tdf: pd.DataFrame) -> None:
         tdf = pd.concat([old, tdf], ignore_index=True)
     with atomic_path(out) as tmp:
         tdf.to_csv(tmp, index=False)
+
+
+def _tree_impact(project: Project, eng: Engine, chosen: list[Scenario],
+                 prepared: dict[str, _Prepared], echo: Callable[[str], None],
+                 grids: list[str] | None, traced: set[str]) -> pd.DataFrame | None:
+    """The tree-impact table (:mod:`radtree.pipeline.tree_impact`) of the chosen scenarios,
+    unless every one of them was reused from earlier parts and the table is there."""
+    from radtree.pipeline.tree_impact import tree_impact, tree_impact_path
+
+    if not traced and tree_impact_path(project).exists():
+        return None
+    return tree_impact(project, eng, chosen,
+                       {n: (p.built, p.states) for n, p in prepared.items()}, echo, grids)
 
 
 def _write_direct_sun(project: Project, chosen: list[Scenario],

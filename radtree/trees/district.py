@@ -156,6 +156,7 @@ def inventory_crowns(project: Project, trees: list[InventoryTree], tree: Tree,
     prototypes: dict[str, list[Mesh]] = {}
     instances: list[Instance] = []
     trunks_v, trunks_f, off = [], [], 0
+    trunk_owners: list[np.ndarray] = []  # the tree of each face (Mesh.owners)
     notes: list[str] = []
     ab = 2
     index = {t.id: i for i, t in enumerate(trees)}
@@ -187,13 +188,14 @@ def inventory_crowns(project: Project, trees: list[InventoryTree], tree: Tree,
                 k = t.crown_radius_m / a_ref
                 b_eff = b_ref * k
                 instances.append(Instance(name, (t.x, t.y, t.crown_base_m + b_eff),
-                                          yaw_of(t.id), k))
+                                          yaw_of(t.id), k, owner=str(t.id)))
                 dz.append(t.crown_base_m + 2 * b_eff - t.height_m)
             notes.append(f"{key}: {len(free)} trees share one crown (instanced; median "
                          f"radius {a_ref:.2f} m, aspect b/a {aspect:.2f}, {len(f)} triangles); "
                          f"crown tops differ from the inventory heights by "
                          f"{min(dz):+.2f}…{max(dz):+.2f} m.")
         polys: list[np.ndarray] = []
+        leaf_owners: list[np.ndarray] = []
         for t in group:
             a, b = t.crown_radius_m, t.vertical_radius_m
             placed = shared and t.id not in clips      # an instance of the shared crown
@@ -213,22 +215,26 @@ def inventory_crowns(project: Project, trees: list[InventoryTree], tree: Tree,
                 seed = lv.seed + TREE_SEED_STEP * index[t.id]
                 slats = _slats(spec, replace(slv, seed=seed), source)
                 polys.extend(slats if wf is None else [wf.to_world(p) for p in slats])
+                leaf_owners.append(np.full(sum(len(q) - 2 for q in slats if len(q) >= 3),
+                                           str(t.id)))
             tv, tf = spec.trunks()
             if wf is not None:
                 tv = wf.to_world(tv)
             trunks_v.append(tv)
             trunks_f.append(tf + off)
+            trunk_owners.append(np.full(len(tf), str(t.id)))
             off += len(tv)
         if polys:
             v, f = polygons_to_mesh(polys)
-            leaves.append(Mesh(f"tree_leaves_{key}", mat, v, f))
+            leaves.append(Mesh(f"tree_leaves_{key}", mat, v, f, np.concatenate(leaf_owners)))
             if len(free) < len(group) or not shared:
                 built = len(group) - (len(free) if shared else 0)
                 notes.append(f"{key}: {built} crown(s) built in place ({len(f)} triangles).")
         notes.append(f"{key} leaves: " + o.describe_slat() + f"; slats {slv.slat_size_m:g} m "
                      f"at {slv.inclination_deg:g}° (species leaf tilt), permeability "
                      f"{species[group[0].id].permeability_leaf_on:g}.")
-    meshes = leaves + [Mesh("tree_trunks", TRUNK, np.vstack(trunks_v), np.vstack(trunks_f))]
+    meshes = leaves + [Mesh("tree_trunks", TRUNK, np.vstack(trunks_v), np.vstack(trunks_f),
+                            np.concatenate(trunk_owners))]
     notes.insert(0, f"Tree inventory: {len(trees)} trees of {len(keys)} species "
                     f"({', '.join(f'{k} {len(v)}' for k, v in by_key.items())}); "
                     f"{len(instances)} instanced from {len(prototypes)} prototype crown(s).")

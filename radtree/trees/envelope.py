@@ -108,6 +108,21 @@ class CrownRowSpec:
     def count(self) -> int:
         return len(self.centres)
 
+    def crown_ids(self, points: np.ndarray) -> np.ndarray:
+        """The crown each local point (k, 3) belongs to by its share of the row (``strips``,
+        along u): ``"C1"`` … ``"C<count>"`` in row order, ``""`` outside every share — the
+        faces' :attr:`radtree.scene.Mesh.owners`."""
+        u = np.asarray(points, float).reshape(-1, 3)[:, 0]
+        out = np.full(len(u), "", dtype=object)
+        for i, (lo, hi) in enumerate(self.strips):
+            out[(out == "") & (u >= lo) & (u <= hi)] = f"C{i + 1}"
+        return out.astype(str)
+
+    def trunk_ids(self, n_faces: int) -> np.ndarray:
+        """The crown of each of the ``n_faces`` faces of :meth:`trunks` (one trunk per crown,
+        in row order, each with the same number of faces)."""
+        return np.repeat([f"C{i + 1}" for i in range(self.count)], n_faces // self.count)
+
     def camera(self, sensors: Sensors) -> np.ndarray:
         """The photo point: the sensor circle's centre on the wall."""
         return np.array([sensors.x_m, 0.0, sensors.height_m])

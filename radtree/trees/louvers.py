@@ -203,6 +203,7 @@ def build_louvers(tree: Tree, sensors: Sensors, street: Street, frame: FacadeFra
                           "form = 'free' and no [tree] photo", source=source,
                           field="tree.points")
     photo: dict | None = None
+    owners = None   # the free crowns' faces: which crown of the row (C1 …)
     if form == "dome":
         spec = dome_spec(tree, sensors, street, source)
         quads, ginfo = build_dome_louvers(spec, lv, sensors, source)
@@ -270,10 +271,12 @@ def build_louvers(tree: Tree, sensors: Sensors, street: Street, frame: FacadeFra
         else:
             polys, ginfo = build_free_louvers(spec_r, lv, source)
         verts, faces = polygons_to_mesh(polys)
+        owners = spec_r.crown_ids(verts[faces].mean(axis=1)) if len(faces) else None
         slats = len(polys)
         tv, tf = spec_r.trunks()
         materials[TRUNK] = Plastic(TRUNK, BARK_REFLECTANCE)
-        meshes.append(Mesh("tree_trunks", TRUNK, frame.to_world(tv), tf))
+        meshes.append(Mesh("tree_trunks", TRUNK, frame.to_world(tv), tf,
+                           spec_r.trunk_ids(len(tf))))
         notes.extend(row_notes(spec_r, tree, sensors))
         ginfo["clip_plane_n_m"] = spec_r.n_clip
     if from_points:
@@ -293,7 +296,7 @@ def build_louvers(tree: Tree, sensors: Sensors, street: Street, frame: FacadeFra
             f"({int(ginfo['slats_cut'])} cut at the wall-side or shared planes). Near-"
             "horizontal views cross fewer layers than vertical ones (SPEC: first physical "
             "check, point 2).")
-    meshes.insert(0, Mesh("tree_leaves", LEAF, frame.to_world(verts), faces))
+    meshes.insert(0, Mesh("tree_leaves", LEAF, frame.to_world(verts), faces, owners))
     if volume:
         notes.append("Leaf optics, " + optics.describe_slat() + ".")
     else:

@@ -261,7 +261,9 @@ class _Tracer:
     def paths(self, points: np.ndarray, normals: np.ndarray, rng: Draws,
               parallel: bool = True, *, dirs: np.ndarray | None = None,
               escapes: Callable[[np.ndarray, np.ndarray, np.ndarray], None] | None = None,
-              orders: np.ndarray | None = None, hour: np.ndarray | None = None) -> np.ndarray:
+              orders: np.ndarray | None = None, hour: np.ndarray | None = None,
+              segments: Callable[[np.ndarray, np.ndarray, np.ndarray, np.ndarray], None]
+              | None = None) -> np.ndarray:
         """Radiance (cd/m²) seen along one cosine-sampled direction from each sensor sample.
 
         ``rng``: the streams of these paths (:class:`~radtree.engines.numpy.streams.Draws`);
@@ -273,7 +275,11 @@ class _Tracer:
         each contribution to the column of its bounce order − 1 (the diffuse segments before it,
         as ``-ab`` counts them), so that the cumulative sum over the columns is the trace at
         ``-ab`` 1, 2, … at once (:func:`trace_bounce_ladder`). ``hour``: each path's state
-        index when the tracer holds several hour states (:func:`trace_states`)."""
+        index when the tracer holds several hour states (:func:`trace_states`).
+        ``segments(path, origin, direction, reach)`` is told of every ray in path order — each
+        path's segment (``reach`` its length, ∞ when it escapes), then its shadow ray towards
+        the sun (``reach`` ∞, blocked or not) — without changing a number
+        (the tree attribution, :mod:`radtree.engines.numpy.attribution`)."""
         k = len(points)
         acc = np.zeros(k)
         alive = np.arange(k)
@@ -292,6 +298,8 @@ class _Tracer:
             bounce += 1
             tri, t = self.caster.first_hit(o, d, parallel)
             miss = tri < 0
+            if segments is not None:
+                segments(alive, o, d, np.where(miss, np.inf, t))
             if miss.any():
                 mi = miss.nonzero()[0]
                 am, dm, bm = alive[mi], d.take(mi, axis=0), beta[mi]
@@ -356,6 +364,8 @@ class _Tracer:
                                       parallel,
                                       None if self.opts.sun_disc else
                                       0 if hour is None else hour[ni])
+                    if segments is not None:
+                        segments(alive.take(ni), so, _rows(sd, ni), np.full(len(ni), np.inf))
                     got = beta[ni] * (self.dni if hour is None else 1.0) * f[ni] * vis
                     an = alive[ni]
                     acc[an] += got

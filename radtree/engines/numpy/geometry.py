@@ -43,16 +43,8 @@ class Geometry:
         self.vertices = np.vstack(verts) if verts else np.zeros((0, 3))
         self.faces = np.vstack(faces) if faces else np.zeros((0, 3), np.int64)
         self.tri_material = np.concatenate(tri_mat) if tri_mat else np.zeros(0, np.int64)
-        tris = self.vertices[self.faces]
-        n = np.cross(tris[:, 1] - tris[:, 0], tris[:, 2] - tris[:, 0]) if len(tris) else \
-            np.zeros((0, 3))
-        length = np.linalg.norm(n, axis=1)
-        bad = length < 1e-300
-        n[bad] = (0.0, 0.0, 1.0)
-        length[bad] = 1.0
-        self.normals = n / length[:, None]
-        self.v0 = np.ascontiguousarray(tris[:, 0])  # first vertex and centroid per triangle
-        self.centroids = tris.mean(axis=1) if len(tris) else np.zeros((0, 3))
+        # unit normal, first vertex and centroid per triangle
+        self.normals, self.v0, self.centroids = triangle_frames(self.vertices, self.faces)
         # the same as (3, n) tables, one row per axis: gathered by the shadow-ray loop, whose
         # arithmetic runs on rows of all rays (contiguous) instead of 3-wide rows
         self.normals_t = np.ascontiguousarray(self.normals.T)
@@ -61,6 +53,21 @@ class Geometry:
         allp = np.vstack(pts)
         self.size = float(np.ptp(allp, axis=0).max()) if len(allp) else 1.0
         self.caster: RayCaster = make_caster(self.vertices, self.faces, backend, workers)
+
+
+def triangle_frames(vertices: np.ndarray, faces: np.ndarray
+                    ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Per triangle: unit normal (right-handed corner order; (0, 0, 1) when degenerate), first
+    vertex and centroid, each (n, 3)."""
+    tris = vertices[faces]
+    n = np.cross(tris[:, 1] - tris[:, 0], tris[:, 2] - tris[:, 0]) if len(tris) else \
+        np.zeros((0, 3))
+    length = np.linalg.norm(n, axis=1)
+    bad = length < 1e-300
+    n[bad] = (0.0, 0.0, 1.0)
+    length[bad] = 1.0
+    centroids = tris.mean(axis=1) if len(tris) else np.zeros((0, 3))
+    return n / length[:, None], np.ascontiguousarray(tris[:, 0]), centroids
 
 
 _GEOMETRY_CACHE: dict[int, tuple[weakref.ref, str, Geometry]] = {}

@@ -6,7 +6,7 @@ from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-from radtree.engines.base import GridResult
+from radtree.engines.base import GridResult, TreeAttribution
 from radtree.engines.numpy.engine import describe
 from radtree.engines.numpy.inprocess import InProcessEngine
 from radtree.engines.numpy.kernel import name as kernel_name
@@ -34,6 +34,7 @@ class NumpyEngine(InProcessEngine):
     name = "numpy"
     seeded = True
     ladder_in_one_trace = True
+    attributes_trees = True
 
     def describe(self) -> str:
         return f"available ({describe()})"
@@ -68,6 +69,16 @@ class NumpyEngine(InProcessEngine):
                         grids: list[str] | None = None) -> dict[int, dict[str, GridResult]]:
         """One trace to the largest ``-ab``, its contributions tallied by bounce order."""
         return trace_bounce_ladder(scene, state, params, ab_values, grids)
+
+    def attribute_trees(self, scene: Scene, state: SkyState, params: EngineParams, ab: int,
+                        grids: list[str] | None = None, owners: set[str] | None = None,
+                        seed: int | None = None) -> dict[str, TreeAttribution]:
+        """Paired paths, each difference given to the first crown it crossed
+        (:mod:`radtree.engines.numpy.attribution`)."""
+        from radtree.engines.numpy.attribution import attribute_hour
+
+        return attribute_hour(scene, state, replace(params, ab=ab, max_bounces=ab), grids,
+                              owners, seed)
 
     def commands(self, plan: NumpyPlan, label: str) -> list[str]:
         st = plan.states[label]
