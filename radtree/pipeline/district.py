@@ -80,7 +80,8 @@ def district_scene(project: Project, scenario: Scenario, dense_grid: bool | None
         prototypes, instances = tree.prototypes, tree.instances
         notes += tree.notes
     seconds = time.perf_counter() - t0
-    scene = Scene(meshes, materials, grids, notes, prototypes=prototypes, instances=instances)
+    scene = Scene(meshes, materials, grids, notes, prototypes=prototypes, instances=instances,
+                  media=None if tree is None else tree.media)
     if instances:
         notes.append(f"Instancing: {len(instances)} crowns placed from {len(prototypes)} "
                      f"prototype(s), {scene.n_triangles} triangles stored; engines without "

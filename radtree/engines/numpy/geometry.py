@@ -61,6 +61,15 @@ class Geometry:
         allp = np.vstack(pts)
         self.size = float(np.ptp(allp, axis=0).max()) if len(allp) else 1.0
         self.caster: RayCaster = make_caster(self.vertices, self.faces, backend, workers)
+        self.media = None   # turbid crowns (radtree.engines.numpy.turbid), None without
+        if scene.media is not None and len(scene.media):
+            from radtree.engines.numpy.turbid import MediumTracer
+
+            self.media = MediumTracer(scene.media, scene.materials, backend, workers)
+            m = scene.media
+            box = np.vstack([m.centres - np.stack([m.a, m.a, m.b], 1),
+                             m.centres + np.stack([m.a, m.a, m.b], 1)])
+            self.size = max(self.size, float(np.ptp(np.vstack([allp, box]), axis=0).max()))
 
 
 _GEOMETRY_CACHE: dict[int, tuple[weakref.ref, str, Geometry]] = {}
@@ -76,6 +85,10 @@ def _fingerprint(scene: Scene, backend: str, workers: int) -> str:
         h.update(np.ascontiguousarray(m.faces).tobytes())
     for g in scene.grids.values():
         h.update(np.ascontiguousarray(g.points).tobytes())
+    if scene.media is not None:   # turbid crowns: their envelopes and densities
+        for a in (scene.media.centres, scene.media.a, scene.media.b, scene.media.lad,
+                  scene.media.planes):
+            h.update(np.ascontiguousarray(a).tobytes())
     return h.hexdigest()
 
 
