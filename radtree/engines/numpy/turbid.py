@@ -1,7 +1,7 @@
 """Free paths through turbid-medium crowns (:mod:`radtree.media`) for the NumPy engine.
 
-Which crowns a ray crosses: every crown's bounding box (12 triangles, 1 cm larger than the
-spheroid) is a proxy mesh in its own ray caster (Embree when available); the faces a ray
+Which crowns a ray crosses: every crown's bounding box (12 triangles, 1–5 cm larger than the
+spheroid, the margin differing from crown to crown) is a proxy mesh in its own ray caster (Embree when available); the faces a ray
 crosses name the candidate crowns (:meth:`MediumTracer.crossings`: repeated first-hit queries
 until the ray leaves the last box or passes its end), then the exact spheroid interval, cut by
 the crown's half-spaces, is solved per (ray, crown) pair. Memory: O(crowns + rays in a batch),
@@ -42,7 +42,8 @@ NORMALS = 6        # stream site of the leaf-normal draws
 PAIR_SHIFT = 40    # (path, crown) streams: path number + (crown + 1) · 2⁴⁰
 MAX_FACES = 4096   # proxy faces one ray may cross (a safety bound)
 MAX_TRIES = 64     # rejection rounds for the leaf normals (then the last draw is kept)
-BOX_MARGIN = 0.01  # m added to the proxy boxes
+BOX_MARGIN = 0.01  # m added to the proxy boxes (times 1–5, crown by crown)
+MARGIN_STEPS = 23  # distinct margins (neighbours in a row never share one)
 
 _BOX_FACES = np.array([[0, 1, 3], [0, 3, 2], [4, 6, 7], [4, 7, 5], [0, 4, 5], [0, 5, 1],
                        [2, 3, 7], [2, 7, 6], [0, 2, 6], [0, 6, 4], [1, 5, 7], [1, 7, 3]])
@@ -74,8 +75,11 @@ class MediumTracer:
         self.media = media
         n = len(media)
         self.n = n
-        lo = media.centres - np.stack([media.a, media.a, media.b], 1) - BOX_MARGIN
-        hi = media.centres + np.stack([media.a, media.a, media.b], 1) + BOX_MARGIN
+        # margins differ crown by crown (1–5 cm): overlapping neighbours' boxes then have no
+        # coplanar faces, one of which a ray stepping past the other would miss
+        margin = (BOX_MARGIN * (1.0 + 4.0 * (np.arange(n) % MARGIN_STEPS) / MARGIN_STEPS))[:, None]
+        lo = media.centres - np.stack([media.a, media.a, media.b], 1) - margin
+        hi = media.centres + np.stack([media.a, media.a, media.b], 1) + margin
         corners = np.array([[i & 1, (i >> 1) & 1, (i >> 2) & 1] for i in range(8)], float)
         verts = lo[:, None, :] + corners[None] * (hi - lo)[:, None, :]
         faces = _BOX_FACES[None] + 8 * np.arange(n)[:, None, None]
