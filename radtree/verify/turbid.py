@@ -18,7 +18,7 @@ every upward path crosses exactly R of medium:
   luminance L from every direction (uniform sky, ground glow of reflectance 1, the floor
   shrunk to 1 cm): the radiance
   field stays uniform, so the sensor must read E = π L whatever the density — within 1 % or 3
-  standard errors, at up to 60 bounces. A leak or a gain of energy at the leaf events would
+  standard errors, at up to 40 bounces. A leak or a gain of energy at the leaf events would
   show here.
 
 References: Ross J. 1981, The Radiation Regime and Architecture of Plant Stands (Junk), ch. 2
@@ -115,7 +115,7 @@ def turbid_checks(rays: int = 8000, seed: int = 7,
                    ground_glow=True)
     for white in (Trans("white_leaf", 0.5, 0.5, 0.0), Trans("white_leaf", 0.4, 0.3, 0.3)):
         scene = crown_scene(1.0, 1.0, white, floor_m=0.005)
-        res = trace(scene, st, _params(60, rays // SENSORS, seed))["facade"]
+        res = trace(scene, st, _params(40, rays // SENSORS, seed))["facade"]
         want = math.pi * LUMINANCE
         out.append(Check(f"turbid energy conservation (white furnace, R {white.reflectance:g}"
                          f" + T_d {white.diffuse_transmittance:g} + T_s "

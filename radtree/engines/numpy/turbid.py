@@ -36,6 +36,7 @@ from radtree.engines.numpy.streams import Draws, PathStreams
 from radtree.errors import EngineError
 from radtree.media import TurbidCrowns
 from radtree.optics import Material, Trans
+from radtree.scene import Scene
 
 COLLIDE = 5        # stream site of the free-path draws (the loop's own sites are 0–4)
 NORMALS = 6        # stream site of the leaf-normal draws
@@ -47,6 +48,16 @@ MARGIN_STEPS = 23  # distinct margins (neighbours in a row never share one)
 
 _BOX_FACES = np.array([[0, 1, 3], [0, 3, 2], [4, 6, 7], [4, 7, 5], [0, 4, 5], [0, 5, 1],
                        [2, 3, 7], [2, 7, 6], [0, 2, 6], [0, 6, 4], [1, 5, 7], [1, 7, 3]])
+
+
+def refuse_media(scene: Scene, engine: str) -> None:
+    """EngineError when ``scene`` holds turbid crowns and ``engine`` cannot trace them (the
+    forward and Radiance engines: not implemented — Radiance's ``mist`` carries no leaf
+    scattering, a crown BSDF was not built for media)."""
+    if scene.media is not None and len(scene.media):
+        raise EngineError(f"the {engine} engine cannot trace turbid-medium crowns ([tree] "
+                          "representation = \"turbid\"): use --engine numpy, or "
+                          "representation = \"explicit\"")
 
 
 def pair_uniforms(draws: Draws, rows: np.ndarray, crown: np.ndarray) -> np.ndarray:
