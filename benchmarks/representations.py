@@ -69,8 +69,8 @@ def _trace_case(project_dir: Path, scenario: str, representation: str, seeds: li
         sc = proj.scenario(scenario)
         tb = time.perf_counter()
         if proj.district is not None:
-            from radtree.pipeline.district import district_scene
             from radtree.pipeline.assemble import BuiltScene, scene_ab
+            from radtree.pipeline.district import district_scene
 
             built = district_scene(proj, sc, False, scene_ab, BuiltScene)
         else:

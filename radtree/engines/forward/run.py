@@ -20,7 +20,6 @@ from radtree.engines.forward.settings import ForwardSettings
 from radtree.engines.forward.sources import EnvironmentSource, SunSource, bounding_sphere
 from radtree.engines.forward.strata import PILOT, Stratum, allocate, pilot, ring_edges, trace_strata
 from radtree.engines.forward.tracer import ForwardTracer, Ledger, Photons, Splitting
-from radtree.engines.numpy.turbid import refuse_media
 from radtree.engines.numpy.engine import Environment, scene_geometry, scene_optics
 from radtree.errors import ConfigError, EngineError
 from radtree.light.sky import SkyState
@@ -99,10 +98,10 @@ def trace_forward(scene: Scene, state: SkyState, settings: ForwardSettings,
     missing = [g for g in names if g not in scene.grids]
     if missing:
         raise EngineError(f"unknown sensor grid(s): {', '.join(missing)}")
-    refuse_media(scene, "forward")
     geo = scene_geometry(scene, backend, workers)
     det = PatchDetectors({n: scene.grids[n] for n in names}, settings.patch_m)
-    pts = np.vstack([geo.vertices, det.corners().reshape(-1, 3)])
+    pts = np.vstack([geo.vertices, det.corners().reshape(-1, 3),
+                     *([] if geo.media is None else [geo.media.corners()])])
     sphere = bounding_sphere(pts)
     sources: list = []
     if state.sun_on:

@@ -30,7 +30,8 @@ class Geometry:
 
     def __init__(self, scene: Scene, backend: str, workers: int):
         meshes = scene.solid_meshes()
-        self.material_names = sorted({m.material for m in meshes})
+        self.material_names = sorted({m.material for m in meshes}
+                                     | set(() if scene.media is None else scene.media.materials))
         mat_index = {n: i for i, n in enumerate(self.material_names)}
         verts, faces, tri_mat, offset = [], [], [], 0
         for m in meshes:

@@ -1,4 +1,6 @@
-"""Free paths through turbid-medium crowns (:mod:`radtree.media`) for the NumPy engine.
+"""Free paths through turbid-medium crowns (:mod:`radtree.media`) for the NumPy engine and
+the forward light tracer (:mod:`radtree.engines.forward.tracer`: the same collisions and leaf
+events from its generator, the absorbed flux booked to the leaf material).
 
 Which crowns a ray crosses: every crown's bounding box (12 triangles, 1–5 cm larger than the
 spheroid, the margin differing from crown to crown) is a proxy mesh in its own ray caster (Embree when available); the faces a ray
@@ -52,8 +54,8 @@ _BOX_FACES = np.array([[0, 1, 3], [0, 3, 2], [4, 6, 7], [4, 7, 5], [0, 4, 5], [0
 
 def refuse_media(scene: Scene, engine: str) -> None:
     """EngineError when ``scene`` holds turbid crowns and ``engine`` cannot trace them (the
-    forward and Radiance engines: not implemented — Radiance's ``mist`` carries no leaf
-    scattering, a crown BSDF was not built for media)."""
+    Radiance engine: not implemented — Radiance's ``mist`` carries no leaf scattering, and no
+    crown BSDF is built for media)."""
     if scene.media is not None and len(scene.media):
         raise EngineError(f"the {engine} engine cannot trace turbid-medium crowns ([tree] "
                           "representation = \"turbid\"): use --engine numpy, or "
@@ -94,7 +96,8 @@ class MediumTracer:
         corners = np.array([[i & 1, (i >> 1) & 1, (i >> 2) & 1] for i in range(8)], float)
         verts = lo[:, None, :] + corners[None] * (hi - lo)[:, None, :]
         faces = _BOX_FACES[None] + 8 * np.arange(n)[:, None, None]
-        self.caster = make_caster(verts.reshape(-1, 3), faces.reshape(-1, 3), backend, workers)
+        self.box_corners = verts.reshape(-1, 3)
+        self.caster = make_caster(self.box_corners, faces.reshape(-1, 3), backend, workers)
         self.face_crown = np.repeat(np.arange(n), 12)
         self.axes = np.stack([media.a, media.a, media.b], 1)
         kinds = media.kinds
@@ -110,6 +113,15 @@ class MediumTracer:
         self.pass_ = 1.0 - ts                      # the share of leaves met that deflect
         self.events = np.stack([r / self.pass_, td / self.pass_], 1)   # (kinds, 2)
         self.scale = max(1.0, float(np.ptp(np.vstack([lo, hi]), axis=0).max()))
+
+    def corners(self) -> np.ndarray:
+        """(8·n, 3) corners of the crowns' proxy boxes (a forward source must enclose them)."""
+        return self.box_corners
+
+    def material_index(self, crown: np.ndarray, names: list[str]) -> np.ndarray:
+        """Index in ``names`` of the leaf material of each crown in ``crown``."""
+        table = np.array([names.index(k.material) for k in self.media.kinds], np.int64)
+        return table[self.media.kind[crown]]
 
     # -- which crowns a ray crosses
     def crossings(self, o: np.ndarray, d: np.ndarray, tmax: np.ndarray, parallel: bool = True
