@@ -76,6 +76,7 @@ class TurbidCrowns:
     planes: np.ndarray = field(default_factory=lambda: np.zeros((0, 0, 4)))
 
     def __post_init__(self) -> None:
+        """Scalars broadcast to one per crown: after this every field is an array."""
         self.centres = np.asarray(self.centres, float).reshape(-1, 3)
         n = len(self.centres)
         self.a = np.broadcast_to(np.asarray(self.a, float), (n,)).copy()
@@ -90,6 +91,15 @@ class TurbidCrowns:
             raise ValueError("turbid crowns: leaf area density must be finite and ≥ 0")
         if n and (self.kind.min() < 0 or self.kind.max() >= len(self.kinds)):
             raise ValueError("turbid crowns: a crown's kind is not among the leaf kinds")
+
+    @classmethod
+    def of(cls, centres: np.ndarray, a: float | np.ndarray, b: float | np.ndarray,
+           lad: float | np.ndarray, kind: int | np.ndarray, kinds: list[LeafKind],
+           planes: np.ndarray | None = None) -> TurbidCrowns:
+        """Crowns from per-crown arrays or scalars shared by all."""
+        return cls(np.asarray(centres, float), np.asarray(a, float), np.asarray(b, float),
+                   np.asarray(lad, float), np.asarray(kind, np.int64), kinds,
+                   np.zeros((0, 0, 4)) if planes is None else planes)
 
     def __len__(self) -> int:
         return len(self.centres)

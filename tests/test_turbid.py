@@ -50,7 +50,7 @@ def test_crossings_are_exact_chords():
     kind = leaf_kind(Louvers(), "leaf")
     planes = np.zeros((3, 1, 4))
     planes[:, 0] = [0.0, 1.0, 0.0, 0.5]          # keep y ≥ 0.5
-    media = TurbidCrowns(np.array([[-8.0, 3.0, 7.0], [0.0, 3.0, 7.0], [8.0, 3.0, 7.0]]), 5.0,
+    media = TurbidCrowns.of(np.array([[-8.0, 3.0, 7.0], [0.0, 3.0, 7.0], [8.0, 3.0, 7.0]]), 5.0,
                          4.0, 1.0, 0, [kind], planes)
     mt = MediumTracer(media, {"leaf": Trans("leaf", 0.1, 0.05, 0.05)})
     rng = np.random.default_rng(3)
@@ -101,7 +101,7 @@ def _pair(crossings: float = 6.0, seeds: tuple[int, ...] = (1, 2)) -> dict:
         for sky, st in skies.items():
             for g, res in trace(scene, st, params).items():
                 out.setdefault(("explicit", sky, g), []).append(float(res.lux.mean()))
-    media = TurbidCrowns(centre[None], a, b, leaf_area_density(lv, b), 0, [leaf_kind(lv, "leaf")])
+    media = TurbidCrowns.of(centre[None], a, b, leaf_area_density(lv, b), 0, [leaf_kind(lv, "leaf")])
     scene = Scene([ground], mats, grids, media=media)
     for sky, st in skies.items():
         for g, res in trace(scene, st, params).items():
@@ -161,7 +161,7 @@ def test_turbid_needs_the_volume_arrangement():
 def test_radiance_refuses_turbid_crowns(tmp_path):
     from radtree.engines.radiance.writer import write_build
 
-    media = TurbidCrowns(np.array([[0.0, 0.0, 3.0]]), 2.0, 2.0, 1.0, 0,
+    media = TurbidCrowns.of(np.array([[0.0, 0.0, 3.0]]), 2.0, 2.0, 1.0, 0,
                          [leaf_kind(Louvers(), "leaf")])
     scene = Scene([quad("g", "g", np.array([[-9, -9, 0], [9, -9, 0], [9, 9, 0], [-9, 9, 0]],
                                            float))],
@@ -222,3 +222,30 @@ def test_small_city_same_table_on_dask(tmp_path):
     assert len(a) == len(b) > 500
     np.testing.assert_array_equal(a["lux"].to_numpy(), b["lux"].to_numpy())
     assert a["lux"].min() > 0
+
+
+def test_districts_above_turbid_above_get_turbid_crowns(tmp_path):
+    """[site] turbid_above: a 40-tree city left at representation 'explicit' gets turbid crowns
+    above 39 trees (a note says so) and slats at 40 or more; a bad value is a ConfigError."""
+    from radtree.pipeline.assemble import BuiltScene, scene_ab
+    from radtree.pipeline.district import district_scene
+
+    root = tmp_path / "city"
+    (root / "data").mkdir(parents=True)
+    (root / "data" / "direct_normal_illuminance.csv").write_bytes(
+        (ROOT / "examples" / "city" / "data" / "direct_normal_illuminance.csv").read_bytes())
+    _make_city().write(root / "data", 40, blocks=2)
+    text = (ROOT / "examples" / "city" / "radtree.toml").read_text()
+    text = text.replace('representation = "turbid"', 'representation = "explicit"')
+    for above, media in ((39, True), (40, False)):
+        (root / "radtree.toml").write_text(text.replace('facade_chunk = 8', 'facade_chunk = 8\n'
+                                                        f'turbid_above = {above}'))
+        p = load_project(root)
+        built = district_scene(p, p.scenario("trees"), False, scene_ab, BuiltScene)
+        assert (built.scene.media is not None) is media
+        assert ("turbid_above = 39" in " ".join(built.notes)) is media
+    (root / "radtree.toml").write_text(text.replace('facade_chunk = 8',
+                                                    'facade_chunk = 8\nturbid_above = -1'))
+    with pytest.raises(ConfigError) as err:
+        load_project(root)
+    assert "turbid_above" in str(err.value)

@@ -18,6 +18,13 @@ Keys of the ``[site]`` table (read here, hooked into :mod:`radtree.config.reader
   (sensor height above each storey's floor, default 1.5 m), ``storey_height_m`` (when a
   building gives no ``storeys``, default 3 m), ``facade_chunk`` (façades per traced grid:
   the unit of work of ``simulate --scheduler``, default 8);
+* ``turbid_above`` — above this many trees (default 500; 0: never) crowns left at
+  ``[tree] representation = "explicit"`` are built as turbid media instead
+  (:mod:`radtree.trees.turbid`): the NumPy engine expands explicit slats tree by tree (240
+  trees ≈ 1.1 GiB, issue 43), so 500 trees would need ≈ 2.3 GiB and 1 000 more than the
+  4 GiB of a small machine, while turbid crowns cost a few numbers each (1 000 trees, 7 hours,
+  every façade: 0.4 GiB, ``benchmarks/city.py``). Turbid crowns are traced by the NumPy and
+  forward engines, not Radiance (set 0 to keep slats for Radiance's instanced crowns);
 * ``instancing`` — ``"auto"`` (a crown shared by ≥ 2 trees is one Radiance ``instance``
   octree per species × realisation, placed, rotated and scaled per tree; crowns used once
   are built in place), ``"never"`` (every crown in place).
@@ -38,7 +45,7 @@ from radtree.errors import ConfigError
 INSTANCING = ("auto", "never")
 #: the ``[site]`` keys this module reads
 DISTRICT_KEYS = ("trees", "buildings", "crs", "facades", "facade_spacing_m", "window_height_m",
-                 "storey_height_m", "facade_chunk", "instancing")
+                 "storey_height_m", "facade_chunk", "instancing", "turbid_above")
 
 
 @dataclass(frozen=True)
@@ -55,6 +62,7 @@ class District(Checked):
     storey_height_m: float = field(default=3.0, metadata=meta(1.5, 10.0))
     facade_chunk: int = field(default=8, metadata=meta(1, 10000))
     instancing: str = field(default="auto", metadata=meta(choices=INSTANCING))
+    turbid_above: int = field(default=500, metadata=meta(0, 10_000_000))
 
     def check(self) -> None:
         if self.trees is None and self.buildings is None:
@@ -94,7 +102,8 @@ def read_district(data: dict[str, Any], base: Path, source: str) -> District | N
                           source=source, field="site.facades")
     kwargs: dict[str, Any] = {k: data[k] for k in ("crs", "facade_spacing_m", "window_height_m",
                                                    "storey_height_m", "facade_chunk",
-                                                   "instancing") if k in data}
+                                                   "instancing", "turbid_above")
+                              if k in data}
     try:
         return District(trees=path("trees"), buildings=path("buildings"),
                         facades=tuple(facades), **kwargs)

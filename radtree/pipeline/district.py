@@ -71,6 +71,12 @@ def district_scene(project: Project, scenario: Scenario, dense_grid: bool | None
 
         tr, _ = apply_switches(project.tree, scenario.switches, source=str(project.source),
                                root=project.root)
+        if tr.representation == "explicit" and 0 < d.turbid_above < len(inputs.trees):
+            from dataclasses import replace
+
+            tr = replace(tr, representation="turbid")   # [site] turbid_above (config.district)
+            notes.append(f"{len(inputs.trees)} trees > [site] turbid_above = {d.turbid_above}: "
+                         "the crowns are turbid media (set turbid_above = 0 for slats).")
         tree = inventory_crowns(project, inputs.trees, tr, d.instancing)
         clash = set(tree.materials) & set(materials)
         if clash:

@@ -130,7 +130,7 @@ def build_turbid(tree: Tree, sensors: Sensors, street: Street, frame: FacadeFram
     optics = LouverOptics.of(lv)
     kind = leaf_kind(lv, LEAF)
     u = leaf_area_density(lv, spec.b)
-    media = TurbidCrowns(frame.to_world(spec.centres), spec.a, spec.b, u, 0, [kind],
+    media = TurbidCrowns.of(frame.to_world(spec.centres), spec.a, spec.b, u, 0, [kind],
                          row_planes(spec, frame))
     tv, tf = spec.trunks()
     meshes = [Mesh("tree_trunks", TRUNK, frame.to_world(tv), tf)]
@@ -190,7 +190,7 @@ def inventory_turbid(project: Project, trees: list[InventoryTree], tree: Tree) -
         tv_all.append(tv)
         tf_all.append(tf + off)
         off += len(tv)
-    media = TurbidCrowns(centres, a, b, lad, kind, kinds)
+    media = TurbidCrowns.of(centres, a, b, lad, kind, kinds)
     meshes = [Mesh("tree_trunks", TRUNK, np.vstack(tv_all), np.vstack(tf_all))]
     notes.insert(0, f"Tree inventory: {n} trees of {len(keys)} species as turbid-medium crowns "
                     f"(representation 'turbid'; leaf area density "

@@ -66,7 +66,7 @@ def crown_scene(x: float, lad: float, leaf: Trans, sensors: int = 1, floor_m: fl
     (the furnace: a 1 cm one, which the sensor sees in 4·10⁻⁸ sr: the engine needs one
     surface), ``sensors`` sensors at its centre facing up."""
     kind = leaf_kind(_lv(x), leaf.name)
-    media = TurbidCrowns(np.array([CENTRE]), RADIUS, RADIUS, lad, 0, [kind])
+    media = TurbidCrowns.of(np.array([CENTRE]), RADIUS, RADIUS, lad, 0, [kind])
     h = floor_m
     floor = quad("floor", "black", np.array([[-h, -h, -47.0], [h, -h, -47.0], [h, h, -47.0],
                                              [-h, h, -47.0]]))

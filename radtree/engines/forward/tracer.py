@@ -177,7 +177,7 @@ class ForwardTracer:
         nf = np.where((cosd < 0)[:, None], ng, -ng)  # normal on the incoming side
         mat = geo.tri_material[tri]
         coef = np.stack([opt.rd[mat], opt.td[mat], opt.ts[mat], opt.rm[mat]], axis=1)
-        if met is not None and (met >= 0).any():   # leaf events: drawn normal, leaf optics
+        if met is not None and geo.media is not None and (met >= 0).any():   # leaf events
             mi = (met >= 0).nonzero()[0]
             nf[mi], leaf = geo.media.leaf_events(met[mi], ph.d[mi], GeneratorDraws(self.rng))
             coef[mi] = leaf.T

@@ -17,6 +17,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from radtree.engines.numpy.raycast import RayCaster, make_caster
+from radtree.engines.numpy.turbid import MediumTracer
 from radtree.errors import EngineError
 from radtree.light.sky import SkyState, sky_luminance
 from radtree.optics import Glass, Hole, Plastic, Trans
@@ -62,14 +63,12 @@ class Geometry:
         allp = np.vstack(pts)
         self.size = float(np.ptp(allp, axis=0).max()) if len(allp) else 1.0
         self.caster: RayCaster = make_caster(self.vertices, self.faces, backend, workers)
-        self.media = None   # turbid crowns (radtree.engines.numpy.turbid), None without
+        self.media: MediumTracer | None = None   # turbid crowns, None without
         if scene.media is not None and len(scene.media):
-            from radtree.engines.numpy.turbid import MediumTracer
-
             self.media = MediumTracer(scene.media, scene.materials, backend, workers)
-            m = scene.media
-            box = np.vstack([m.centres - np.stack([m.a, m.a, m.b], 1),
-                             m.centres + np.stack([m.a, m.a, m.b], 1)])
+            tc = scene.media
+            box = np.vstack([tc.centres - np.stack([tc.a, tc.a, tc.b], 1),
+                             tc.centres + np.stack([tc.a, tc.a, tc.b], 1)])
             self.size = max(self.size, float(np.ptp(np.vstack([allp, box]), axis=0).max()))
 
 
