@@ -35,6 +35,27 @@ rerun resumes. Memory per worker: the scene + one batch of paths
 tasks lower ``facade_chunk`` (1 → 1 400 tasks for 200 façades; the cost is the once-per-worker
 preparation, not per task). Not measured here beyond 2 workers.
 
+Measured 2026-12-07 02:27–03:13 UTC on the 2-core machine shared with 7 other sessions, load
+average 17–25 throughout (so wall times are inflated several-fold; CPU = the process tree's
+user + system seconds), 4 036 façade sensors × 7 hours, 128 paths, -ab 2::
+
+    trees  run                wall s   CPU s   peak GiB (tree sum)  ru_maxrss GiB
+      250  one process         238.2    14.4   0.39                 0.38
+      250  Dask 1 worker       485.2    35.5   0.51                 0.36
+      250  Dask 2 workers      313.4    37.9   0.85                 0.36
+      500  one process         132.6    18.0   0.41                 0.41
+      500  Dask 1 worker       231.9    35.5   0.52                 0.38
+      500  Dask 2 workers      254.9    43.3   0.87                 0.37
+     1000  one process         167.3    27.6   0.46                 0.45
+     1000  Dask 1 worker       362.3    51.7   0.55                 0.40
+     1000  Dask 2 workers      358.5    56.4   0.91                 0.41
+
+Every Dask table equal to the one-process table (0 of 28 252 rows differ). 1 000 / 250 trees:
+CPU × 1.91, peak memory × 1.19 for 4 × the trees (sub-linear); targets met (167 s ≤ 600 s,
+0.46 GiB ≤ 4 GiB). 2 workers against 1: 313 vs 485 s at 250 trees, 255 vs 232 s at 500 and
+359 vs 362 s at 1 000 — at load 17–25 the two cores are taken by other sessions, so a second
+worker gets little CPU: the speed-up of more workers is not shown by these figures.
+
 Run: ``.venv/bin/python benchmarks/city.py [--trees 250 500 1000] [--workers 1 2] [--keep]``.
 """
 

@@ -77,7 +77,12 @@ def district_scene(project: Project, scenario: Scenario, dense_grid: bool | None
             tr = replace(tr, representation="turbid")   # [site] turbid_above (config.district)
             notes.append(f"{len(inputs.trees)} trees > [site] turbid_above = {d.turbid_above}: "
                          "the crowns are turbid media (set turbid_above = 0 for slats).")
-        tree = inventory_crowns(project, inputs.trees, tr, d.instancing)
+        if tr.representation == "turbid":   # one turbid crown per tree, no slats
+            from radtree.trees.turbid import inventory_turbid
+
+            tree = inventory_turbid(project, inputs.trees, tr)
+        else:
+            tree = inventory_crowns(project, inputs.trees, tr, d.instancing)
         clash = set(tree.materials) & set(materials)
         if clash:
             raise RadtreeError(f"crown materials clash with the buildings': {clash}")

@@ -94,10 +94,6 @@ def inventory_crowns(project: Project, trees: list[InventoryTree], tree: Tree,
                      instancing: str = "auto") -> TreeModel:
     """The crowns of every inventory tree (louvers model, free form) as one TreeModel;
     ``tree``: the project's [tree] after the scenario's switches."""
-    if tree.representation == "turbid":   # one turbid crown per tree, no slats
-        from radtree.trees.turbid import inventory_turbid
-
-        return inventory_turbid(project, trees, tree)
     lv = tree.louvers
     source = str(project.source)
     species = species_of(trees, source)

@@ -48,6 +48,7 @@ from radtree.scene import Mesh
 from radtree.site.frame import FacadeFrame
 from radtree.site.inventory import InventoryTree
 from radtree.trees.clumping import clumped_g
+from radtree.trees.district import single_spec, species_louvers, species_of
 from radtree.trees.envelope import CrownRowSpec, crown_row_spec, row_notes
 from radtree.trees.leaf_angles import BINS, inclination_pdf
 from radtree.trees.louvers import LouverOptics, check_louvers
@@ -152,8 +153,6 @@ def inventory_turbid(project: Project, trees: list[InventoryTree], tree: Tree) -
     """Every inventory tree as one turbid crown of its own size (no instancing needed), leaf
     optics, tilt and density from its species (:func:`radtree.trees.district.species_louvers`),
     trunks as meshes (:func:`radtree.trees.district.inventory_crowns` with slats)."""
-    from radtree.trees.district import single_spec, species_louvers, species_of
-
     source = str(project.source)
     _check(tree.louvers, tree, source)
     species = species_of(trees, source)

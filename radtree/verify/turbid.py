@@ -39,6 +39,7 @@ import numpy as np
 
 from radtree.config import EngineParams, Louvers
 from radtree.engines.base import GridResult
+from radtree.engines.numpy.engine import ENGINE_NAME
 from radtree.engines.numpy.scenes import sky_state
 from radtree.engines.numpy.tracing import trace
 from radtree.media import TurbidCrowns
@@ -51,7 +52,7 @@ RADIUS = 2.0
 CENTRE = (0.0, 0.0, 3.0)
 DNI = 100000.0
 LUMINANCE = 1000.0   # cd/m² of the uniform sky
-ENGINE = "numpy"
+ENGINE = ENGINE_NAME   # the NumPy engine's registered name
 CASES = ((1.0, 1.0), (3.0, 0.8))   # (ellipsoid x, leaf area density m²/m³)
 SENSORS = 16                        # sensors at the centre (the sky check's mean)
 
@@ -91,7 +92,7 @@ def sky_through_crown(x: float, lad: float) -> float:
 
 
 def _params(ab: int, rays: int, seed: int) -> EngineParams:
-    return EngineParams(name="numpy", max_bounces=ab, rays=rays, seed=seed)
+    return EngineParams(name=ENGINE, max_bounces=ab, rays=rays, seed=seed)
 
 
 def turbid_checks(rays: int = 8000, seed: int = 7, forward_photons: int = 100_000,
@@ -153,7 +154,7 @@ def forward_checks(photons: int, seed: int = 7) -> list[Check]:
                                                    beam_diameter_m=9.0, patch_m=1.0,
                                                    seed=seed))
     got = res.grids["facade"]
-    values = backward_patch_values("numpy", scene, st, "facade", 1.0, ab=0, points=256,
+    values = backward_patch_values(ENGINE, scene, st, "facade", 1.0, ab=0, points=256,
                                    rays=1, seed=seed)
     want = float(values.mean())
     se_b = float(values.mean(axis=0).std(ddof=1) / math.sqrt(values.shape[1]))
