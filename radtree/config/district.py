@@ -20,11 +20,15 @@ Keys of the ``[site]`` table (read here, hooked into :mod:`radtree.config.reader
   the unit of work of ``simulate --scheduler``, default 8);
 * ``turbid_above`` — above this many trees (default 500; 0: never) crowns left at
   ``[tree] representation = "explicit"`` are built as turbid media instead
-  (:mod:`radtree.trees.turbid`): the NumPy engine expands explicit slats tree by tree (240
-  trees ≈ 1.1 GiB, issue 43), so 500 trees would need ≈ 2.3 GiB and 1 000 more than the
-  4 GiB of a small machine, while turbid crowns cost a few numbers each (1 000 trees, 7 hours,
-  every façade: 0.4 GiB, ``benchmarks/city.py``). Turbid crowns are traced by the NumPy and
-  forward engines, not Radiance (set 0 to keep slats for Radiance's instanced crowns);
+  (:mod:`radtree.trees.turbid`). Why: the NumPy engine expands the instanced slats tree by
+  tree, so memory and time grow with the leaves — measured on the generated city
+  (``benchmarks/representations.py``, one hour, 4 036 façade sensors, 128 paths, shared
+  machine at load ≈ 22): 250 trees explicit 75 s / 0.41 GiB vs turbid 46 s / 0.21 GiB,
+  1 000 trees explicit 85 s / 1.13 GiB (1.25 M triangles) vs turbid 28 s / 0.24 GiB, the
+  façade-chunk means within 0.6 % (250) and 2.4 % (1 000). From ≈ 500 trees the slats cost
+  about twice the time and three times the memory for the same façade light; below it they
+  keep the real leaf placement, and Radiance traces slats only (no turbid form), so set 0 to
+  keep slats for Radiance's instanced crowns;
 * ``instancing`` — ``"auto"`` (a crown shared by ≥ 2 trees is one Radiance ``instance``
   octree per species × realisation, placed, rotated and scaled per tree; crowns used once
   are built in place), ``"never"`` (every crown in place).
