@@ -10,6 +10,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from radtree.media import TurbidCrowns
 from radtree.optics import Hole, Material
 
 
@@ -152,11 +153,16 @@ class Scene:
     ground_material: str = "ground"
     prototypes: dict[str, list[Mesh]] = field(default_factory=dict)
     instances: list[Instance] = field(default_factory=list)
+    #: turbid-medium crowns (``[tree] representation = "turbid"``; :mod:`radtree.media`)
+    media: TurbidCrowns | None = None
 
     def __post_init__(self) -> None:
         for m in [*self.meshes, *(p for ms in self.prototypes.values() for p in ms)]:
             if m.material not in self.materials:
                 raise ValueError(f"mesh '{m.name}' uses undefined material '{m.material}'")
+        for name in ([] if self.media is None else self.media.materials):
+            if name not in self.materials:
+                raise ValueError(f"turbid crowns use undefined material '{name}'")
         for inst in self.instances:
             if inst.prototype not in self.prototypes:
                 raise ValueError(f"instance of unknown prototype '{inst.prototype}'")

@@ -2,7 +2,9 @@
 
 ``representation = "explicit"`` (default) traces the crown's slats; ``"bsdf"`` replaces the
 sensor dome (or the free crowns' envelopes) by a shell carrying the crown layer's Klems BSDF
-(Radiance ``BSDF`` material; the NumPy and forward engines refuse it with a clear error).
+(Radiance ``BSDF`` material; the NumPy and forward engines refuse it with a clear error);
+``"turbid"`` makes the free volume crowns turbid media of the slats' leaf area density, leaf
+angles, clumping and optics (:mod:`radtree.trees.turbid`; NumPy and forward engines).
 
 rfluxmtx sampling: ``samples`` rays per Klems patch (``-c``), ``ab`` (0: the crown model's
 recommendation), ``ad``, ``lw``; ``tiles`` × ``tiles`` periodic copies of the sample cell.
@@ -50,7 +52,7 @@ from typing import ClassVar
 
 from radtree.config.spec import Checked, SchemaError, meta
 
-REPRESENTATIONS = ("explicit", "bsdf")
+REPRESENTATIONS = ("explicit", "bsdf", "turbid")
 CROSSINGS = ("chord", "slab")
 CURVATURES = ("traced", "rings", "planar")
 WALL_DEPTHS = ("sensors", "centre")

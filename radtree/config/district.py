@@ -18,6 +18,17 @@ Keys of the ``[site]`` table (read here, hooked into :mod:`radtree.config.reader
   (sensor height above each storey's floor, default 1.5 m), ``storey_height_m`` (when a
   building gives no ``storeys``, default 3 m), ``facade_chunk`` (façades per traced grid:
   the unit of work of ``simulate --scheduler``, default 8);
+* ``turbid_above`` — above this many trees (default 500; 0: never) crowns left at
+  ``[tree] representation = "explicit"`` are built as turbid media instead
+  (:mod:`radtree.trees.turbid`). Why: the NumPy engine expands the instanced slats tree by
+  tree, so memory and time grow with the leaves — measured on the generated city
+  (``benchmarks/representations.py``, one hour, 4 036 façade sensors, 128 paths, shared
+  machine at load ≈ 22): 250 trees explicit 75 s / 0.41 GiB vs turbid 46 s / 0.21 GiB,
+  1 000 trees explicit 85 s / 1.13 GiB (1.25 M triangles) vs turbid 28 s / 0.24 GiB, the
+  façade-chunk means within 0.6 % (250) and 2.4 % (1 000). From ≈ 500 trees the slats cost
+  about twice the time and three times the memory for the same façade light; below it they
+  keep the real leaf placement, and Radiance traces slats only (no turbid form), so set 0 to
+  keep slats for Radiance's instanced crowns;
 * ``instancing`` — ``"auto"`` (a crown shared by ≥ 2 trees is one Radiance ``instance``
   octree per species × realisation, placed, rotated and scaled per tree; crowns used once
   are built in place), ``"never"`` (every crown in place).
@@ -41,7 +52,7 @@ from radtree.errors import ConfigError
 INSTANCING = ("auto", "never")
 #: the ``[site]`` keys this module reads
 DISTRICT_KEYS = ("trees", "buildings", "crs", "facades", "facade_spacing_m", "window_height_m",
-                 "storey_height_m", "facade_chunk", "instancing")
+                 "storey_height_m", "facade_chunk", "instancing", "turbid_above")
 
 
 @dataclass(frozen=True)
@@ -58,6 +69,7 @@ class District(Checked):
     storey_height_m: float = field(default=3.0, metadata=meta(1.5, 10.0))
     facade_chunk: int = field(default=8, metadata=meta(1, 10000))
     instancing: str = field(default="auto", metadata=meta(choices=INSTANCING))
+    turbid_above: int = field(default=500, metadata=meta(0, 10_000_000))
 
     def check(self) -> None:
         if self.trees is None and self.buildings is None:
@@ -97,7 +109,8 @@ def read_district(data: dict[str, Any], base: Path, source: str) -> District | N
                           source=source, field="site.facades")
     kwargs: dict[str, Any] = {k: data[k] for k in ("crs", "facade_spacing_m", "window_height_m",
                                                    "storey_height_m", "facade_chunk",
-                                                   "instancing") if k in data}
+                                                   "instancing", "turbid_above")
+                              if k in data}
     try:
         return District(trees=path("trees"), buildings=path("buildings"),
                         facades=tuple(facades), **kwargs)

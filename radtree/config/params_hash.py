@@ -75,6 +75,8 @@ def _project_payload(project: Any) -> dict[str, Any]:
         payload["tree"].pop(key, None)
     if project.district is not None:   # inventory inputs: relative path + content (_file_key)
         payload["district"] = d["district"]
+        if payload["district"].get("turbid_above") == 500:   # at its default: hashes unchanged
+            payload["district"].pop("turbid_above")
     return payload
 
 

@@ -116,6 +116,6 @@ def make_scene(project: Project, scenario: Scenario, dense_grid: bool | None = N
 
         meshes = meshes + load_user_meshes(project.extra_geometry, materials)
     ab = scene_ab(project, None if tree is None else tree.recommended_ab)
-    scene = Scene(meshes, materials, grids, notes)
+    scene = Scene(meshes, materials, grids, notes, media=None if tree is None else tree.media)
     check_triangles(project, scenario, scene.n_triangles)
     return BuiltScene(scenario, scene, ab, notes, scene.n_triangles, geometry_seconds, info, tree)

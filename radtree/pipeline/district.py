@@ -76,7 +76,18 @@ def district_scene(project: Project, scenario: Scenario, dense_grid: bool | None
 
         tr, _ = apply_switches(project.tree, scenario.switches, source=str(project.source),
                                root=project.root)
-        tree = inventory_crowns(project, inputs.trees, tr, d.instancing, clips)
+        if tr.representation == "explicit" and 0 < d.turbid_above < len(inputs.trees):
+            from dataclasses import replace
+
+            tr = replace(tr, representation="turbid")   # [site] turbid_above (config.district)
+            notes.append(f"{len(inputs.trees)} trees > [site] turbid_above = {d.turbid_above}: "
+                         "the crowns are turbid media (set turbid_above = 0 for slats).")
+        if tr.representation == "turbid":   # one turbid crown per tree, no slats
+            from radtree.trees.turbid import inventory_turbid
+
+            tree = inventory_turbid(project, inputs.trees, tr)
+        else:
+            tree = inventory_crowns(project, inputs.trees, tr, d.instancing, clips)
         clash = set(tree.materials) & set(materials)
         if clash:
             raise RadtreeError(f"crown materials clash with the buildings': {clash}")
@@ -85,7 +96,8 @@ def district_scene(project: Project, scenario: Scenario, dense_grid: bool | None
         prototypes, instances = tree.prototypes, tree.instances
         notes += tree.notes
     seconds = time.perf_counter() - t0
-    scene = Scene(meshes, materials, grids, notes, prototypes=prototypes, instances=instances)
+    scene = Scene(meshes, materials, grids, notes, prototypes=prototypes, instances=instances,
+                  media=None if tree is None else tree.media)
     if instances:
         notes.append(f"Instancing: {len(instances)} crowns placed from {len(prototypes)} "
                      f"prototype(s), {scene.n_triangles} triangles stored; engines without "

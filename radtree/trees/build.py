@@ -93,6 +93,10 @@ def build_crown(project: Project, model: str, form: str, frame: FacadeFrame,
         result = build_homogeneous(tree, project.sensors, project.street, frame, form, source)
     elif model == "perforated":
         result = build_perforated(tree, project.sensors, project.street, frame, form, source)
+    elif model == "louvers" and tree.representation == "turbid":
+        from radtree.trees.turbid import build_turbid
+
+        result = build_turbid(tree, project.sensors, project.street, frame, form, source)
     elif model == "louvers":
         result = build_louvers(tree, project.sensors, project.street, frame, form, source)
     else:

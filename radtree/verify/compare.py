@@ -71,7 +71,7 @@ def backward_patch_values(engine: str, scene: Scene, state: SkyState, grid: str,
     g = scene.grids[grid]
     pg = patch_points(g, side, points, np.random.default_rng(seed))
     sub = Scene(scene.meshes, scene.materials, {pg.name: pg}, scene.notes,
-                scene.ground_material)
+                scene.ground_material, media=scene.media)
     base = params or EngineParams()
     p = replace(base, rays=rays, seed=seed, max_bounces=ab, ab=ab)
     res = get_engine(engine).trace_once(sub, state, p, ab)[pg.name]

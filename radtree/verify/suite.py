@@ -21,6 +21,7 @@ from radtree.verify.checks import (
     sphere_checks,
     transmission_checks,
 )
+from radtree.verify.turbid import turbid_checks
 
 # Radiance at -ad 2048 over 64 points per patch took 206 s per scenario and hour on the reduced
 # dome (2 cores); at -ad 1024 over 32 points ≈ 75 s, so it is compared at noon only, while NumPy
@@ -58,6 +59,7 @@ def run_verify(out: Path, full: bool = False, backward: list[str] | None = None,
         checks += sphere_checks(realisations=8, photons=400_000, points=64,
                                 engines=("forward", "numpy"), progress=echo)
         checks += energy_checks(photons=200_000)
+        checks += turbid_checks(rays=64_000, progress=echo)
         for crown in ("louvers dome", "free volume crown"):
             checks += agreement_checks(hours=("10:30", "12:30", "14:30"), scenarios=("A", "B"),
                                        photons=40_000_000, backward=backward, crown=crown,
@@ -66,6 +68,7 @@ def run_verify(out: Path, full: bool = False, backward: list[str] | None = None,
         checks += transmission_checks(progress=echo)
         checks += sphere_checks(progress=echo)
         checks += energy_checks()
+        checks += turbid_checks(progress=echo)
         checks += agreement_checks(backward=backward, progress=echo)
         checks += agreement_checks(backward=backward, crown="free volume crown",
                                    photons=4_000_000, progress=echo)

@@ -100,7 +100,8 @@ def trace_forward(scene: Scene, state: SkyState, settings: ForwardSettings,
         raise EngineError(f"unknown sensor grid(s): {', '.join(missing)}")
     geo = scene_geometry(scene, backend, workers)
     det = PatchDetectors({n: scene.grids[n] for n in names}, settings.patch_m)
-    pts = np.vstack([geo.vertices, det.corners().reshape(-1, 3)])
+    pts = np.vstack([geo.vertices, det.corners().reshape(-1, 3),
+                     *([] if geo.media is None else [geo.media.corners()])])
     sphere = bounding_sphere(pts)
     sources: list = []
     if state.sun_on:

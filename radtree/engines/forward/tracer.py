@@ -39,6 +39,7 @@ from radtree.engines.forward.guide import Guide
 from radtree.engines.forward.sources import Launch
 from radtree.engines.numpy.engine import Geometry, Optics, glass_coefficients
 from radtree.engines.numpy.sampling import cosine_hemisphere, mirror
+from radtree.engines.numpy.streams import GeneratorDraws
 
 
 @dataclass
@@ -154,6 +155,10 @@ class ForwardTracer:
         """One segment per photon: tally detectors, absorb, scatter; the children."""
         geo, opt, led = self.geo, self.opt, self.ledger
         tri, t = geo.caster.first_hit(ph.o, ph.d)
+        met = None
+        if geo.media is not None:   # a leaf of a turbid crown first? (engines.numpy.turbid)
+            met, t = geo.media.collide(ph.o, ph.d, t, GeneratorDraws(self.rng))
+            tri = np.where(met >= 0, 0, tri)   # a stand-in row, replaced below
         self.segments += len(ph)
         self.det.tally(ph.o, ph.d, t, ph.w, ph.batch, self.tally)
         miss = tri < 0
@@ -163,6 +168,7 @@ class ForwardTracer:
             led.escaped_down += float(ph.w[miss][~up].sum())
             keep = ~miss
             ph, tri, t = ph.take(keep), tri[keep], t[keep]
+            met = None if met is None else met[keep]
             if len(ph) == 0:
                 return ph
         p = ph.o + t[:, None] * ph.d
@@ -171,6 +177,11 @@ class ForwardTracer:
         nf = np.where((cosd < 0)[:, None], ng, -ng)  # normal on the incoming side
         mat = geo.tri_material[tri]
         coef = np.stack([opt.rd[mat], opt.td[mat], opt.ts[mat], opt.rm[mat]], axis=1)
+        if met is not None and geo.media is not None and (met >= 0).any():   # leaf events
+            mi = (met >= 0).nonzero()[0]
+            nf[mi], leaf = geo.media.leaf_events(met[mi], ph.d[mi], GeneratorDraws(self.rng))
+            coef[mi] = leaf.T
+            mat[mi] = geo.media.material_index(met[mi], geo.material_names)
         glass = np.isfinite(opt.glass_tn[mat])
         if glass.any():
             tg, rg = glass_coefficients(cosd[glass], opt.glass_tn[mat][glass])

@@ -154,6 +154,7 @@ class _Tracer:
         arrays then carry each path's state index (0 = ``state``)."""
         self.geo = geo
         self.caster = geo.caster
+        self.media = geo.media   # turbid crowns (radtree.engines.numpy.turbid) or None
         self.opt = optics
         self.env = Environment(state)
         self.state = state
@@ -231,7 +232,11 @@ class _Tracer:
         ``hour``: the hour state(s) whose point sun ``dirs`` are (per-triangle tables of the
         cosines and offsets), None for other directions (a sampled sun disc).
         """
-        return transmittance(self, origins, dirs, rng, parallel, hour)
+        vis = transmittance(self, origins, dirs, rng, parallel, hour)
+        if self.media is not None and len(vis):   # the turbid crowns' mean transmittance
+            on = (vis > 0).nonzero()[0]
+            vis[on] *= self.media.transmittance(origins[on], _rows(dirs, on), parallel)
+        return vis
 
     def sensor_sun(self, points: np.ndarray, normals: np.ndarray, dirs: np.ndarray | None = None,
                    rng: Draws | np.random.Generator | None = None, state: int | None = None
@@ -297,6 +302,10 @@ class _Tracer:
         while len(alive):
             bounce += 1
             tri, t = self.caster.first_hit(o, d, parallel)
+            met = None
+            if self.media is not None:   # a leaf of a turbid crown before the surface?
+                met, t = self.media.collide(o, d, t, rng.rows(alive, bounce, 5), parallel)
+                tri = np.where(met >= 0, max(self.n_tri - 1, 0), tri)   # a stand-in row
             miss = tri < 0
             if segments is not None:
                 segments(alive, o, d, np.where(miss, np.inf, t))
@@ -313,6 +322,8 @@ class _Tracer:
                 alive, o, d, beta, depth, nspec, tri, t = (
                     alive[hi], o.take(hi, axis=0), d.take(hi, axis=0), beta[hi], depth[hi],
                     nspec[hi], tri[hi], t[hi])
+                if met is not None:
+                    met = met[hi]
                 if hour is not None:
                     hour = hour[hi]
                 if len(alive) == 0:
@@ -336,6 +347,11 @@ class _Tracer:
                 # diffuse R, diffuse T, specular T, mirror (a copy, (4, k): one row per event)
                 coef = (self.tri_coef_t.take(tri, axis=1) if hour is None else
                         self.tri_coefs_flat_t.take(hour * self.n_tri + tri, axis=1))
+            if met is not None and self.media is not None and (met >= 0).any():
+                mi = (met >= 0).nonzero()[0]   # leaf events: drawn normal, leaf optics
+                nf[mi], coef[:, mi] = self.media.leaf_events(
+                    met[mi], d.take(mi, axis=0), rng.rows(alive.take(mi), bounce, 6))
+                cosd[mi] = -1.0
             rd, td = coef[0], coef[1]
 
             # next-event estimation towards the sun
@@ -374,7 +390,7 @@ class _Tracer:
 
             # scattering events: diffuse reflect, diffuse transmit, specular transmit, mirror
             if self.glass_any:
-                glass = self.tri_glass[tri]
+                glass = self.tri_glass[tri] if met is None else self.tri_glass[tri] & (met < 0)
                 if glass.any():
                     tg, rg = glass_coefficients(cosd[glass], self.tri_glass_tn[tri][glass])
                     coef[2, glass] = tg

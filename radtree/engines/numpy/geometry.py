@@ -17,6 +17,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from radtree.engines.numpy.raycast import RayCaster, make_caster
+from radtree.engines.numpy.turbid import MediumTracer
 from radtree.errors import EngineError
 from radtree.light.sky import SkyState, sky_luminance
 from radtree.optics import Glass, Hole, Plastic, Trans
@@ -30,7 +31,8 @@ class Geometry:
 
     def __init__(self, scene: Scene, backend: str, workers: int):
         meshes = scene.solid_meshes()
-        self.material_names = sorted({m.material for m in meshes})
+        self.material_names = sorted({m.material for m in meshes}
+                                     | set(() if scene.media is None else scene.media.materials))
         mat_index = {n: i for i, n in enumerate(self.material_names)}
         verts, faces, tri_mat, offset = [], [], [], 0
         for m in meshes:
@@ -53,6 +55,13 @@ class Geometry:
         allp = np.vstack(pts)
         self.size = float(np.ptp(allp, axis=0).max()) if len(allp) else 1.0
         self.caster: RayCaster = make_caster(self.vertices, self.faces, backend, workers)
+        self.media: MediumTracer | None = None   # turbid crowns, None without
+        if scene.media is not None and len(scene.media):
+            self.media = MediumTracer(scene.media, scene.materials, backend, workers)
+            tc = scene.media
+            box = np.vstack([tc.centres - np.stack([tc.a, tc.a, tc.b], 1),
+                             tc.centres + np.stack([tc.a, tc.a, tc.b], 1)])
+            self.size = max(self.size, float(np.ptp(np.vstack([allp, box]), axis=0).max()))
 
 
 def triangle_frames(vertices: np.ndarray, faces: np.ndarray
@@ -83,6 +92,10 @@ def _fingerprint(scene: Scene, backend: str, workers: int) -> str:
         h.update(np.ascontiguousarray(m.faces).tobytes())
     for g in scene.grids.values():
         h.update(np.ascontiguousarray(g.points).tobytes())
+    if scene.media is not None:   # turbid crowns: their envelopes and densities
+        for a in (scene.media.centres, scene.media.a, scene.media.b, scene.media.lad,
+                  scene.media.planes):
+            h.update(np.ascontiguousarray(a).tobytes())
     return h.hexdigest()
 
 

@@ -25,6 +25,7 @@ from jinja2 import Template
 
 import radtree
 from radtree.config import EngineParams
+from radtree.engines.numpy.turbid import refuse_media
 from radtree.engines.radiance.binaries import FIXED_SEED, RadianceInstall
 from radtree.engines.radiance.meshes import (
     as_compiled_mesh,
@@ -157,6 +158,7 @@ def write_build(scene: Scene, states: list[SkyState], params: EngineParams, ab: 
 
     ``hour_grids`` maps an hour label (HHMM) to the grids the Makefile traces then (default:
     every grid at every hour)."""
+    refuse_media(scene, "radiance")
     folder.mkdir(parents=True, exist_ok=True)
     (folder / "geometry").mkdir(exist_ok=True)
     (folder / "grids").mkdir(exist_ok=True)
