@@ -169,6 +169,7 @@ def _without_one_geometry(bare: Geometry, crowns: _Crowns, names: list[str], siz
     g.normals_t = np.ascontiguousarray(g.normals.T)
     g.v0_t = np.ascontiguousarray(g.v0.T)
     g.size = size
+    g.media = bare.media   # turbid crowns carry no tree ids: never attributed
     return g
 
 
