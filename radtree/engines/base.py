@@ -60,6 +60,10 @@ class Engine(ABC):
     #: :meth:`trace_ab_ladder` traces the whole ``-ab`` ladder at once (bounce orders tallied
     #: from one set of paths) rather than one trace per ``-ab``
     ladder_in_one_trace: ClassVar[bool] = False
+    #: the engine traces light from the sources to detectors (forward): its noise is set by
+    #: ``engine.photons`` per hour, which the results of such an engine are labelled with
+    #: (the backward engines' by ``engine.rays`` or Radiance's ``-ad``)
+    photon_budget: ClassVar[bool] = False
 
     @classmethod
     @abstractmethod

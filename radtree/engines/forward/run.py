@@ -14,13 +14,13 @@ from dataclasses import dataclass
 import numpy as np
 
 from radtree.engines.base import GridResult
+from radtree.engines.common.geometry import Environment, scene_geometry, scene_optics
 from radtree.engines.forward.detectors import PatchDetectors
 from radtree.engines.forward.guide import Guide
 from radtree.engines.forward.settings import ForwardSettings
 from radtree.engines.forward.sources import EnvironmentSource, SunSource, bounding_sphere
 from radtree.engines.forward.strata import PILOT, Stratum, allocate, pilot, ring_edges, trace_strata
 from radtree.engines.forward.tracer import ForwardTracer, Ledger, Photons, Splitting
-from radtree.engines.numpy.engine import Environment, scene_geometry, scene_optics
 from radtree.errors import ConfigError, EngineError
 from radtree.light.sky import SkyState
 from radtree.scene import Scene

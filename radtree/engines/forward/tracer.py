@@ -34,11 +34,11 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from radtree.engines.common.geometry import Geometry, Optics, glass_coefficients
+from radtree.engines.common.sampling import cosine_hemisphere, mirror
 from radtree.engines.forward.detectors import PatchDetectors
 from radtree.engines.forward.guide import Guide
 from radtree.engines.forward.sources import Launch
-from radtree.engines.numpy.engine import Geometry, Optics, glass_coefficients
-from radtree.engines.numpy.sampling import cosine_hemisphere, mirror
 
 
 @dataclass

@@ -58,7 +58,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from radtree.config import EngineParams
-from radtree.engines.numpy.geometry import (
+from radtree.engines.common.geometry import (
     GLASS_INDEX,
     Environment,
     Geometry,
@@ -67,10 +67,10 @@ from radtree.engines.numpy.geometry import (
     scene_geometry,
     scene_optics,
 )
-from radtree.engines.numpy.kernel import describe as kernel_describe
-from radtree.engines.numpy.kernel import kernel
-from radtree.engines.numpy.raycast import embree_available
-from radtree.engines.numpy.sampling import cosine_hemisphere, cosine_rows, mirror, uniform_cone
+from radtree.engines.common.kernel import describe as kernel_describe
+from radtree.engines.common.kernel import kernel
+from radtree.engines.common.raycast import embree_available
+from radtree.engines.common.sampling import cosine_hemisphere, cosine_rows, mirror, uniform_cone
 from radtree.engines.numpy.shadow import kernel_tables, transmittance
 from radtree.engines.numpy.shadow import rows as _rows
 from radtree.engines.numpy.streams import (
@@ -196,7 +196,7 @@ class _Tracer:
         self.sun_cos = cos.reshape(-1)
         self.sun_side = np.where(self.sun_cos < 0, -self.eps, self.eps)
         self.sun_grazing = bool(np.any(np.abs(self.sun_cos) < 1e-12))  # plane_distance's test
-        # the C kernel's table (radtree.engines.numpy.kernel): per triangle its normal, first
+        # the C kernel's table (radtree.engines.common.kernel): per triangle its normal, first
         # vertex, specular transmittance and cosine to the first state's sun, one 64-byte row
         self.tri_pack: np.ndarray | None = None
         if kernel() is not None:
@@ -311,7 +311,7 @@ class _Tracer:
                     break
             k_mod = kernel() if self.tri_pack is not None else None
             if k_mod is not None and tri.dtype == np.int64:
-                # the same numbers in one pass (radtree.engines.numpy.kernel)
+                # the same numbers in one pass (radtree.engines.common.kernel)
                 n_a = len(alive)
                 p, nf, cosd, coef = (np.empty((n_a, 3)), np.empty((n_a, 3)), np.empty(n_a),
                                      np.empty((4, n_a)))

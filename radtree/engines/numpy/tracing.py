@@ -13,6 +13,7 @@ import numpy as np
 
 from radtree.config import EngineParams
 from radtree.engines.base import GridResult
+from radtree.engines.common.sampling import cosine_directions as cosine_from
 from radtree.engines.numpy.engine import (
     DEFAULT_OPTIONS,
     TraceOptions,
@@ -21,7 +22,6 @@ from radtree.engines.numpy.engine import (
     scene_optics,
 )
 from radtree.engines.numpy.qmc import FirstDirections
-from radtree.engines.numpy.sampling import cosine_directions as cosine_from
 from radtree.engines.numpy.streams import SUN_DISC, PathStreams, stream_key
 from radtree.engines.numpy.tally import SensorTally
 from radtree.errors import EngineError

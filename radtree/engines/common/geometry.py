@@ -16,7 +16,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from radtree.engines.numpy.raycast import RayCaster, make_caster
+from radtree.engines.common.raycast import RayCaster, make_caster
 from radtree.errors import EngineError
 from radtree.light.sky import SkyState, sky_luminance
 from radtree.optics import Glass, Hole, Plastic, Trans
