@@ -16,7 +16,10 @@ the target grid's centre, innermost disc of that radius, m — unbiased, see
 target grid's centre split into that many children, at most twice per photon; 1 = never),
 ``forward_guide`` and ``forward_guide_radius_m`` (that share of every diffuse event outside a
 sphere of that radius around the target grid's centre aims its direction at the sphere, the
-flux corrected: :mod:`radtree.engines.forward.guide`; 0 = Lambertian scattering only).
+flux corrected: :mod:`radtree.engines.forward.guide`; 0 = Lambertian scattering only),
+``target_rel_se`` and ``max_photons`` (rounds of ``photons`` added until every traced grid's
+mean has that relative standard error, or that many photons:
+:mod:`radtree.engines.forward.precision`; unset = one round).
 """
 
 from __future__ import annotations
@@ -52,7 +55,10 @@ class ForwardSettings:
     (None: start points uniform on the launch disc; ignored with a beam). ``split``: children
     per diffuse event within ``split_radius_m`` (m) of the target grid's centre (1: none).
     ``guide``: share (0 ≤ q < 1) of diffuse directions aimed at the sphere of ``guide_radius_m``
-    (m) around the target grid's centre (0: none).
+    (m) around the target grid's centre (0: none). ``target_rel_se``: trace further rounds of
+    ``photons`` until every grid's mean has this relative standard error (None: one round);
+    ``max_photons``: the cap (then a :class:`~radtree.engines.forward.precision.PrecisionWarning`
+    with the error reached).
     """
 
     photons: int = 1_000_000
@@ -70,6 +76,8 @@ class ForwardSettings:
     split_radius_m: float = 2.0
     guide: float = 0.0
     guide_radius_m: float = 2.0
+    target_rel_se: float | None = None
+    max_photons: int = 64_000_000
 
     def __post_init__(self) -> None:
         if isinstance(self.photons, bool) or not isinstance(self.photons, int) or self.photons < 1:
@@ -108,6 +116,16 @@ class ForwardSettings:
         r = self.guide_radius_m
         if not isinstance(r, int | float) or not math.isfinite(r) or r <= 0:
             raise _bad("forward_guide_radius_m", f"must be > 0 m, got {r!r}")
+        t = self.target_rel_se
+        if t is not None and (isinstance(t, bool) or not isinstance(t, int | float)
+                              or not 0.0 < t < 1.0):
+            raise _bad("target_rel_se", f"must be strictly between 0 and 1 (a relative standard "
+                       f"error, e.g. 0.02), or unset for a fixed photon count, got {t!r}")
+        m = self.max_photons
+        if isinstance(m, bool) or not isinstance(m, int) or m < 1 \
+                or (t is not None and m < self.photons):
+            raise _bad("max_photons", f"must be a whole number ≥ engine.photons "
+                       f"({self.photons}), got {m!r}")
         if self.max_bounces < 0 or self.max_specular < 0 or self.chunk < 1:
             raise _bad("max_bounces", "bounce caps must be ≥ 0 and the chunk ≥ 1")
 
@@ -121,7 +139,8 @@ class ForwardSettings:
                    max_bounces=int(params.max_bounces if ab is None else ab),
                    seed=int(params.seed), focus_m=params.forward_focus_m,
                    split=params.forward_split, split_radius_m=params.forward_split_radius_m,
-                   guide=params.forward_guide, guide_radius_m=params.forward_guide_radius_m)
+                   guide=params.forward_guide, guide_radius_m=params.forward_guide_radius_m,
+                   target_rel_se=params.target_rel_se, max_photons=params.max_photons)
 
     def describe(self) -> str:
         source = ("sun over the whole scene" if self.beam_diameter_m is None
@@ -134,5 +153,8 @@ class ForwardSettings:
         if self.guide > 0:
             scatter += f", {self.guide:.0%} of diffuse directions aimed at the target " \
                        f"({self.guide_radius_m:g} m)"
-        return (f"{self.photons} photons, {source}, {scatter}, threshold {self.threshold:g}, "
+        count = (f"{self.photons} photons" if self.target_rel_se is None else
+                 f"photons in rounds of {self.photons} to a {self.target_rel_se:.1%} standard "
+                 f"error of each grid mean (cap {self.max_photons})")
+        return (f"{count}, {source}, {scatter}, threshold {self.threshold:g}, "
                 f"patches {self.patch_m:g} m, {self.batches} batches, seed {self.seed}")
