@@ -19,6 +19,7 @@ import numpy as np
 from radtree.engines.base import GridResult
 from radtree.engines.common.geometry import Environment, scene_geometry, scene_optics
 from radtree.engines.forward.detectors import PatchDetectors
+from radtree.engines.forward.direct import direct_sun
 from radtree.engines.forward.guide import Guide
 from radtree.engines.forward.precision import Budget, worst_relative_se
 from radtree.engines.forward.settings import ForwardSettings
@@ -111,8 +112,11 @@ def trace_forward(scene: Scene, state: SkyState, settings: ForwardSettings,
     pts = np.vstack([geo.vertices, det.corners().reshape(-1, 3)])
     sphere = bounding_sphere(pts)
     sources: list = []
+    direct: frozenset[int] = frozenset()
     if state.sun_on:
         sources.append(sun_source(scene, state, settings, sphere))
+        if settings.direct_sun and settings.beam_diameter_m is None:
+            direct = frozenset({0})  # the sun's beam at the points, not on the patches
     if settings.beam_diameter_m is None:  # a beam is the study's only source: no sky, no glow
         env = EnvironmentSource(Environment(state), sphere)
         if env.cdf is not None and env.flux > 0:
@@ -124,7 +128,11 @@ def trace_forward(scene: Scene, state: SkyState, settings: ForwardSettings,
     target = scene.grids[aim].points.mean(axis=0)
     near = (Splitting(target, settings.split_radius_m, settings.split)
             if settings.split > 1 else None)
-    guide = (Guide(target, settings.guide_radius_m, settings.guide)
+    radius = settings.guide_radius_m
+    if radius is None:  # the sphere just holding the target grid's patches
+        corners = det.corners()[det.slices[aim]].reshape(-1, 3)
+        radius = float(np.linalg.norm(corners - target, axis=1).max())
+    guide = (Guide(target, radius, settings.guide)
              if settings.guide > 0 else None)
 
     def new_tracer(batches: int) -> ForwardTracer:
@@ -143,7 +151,7 @@ def trace_forward(scene: Scene, state: SkyState, settings: ForwardSettings,
                   for a, b_ in zip(edges[:-1], edges[1:])]
         per_ring = max(64, int(PILOT * settings.photons / len(strata)))
         scout = new_tracer(1)
-        pilot(sources, strata, target, scout, per_ring, rng)
+        pilot(sources, strata, target, scout, per_ring, rng, direct)
         n_pilot, pilot_segments = per_ring * len(strata), scout.segments
         allocate(strata, max(settings.photons - n_pilot, b * len(strata)), b)
 
@@ -152,7 +160,7 @@ def trace_forward(scene: Scene, state: SkyState, settings: ForwardSettings,
         lux of each batch."""
         tracer.tally = np.zeros((b, det.count))
         if strata is not None:
-            trace_strata(sources, strata, target, tracer, settings.chunk, b, rng)
+            trace_strata(sources, strata, target, tracer, settings.chunk, b, rng, direct)
             n = sum(st.photons for st in strata)
         else:
             counts = _allot(settings.photons, [s.flux for s in sources], b)
@@ -161,10 +169,20 @@ def trace_forward(scene: Scene, state: SkyState, settings: ForwardSettings,
                 for c0 in range(0, n_src, settings.chunk):
                     k = min(settings.chunk, n_src - c0)
                     batch = (c0 + np.arange(k)) % b
-                    tracer.run(Photons.start(src.launch(k, per_photon, rng), batch))
+                    tracer.run(Photons.start(src.launch(k, per_photon, rng), batch,
+                                             src is sources[0] and bool(direct)))
             n = sum(counts)
-        return n, tracer.tally * b / det.area
+        rows = tracer.tally * b / det.area
+        if direct:
+            rows += at_points  # the direct sun, exact at the points: the same in every batch
+        return n, rows
 
+    at_points = np.zeros(det.count)
+    if direct:
+        sun = np.asarray(state.sun.vector, float)
+        for name in names:
+            at_points[det.slices[name]] = direct_sun(geo, optics, scene.grids[name], sun,
+                                                     state.direct_normal_lux)
     budget = Budget(settings.photons, settings.target_rel_se, settings.max_photons)
     traced, rows = 0, []
     leg = settings.photons

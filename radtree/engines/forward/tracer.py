@@ -97,26 +97,29 @@ class Photons:
     nspec: np.ndarray    # specular events so far
     batch: np.ndarray    # batch of the photon (standard errors)
     nsplit: np.ndarray   # splits in its lineage so far
+    direct: np.ndarray   # still the sun's direct beam (counted at the points: direct.py)
 
     def __len__(self) -> int:
         return len(self.w)
 
     def take(self, m: np.ndarray | slice) -> Photons:
         return Photons(self.o[m], self.d[m], self.w[m], self.w0[m], self.ndiff[m],
-                       self.nspec[m], self.batch[m], self.nsplit[m])
+                       self.nspec[m], self.batch[m], self.nsplit[m], self.direct[m])
 
     @staticmethod
     def join(parts: list[Photons]) -> Photons:
         return Photons(*(np.concatenate([getattr(p, f) for p in parts])
                          for f in ("o", "d", "w", "w0", "ndiff", "nspec", "batch",
-                                   "nsplit")))
+                                   "nsplit", "direct")))
 
     @staticmethod
-    def start(launch: Launch, batch: np.ndarray) -> Photons:
+    def start(launch: Launch, batch: np.ndarray, direct: bool = False) -> Photons:
+        """Photons of ``launch``; ``direct``: the sun's beam, not tallied on the detectors
+        until scattered (its direct light is computed at the sensor points)."""
         k = len(launch.flux)
         z = np.zeros(k, np.int64)
         return Photons(launch.origins, launch.dirs, launch.flux.copy(), launch.flux.copy(),
-                       z, z.copy(), batch, z.copy())
+                       z, z.copy(), batch, z.copy(), np.full(k, bool(direct)))
 
 
 class ForwardTracer:
@@ -155,7 +158,12 @@ class ForwardTracer:
         geo, opt, led = self.geo, self.opt, self.ledger
         tri, t = geo.caster.first_hit(ph.o, ph.d)
         self.segments += len(ph)
-        self.det.tally(ph.o, ph.d, t, ph.w, ph.batch, self.tally)
+        if ph.direct.any():
+            seen = ~ph.direct
+            self.det.tally(ph.o[seen], ph.d[seen], t[seen], ph.w[seen], ph.batch[seen],
+                           self.tally)
+        else:
+            self.det.tally(ph.o, ph.d, t, ph.w, ph.batch, self.tally)
         miss = tri < 0
         if miss.any():
             up = ph.d[miss, 2] > 0
@@ -237,7 +245,7 @@ class ForwardTracer:
         side = np.where(diff_t | spec_t, -1.0, 1.0)
         out = Photons(p[src] + n * (self.eps * side)[:, None], new_d, cw, w0,
                       ph.ndiff[src] + diffuse, ph.nspec[src] + (spec_t | mir), ph.batch[src],
-                      nsplit)
+                      nsplit, ph.direct[src] & spec_t)
         return out if self.guide is None else out.take(out.w > 0)
 
     def _split(self, p: np.ndarray, src: np.ndarray, ev: np.ndarray, cw: np.ndarray,
