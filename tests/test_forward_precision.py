@@ -119,3 +119,45 @@ def test_errors_are_calibrated_over_seeded_repeats():
           f"relative error {np.mean(se / m):.3%}")
     assert np.all(se <= 0.05 * m)
     assert 0.8 <= z.std(ddof=1) <= 1.25 and np.all(np.abs(z) <= 3.0)
+
+
+# ------------------------------------------------------------------ the direct sun at the points
+
+
+def _strip_scene(material) -> tuple[Scene, object]:
+    """A 0.3 m wide strip (along y) 1 m above an upward sensor at the origin, sun at the
+    zenith: the sensor point in the strip's shadow, its 0.5 m patch 60 % in it."""
+    from radtree.scene import quad
+
+    st = sky_state("none", altitude=90.0, azimuth=0.0, dni=DNI, ground_glow=False)
+    strip = quad("strip", "strip", np.array([[-0.15, -5, 1], [0.15, -5, 1], [0.15, 5, 1],
+                                             [-0.15, 5, 1]], float))
+    return Scene([strip], {"strip": material},
+                 {"facade": SensorGrid("facade", [[0, 0, 0.0]], [UP])}), st
+
+
+def test_direct_sun_at_a_point_through_a_specular_layer():
+    """E = E_dn · T_s under a Trans strip (T_s 0.3), E_dn outside its shadow, exactly."""
+    from radtree.engines.common.geometry import scene_geometry, scene_optics
+    from radtree.engines.forward.direct import direct_sun
+
+    sc, st = _strip_scene(Trans("strip", 0.1, 0.2, 0.3))
+    geo = scene_geometry(sc, "auto", 1)
+    optics = scene_optics(sc, st, geo.material_names)
+    grid = SensorGrid("g", [[0, 0, 0.0], [1.0, 0, 0.0], [0, 0, 2.0]], [UP, UP, UP])
+    got = direct_sun(geo, optics, grid, np.asarray(st.sun.vector), DNI)
+    assert got == pytest.approx([0.3 * DNI, DNI, DNI], rel=1e-9)
+
+
+def test_direct_sun_counted_at_the_point_not_over_the_patch():
+    """A black strip shading the sensor point: 0 lx at the point (nothing scatters), where
+    the 0.5 m patch tally of the sun's photons reads the lit 40 % of the square."""
+    from radtree.optics import Plastic
+
+    sc, st = _strip_scene(Plastic("strip", 0.0))
+    at_point = trace_forward(sc, st, ForwardSettings(photons=100_000, direct_sun=True,
+                                                       focus_m=0.5))
+    on_patch = trace_forward(sc, st, ForwardSettings(photons=100_000, focus_m=0.5))
+    assert at_point.grids["facade"].lux[0] == 0.0
+    lux, se = on_patch.grids["facade"].lux[0], on_patch.grids["facade"].stderr[0]
+    assert abs(lux - 0.4 * DNI) <= 3 * se and se < 0.02 * DNI
