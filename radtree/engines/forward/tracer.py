@@ -128,7 +128,7 @@ class ForwardTracer:
     def __init__(self, geo: Geometry, optics: Optics, detectors: PatchDetectors, batches: int,
                  *, threshold: float, splitting: bool, max_bounces: int, max_specular: int,
                  chunk: int, rng: np.random.Generator, splitting_near: Splitting | None = None,
-                 guide: Guide | None = None):
+                 guide: Guide | None = None, escape_axes: np.ndarray | None = None):
         self.geo, self.opt, self.det = geo, optics, detectors
         self.near, self.guide = splitting_near, guide
         self.threshold, self.splitting = float(threshold), bool(splitting)
@@ -139,6 +139,11 @@ class ForwardTracer:
         self.tally = np.zeros((batches, detectors.count))
         self.ledger = Ledger(list(geo.material_names))
         self.segments = 0
+        #: with ``escape_axes`` (batches, 3) unit vectors: per batch, the flux escaping the scene
+        #: along its axis (d · axis > 0, lm), and the part still the direct beam
+        self.axes = escape_axes
+        self.ahead = np.zeros(0 if escape_axes is None else len(escape_axes))
+        self.ahead_direct = np.zeros_like(self.ahead)
 
     def run(self, photons: Photons) -> None:
         """Trace ``photons`` (and every child) until none is left."""
@@ -165,6 +170,13 @@ class ForwardTracer:
         else:
             self.det.tally(ph.o, ph.d, t, ph.w, ph.batch, self.tally)
         miss = tri < 0
+        if miss.any() and self.axes is not None:
+            gone = ph.take(miss)
+            ahead = np.einsum("ij,ij->i", gone.d, self.axes[gone.batch]) > 0
+            n = len(self.ahead)
+            self.ahead += np.bincount(gone.batch[ahead], gone.w[ahead], minlength=n)
+            lit = ahead & gone.direct
+            self.ahead_direct += np.bincount(gone.batch[lit], gone.w[lit], minlength=n)
         if miss.any():
             up = ph.d[miss, 2] > 0
             led.escaped_up += float(ph.w[miss][up].sum())
