@@ -4,7 +4,7 @@ the NumPy engine's optional C kernel.
 The folders are mapped as the data subpackages ``radtree.templates`` and ``radtree.materials``,
 so an installed radtree finds them beside its code (see ``radtree/resources.py``).
 
-``radtree.engines.numpy._kernel`` (``radtree/engines/numpy/_kernel.c``, the shadow-ray loop's
+``radtree.engines.common._kernel`` (``radtree/engines/common/_kernel.c``, the shadow-ray loop's
 per-crossing arithmetic in one pass) is optional: without a C compiler the install goes on and
 the engine runs its NumPy code, which gives the same numbers (``radtree doctor`` says which is
 in use; ``RADTREE_KERNEL=numpy`` forces NumPy). It is compiled without floating-point
@@ -39,7 +39,7 @@ DATA_PACKAGES = _data_packages()
 STRICT_FP = {"msvc": ["/O2", "/fp:precise"],
              "unix": ["-O2", "-ffp-contract=off", "-fno-fast-math"]}
 
-KERNEL = Extension("radtree.engines.numpy._kernel", sources=["radtree/engines/numpy/_kernel.c"],
+KERNEL = Extension("radtree.engines.common._kernel", sources=["radtree/engines/common/_kernel.c"],
                    optional=True)
 
 

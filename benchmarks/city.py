@@ -18,7 +18,7 @@ with every row; wall time at load L on 2 cores is inflated by up to ≈ L/2, CPU
 The same table: every run writes ``results/illuminance.csv``; the one-process table and the
 Dask ones are compared row by row (max |Δ lux| and the number of differing rows printed) —
 the NumPy engine's paths draw from counter-based streams keyed by grid and path number
-(:mod:`radtree.engines.numpy.streams`), so the numbers do not depend on the scheduler or the
+(:mod:`radtree.engines.common.streams`), so the numbers do not depend on the scheduler or the
 worker count.
 
 Design for 100 workers (``--scheduler tcp://HOST:PORT`` on a Dask cluster). The unit of work

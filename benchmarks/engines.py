@@ -42,10 +42,10 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
 from radtree.config import EngineParams, Sensors, Street  # noqa: E402
+from radtree.engines.common.raycast import BVHCaster, EmbreeCaster, embree_available  # noqa: E402
+from radtree.engines.common.sampling import cosine_hemisphere  # noqa: E402
 from radtree.engines.numpy import describe, trace  # noqa: E402
 from radtree.engines.numpy.engine import DEFAULT_OPTIONS, scene_geometry  # noqa: E402
-from radtree.engines.numpy.raycast import BVHCaster, EmbreeCaster, embree_available  # noqa: E402
-from radtree.engines.numpy.sampling import cosine_hemisphere  # noqa: E402
 from radtree.engines.numpy.scenes import dome_slats, sky_state  # noqa: E402
 from radtree.engines.radiance.binaries import find_radiance  # noqa: E402
 from radtree.optics import Material, Trans  # noqa: E402
@@ -271,7 +271,7 @@ def engine_vs_embree(quick: bool, repeats: int = 3) -> None:
                 best.append((engine, raw, first_hit, engine_cpu, raw_cpu))
             engine, raw, first_hit, engine_cpu, raw_cpu = min(best)
             inside, inside_cpu = _embree_inside(caster, work, *args)
-            from radtree.engines.numpy.kernel import name as kernel_name
+            from radtree.engines.common.kernel import name as kernel_name
             n = len(o)
             print(f"  scenario {name}, {len(hours)} hour(s): {built.triangles} triangles, "
                   f"{workers} thread(s), "

@@ -12,6 +12,22 @@ dome of ``radtree verify`` (:data:`radtree.verify.compare.REDUCED_DOME`), prints
 * the time to a 1 % standard error of the façade mean, extrapolated as t · (s.e. / 1 %)².
 
 Run: ``.venv/bin/python benchmarks/forward.py [--photons N] [--rays N]``. No assertions.
+
+Issue 40 (the estimator a user can trust by default), each a separate mode:
+
+* ``--zscores N``: N seeded repeats of every chosen scenario-hour with the project's forward
+  settings (precision loop on; ``--z-target`` and ``--z-round`` make it affordable: the
+  stopping logic is the one of the 2 % default): z of each run against the mean of the others
+  (combined standard error), per scenario-hour and pooled: s.d., share |z| > 3.
+* ``--radiance``: the forward engine at the project's defaults (2 % target) against the
+  Radiance engine at the project's settings (point sensors, fixed seed) on the same build,
+  traced façade mean per scenario-hour (the calculated ground term, the same for both, left
+  out): difference, forward standard error, within 2 % or 3 s.e.
+* ``--patch-bias``: the NumPy engine at the 8 sensor points vs averaged over their squares of
+  ``--patch`` m (why a patch tally of the direct sun cannot stand for point sensors).
+
+``--hours`` and ``--scenarios`` choose the scenario-hours (hour-major order, each line printed
+when done, so a partial run reports what it covered).
 """
 
 from __future__ import annotations
@@ -20,6 +36,7 @@ import argparse
 import math
 import sys
 import time
+import warnings
 from dataclasses import replace
 from pathlib import Path
 
@@ -80,14 +97,107 @@ def run(label: str, overrides: dict, scenarios: list[str], photons: int, rays: i
               float(res.lux.mean()), se_b)
 
 
+def _cases(hours: list[str], scenarios: list[str]):
+    """(project, scenario name, hour, built scene, hour state), hour-major."""
+    proj = load_project(MENDOZA, overrides={"site.hours": hours, "sensors.dense_grid": False})
+    for hour in hours:
+        for name in scenarios:
+            sc = proj.scenario(name)
+            built = make_scene(proj, sc, dense_grid=False)
+            yield proj, name, hour, built, hour_states(proj, sc, [hour])[0]
+
+
+def zscores(hours: list[str], scenarios: list[str], repeats: int, target: float,
+            round_photons: int) -> None:
+    print(f"z-scores: {repeats} seeds per scenario-hour, target {target:.1%}, rounds of "
+          f"{round_photons} photons (project forward settings otherwise)")
+    pooled = []
+    for proj, name, hour, built, st in _cases(hours, scenarios):
+        s = replace(ForwardSettings.from_params(proj.engine, built.ab), photons=round_photons,
+                    target_rel_se=target)
+        t0 = time.perf_counter()
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            runs = [trace_forward(built.scene, st, replace(s, seed=k), ["facade"],
+                                  workers=1).grid_mean("facade") for k in range(1, repeats + 1)]
+        m = np.array([r[0] for r in runs])
+        se = np.array([r[1] for r in runs])
+        others = (m.sum() - m) / (len(m) - 1)
+        z = (m - others) / np.sqrt(se ** 2 + np.mean(se ** 2) / (len(m) - 1))
+        pooled += list(z)
+        print(f"  {name:6s} {hour}: mean {m.mean():8.1f} lx, mean rel. s.e. {np.mean(se / m):6.2%}"
+              f", z s.d. {z.std(ddof=1):5.3f}, max |z| {np.abs(z).max():4.2f}, |z| > 3: "
+              f"{np.mean(np.abs(z) > 3):5.1%}  ({time.perf_counter() - t0:.0f} s)", flush=True)
+    zp = np.array(pooled)
+    print(f" pooled over {len(zp)} runs: z s.d. {zp.std(ddof=1):.3f}, |z| > 3: "
+          f"{np.mean(np.abs(zp) > 3):.2%}", flush=True)
+
+
+def against_radiance(hours: list[str], scenarios: list[str]) -> None:
+    from radtree.engines.registry import get_engine
+
+    print("forward (project defaults) vs Radiance (project settings, point sensors), traced "
+          "façade mean")
+    rad = get_engine("radiance")
+    ok = 0
+    n = 0
+    for proj, name, hour, built, st in _cases(hours, scenarios):
+        t0 = time.perf_counter()
+        rl = float(rad.trace_once(built.scene, st, proj.engine, built.ab, ["facade"])
+                   ["facade"].lux.mean())
+        t1 = time.perf_counter()
+        fw = trace_forward(built.scene, st, ForwardSettings.from_params(proj.engine, built.ab),
+                           ["facade"], workers=1)
+        m, se = fw.grid_mean("facade")
+        d = m - rl
+        good = abs(d) <= max(0.02 * rl, 3 * se)
+        ok += good
+        n += 1
+        print(f"  {name:6s} {hour}: radiance {rl:8.1f}  forward {m:8.1f} ± {se:6.1f} "
+              f"({fw.photons / 1e6:.1f} M photons)  diff {d / rl:+6.2%} = {d / se:+5.2f} s.e.  "
+              f"{'ok' if good else 'MISS'}  (radiance {t1 - t0:.0f} s, forward "
+              f"{time.perf_counter() - t1:.0f} s)", flush=True)
+    print(f" within 2 % or 3 s.e.: {ok} of {n}", flush=True)
+
+
+def patch_bias(hours: list[str], scenarios: list[str], side: float) -> None:
+    from radtree.verify.compare import backward_patch_mean
+
+    print(f"NumPy engine: 8 sensor points vs their {side:g} m squares (direct sun included)")
+    for proj, name, hour, built, st in _cases(hours, scenarios):
+        p = replace(proj.engine, rays=2048, max_bounces=built.ab, ab=built.ab)
+        pt = trace_hour(built.scene, st, p, ["facade"])["facade"]
+        pm = backward_patch_mean("numpy", built.scene, st, "facade", side, ab=built.ab,
+                                 points=96, rays=128, params=p)
+        print(f"  {name:6s} {hour}: points {pt.lux.mean():8.1f}, squares {pm.lux:8.1f} ± "
+              f"{pm.stderr:6.1f} ({pm.lux / pt.lux.mean() - 1:+.1%})", flush=True)
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--photons", type=int, default=2_000_000)
     ap.add_argument("--rays", type=int, default=2048)
-    ap.add_argument("--scenarios", nargs="+", default=["A", "B"])
+    ap.add_argument("--scenarios", nargs="+", default=None)
+    ap.add_argument("--hours", nargs="+", default=["12:30", "10:30", "16:30", "11:30",
+                                                      "15:30", "13:30", "14:30"])
+    ap.add_argument("--zscores", type=int, default=0, metavar="N")
+    ap.add_argument("--z-target", type=float, default=0.05)
+    ap.add_argument("--z-round", type=int, default=100_000)
+    ap.add_argument("--radiance", action="store_true")
+    ap.add_argument("--patch-bias", action="store_true")
+    ap.add_argument("--patch", type=float, default=0.5)
     a = ap.parse_args()
-    run("Mendoza louvers dome (shipped example)", {}, a.scenarios, a.photons, a.rays)
-    run("reduced dome (radtree verify)", dict(REDUCED_DOME), a.scenarios, a.photons, a.rays)
+    every = ["A", "B", "C", "D", "E", "A-sky", "F"]
+    if a.zscores:
+        zscores(a.hours, a.scenarios or every, a.zscores, a.z_target, a.z_round)
+    elif a.radiance:
+        against_radiance(a.hours, a.scenarios or every)
+    elif a.patch_bias:
+        patch_bias(a.hours, a.scenarios or every, a.patch)
+    else:
+        scenarios = a.scenarios or ["A", "B"]
+        run("Mendoza louvers dome (shipped example)", {}, scenarios, a.photons, a.rays)
+        run("reduced dome (radtree verify)", dict(REDUCED_DOME), scenarios, a.photons, a.rays)
 
 
 if __name__ == "__main__":

@@ -19,7 +19,7 @@ transmittance T_d, and an undeviated share T_s — the optics of the crown's lea
 
 Memory: a crown is a few numbers (centre, axes, density, kind, clip planes), whatever its
 leaf count. The engines that trace media sample free paths through them
-(:mod:`radtree.engines.numpy.turbid`).
+(:mod:`radtree.engines.common.turbid`).
 """
 
 from __future__ import annotations

@@ -1,4 +1,5 @@
-"""Radiance materials as small classes that render their exact Radiance text.
+"""Materials as small typed classes (plain data; their Radiance text is written by
+:mod:`radtree.engines.radiance.materials`, the NumPy and forward engines read the coefficients).
 
 All optical values are photopic (visible) fractions in [0, 1]; colours are grey (R = G = B), so
 the photopic value Radiance computes (0.265 R + 0.670 G + 0.065 B) equals the stated value.
@@ -67,13 +68,6 @@ class Plastic:
     def transmittance(self) -> float:
         return 0.0
 
-    def to_radiance(self) -> str:
-        r = fmt(self.reflectance)
-        return (
-            f"void plastic {self.name}\n0\n0\n5 {r} {r} {r} "
-            f"{fmt(self.specularity)} {fmt(self.roughness)}\n"
-        )
-
 
 @dataclass(frozen=True)
 class Trans:
@@ -114,11 +108,6 @@ class Trans:
         tspec = self.specular_transmittance / t if t > 0 else 0.0
         return c, trans, tspec
 
-    def to_radiance(self) -> str:
-        c, trans, tspec = self.coefficients
-        cc = fmt(c)
-        return f"void trans {self.name}\n0\n0\n7 {cc} {cc} {cc} 0 0 {fmt(trans)} {fmt(tspec)}\n"
-
 
 @dataclass(frozen=True)
 class Glass:
@@ -149,10 +138,6 @@ class Glass:
         r = ((1.52 - 1.0) / (1.52 + 1.0)) ** 2
         return tn * (1 - r) ** 2 / (1 - (r * tn) ** 2)
 
-    def to_radiance(self) -> str:
-        t = fmt(self.transmissivity)
-        return f"void glass {self.name}\n0\n0\n3 {t} {t} {t}\n"
-
 
 @dataclass(frozen=True)
 class Hole:
@@ -170,9 +155,6 @@ class Hole:
     @property
     def transmittance(self) -> float:
         return 1.0
-
-    def to_radiance(self) -> str:
-        return ""
 
 
 @dataclass(frozen=True)
@@ -194,11 +176,6 @@ class Bsdf:
                              f"got {self.xml!r}")
         if not math.isfinite(self.thickness) or self.thickness < 0:
             raise ValueError(f"material '{self.name}': thickness must be ≥ 0 m")
-
-    def to_radiance(self) -> str:
-        ux, uy, uz = (f"{v:g}" for v in self.up)
-        return (f"void BSDF {self.name}\n6 {self.thickness:g} {self.xml} {ux} {uy} {uz} .\n"
-                "0\n0\n")
 
 
 #: The Klems full basis (LBNL/WINDOW "LBNL/Klems Full"): per θ ring (lower, upper, centre

@@ -26,7 +26,7 @@ import pandas as pd
 
 from radtree.errors import RadtreeError
 from radtree.measurements import grid_mean, normalise_time
-from radtree.pipeline.results import REQUIRED_COLUMNS
+from radtree.results_schema import REQUIRED_COLUMNS
 
 FloatArray = npt.NDArray[np.float64]
 

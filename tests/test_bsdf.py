@@ -14,6 +14,7 @@ from radtree.bsdf.klems import read_klems
 from radtree.config import CrownBsdf, check_key, load_project
 from radtree.engines.radiance.binaries import run
 from radtree.engines.radiance.bsdf import FluxSettings, check_bsdf, klems_bsdf, write_system
+from radtree.engines.radiance.materials import material_text
 from radtree.errors import ConfigError, EngineError
 from radtree.optics import Bsdf, Plastic
 from radtree.pipeline.crown_bsdf import band_elevations, leaf_on_sample
@@ -167,7 +168,7 @@ def test_bsdf_crown_scene_and_in_process_engines_refuse_it(tmp_path):
         area += m.area()
     r = proj.tree.dome.radius_m
     assert area == pytest.approx(2 * math.pi * r * r, rel=0.02)   # the whole hemisphere
-    assert built.scene.materials["crown_bsdf_b1_low"].to_radiance() == (
+    assert material_text(built.scene.materials["crown_bsdf_b1_low"]) == (
         f"void BSDF crown_bsdf_b1_low\n6 0 {xml.resolve()} 0 0 -1 .\n0\n0\n")
     with pytest.raises(EngineError, match="Radiance only"):
         trace_hours(proj, proj.scenario("B"), NumpyEngine(), grids=["facade"], built=built)

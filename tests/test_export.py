@@ -70,8 +70,9 @@ def project(tmp_path_factory):
 
 @pytest.fixture(scope="module")
 def exported(project, tmp_path_factory):
-    """``radtree export PROJECT --format honeybee`` (16 rays per hour): the HBJSON loaded back
-    with honeybee-core, and the schedules as written (with their crowns and leaf states)."""
+    """``radtree export PROJECT --format honeybee --definition beam`` (16 rays per hour): the
+    HBJSON loaded back with honeybee-core, and the schedules as written (with their crowns and
+    leaf states)."""
     from click.testing import CliRunner
     from honeybee.model import Model
 
@@ -85,7 +86,7 @@ def exported(project, tmp_path_factory):
 
     out = tmp_path_factory.mktemp("hbjson")
     r = CliRunner().invoke(main, ["export", str(project.root), "--format", "honeybee", "--out",
-                                  str(out), "--rays", str(RAYS)])
+                                  str(out), "--rays", str(RAYS), "--definition", "beam"])
     assert r.exit_code == 0, r.output
     path = out / "radtree_crowns.hbjson"
     assert f"wrote {path}" in r.output and "1 crown shades" in r.output
@@ -183,6 +184,10 @@ def test_honeybee_round_trip_idf_and_csv(project, exported, year, tmp_path):
     idf = write_idf(model, tmp_path).read_text()
     assert idf.count("Shading:Building:Detailed,") == len(shade.faces)
     assert "radtree_crown_1_transmittance" in idf
+    shadow = ("ShadowCalculation,\n PolygonClipping,          !- calculation method\n"
+              " Periodic,                 !- calculation update method\n"
+              " 1,                        !- calculation frequency\n")
+    assert shadow in idf
 
     csv, sidf = write_schedule_csv(schedules, tmp_path)
     lines = csv.read_text().splitlines()
@@ -190,6 +195,29 @@ def test_honeybee_round_trip_idf_and_csv(project, exported, year, tmp_path):
     assert float(lines[1 + 4000]) == pytest.approx(schedules[0].values[4000], abs=1e-6)
     text = sidf.read_text()
     assert "Schedule:File," in text and "crown_transmittance.csv" in text and "8760" in text
+    assert shadow in text
+
+
+def test_total_schedule_by_default_with_its_caveats(project, exported, tmp_path):
+    """The default definition (total) passes at least the beam every hour, more on average
+    in leaf (the light the crown scatters forward), and the export prints the caveats."""
+    from click.testing import CliRunner
+
+    from radtree.cli import main
+
+    r = CliRunner().invoke(main, ["export", str(project.root), "--format", "schedule", "--out",
+                                  str(tmp_path), "--rays", str(RAYS)])
+    assert r.exit_code == 0, r.output
+    assert "transmittance (total)" in r.output
+    assert "caveat: EnergyPlus passes a shade's scheduled transmittance on undeviated" in r.output
+    assert "PixelCounting makes the shade opaque, EnergyPlus issue #9059" in r.output
+    lines = (tmp_path / "crown_transmittance.csv").read_text().splitlines()[1:]
+    total = np.array([float(x) for x in lines])
+    beam = exported[1][0].values
+    on = exported[1][0].leaf_on
+    assert np.all(total >= beam - 1e-6)
+    print(f"leaf-on mean: beam {beam[on].mean():.4f}, total {total[on].mean():.4f}")
+    assert total[on].mean() > beam[on].mean() + 0.01
 
 
 def test_cli_gltf_and_obj(project, tmp_path):

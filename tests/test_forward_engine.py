@@ -14,6 +14,7 @@ import pytest
 
 from radtree.config import EngineParams, load_project
 from radtree.engines.forward import ForwardSettings, trace_forward
+from radtree.engines.forward.precision import PrecisionWarning
 from radtree.engines.numpy.scenes import hemisphere_shell, sky_state, slat_layer
 from radtree.engines.registry import ENGINE_CHOICES, get_engine
 from radtree.errors import ConfigError
@@ -227,9 +228,10 @@ def test_simulate_with_the_forward_engine(tmp_path):
 
     root = copy_project(tmp_path / "p", hours=["13:30"])
     proj = load_project(root, overrides={"engine.photons": 20_000, "sensors.dense_grid": False,
-                                         "street.length_m": 10.0})
-    out = simulate_project(proj, engine="forward", scenarios=["A", "E"], echo=lambda _m: None,
-                           progress=False, resume=False)
+                                         "street.length_m": 10.0, "engine.max_photons": 40_000})
+    with pytest.warns(PrecisionWarning, match="photon cap 40,000 reached"):
+        out = simulate_project(proj, engine="forward", scenarios=["A", "E"],
+                               echo=lambda _m: None, progress=False, resume=False)
     assert out is not None
     t = out.table
     assert set(t["engine"]) == {"forward"} and set(t["scenario"]) == {"A", "E"}

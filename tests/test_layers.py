@@ -85,10 +85,29 @@ def test_modules_are_small():
     assert big == {}
 
 
+def _engine_name_pattern(names: list[str]) -> re.Pattern[str]:
+    """A comparison with, an assignment of, or a tuple of quoted engine names."""
+    name = rf"""["'](?:{'|'.join(map(re.escape, names))})["']"""
+    return re.compile(rf"(?:==|!=|=)\s*{name}|{name}\s*(?:==|!=|\bin\b)|{name}\s*,\s*{name}")
+
+
+def test_engine_name_pattern_catches_comparisons():
+    pattern = _engine_name_pattern(["forward", "numpy"])
+    assert pattern.search('if t["engine"] == "forward":')
+    assert pattern.search("keep = 'numpy' != e")
+    assert pattern.search('engines=("forward", "numpy")')
+    assert not pattern.search('Variant("study", {}, "forward", "the method")')
+    assert not pattern.search('engine = "radiance"')
+
+
 def test_engine_names_only_in_engines_and_cli():
-    """No ``== "radiance"`` / ``"numpy"`` branches above the engine interface."""
-    name = r"""["'](?:radiance|numpy)["']"""
-    pattern = re.compile(rf"(?:==|!=|=)\s*{name}|{name}\s*(?:==|!=|\bin\b)|{name}\s*,\s*{name}")
+    """No ``== "radiance"`` / ``"numpy"`` / ``"forward"`` branches above the engine interface:
+    every name of the engine registry is checked (a capability on the engine class —
+    ``photon_budget``, ``seeded``, ``uses_build_folder`` — says what a caller needs)."""
+    from radtree.engines.registry import ENGINES
+
+    assert {"radiance", "numpy", "forward"} <= set(ENGINES)
+    pattern = _engine_name_pattern(sorted(ENGINES))
     offenders = []
     for p in PACKAGE.rglob("*.py"):
         rel = p.relative_to(PACKAGE).as_posix()

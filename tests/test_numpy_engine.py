@@ -9,9 +9,9 @@ import pytest
 
 from radtree.config import EngineParams
 from radtree.engines.base import GridResult
+from radtree.engines.common.raycast import BVHCaster, EmbreeCaster, embree_available, make_caster
 from radtree.engines.numpy import ENGINE_NAME, TraceOptions, describe, trace, trace_hour
 from radtree.engines.numpy.engine import glass_coefficients
-from radtree.engines.numpy.raycast import BVHCaster, EmbreeCaster, embree_available, make_caster
 from radtree.engines.numpy.scenes import (
     hemisphere_shell,
     regular_layers,

@@ -1,4 +1,4 @@
-"""The NumPy engine's C kernel (``radtree.engines.numpy._kernel``) gives the NumPy code's numbers
+"""The NumPy engine's C kernel (``radtree.engines.common._kernel``) gives the NumPy code's numbers
 to the bit: the shadow-ray loop with both kernels on the same rays, whole traces with both,
 the conversion into Embree's float32 frame; ``RADTREE_KERNEL`` selects the kernel.
 
@@ -15,11 +15,12 @@ import numpy as np
 import pytest
 
 from radtree.config import EngineParams
-from radtree.engines.numpy import kernel, shadow, tracing
+from radtree.engines.common import kernel
+from radtree.engines.common.raycast import EmbreeCaster, embree_available
+from radtree.engines.common.streams import PathStreams
+from radtree.engines.numpy import shadow, tracing
 from radtree.engines.numpy.engine import DEFAULT_OPTIONS, TraceOptions, describe
-from radtree.engines.numpy.raycast import EmbreeCaster, embree_available
 from radtree.engines.numpy.scenes import dome_slats, sky_state
-from radtree.engines.numpy.streams import PathStreams
 from radtree.optics import Plastic, Trans
 from radtree.scene import Scene, SensorGrid, quad
 
@@ -32,7 +33,7 @@ def test_kernel_is_built_where_a_compiler_is():
     cc = (sysconfig.get_config_var("CC") or "cc").split()[0]
     if shutil.which(cc) is None:
         pytest.skip(f"no C compiler ({cc})")
-    assert built, f"radtree.engines.numpy._kernel is {kernel._load()[1]}: pip install -e ."
+    assert built, f"radtree.engines.common._kernel is {kernel._load()[1]}: pip install -e ."
 
 
 def test_radtree_kernel_selects_the_kernel(monkeypatch):
@@ -213,7 +214,7 @@ def test_crossing_equals_the_numpy_crossing(monkeypatch, states):
 def test_first_hit_distances_equal_plane_distance():
     """``distances`` (EmbreeCaster._chunk with the kernel) against ``plane_distance``: hits,
     misses (inf), grazing rays (the centroid's distance), a broadcast direction row."""
-    from radtree.engines.numpy.raycast import plane_distance
+    from radtree.engines.common.raycast import plane_distance
 
     k_mod = kernel._load()[0]
     scene, _ = _scene()

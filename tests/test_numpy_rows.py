@@ -13,9 +13,9 @@ import numpy as np
 import pytest
 
 from radtree.config import EngineParams
+from radtree.engines.common.sampling import cosine_hemisphere, cosine_rows
 from radtree.engines.numpy import tracing
 from radtree.engines.numpy.engine import DEFAULT_OPTIONS, _cumulative, _event
-from radtree.engines.numpy.sampling import cosine_hemisphere, cosine_rows
 from radtree.engines.numpy.scenes import dome_slats, sky_state
 from radtree.engines.numpy.shadow import crossed, crossed_sun
 from radtree.optics import Plastic, Trans
@@ -82,7 +82,7 @@ def test_unit32_equals_trimesh_unitize():
     trimesh's ``unitize`` + float32 to the bit — rows over five decades, zero rows, a row."""
     from trimesh.util import unitize
 
-    from radtree.engines.numpy.raycast import _unit32
+    from radtree.engines.common.raycast import _unit32
 
     rng = np.random.default_rng(12)
     v = (rng.normal(size=(200_000, 3)) * 10.0 ** rng.uniform(-4, 1, (200_000, 3)))

@@ -1,6 +1,6 @@
 """The NumPy engine's random numbers: one counter-based stream per path.
 
-``radtree.engines.numpy.streams``: each path's uniforms are SplitMix64 outputs keyed by the
+``radtree.engines.common.streams``: each path's uniforms are SplitMix64 outputs keyed by the
 path's number and the draw's place in the program, so a result depends neither on how many
 worker threads trace a batch nor on how the paths are batched.
 """
@@ -12,9 +12,9 @@ import pytest
 from scipy import stats
 
 from radtree.config import EngineParams
+from radtree.engines.common.streams import GeneratorDraws, PathStreams, as_draws, uniforms
 from radtree.engines.numpy import TraceOptions, trace
 from radtree.engines.numpy.scenes import sky_state, slat_layer
-from radtree.engines.numpy.streams import GeneratorDraws, PathStreams, as_draws, uniforms
 from radtree.optics import Glass, Plastic, Trans
 from radtree.scene import Scene, SensorGrid, quad
 

@@ -2,17 +2,18 @@ import math
 
 import pytest
 
+from radtree.engines.radiance.materials import material_text
 from radtree.optics import Glass, Hole, Plastic, Trans, transmissivity_from_transmittance
 
 
 def test_plastic_text():
-    assert Plastic("facade_paint", 0.9).to_radiance() == (
+    assert material_text(Plastic("facade_paint", 0.9)) == (
         "void plastic facade_paint\n0\n0\n5 0.9 0.9 0.9 0 0\n")
 
 
 def test_trans_leaf_text_from_spec():
     # R 0.11, T_d 0.50 all diffuse: C = 0.61, trans = 0.8197, tspec = 0 (SPEC.md)
-    assert Trans("leaf", 0.11, 0.50).to_radiance() == (
+    assert material_text(Trans("leaf", 0.11, 0.50)) == (
         "void trans leaf\n0\n0\n7 0.61 0.61 0.61 0 0 0.8197 0\n")
 
 
@@ -33,7 +34,7 @@ def test_glass_from_transmittance(tn, expected, text):
     g = Glass.from_transmittance("glazing", tn)
     # SPEC.md rounds 0.065455 down to 0.0654; radtree writes 4 decimals, rounded
     assert g.transmissivity == pytest.approx(expected, abs=1.5e-4)
-    assert g.to_radiance() == f"void glass glazing\n0\n0\n3 {text} {text} {text}\n"
+    assert material_text(g) == f"void glass glazing\n0\n0\n3 {text} {text} {text}\n"
     assert g.transmittance == pytest.approx(tn, abs=1e-6)  # the converter's inverse
 
 
@@ -55,5 +56,5 @@ def test_trans_rejects_bad_optics(args):
 
 
 def test_hole_writes_nothing():
-    assert Hole("gap").to_radiance() == ""
+    assert material_text(Hole("gap")) == ""
     assert Hole("gap").transmittance == 1.0

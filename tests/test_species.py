@@ -13,6 +13,7 @@ import tomllib
 
 from radtree.annual.phenology import Phenology, blend
 from radtree.config import load_project
+from radtree.engines.radiance.materials import material_text
 from radtree.errors import ConfigError
 from radtree.resources import folder, read_text
 from radtree.site.frame import FacadeFrame
@@ -76,11 +77,11 @@ def test_leaf_rad_files_are_what_the_species_renders() -> None:
     node = folder("materials") / "species"
     for key, sp in species_library().items():
         text = (node / f"{key}.rad").read_text(encoding="utf-8")
-        assert entries(text) == {sp.material_name: sp.leaf_material().to_radiance()}
+        assert entries(text) == {sp.material_name: material_text(sp.leaf_material())}
     # Morus: C = 0.11 + 0.53 = 0.64, trans = 0.53/0.64 = 0.8281, tspec = 0.48/0.53 = 0.9057
-    assert load_species("morus_alba").leaf_material().to_radiance().splitlines()[-1] == \
+    assert material_text(load_species("morus_alba").leaf_material()).splitlines()[-1] == \
         "7 0.64 0.64 0.64 0 0 0.8281 0.9057"
-    assert load_species("tilia_cordata").leaf_material().to_radiance().splitlines()[-1] == \
+    assert material_text(load_species("tilia_cordata").leaf_material()).splitlines()[-1] == \
         "7 0.15 0.15 0.15 0 0 0.4 0"
 
 
@@ -174,7 +175,7 @@ def test_tree_species_fills_what_the_project_leaves_out(tmp_path: Path) -> None:
     assert p.tree.perforated.openness == 0.06                            # given in the file
     # the crown carries the species' leaf and says so
     model = build_crown(p, "louvers", "dome", FacadeFrame(p.street.facade_azimuth_deg))
-    assert model.materials["leaf"].to_radiance().splitlines()[-1] == "7 0.15 0.15 0.15 0 0 0.4 0"
+    assert material_text(model.materials["leaf"]).splitlines()[-1] == "7 0.15 0.15 0.15 0 0 0.4 0"
     assert model.notes[0].startswith("Species Melia azedarach (chinaberry, "
                                      "materials/species/melia_azedarach.toml)")
     assert melia.describe() in model.notes[0]

@@ -1,5 +1,5 @@
 """Turbid-medium crowns ([tree] representation = "turbid", radtree.media, radtree.trees.turbid,
-radtree.engines.numpy.turbid): Beer–Lambert with the G-function, energy conservation, the
+radtree.engines.common.turbid): Beer–Lambert with the G-function, energy conservation, the
 same façade light as explicit volume slats of equal leaf area density, angles and optics, the
 crowns of the reference street, the engines that refuse media, and the generated city (the
 same table on Dask as in one process)."""
@@ -16,9 +16,9 @@ import numpy as np
 import pytest
 
 from radtree.config import EngineParams, Louvers, load_project
+from radtree.engines.common.turbid import MediumTracer
 from radtree.engines.numpy.scenes import sky_state
 from radtree.engines.numpy.tracing import trace
-from radtree.engines.numpy.turbid import MediumTracer
 from radtree.errors import ConfigError, EngineError
 from radtree.media import TurbidCrowns
 from radtree.optics import Plastic, Trans

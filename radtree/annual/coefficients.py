@@ -32,6 +32,7 @@ import numpy as np
 
 from radtree.annual.skymatrix import patch_count
 from radtree.engines.radiance.binaries import FIXED_SEED, run
+from radtree.engines.radiance.materials import material_text
 from radtree.engines.radiance.writer import mesh_to_radiance
 from radtree.errors import EngineError
 from radtree.fileio import atomic_path, write_text
@@ -74,7 +75,7 @@ def scene_text(scene: Scene, ground_reflectance: float | None) -> str:
         if name == scene.ground_material and isinstance(m, Plastic) and \
                 ground_reflectance is not None:
             m = with_reflectance(m, ground_reflectance)
-        parts.append(m.to_radiance())
+        parts.append(material_text(m))
     for mesh in scene.solid_meshes():
         parts.append(mesh_to_radiance(mesh))
     return "\n".join(parts)

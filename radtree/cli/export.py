@@ -20,14 +20,20 @@ from radtree.export import FORMATS
 @click.option("--leaf-on", default=None, help="Leaf-on date MM-DD (default by hemisphere).")
 @click.option("--leaf-off", default=None, help="Leaf-off date MM-DD (default by hemisphere).")
 @click.option("--no-seasons", is_flag=True, help="Leafed crowns all year (no leaf-off).")
+@click.option("--definition", type=click.Choice(["total", "beam"]), default="total",
+              show_default=True, help="Schedule transmittance: total (beam + light the crown "
+              "scatters forward) or beam (undeviated only).")
 def export_command(project: str, fmt: str, out: str, scenario: str | None, rays: int,
-                   leaf_on: str | None, leaf_off: str | None, no_seasons: bool) -> None:
+                   leaf_on: str | None, leaf_off: str | None, no_seasons: bool,
+                   definition: str) -> None:
     """Write PROJECT's crowns or scene for other tools into DIR.
 
     \b
     honeybee  radtree_crowns.hbjson: crowns as Honeybee ShadeMesh, leaf Radiance modifier,
               hourly transmittance schedule (8760 values) along the sun direction
-    idf       radtree_crowns.idf: the same shades and schedules for EnergyPlus
+              (--definition total: beam + forward-scattered light; beam: undeviated only)
+    idf       radtree_crowns.idf: the same shades and schedules for EnergyPlus, with
+              ShadowCalculation PolygonClipping, frequency 1 (else EnergyPlus may ignore them)
     schedule  crown_transmittance.csv (8760 rows, a column per crown) + Schedule:File .idf
     gltf/obj  <scenario>_scene.glb / .obj: the whole scene for any 3-D viewer
     """
@@ -37,6 +43,6 @@ def export_command(project: str, fmt: str, out: str, scenario: str | None, rays:
     from radtree.export.run import export_project
 
     paths = export_project(load_project(project), fmt, Path(out), scenario, rays, leaf_on,
-                           leaf_off, not no_seasons, echo=click.echo)
+                           leaf_off, not no_seasons, echo=click.echo, definition=definition)
     for p in paths:
         click.echo(f"wrote {p}")

@@ -23,7 +23,8 @@ PMAP_KEYS = ("pmap_photons", "pmap_caustic_photons", "pmap_bandwidth")
 #: the ``EngineParams`` fields only the forward engine reads
 FORWARD_KEYS = ("photons", "forward_threshold", "forward_splitting", "beam_diameter_m",
                 "patch_m", "forward_batches", "forward_focus_m", "forward_split",
-                "forward_split_radius_m", "forward_guide", "forward_guide_radius_m")
+                "forward_split_radius_m", "forward_guide", "forward_guide_radius_m",
+                "target_rel_se", "max_photons", "forward_direct_sun")
 
 
 def plain(obj: Any, path: Callable[[Path], Any] = str) -> Any:

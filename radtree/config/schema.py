@@ -340,16 +340,29 @@ class EngineParams(Checked):
     forward_splitting: bool = False
     beam_diameter_m: float | None = field(default=None, metadata=meta(0.0, lo_open=True))
     patch_m: float = field(default=0.5, metadata=meta(0.0, lo_open=True))
-    forward_batches: int = field(default=16, metadata=meta(2))
+    forward_batches: int = field(default=32, metadata=meta(2))  # per round (precision.py)
     # forward engine: focused launch, innermost disc radius (m) around the target grid (None =
     # start points uniform over the launch disc)
-    forward_focus_m: float | None = field(default=None, metadata=meta(0.0, lo_open=True))
+    # (default 1 m, with forward_guide 0.8: the variance reduction that makes the precision target
+    # affordable — on Mendoza A/B at 12:30 10–20× less time to a 2 % *estimated* error than the
+    # uniform launch, whose 64 M photons still left 3.5 %: benchmarks/forward.py)
+    forward_focus_m: float | None = field(default=1.0, metadata=meta(0.0, lo_open=True))
     # forward engine: children per diffuse event near the target grid (1 = none), and how near
     forward_split: int = field(default=1, metadata=meta(1))
     forward_split_radius_m: float = field(default=2.0, metadata=meta(0.0, lo_open=True))
     # forward engine: share of diffuse directions aimed at the target grid (0 = none), sphere
-    forward_guide: float = field(default=0.0, metadata=meta(0.0, 1.0, hi_open=True))
-    forward_guide_radius_m: float = field(default=2.0, metadata=meta(0.0, lo_open=True))
+    # (default 0.8 towards the sphere just holding the target grid's patches, None = that radius)
+    forward_guide: float = field(default=0.8, metadata=meta(0.0, 1.0, hi_open=True))
+    forward_guide_radius_m: float | None = field(default=None, metadata=meta(0.0, lo_open=True))
+    # forward engine: rounds of `photons` added until every traced grid's mean has this relative
+    # standard error (None = one round of `photons`), at most `max_photons` per hour (then a
+    # warning with the error reached): radtree.engines.forward.precision
+    target_rel_se: float | None = field(default=0.02, metadata=meta(0.0, 1.0, lo_open=True,
+                                                                    hi_open=True))
+    max_photons: int = field(default=16_000_000, metadata=meta(1))
+    # forward engine: the sun's direct beam computed at the sensor points (as the backward engines
+    # see it), sun photons tallied on the patches only once scattered: radtree.engines.forward.direct
+    forward_direct_sun: bool = True
     # Radiance photon map (radtree.engines.radiance.pmap): global photons per hour (None = no
     # photon map, plain rtrace -I), caustic photons (None = none), photons per density estimate
     pmap_photons: int | None = field(default=None, metadata=meta(1))

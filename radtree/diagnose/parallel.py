@@ -10,7 +10,7 @@ seed, scene), only computed elsewhere. Each worker makes each simulator once (fr
 :meth:`~radtree.diagnose.simulate.Simulator.spec`) and keeps its scenes between tasks. The
 workers trace with ``engine.workers`` = the cores ÷ the processes (at least 1): the NumPy
 engine's threads would otherwise compete with the other processes for the same cores (the
-numbers do not depend on it, :mod:`radtree.engines.numpy.streams`; measured on the rich
+numbers do not depend on it, :mod:`radtree.engines.common.streams`; measured on the rich
 campaign's runs: 2 threads in one process take 1.35 × the CPU time of 1 for the same wall
 time — a diagnosis's grids are too small for threads to pay).
 :meth:`TracePool.loops` runs whole diagnosis loops in the workers (the self-test's hidden

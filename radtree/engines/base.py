@@ -83,6 +83,10 @@ class Engine(ABC):
     ladder_in_one_trace: ClassVar[bool] = False
     #: :meth:`attribute_trees` attributes the light the trees remove to each tree while tracing
     attributes_trees: ClassVar[bool] = False
+    #: the engine traces light from the sources to detectors (forward): its noise is set by
+    #: ``engine.photons`` per hour, which the results of such an engine are labelled with
+    #: (the backward engines' by ``engine.rays`` or Radiance's ``-ad``)
+    photon_budget: ClassVar[bool] = False
 
     @classmethod
     @abstractmethod

@@ -52,6 +52,12 @@ def available_engines() -> list[Engine]:
     return [engine_class(n)() for n in ENGINES if engine_class(n).available()]
 
 
+def photon_engines() -> list[str]:
+    """Names of the registered engines with a photon budget (:attr:`Engine.photon_budget`:
+    forward light tracing, noise set by ``engine.photons``)."""
+    return [n for n in ENGINES if engine_class(n).photon_budget]
+
+
 def folder_engine() -> Engine:
     """The engine whose inspectable build folders ``radtree build`` writes (Radiance)."""
     for name in ENGINES:

@@ -12,6 +12,8 @@ results in honeybee-radiance's point-in-time layout.
 * Schedule CSV: ``crown_transmittance.csv`` — a header row of crown names, then 8760 rows
   (hour 1 = 00:00–01:00 local standard time, 1 January), one column per crown; and
   ``crown_transmittance.idf`` with the matching ``Schedule:File`` objects (1 row to skip).
+* Both IDFs carry ``ShadowCalculation`` PolygonClipping, recomputed daily
+  (:data:`SHADOW_CALCULATION`): without it EnergyPlus may ignore the schedule.
 * Results: ``<out>/<scenario>/<HHMM>/<grid>.res`` (one lux value per sensor, in the grid's
   order) with ``grids_info.json``, and the model with its grids as ``model.hbjson`` — the
   folder Ladybug Tools' point-in-time result loaders read; and after ``radtree annual`` the
@@ -33,6 +35,13 @@ from radtree.fileio import write_text
 from radtree.optics import Glass, Material, Plastic, Trans
 
 CSV_NAME = "crown_transmittance"
+#: EnergyPlus ShadowCalculation for scheduled shade transmittance: PolygonClipping (the
+#: PixelCounting method treats transmitting shades as opaque, EnergyPlus issue #9059 and its
+#: warning, pull request #9653) recomputed every day (a transmittance schedule is sampled at
+#: the shadow calculation's update frequency, default 20 days: issue #3073, whose workaround
+#: is frequency 1)
+SHADOW_CALCULATION = {"calculation_method": "PolygonClipping",
+                      "calculation_update_method": "Periodic", "calculation_frequency": 1}
 RADTREE_GRIDS = ("facade", "facade_map")
 
 
@@ -99,10 +108,18 @@ def write_hbjson(model: Any, out: Path, name: str = "radtree_crowns") -> Path:
     return path
 
 
+def shadow_calculation_idf() -> str:
+    """The ``ShadowCalculation`` object of :data:`SHADOW_CALCULATION` (honeybee-energy)."""
+    from honeybee_energy.simulation.shadowcalculation import ShadowCalculation
+
+    return str(ShadowCalculation(**SHADOW_CALCULATION).to_idf())
+
+
 def write_idf(model: Any, out: Path, name: str = "radtree_crowns") -> Path:
+    """The model as IDF (honeybee-energy) with the :func:`shadow_calculation_idf` object."""
     from honeybee_energy.writer import model_to_idf
 
-    text = model_to_idf(model, schedule_directory=str(out))
+    text = model_to_idf(model, schedule_directory=str(out)) + "\n\n" + shadow_calculation_idf()
     path = out / f"{name}.idf"
     write_text(path, text)
     return path
@@ -126,6 +143,7 @@ def write_schedule_csv(schedules: list[CrownSchedule], out: Path) -> tuple[Path,
     objs = [fractional.to_idf()] + [generate_idf_string(
         "Schedule:File", (f"radtree_{n}_transmittance", fractional.identifier, csv.name, i + 1,
                           1, HOURS, "Comma", "No", 60), comments) for i, n in enumerate(names)]
+    objs.append(shadow_calculation_idf())
     idf = write_text(out / f"{CSV_NAME}.idf", "\n\n".join(objs) + "\n")
     return csv, idf
 

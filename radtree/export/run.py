@@ -37,8 +37,10 @@ def leaf_material(meshes, materials):
 def export_project(project: Project, fmt: str, out: Path, scenario: str | None = None,
                    rays: int = 128, leaf_on: str | None = None, leaf_off: str | None = None,
                    seasons: bool = True, echo: Callable[[str], None] = print,
-                   progress: bool = True) -> list[Path]:
-    """Write ``project`` in format ``fmt`` into folder ``out``; return the files written."""
+                   progress: bool = True, definition: str = "total") -> list[Path]:
+    """Write ``project`` in format ``fmt`` into folder ``out``; return the files written.
+    ``definition``: the schedules' transmittance, ``total`` or ``beam``
+    (:mod:`radtree.export.transmittance`); the caveats that remain are echoed."""
     from radtree.pipeline.assemble import facade_frame, make_scene
 
     if fmt not in FORMATS:
@@ -55,14 +57,23 @@ def export_project(project: Project, fmt: str, out: Path, scenario: str | None =
         echo(f"{sc.name}: {len(built.scene.solid_meshes())} meshes, {built.triangles} "
              f"triangles → {path}")
         return [path]
-    from radtree.export.transmittance import crown_models, default_leaf_schedule, year_schedules
+    from radtree.export.transmittance import (
+        CAVEATS,
+        DEFINITIONS,
+        crown_models,
+        default_leaf_schedule,
+        year_schedules,
+    )
     from radtree.pipeline.build import progress_bar
 
     if sc.model == "none":
         raise ConfigError(f"scenario {sc.name!r} has no crown (model 'none'): choose one with "
                           "a crown model", source=str(project.source), field="--scenario")
+    if definition not in DEFINITIONS:
+        raise ConfigError(f"got {definition!r}, expected one of {', '.join(DEFINITIONS)}",
+                          field="--definition")
     leaf = default_leaf_schedule(project, leaf_on, leaf_off)
-    echo(f"{sc.name}: hourly crown transmittance along the sun for {8760} hours, "
+    echo(f"{sc.name}: hourly crown transmittance ({definition}) along the sun for {8760} hours, "
          f"{rays} rays per hour and crown; leaf " + (
              f"on {leaf.leaf_on} → off {leaf.leaf_off} (MM-DD)" if seasons else "on all year"))
 
@@ -72,10 +83,13 @@ def export_project(project: Project, fmt: str, out: Path, scenario: str | None =
                             progress, unit="chunk")
 
     models = crown_models(project, sc, frame)
-    schedules = year_schedules(project, sc, frame, rays, leaf_on, leaf_off, seasons, bar, models)
+    schedules = year_schedules(project, sc, frame, rays, leaf_on, leaf_off, seasons, bar, models,
+                               definition)
     for cs in schedules:
         echo(f"  {cs.crown.name}: transmittance {cs.values.min():.4f}–{cs.values.max():.4f}, "
              f"mean {cs.values.mean():.4f} ({int(cs.leaf_on.sum())} leaf-on hours)")
+    for caveat in CAVEATS:
+        echo(f"  caveat: {caveat}")
     if fmt == "schedule":
         from radtree.export.honeybee import write_schedule_csv
 

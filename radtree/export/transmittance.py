@@ -1,13 +1,34 @@
 """Each crown's hourly transmittance along the sun direction for a year (energy shading schedules).
 
-**Definition.** For a sun direction s (unit vector towards the sun) the crown's transmittance
-is the mean, over a bundle of parallel rays travelling towards the sun through the crown, of
-the product of the *specular* (undeviated) transmittances of every crown surface the ray
-crosses (:class:`radtree.trees.raycast.DirectTracer`: ``trans`` T_s, holes 1, trunk and
-branches 0). That is the beam an energy model's shading surface lets through. The bundle
-(:func:`bundle`) starts on the horizontal plane 1 cm below the crown's lowest point: the points
-of a square lattice whose ray towards the sun meets the crown envelope, i.e. the crown's
-shadow on that plane sampled uniformly (equal area across the beam), about ``rays`` points.
+**Definitions.** Two, both relative to the open-sky beam falling on the crown's shadow:
+
+* ``beam`` — the undeviated beam: for a sun direction s (unit vector towards the sun) the mean,
+  over a bundle of parallel rays travelling towards the sun through the crown, of the product
+  of the *specular* (undeviated) transmittances of every crown surface the ray crosses
+  (:class:`radtree.trees.raycast.DirectTracer`: ``trans`` T_s, holes 1, trunk and branches 0).
+  A crown of leaves with no specular transmission (the homogeneous crown, T_s = 0) is opaque.
+* ``total`` (**the default**) — the beam plus the sunlight the crown scatters *forward*
+  (diffuse transmission through leaves, reflections between them), leaving it travelling away
+  from the sun: what a pyranometer facing the sun behind the crown, summed over a plane
+  behind it, receives over what it receives with no crown. Traced by the forward engine's
+  transport from the same bundle (:func:`radtree.engines.forward.passage.beam_passage`: the
+  scattered part is its total minus its beam), added to the exact ``beam``.
+
+*Why total by default:* an EnergyPlus shading surface stops what its schedule does not pass,
+and scattered light passes the crown: with ``beam`` every crown without gaps exports as opaque
+(Mendoza's homogeneous dome, sun at the zenith, 60° and 40° altitude: beam 0.2–0.6 %, total
+3.9–5.1 %, benchmarks/schedule_total.py) and all scattered light is dropped. Remaining caveats (printed by the export): EnergyPlus applies the
+value to the beam *and* diffuse solar on the shade and passes it on undeviated, as solar and
+visible alike (its issue #992: "the solar and visible transmittance is the same and … the
+surfaces are non-diffusing"); the schedule takes effect only with the ``PolygonClipping``
+shadow calculation (#9059: ``PixelCounting`` treats the shade as opaque) recomputed every day
+(#3073: a transmittance schedule follows the shadow calculation's update frequency) — the IDF
+written sets ``ShadowCalculation`` so (:func:`radtree.export.honeybee.shadow_calculation_idf`).
+
+The bundle (:func:`bundle`) starts on the horizontal plane 1 cm below the crown's lowest point:
+the points of a square lattice whose ray towards the sun meets the crown envelope, i.e. the
+crown's shadow on that plane sampled uniformly (equal area across the beam), about ``rays``
+points.
 
 **Year.** 8760 hours of a non-leap year (the site's year, or the year before when that is a
 leap year), hour k covering local standard time [k, k + 1) h; the sun position is taken at
@@ -36,6 +57,18 @@ from radtree.site.frame import FacadeFrame
 from radtree.trees.raycast import DirectTracer
 
 HOURS = 8760
+DEFINITIONS = ("total", "beam")
+"""Schedule definitions (see the module); the first is the default."""
+CAVEATS = (
+    "EnergyPlus passes a shade's scheduled transmittance on undeviated and applies it to beam and "
+    "diffuse solar and to daylight alike (EnergyPlus issue #992); 'total' counts the scattered "
+    "light as if it went on along the sun",
+    "the schedule takes effect only with ShadowCalculation PolygonClipping (PixelCounting makes "
+    "the shade opaque, EnergyPlus issue #9059) recomputed every day (frequency 1, issue #3073): "
+    "the IDF written sets it; keep it if you merge the objects into another model",
+    "the hourly value is the crown's own: light reflected back by the crown and by neighbouring "
+    "crowns is not in it",
+)
 MIN_ALTITUDE_DEG = 2.0
 """Below this sun altitude an hour takes the zenith transmittance (see the module)."""
 PLANE_GAP_M = 0.01
@@ -177,12 +210,18 @@ def crown_models(project: Project, scenario: Scenario, frame: FacadeFrame
 
 def own_tracer(crown: Crown, meshes: list[Mesh], materials: dict[str, Material]
                ) -> DirectTracer:
-    """A tracer of the triangles with a corner in ``crown``'s envelope only (a crown's
-    schedule leaves its neighbours out: they are shades of their own; the part of a trunk
-    below the crown is below the rays' start plane and never crossed)."""
+    """A tracer of :func:`own_meshes` (a crown's schedule leaves its neighbours out: they are
+    shades of their own; the part of a trunk below the crown is below the rays' start plane
+    and never crossed)."""
+    return DirectTracer(own_meshes(crown, meshes), materials)
+
+
+def own_meshes(crown: Crown, meshes: list[Mesh]) -> list[Mesh]:
+    """The triangles with a corner in ``crown``'s envelope (all of them for the sensor dome,
+    open on the wall: one crown)."""
     env = crown.trimesh()
-    if not env.is_watertight:   # the sensor dome (open on the wall): one crown, all of it
-        return DirectTracer(meshes, materials)
+    if not env.is_watertight:
+        return list(meshes)
     own = []
     for m in meshes:
         if not m.n_triangles:
@@ -192,14 +231,39 @@ def own_tracer(crown: Crown, meshes: list[Mesh], materials: dict[str, Material]
         if keep.any():
             own.append(Mesh(m.name, m.material, m.triangles[keep].reshape(-1, 3),
                             np.arange(3 * int(keep.sum())).reshape(-1, 3)))
-    return DirectTracer(own, materials)
+    return own
+
+
+def scattered_forward(crown: Crown, meshes: list[Mesh], materials: dict[str, Material],
+                      suns: np.ndarray, rays: int, seed: int = 1) -> np.ndarray:
+    """The part of the ``total`` definition beyond the beam, per sun of ``suns`` (k, 3): the
+    crown's forward-scattered sunlight over the open beam on its shadow (0–1), forward-traced
+    from the :func:`lattice` bundle (photons start above the crown, travel along −s)."""
+    from radtree.engines.forward.passage import beam_passage
+
+    suns = np.atleast_2d(np.asarray(suns, float))
+    suns = suns / np.linalg.norm(suns, axis=1)[:, None]
+    top = float(crown.vertices[:, 2].max()) + PLANE_GAP_M
+    starts = []
+    for s, a in zip(suns, shadow_areas(crown, suns)):
+        o = lattice(crown, s, rays, a)
+        o = o[crown.trimesh().ray.intersects_any(o, np.tile(s, (len(o), 1)))]
+        if len(o) == 0:
+            raise RadtreeError(f"{crown.name}: no ray of the bundle meets the crown")
+        starts.append(o + s * ((top - o[:, 2]) / s[2])[:, None])
+    total, beam = beam_passage(own_meshes(crown, meshes), materials, -suns, starts, seed=seed)
+    return np.maximum(total - beam, 0.0)
 
 
 def year_schedules(project: Project, scenario: Scenario, frame: FacadeFrame, rays: int = 128,
                    leaf_on: str | None = None, leaf_off: str | None = None,
-                   seasons: bool = True, progress=None, models=None) -> list[CrownSchedule]:
-    """8760 hourly transmittances per crown (leafed in the leaf season, bare outside it).
-    ``models``: the :func:`crown_models` of the scenario when already built."""
+                   seasons: bool = True, progress=None, models=None,
+                   definition: str = DEFINITIONS[0]) -> list[CrownSchedule]:
+    """8760 hourly transmittances per crown (leafed in the leaf season, bare outside it), of
+    ``definition`` ``total`` or ``beam`` (see the module). ``models``: the
+    :func:`crown_models` of the scenario when already built."""
+    if definition not in DEFINITIONS:
+        raise ValueError(f"definition must be one of {DEFINITIONS}, got {definition!r}")
     crowns = crown_envelopes(project, scenario, frame)
     on_meshes, off_meshes, materials, _ = models or crown_models(project, scenario, frame)
     hours = year_hours(project)
@@ -221,9 +285,14 @@ def year_schedules(project: Project, scenario: Scenario, frame: FacadeFrame, ray
             if not sel.any():
                 continue
             values[sel & ~up] = transmittances(tracer, crown, zenith, rays)[0]
+            if definition == "total":
+                values[sel & ~up] += scattered_forward(crown, meshes, materials, zenith, rays)[0]
             idx = np.flatnonzero(sel & up)
             for chunk in (progress(idx, crown.name, state) if progress else [idx]):
                 values[chunk] = transmittances(tracer, crown, sun[chunk], rays)
+                if definition == "total":
+                    values[chunk] += scattered_forward(crown, meshes, materials, sun[chunk],
+                                                       rays, seed=int(chunk[0]) + 1)
         out.append(CrownSchedule(crown, np.clip(values, 0.0, 1.0), in_leaf))
     return out
 

@@ -22,7 +22,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from radtree.config import Project, Scenario
-from radtree.engines.numpy.raycast import any_hit, make_caster
+from radtree.engines.common.raycast import any_hit, make_caster
 from radtree.errors import ConfigError
 from radtree.hemi import HemiConfig, HemiResult, analyse_array
 from radtree.hemi.classify import ThresholdSpec

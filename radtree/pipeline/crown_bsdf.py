@@ -30,6 +30,7 @@ from radtree.engines.radiance.bsdf import (
     tensor_tree_bsdf,
     write_system,
 )
+from radtree.engines.radiance.materials import material_text
 from radtree.errors import ConfigError
 from radtree.fileio import write_text
 from radtree.pipeline.dome_curvature import (
@@ -159,7 +160,7 @@ def sample_key(sample: SlabSample | RingSamples | PatchDepthSample,
         for name in sorted(slab.polygons):
             h.update(name.encode())
             h.update(slab.polygons[name].round(7).tobytes())
-            h.update(slab.materials[name].to_radiance().encode())
+            h.update(material_text(slab.materials[name]).encode())
         h.update(json.dumps([slab.width, slab.height, slab.thickness]).encode())
     # rfluxmtx -n only splits the work: not part of the key
     h.update(json.dumps([sample.thickness, repr(replace(settings, nproc=1))]).encode())

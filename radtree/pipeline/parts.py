@@ -17,7 +17,7 @@ import pandas as pd
 import radtree
 from radtree.fileio import atomic_path, write_text
 from radtree.pipeline.manifest import file_sha256
-from radtree.pipeline.results import REQUIRED_COLUMNS
+from radtree.results_schema import REQUIRED_COLUMNS
 
 
 def manifest_path(part: Path) -> Path:

@@ -6,7 +6,7 @@ gains little from the NumPy engine's threads: its batches are too small, so two 
 :mod:`radtree.diagnose.parallel`). :func:`spawned_map` runs such traces in *spawned* worker
 processes (a fresh interpreter each: no ray-tracer thread state is forked), each with
 ``engine.workers`` = the usable cores ÷ the processes. The NumPy engine's numbers do not
-depend on its thread count (:mod:`radtree.engines.numpy.streams`), so the results are those
+depend on its thread count (:mod:`radtree.engines.common.streams`), so the results are those
 of the same calls in this process, in the same order.
 """
 

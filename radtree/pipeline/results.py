@@ -1,11 +1,7 @@
-"""The one results table: schema, path, rows from engine output, validated read, atomic write.
+"""The one results table: path, rows from engine output, validated read, atomic write (its
+schema: :mod:`radtree.results_schema`, re-exported here).
 
-``PROJECT/results/illuminance.csv`` holds one row per scenario × hour × grid × sensor:
-illuminance ``lux`` (traced + calculated ground terms), its Monte Carlo standard error
-``lux_stderr`` (NaN when the engine gives none), sensor position ``x y z`` (m, x east, y north,
-z up), the ``engine`` that traced it and the scenario's ``params_hash``; then ``lux_traced``,
-``lux_reflected_calc`` and ``reflection`` (and, for crown realisations, ``lux_realisation_sd``
-and ``realisations``). Statistics, reports and diagnosis read only this table.
+Statistics, reports and diagnosis read only this table.
 """
 
 from __future__ import annotations
@@ -22,23 +18,11 @@ from radtree.fileio import atomic_path
 from radtree.light.ground import ground_terms
 from radtree.light.sky import SkyState
 from radtree.measurements import normalise_time
+from radtree.results_schema import DTYPES, OPTIONAL_COLUMNS, REQUIRED_COLUMNS, RESULT_COLUMNS
 from radtree.scene import Scene
 
-#: the written column order (extra columns follow)
-RESULT_COLUMNS = [
-    "scenario", "model", "datetime", "time", "grid", "sensor", "row", "x", "y", "z",
-    "lux", "lux_stderr", "engine", "params_hash",
-]
-#: optional per-sensor columns (sensor grids' ``labels``): the building id and the façade
-#: ``BUILDING:FACE`` (inventory projects), the storey (0 = ground; inventory façades, office
-#: rooms, a street's sensor heights) and the office ``room`` ``"STOREY-BAY"``
-#: (:mod:`radtree.site.office`); absent in tables whose grids carry none
-OPTIONAL_COLUMNS = ("building", "facade", "storey", "room")
-#: what a table must have to be read back
-REQUIRED_COLUMNS = ("scenario", "model", "time", "grid", "sensor", "row", "lux")
-_DTYPES = {"scenario": str, "time": str, "row": str, "grid": str, "params_hash": str,
-           "engine": str, "model": str, "reflection": str, "building": str, "facade": str,
-           "room": str}
+__all__ = ["OPTIONAL_COLUMNS", "REQUIRED_COLUMNS", "RESULT_COLUMNS", "facade_means", "hour_rows",
+           "in_column_order", "merge_write", "read_results", "read_table", "results_path"]
 
 
 def results_path(project: Project) -> Path:
@@ -83,7 +67,7 @@ def read_table(path: Path, hint: str = "") -> pd.DataFrame:
     if not path.is_file():
         raise RadtreeError(f"no results: {hint + ' ' if hint else ''}({path} not found)")
     try:
-        df = pd.read_csv(path, dtype=_DTYPES)  # type: ignore[arg-type]
+        df = pd.read_csv(path, dtype=DTYPES)  # type: ignore[arg-type]
     except (OSError, ValueError) as exc:
         raise RadtreeError(f"{path}: cannot read the results table ({exc})") from exc
     missing = [c for c in REQUIRED_COLUMNS if c not in df.columns]
@@ -108,7 +92,7 @@ def read_results(project: Project) -> pd.DataFrame:
 def merge_write(out: Path, table: pd.DataFrame, names: list[str]) -> None:
     """Replace the named scenarios' rows in the table at ``out`` (keep the others), atomically."""
     if out.exists():
-        old = pd.read_csv(out, dtype=_DTYPES)  # type: ignore[arg-type]
+        old = pd.read_csv(out, dtype=DTYPES)  # type: ignore[arg-type]
         old = old[~old["scenario"].astype(str).isin(names)]
         table = pd.concat([old, table], ignore_index=True) if len(old) else table
     with atomic_path(out) as tmp:

@@ -27,7 +27,7 @@ s/√2 out of the spheroid, slats at the trunk are dropped, cut slats lose area)
 realisation; turbid leaves are points of the statistical law. The photo-fitted crown and the
 layered arrangement have no turbid form (ConfigError).
 
-The NumPy and forward engines trace media (:mod:`radtree.engines.numpy.turbid`); the
+The NumPy and forward engines trace media (:mod:`radtree.engines.common.turbid`); the
 Radiance engine refuses a scene with turbid crowns with a message naming the representation
 (not implemented: ``mist`` carries no leaf scattering; a crown BSDF of a medium was not
 built).

@@ -22,14 +22,16 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from radtree.engines.forward import ForwardSettings, trace_forward
+from radtree.engines.forward.interface import ForwardEngine
 from radtree.engines.numpy.scenes import sky_state
+from radtree.engines.registry import engine_class
 from radtree.optics import Plastic, Trans
 from radtree.scene import Mesh, Scene, SensorGrid, quad
 from radtree.verify.compare import backward_patch_mean, backward_patch_values, reduced_dome_project
 from radtree.verify.leaves import LEAF_DISTRIBUTIONS, leaf_layer, uncollided_transmission
 from radtree.verify.spheres import place_spheres, sphere_leaves, sphere_transmission
 
-FORWARD = "forward"
+FORWARD = ForwardEngine.name  # the Check rows' engine label
 DNI = 100000.0
 UP = np.array([0.0, 0.0, 1.0])
 
@@ -108,7 +110,7 @@ def transmission_checks(realisations: int = 4, photons: int = 20_000, points: in
                                    ground_glow=False)
                     direct = DNI * math.cos(math.radians(z))
                     for e in engines:
-                        if e == FORWARD:
+                        if engine_class(e).photon_budget:
                             res = trace_forward(scene, st, ForwardSettings(
                                 photons=int(photons / max(expected, 0.05)), batches=4,
                                 max_bounces=0, beam_diameter_m=9.0, patch_m=1.0,
@@ -162,7 +164,7 @@ def sphere_checks(realisations: int = 2, photons: int = 100_000, points: int = 3
                                                 spheres)
             direct = DNI * math.cos(math.radians(z))
             for e in engines:
-                if e == FORWARD:
+                if engine_class(e).photon_budget:
                     value = trace_forward(scene, st, ForwardSettings(
                         photons=photons, batches=4, max_bounces=0, beam_diameter_m=9.0,
                         patch_m=1.0, seed=r + 1)).grids["facade"].lux
@@ -259,7 +261,7 @@ def agreement_checks(hours: tuple[str, ...] = ("12:30",), scenarios: tuple[str, 
     from radtree.pipeline.assemble import make_scene
 
     names = backward if backward is not None else [
-        e.name for e in available_engines() if e.name != FORWARD]
+        e.name for e in available_engines() if not e.photon_budget]
     plan_of = {e: (plans or {}).get(e, BackwardPlan()) for e in names}
     out = []
     for hour in hours:

@@ -32,6 +32,7 @@ from typing import Any
 import pandas as pd
 
 from radtree.config import Project, load_project
+from radtree.engines.registry import photon_engines
 from radtree.errors import RadtreeError
 from radtree.fileio import atomic_path
 from radtree.pipeline.trace import trace_scenario
@@ -62,7 +63,7 @@ def _resume(path: Path, photons: int) -> pd.DataFrame:
     if not path.exists():
         return pd.DataFrame(columns=COLUMNS)
     t = pd.read_csv(path, dtype={"time": str})
-    keep = (t["engine"] != "forward") | (t["photons"] == photons)
+    keep = ~t["engine"].isin(photon_engines()) | (t["photons"] == photons)
     return t.loc[keep, COLUMNS].reset_index(drop=True)
 
 
@@ -156,7 +157,7 @@ def run_method_study(root: Path, *, photons: int = 1_000_000, radii: Sequence[fl
                 continue
             h["variant"], h["radius_m"], h["engine"] = variant.label, radius, variant.engine
             h["slat_m"] = use.tree.louvers.slat_size_m
-            h["photons"] = photons if variant.engine == "forward" else proj.engine.rays
+            h["photons"] = photons if variant.engine in photon_engines() else proj.engine.rays
             echo(f"  {variant.label}, dome {radius:g} m, {name}: "
                  + " ".join(f"{v:.0f}" for v in h["lux"]))
             table = pd.concat([table, h[COLUMNS]], ignore_index=True)

@@ -12,8 +12,10 @@ from pathlib import Path
 
 import pandas as pd
 
+from radtree.engines.registry import seeded_engine
 from radtree.fileio import atomic_path
 from radtree.verify.checks import (
+    FORWARD,
     BackwardPlan,
     Check,
     agreement_checks,
@@ -57,7 +59,7 @@ def run_verify(out: Path, full: bool = False, backward: list[str] | None = None,
         checks += transmission_checks(realisations=16, photons=200_000, points=64,
                                       progress=echo)
         checks += sphere_checks(realisations=8, photons=400_000, points=64,
-                                engines=("forward", "numpy"), progress=echo)
+                                engines=(FORWARD, seeded_engine().name), progress=echo)
         checks += energy_checks(photons=200_000)
         checks += turbid_checks(rays=64_000, progress=echo)
         for crown in ("louvers dome", "free volume crown"):

@@ -1,5 +1,5 @@
 """Checks of the turbid-medium crowns (:mod:`radtree.media`, traced by the NumPy engine's
-:mod:`radtree.engines.numpy.turbid`), rows of ``radtree verify``.
+:mod:`radtree.engines.common.turbid`), rows of ``radtree verify``.
 
 One spherical crown of radius R = 2 m (centre 3 m up) of leaf area density u, no other
 surface but a black floor far below; the sensor sits at the crown's centre, facing up, so that

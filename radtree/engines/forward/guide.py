@@ -22,7 +22,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from radtree.engines.numpy.sampling import cosine_hemisphere, orthonormal_basis
+from radtree.engines.common.sampling import cosine_hemisphere, orthonormal_basis
 
 
 @dataclass(frozen=True)

@@ -7,10 +7,10 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from radtree.engines.base import GridResult
+from radtree.engines.common.inprocess import InProcessEngine
+from radtree.engines.common.raycast import embree_available
 from radtree.engines.forward.run import check_beam, trace_forward
 from radtree.engines.forward.settings import ForwardSettings
-from radtree.engines.numpy.inprocess import InProcessEngine
-from radtree.engines.numpy.raycast import embree_available
 
 if TYPE_CHECKING:
     from radtree.config import EngineParams
@@ -33,6 +33,7 @@ class ForwardEngine(InProcessEngine):
     Russian roulette, square patch detectors around the sensors (TracePro's method)."""
 
     name = "forward"
+    photon_budget = True
 
     def describe(self) -> str:
         ray = "embree" if embree_available() else "numpy-bvh"

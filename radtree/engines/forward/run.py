@@ -1,8 +1,11 @@
 """One hour of forward light tracing: sources, transport, detectors → lux per sensor.
 
 :func:`trace_forward` returns the illuminance of every traced grid (lux = tallied lm / patch
-area, mean of all photons; standard error = s.d. of the ``batches`` batch estimates / √batches)
-with the hour's :class:`~radtree.engines.forward.tracer.Ledger` and counters.
+area, mean of all photons; standard error = s.d. of the batch estimates / √their number) with
+the hour's :class:`~radtree.engines.forward.tracer.Ledger` and counters. Photons are traced in
+rounds of ``settings.photons`` (``settings.batches`` batches each); with
+``settings.target_rel_se`` rounds are added until every grid's mean reaches it or
+``settings.max_photons`` (:mod:`radtree.engines.forward.precision`).
 """
 
 from __future__ import annotations
@@ -14,13 +17,15 @@ from dataclasses import dataclass
 import numpy as np
 
 from radtree.engines.base import GridResult
+from radtree.engines.common.geometry import Environment, scene_geometry, scene_optics
 from radtree.engines.forward.detectors import PatchDetectors
+from radtree.engines.forward.direct import direct_sun
 from radtree.engines.forward.guide import Guide
+from radtree.engines.forward.precision import Budget, worst_relative_se
 from radtree.engines.forward.settings import ForwardSettings
 from radtree.engines.forward.sources import EnvironmentSource, SunSource, bounding_sphere
 from radtree.engines.forward.strata import PILOT, Stratum, allocate, pilot, ring_edges, trace_strata
 from radtree.engines.forward.tracer import ForwardTracer, Ledger, Photons, Splitting
-from radtree.engines.numpy.engine import Environment, scene_geometry, scene_optics
 from radtree.errors import ConfigError, EngineError
 from radtree.light.sky import SkyState
 from radtree.scene import Scene
@@ -33,13 +38,17 @@ class ForwardResult:
 
     grids: dict[str, GridResult]
     ledger: Ledger
-    photons: int
+    photons: int           # photons traced (every round; the pilot's not counted)
     segments: int
     seconds: float
     batches: dict[str, np.ndarray]
     #: the stratified launch's rings (None: uniform launch) and the pilot's photons
     strata: list[Stratum] | None = None
     pilot_photons: int = 0
+    #: rounds of ``settings.photons`` traced (more than 1: the precision target asked for
+    #: more), and the :class:`PrecisionWarning` text when the photon cap stopped the run
+    rounds: int = 1
+    warning: str | None = None
 
     def grid_mean(self, grid: str) -> tuple[float, float]:
         """Mean lux over the grid's sensors and its standard error from the batches (patches
@@ -104,8 +113,11 @@ def trace_forward(scene: Scene, state: SkyState, settings: ForwardSettings,
                      *([] if geo.media is None else [geo.media.corners()])])
     sphere = bounding_sphere(pts)
     sources: list = []
+    direct: frozenset[int] = frozenset()
     if state.sun_on:
         sources.append(sun_source(scene, state, settings, sphere))
+        if settings.direct_sun and settings.beam_diameter_m is None:
+            direct = frozenset({0})  # the sun's beam at the points, not on the patches
     if settings.beam_diameter_m is None:  # a beam is the study's only source: no sky, no glow
         env = EnvironmentSource(Environment(state), sphere)
         if env.cdf is not None and env.flux > 0:
@@ -117,7 +129,11 @@ def trace_forward(scene: Scene, state: SkyState, settings: ForwardSettings,
     target = scene.grids[aim].points.mean(axis=0)
     near = (Splitting(target, settings.split_radius_m, settings.split)
             if settings.split > 1 else None)
-    guide = (Guide(target, settings.guide_radius_m, settings.guide)
+    radius = settings.guide_radius_m
+    if radius is None:  # the sphere just holding the target grid's patches
+        corners = det.corners()[det.slices[aim]].reshape(-1, 3)
+        radius = float(np.linalg.norm(corners - target, axis=1).max())
+    guide = (Guide(target, radius, settings.guide)
              if settings.guide > 0 else None)
 
     def new_tracer(batches: int) -> ForwardTracer:
@@ -127,36 +143,66 @@ def trace_forward(scene: Scene, state: SkyState, settings: ForwardSettings,
                              splitting_near=near, guide=guide)
 
     tracer = new_tracer(settings.batches)
+    b = settings.batches
     strata, n_pilot, pilot_segments = None, 0, 0
     if settings.focus_m is not None and settings.beam_diameter_m is None and sources:
         edges = ring_edges(float(settings.focus_m),
                            sphere.radius + float(np.linalg.norm(target - sphere.centre)))
-        strata = [Stratum(i, a, b) for i in range(len(sources))
-                  for a, b in zip(edges[:-1], edges[1:])]
+        strata = [Stratum(i, a, b_) for i in range(len(sources))
+                  for a, b_ in zip(edges[:-1], edges[1:])]
         per_ring = max(64, int(PILOT * settings.photons / len(strata)))
         scout = new_tracer(1)
-        pilot(sources, strata, target, scout, per_ring, rng)
+        pilot(sources, strata, target, scout, per_ring, rng, direct)
         n_pilot, pilot_segments = per_ring * len(strata), scout.segments
-        allocate(strata, max(settings.photons - n_pilot, settings.batches * len(strata)),
-                 settings.batches)
-        trace_strata(sources, strata, target, tracer, settings.chunk, settings.batches, rng)
-        counts = [sum(st.photons for st in strata)]
-    else:
-        counts = _allot(settings.photons, [s.flux for s in sources], settings.batches)
-        for src, n_src in zip(sources, counts):
-            per_photon = src.flux / n_src
-            for c0 in range(0, n_src, settings.chunk):
-                k = min(settings.chunk, n_src - c0)
-                batch = (c0 + np.arange(k)) % settings.batches
-                tracer.run(Photons.start(src.launch(k, per_photon, rng), batch))
+        allocate(strata, max(settings.photons - n_pilot, b * len(strata)), b)
+
+    def one_round() -> tuple[int, np.ndarray]:
+        """Trace one round of photons into a fresh tally: its photons and (batches, detectors)
+        lux of each batch."""
+        tracer.tally = np.zeros((b, det.count))
+        if strata is not None:
+            trace_strata(sources, strata, target, tracer, settings.chunk, b, rng, direct)
+            n = sum(st.photons for st in strata)
+        else:
+            counts = _allot(settings.photons, [s.flux for s in sources], b)
+            for src, n_src in zip(sources, counts):
+                per_photon = src.flux / n_src
+                for c0 in range(0, n_src, settings.chunk):
+                    k = min(settings.chunk, n_src - c0)
+                    batch = (c0 + np.arange(k)) % b
+                    tracer.run(Photons.start(src.launch(k, per_photon, rng), batch,
+                                             src is sources[0] and bool(direct)))
+            n = sum(counts)
+        rows = tracer.tally * b / det.area
+        if direct:
+            rows += at_points  # the direct sun, exact at the points: the same in every batch
+        return n, rows
+
+    at_points = np.zeros(det.count)
+    if direct:
+        sun = np.asarray(state.sun.vector, float)
+        for name in names:
+            at_points[det.slices[name]] = direct_sun(geo, optics, scene.grids[name], sun,
+                                                     state.direct_normal_lux)
+    budget = Budget(settings.photons, settings.target_rel_se, settings.max_photons)
+    traced, rows = 0, []
+    leg = settings.photons
+    while leg > 0:
+        for _ in range(max(1, leg // settings.photons)):
+            n, r = one_round()
+            traced += n
+            rows.append(r)
+        per_batch = np.vstack(rows)
+        grid_batches = {name: per_batch[:, det.slices[name]].mean(axis=1) for name in names}
+        leg = budget.next_leg(traced, worst_relative_se(grid_batches)[1])
+    warning = budget.warn_if_short(traced, grid_batches)
     out, per = {}, {}
-    b = settings.batches
     for name in names:
-        per[name] = tracer.tally[:, det.slices[name]] * b / det.area
-        mean = tracer.tally[:, det.slices[name]].sum(axis=0) / det.area
-        out[name] = GridResult(mean, per[name].std(axis=0, ddof=1) / np.sqrt(b))
-    return ForwardResult(out, tracer.ledger, int(sum(counts)), tracer.segments + pilot_segments,
-                         time.perf_counter() - t0, per, strata, n_pilot)
+        per[name] = per_batch[:, det.slices[name]]
+        out[name] = GridResult(per[name].mean(axis=0),
+                               per[name].std(axis=0, ddof=1) / np.sqrt(len(per[name])))
+    return ForwardResult(out, tracer.ledger, traced, tracer.segments + pilot_segments,
+                         time.perf_counter() - t0, per, strata, n_pilot, len(rows), warning)
 
 
 def _allot(photons: int, fluxes: list[float], batches: int) -> list[int]:

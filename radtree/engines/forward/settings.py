@@ -16,7 +16,12 @@ the target grid's centre, innermost disc of that radius, m — unbiased, see
 target grid's centre split into that many children, at most twice per photon; 1 = never),
 ``forward_guide`` and ``forward_guide_radius_m`` (that share of every diffuse event outside a
 sphere of that radius around the target grid's centre aims its direction at the sphere, the
-flux corrected: :mod:`radtree.engines.forward.guide`; 0 = Lambertian scattering only).
+flux corrected: :mod:`radtree.engines.forward.guide`; 0 = Lambertian scattering only),
+``target_rel_se`` and ``max_photons`` (rounds of ``photons`` added until every traced grid's
+mean has that relative standard error, or that many photons:
+:mod:`radtree.engines.forward.precision`; unset = one round) and ``forward_direct_sun`` (the
+sun's direct beam computed at the sensor points, sun photons tallied only once scattered:
+:mod:`radtree.engines.forward.direct`).
 """
 
 from __future__ import annotations
@@ -52,7 +57,13 @@ class ForwardSettings:
     (None: start points uniform on the launch disc; ignored with a beam). ``split``: children
     per diffuse event within ``split_radius_m`` (m) of the target grid's centre (1: none).
     ``guide``: share (0 ≤ q < 1) of diffuse directions aimed at the sphere of ``guide_radius_m``
-    (m) around the target grid's centre (0: none).
+    (m; None: the smallest holding the target grid's patches) around the target grid's centre
+    (0: none). ``target_rel_se``: trace further rounds of
+    ``photons`` until every grid's mean has this relative standard error (None: one round);
+    ``max_photons``: the cap (then a :class:`~radtree.engines.forward.precision.PrecisionWarning`
+    with the error reached). ``direct_sun``: the sun's direct beam computed at the sensor points
+    and sun photons tallied on the patches only once scattered (:mod:`.direct`; whole-scene
+    sun only).
     """
 
     photons: int = 1_000_000
@@ -69,7 +80,10 @@ class ForwardSettings:
     split: int = 1
     split_radius_m: float = 2.0
     guide: float = 0.0
-    guide_radius_m: float = 2.0
+    guide_radius_m: float | None = 2.0
+    target_rel_se: float | None = None
+    max_photons: int = 64_000_000
+    direct_sun: bool = False
 
     def __post_init__(self) -> None:
         if isinstance(self.photons, bool) or not isinstance(self.photons, int) or self.photons < 1:
@@ -105,9 +119,23 @@ class ForwardSettings:
         if isinstance(q, bool) or not isinstance(q, int | float) or not 0.0 <= q < 1.0:
             raise _bad("forward_guide", f"must be ≥ 0 and < 1 (a share of the diffuse "
                        f"directions), got {q!r}")
-        r = self.guide_radius_m
-        if not isinstance(r, int | float) or not math.isfinite(r) or r <= 0:
-            raise _bad("forward_guide_radius_m", f"must be > 0 m, got {r!r}")
+        gr = self.guide_radius_m
+        if gr is not None and (not isinstance(gr, int | float) or not math.isfinite(gr)
+                               or gr <= 0):
+            raise _bad("forward_guide_radius_m", f"must be > 0 m (or unset: the sphere just "
+                       f"holding the target grid's patches), got {gr!r}")
+        t = self.target_rel_se
+        if t is not None and (isinstance(t, bool) or not isinstance(t, int | float)
+                              or not 0.0 < t < 1.0):
+            raise _bad("target_rel_se", f"must be strictly between 0 and 1 (a relative standard "
+                       f"error, e.g. 0.02), or unset for a fixed photon count, got {t!r}")
+        m = self.max_photons
+        if isinstance(m, bool) or not isinstance(m, int) or m < 1 \
+                or (t is not None and m < self.photons):
+            raise _bad("max_photons", f"must be a whole number ≥ engine.photons "
+                       f"({self.photons}), got {m!r}")
+        if not isinstance(self.direct_sun, bool):
+            raise _bad("forward_direct_sun", f"must be true or false, got {self.direct_sun!r}")
         if self.max_bounces < 0 or self.max_specular < 0 or self.chunk < 1:
             raise _bad("max_bounces", "bounce caps must be ≥ 0 and the chunk ≥ 1")
 
@@ -121,18 +149,27 @@ class ForwardSettings:
                    max_bounces=int(params.max_bounces if ab is None else ab),
                    seed=int(params.seed), focus_m=params.forward_focus_m,
                    split=params.forward_split, split_radius_m=params.forward_split_radius_m,
-                   guide=params.forward_guide, guide_radius_m=params.forward_guide_radius_m)
+                   guide=params.forward_guide, guide_radius_m=params.forward_guide_radius_m,
+                   target_rel_se=params.target_rel_se, max_photons=params.max_photons,
+                   direct_sun=params.forward_direct_sun)
 
     def describe(self) -> str:
         source = ("sun over the whole scene" if self.beam_diameter_m is None
                   else f"sun beam {self.beam_diameter_m:g} m")
         if self.beam_diameter_m is None and self.focus_m is not None:
             source += f", focused launch from {self.focus_m:g} m"
+        if self.direct_sun and self.beam_diameter_m is None:
+            source += ", direct sun at the points"
         scatter = "ray splitting" if self.splitting else "Russian roulette"
         if self.split > 1:
             scatter += f", ×{self.split} within {self.split_radius_m:g} m of the target"
         if self.guide > 0:
+            radius = ("its patches" if self.guide_radius_m is None
+                      else f"{self.guide_radius_m:g} m")
             scatter += f", {self.guide:.0%} of diffuse directions aimed at the target " \
-                       f"({self.guide_radius_m:g} m)"
-        return (f"{self.photons} photons, {source}, {scatter}, threshold {self.threshold:g}, "
+                       f"({radius})"
+        count = (f"{self.photons} photons" if self.target_rel_se is None else
+                 f"photons in rounds of {self.photons} to a {self.target_rel_se:.1%} standard "
+                 f"error of each grid mean (cap {self.max_photons})")
+        return (f"{count}, {source}, {scatter}, threshold {self.threshold:g}, "
                 f"patches {self.patch_m:g} m, {self.batches} batches, seed {self.seed}")

@@ -6,7 +6,7 @@ scene or as a beam aimed at a target), and the sky and distant ground glow.
   illuminance in lux), photon origins uniform on the disc, all travelling along −sun.
 * **Sun beam**: the same disc with the stated diameter, its axis through the target point.
 * **Environment** (sky above the horizon, the distant ground glow below — the luminance the
-  NumPy engine's escaping rays see, :class:`radtree.engines.numpy.engine.Environment`): a
+  NumPy engine's escaping rays see, :class:`radtree.engines.common.geometry.Environment`): a
   direction ω is drawn from a table of the luminance over the whole sphere (equal solid-angle
   cells, ∝ L·Ω) and a photon starts on the disc of radius R perpendicular to ω outside the
   bounding sphere, travelling along −ω; flux through the disc from dω is L(ω) dω · π R², so
@@ -25,7 +25,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from radtree.engines.numpy.sampling import orthonormal_basis
+from radtree.engines.common.sampling import orthonormal_basis
 
 _ENV_ZONES = (48, 96)  # cells in z (uniform in cos θ) and in azimuth: equal solid angles
 

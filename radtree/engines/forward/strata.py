@@ -70,16 +70,18 @@ def _batches(k: int, batches: int, offset: int = 0) -> np.ndarray:
 
 
 def pilot(sources: list, strata: list[Stratum], target: np.ndarray, tracer: ForwardTracer,
-          per_ring: int, rng: np.random.Generator) -> None:
+          per_ring: int, rng: np.random.Generator, direct: frozenset[int] = frozenset()
+          ) -> None:
     """Trace ``per_ring`` photons in every stratum with a tally row per photon (``tracer``: a
     throw-away tracer on the same scene) and set each stratum's ``sigma``, ``cost``, ``mean``.
-    The figure of merit is the mean over every traced detector (lux)."""
+    The figure of merit is the mean over every traced detector (lux). ``direct``: the sources
+    whose photons start as the sun's direct beam (:meth:`Photons.start`)."""
     det = tracer.det
     for st in strata:
         tracer.tally = np.zeros((per_ring, det.count))
         before = tracer.segments
         launch = sources[st.source].ring_launch(per_ring, st.a, st.b, target, rng)
-        tracer.run(Photons.start(launch, np.arange(per_ring)))
+        tracer.run(Photons.start(launch, np.arange(per_ring), st.source in direct))
         y = tracer.tally.sum(axis=1) / (det.count * det.area) * per_ring
         st.sigma = float(y.std(ddof=1))
         st.mean = float(y.mean())
@@ -107,7 +109,7 @@ def allocate(strata: list[Stratum], photons: int, batches: int, floor: float = F
 
 def trace_strata(sources: list, strata: list[Stratum], target: np.ndarray,
                  tracer: ForwardTracer, chunk: int, batches: int,
-                 rng: np.random.Generator) -> None:
+                 rng: np.random.Generator, direct: frozenset[int] = frozenset()) -> None:
     """The main run: every stratum's photons, in chunks, assigned to the batches in turn;
     each stratum's ``got`` ± ``got_se``: its share of the traced detectors' mean (lux)."""
     det = tracer.det
@@ -118,6 +120,6 @@ def trace_strata(sources: list, strata: list[Stratum], target: np.ndarray,
             k = min(chunk, st.photons - c0)
             launch = src.ring_launch(k, st.a, st.b, target, rng)
             launch.flux *= k / st.photons  # the ring's flux shared by all its photons
-            tracer.run(Photons.start(launch, _batches(k, batches, c0)))
+            tracer.run(Photons.start(launch, _batches(k, batches, c0), st.source in direct))
         part = (tracer.tally.sum(axis=1) - before) * batches / (det.count * det.area)
         st.got, st.got_se = float(part.mean()), float(part.std(ddof=1) / math.sqrt(batches))

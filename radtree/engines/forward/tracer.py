@@ -34,12 +34,12 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from radtree.engines.common.geometry import Geometry, Optics, glass_coefficients
+from radtree.engines.common.sampling import cosine_hemisphere, mirror
+from radtree.engines.common.streams import GeneratorDraws
 from radtree.engines.forward.detectors import PatchDetectors
 from radtree.engines.forward.guide import Guide
 from radtree.engines.forward.sources import Launch
-from radtree.engines.numpy.engine import Geometry, Optics, glass_coefficients
-from radtree.engines.numpy.sampling import cosine_hemisphere, mirror
-from radtree.engines.numpy.streams import GeneratorDraws
 
 
 @dataclass
@@ -98,26 +98,29 @@ class Photons:
     nspec: np.ndarray    # specular events so far
     batch: np.ndarray    # batch of the photon (standard errors)
     nsplit: np.ndarray   # splits in its lineage so far
+    direct: np.ndarray   # still the sun's direct beam (counted at the points: direct.py)
 
     def __len__(self) -> int:
         return len(self.w)
 
     def take(self, m: np.ndarray | slice) -> Photons:
         return Photons(self.o[m], self.d[m], self.w[m], self.w0[m], self.ndiff[m],
-                       self.nspec[m], self.batch[m], self.nsplit[m])
+                       self.nspec[m], self.batch[m], self.nsplit[m], self.direct[m])
 
     @staticmethod
     def join(parts: list[Photons]) -> Photons:
         return Photons(*(np.concatenate([getattr(p, f) for p in parts])
                          for f in ("o", "d", "w", "w0", "ndiff", "nspec", "batch",
-                                   "nsplit")))
+                                   "nsplit", "direct")))
 
     @staticmethod
-    def start(launch: Launch, batch: np.ndarray) -> Photons:
+    def start(launch: Launch, batch: np.ndarray, direct: bool = False) -> Photons:
+        """Photons of ``launch``; ``direct``: the sun's beam, not tallied on the detectors
+        until scattered (its direct light is computed at the sensor points)."""
         k = len(launch.flux)
         z = np.zeros(k, np.int64)
         return Photons(launch.origins, launch.dirs, launch.flux.copy(), launch.flux.copy(),
-                       z, z.copy(), batch, z.copy())
+                       z, z.copy(), batch, z.copy(), np.full(k, bool(direct)))
 
 
 class ForwardTracer:
@@ -126,7 +129,7 @@ class ForwardTracer:
     def __init__(self, geo: Geometry, optics: Optics, detectors: PatchDetectors, batches: int,
                  *, threshold: float, splitting: bool, max_bounces: int, max_specular: int,
                  chunk: int, rng: np.random.Generator, splitting_near: Splitting | None = None,
-                 guide: Guide | None = None):
+                 guide: Guide | None = None, escape_axes: np.ndarray | None = None):
         self.geo, self.opt, self.det = geo, optics, detectors
         self.near, self.guide = splitting_near, guide
         self.threshold, self.splitting = float(threshold), bool(splitting)
@@ -137,6 +140,11 @@ class ForwardTracer:
         self.tally = np.zeros((batches, detectors.count))
         self.ledger = Ledger(list(geo.material_names))
         self.segments = 0
+        #: with ``escape_axes`` (batches, 3) unit vectors: per batch, the flux escaping the scene
+        #: along its axis (d · axis > 0, lm), and the part still the direct beam
+        self.axes = escape_axes
+        self.ahead = np.zeros(0 if escape_axes is None else len(escape_axes))
+        self.ahead_direct = np.zeros_like(self.ahead)
 
     def run(self, photons: Photons) -> None:
         """Trace ``photons`` (and every child) until none is left."""
@@ -156,12 +164,24 @@ class ForwardTracer:
         geo, opt, led = self.geo, self.opt, self.ledger
         tri, t = geo.caster.first_hit(ph.o, ph.d)
         met = None
-        if geo.media is not None:   # a leaf of a turbid crown first? (engines.numpy.turbid)
+        if geo.media is not None:   # a leaf of a turbid crown first? (engines.common.turbid)
             met, t = geo.media.collide(ph.o, ph.d, t, GeneratorDraws(self.rng))
             tri = np.where(met >= 0, 0, tri)   # a stand-in row, replaced below
         self.segments += len(ph)
-        self.det.tally(ph.o, ph.d, t, ph.w, ph.batch, self.tally)
+        if ph.direct.any():
+            seen = ~ph.direct
+            self.det.tally(ph.o[seen], ph.d[seen], t[seen], ph.w[seen], ph.batch[seen],
+                           self.tally)
+        else:
+            self.det.tally(ph.o, ph.d, t, ph.w, ph.batch, self.tally)
         miss = tri < 0
+        if miss.any() and self.axes is not None:
+            gone = ph.take(miss)
+            ahead = np.einsum("ij,ij->i", gone.d, self.axes[gone.batch]) > 0
+            n = len(self.ahead)
+            self.ahead += np.bincount(gone.batch[ahead], gone.w[ahead], minlength=n)
+            lit = ahead & gone.direct
+            self.ahead_direct += np.bincount(gone.batch[lit], gone.w[lit], minlength=n)
         if miss.any():
             up = ph.d[miss, 2] > 0
             led.escaped_up += float(ph.w[miss][up].sum())
@@ -248,7 +268,7 @@ class ForwardTracer:
         side = np.where(diff_t | spec_t, -1.0, 1.0)
         out = Photons(p[src] + n * (self.eps * side)[:, None], new_d, cw, w0,
                       ph.ndiff[src] + diffuse, ph.nspec[src] + (spec_t | mir), ph.batch[src],
-                      nsplit)
+                      nsplit, ph.direct[src] & spec_t)
         return out if self.guide is None else out.take(out.w > 0)
 
     def _split(self, p: np.ndarray, src: np.ndarray, ev: np.ndarray, cw: np.ndarray,

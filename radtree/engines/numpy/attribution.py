@@ -46,12 +46,12 @@ import numpy as np
 
 from radtree.config import EngineParams
 from radtree.engines.base import GridResult, TreeAttribution
+from radtree.engines.common.geometry import Geometry, Optics, scene_optics, triangle_frames
+from radtree.engines.common.raycast import RayCaster, make_caster
+from radtree.engines.common.sampling import cosine_directions
+from radtree.engines.common.streams import PathStreams, stream_key
 from radtree.engines.numpy.engine import DEFAULT_OPTIONS, TraceOptions, _Tracer, scene_geometry
-from radtree.engines.numpy.geometry import Geometry, Optics, scene_optics, triangle_frames
 from radtree.engines.numpy.qmc import FirstDirections, replicate_stderr
-from radtree.engines.numpy.raycast import RayCaster, make_caster
-from radtree.engines.numpy.sampling import cosine_directions
-from radtree.engines.numpy.streams import PathStreams, stream_key
 from radtree.engines.numpy.tally import SensorTally
 from radtree.engines.numpy.tracing import _grid_seed, _tracer, grid_rays
 from radtree.errors import EngineError

@@ -44,7 +44,7 @@ first-hit query per bounce plus the shadow queries), never a Python loop per ray
 ``engine.workers`` > 1 a batch is split into that many parts (of at least ``min_part_paths``;
 blocks of ``SPLIT_BLOCK`` paths taken in turn) traced in parallel threads, each running its own
 NumPy work and single-threaded Embree queries. Each path draws from its own counter-based stream
-(:mod:`radtree.engines.numpy.streams`), so the parts never wait for each other and the numbers
+(:mod:`radtree.engines.common.streams`), so the parts never wait for each other and the numbers
 depend neither on ``workers`` nor on ``batch_paths``.
 """
 
@@ -58,7 +58,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from radtree.config import EngineParams
-from radtree.engines.numpy.geometry import (
+from radtree.engines.common.geometry import (
     GLASS_INDEX,
     Environment,
     Geometry,
@@ -67,19 +67,19 @@ from radtree.engines.numpy.geometry import (
     scene_geometry,
     scene_optics,
 )
-from radtree.engines.numpy.kernel import describe as kernel_describe
-from radtree.engines.numpy.kernel import kernel
-from radtree.engines.numpy.raycast import embree_available
-from radtree.engines.numpy.sampling import cosine_hemisphere, cosine_rows, mirror, uniform_cone
-from radtree.engines.numpy.shadow import kernel_tables, transmittance
-from radtree.engines.numpy.shadow import rows as _rows
-from radtree.engines.numpy.streams import (
+from radtree.engines.common.kernel import describe as kernel_describe
+from radtree.engines.common.kernel import kernel
+from radtree.engines.common.raycast import embree_available
+from radtree.engines.common.sampling import cosine_hemisphere, cosine_rows, mirror, uniform_cone
+from radtree.engines.common.streams import (
     FIRST_DIRECTIONS,
     SENSOR_SUN_ROULETTE,
     Draws,
     PathStreams,
     as_draws,
 )
+from radtree.engines.numpy.shadow import kernel_tables, transmittance
+from radtree.engines.numpy.shadow import rows as _rows
 from radtree.light.sky import SkyState
 from radtree.light.sun import SUN_HALF_ANGLE_DEG
 
@@ -154,7 +154,7 @@ class _Tracer:
         arrays then carry each path's state index (0 = ``state``)."""
         self.geo = geo
         self.caster = geo.caster
-        self.media = geo.media   # turbid crowns (radtree.engines.numpy.turbid) or None
+        self.media = geo.media   # turbid crowns (radtree.engines.common.turbid) or None
         self.opt = optics
         self.env = Environment(state)
         self.state = state
@@ -197,7 +197,7 @@ class _Tracer:
         self.sun_cos = cos.reshape(-1)
         self.sun_side = np.where(self.sun_cos < 0, -self.eps, self.eps)
         self.sun_grazing = bool(np.any(np.abs(self.sun_cos) < 1e-12))  # plane_distance's test
-        # the C kernel's table (radtree.engines.numpy.kernel): per triangle its normal, first
+        # the C kernel's table (radtree.engines.common.kernel): per triangle its normal, first
         # vertex, specular transmittance and cosine to the first state's sun, one 64-byte row
         self.tri_pack: np.ndarray | None = None
         if kernel() is not None:
@@ -226,7 +226,7 @@ class _Tracer:
 
         With ``rng``, faint shadow rays are continued by Russian roulette (unbiased); without,
         the product is exact (the sensors' own direct sun); ``rng``: one stream per shadow
-        ray (:class:`~radtree.engines.numpy.streams.Draws`, the layer crossed appended to its
+        ray (:class:`~radtree.engines.common.streams.Draws`, the layer crossed appended to its
         place) or a plain ``Generator``; ``parallel``:
         whether the ray caster may split its queries over threads (not inside a part thread);
         ``hour``: the hour state(s) whose point sun ``dirs`` are (per-triangle tables of the
@@ -271,7 +271,7 @@ class _Tracer:
               | None = None) -> np.ndarray:
         """Radiance (cd/m²) seen along one cosine-sampled direction from each sensor sample.
 
-        ``rng``: the streams of these paths (:class:`~radtree.engines.numpy.streams.Draws`);
+        ``rng``: the streams of these paths (:class:`~radtree.engines.common.streams.Draws`);
         every draw is taken at its place in the program — (bounce, site) — from the streams of
         the paths still alive, so a path's numbers do not depend on the others. ``dirs``: the
         first directions instead of the cosine samples about ``normals``; ``escapes(path,
@@ -330,7 +330,7 @@ class _Tracer:
                     break
             k_mod = kernel() if self.tri_pack is not None else None
             if k_mod is not None and tri.dtype == np.int64:
-                # the same numbers in one pass (radtree.engines.numpy.kernel)
+                # the same numbers in one pass (radtree.engines.common.kernel)
                 n_a = len(alive)
                 p, nf, cosd, coef = (np.empty((n_a, 3)), np.empty((n_a, 3)), np.empty(n_a),
                                      np.empty((4, n_a)))

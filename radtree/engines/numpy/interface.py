@@ -7,9 +7,9 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from radtree.engines.base import GridResult, TreeAttribution
+from radtree.engines.common.inprocess import InProcessEngine
+from radtree.engines.common.kernel import name as kernel_name
 from radtree.engines.numpy.engine import describe
-from radtree.engines.numpy.inprocess import InProcessEngine
-from radtree.engines.numpy.kernel import name as kernel_name
 from radtree.engines.numpy.tracing import trace_bounce_ladder, trace_hour, trace_states
 
 if TYPE_CHECKING:

@@ -14,10 +14,10 @@ from typing import Any, Protocol
 
 import numpy as np
 
-from radtree.engines.numpy.geometry import Geometry, Optics, glass_coefficients
-from radtree.engines.numpy.kernel import kernel, triangle_rows
-from radtree.engines.numpy.raycast import EmbreeCaster, RayCaster, hit_triangles, plane_distance
-from radtree.engines.numpy.streams import Draws, as_draws
+from radtree.engines.common.geometry import Geometry, Optics, glass_coefficients
+from radtree.engines.common.kernel import kernel, triangle_rows
+from radtree.engines.common.raycast import EmbreeCaster, RayCaster, hit_triangles, plane_distance
+from radtree.engines.common.streams import Draws, as_draws
 
 SHADOW_ROULETTE = 0.02  # shadow-ray transmittance below which Russian roulette starts
 

@@ -13,6 +13,8 @@ import numpy as np
 
 from radtree.config import EngineParams
 from radtree.engines.base import GridResult
+from radtree.engines.common.sampling import cosine_directions as cosine_from
+from radtree.engines.common.streams import SUN_DISC, PathStreams, stream_key
 from radtree.engines.numpy.engine import (
     DEFAULT_OPTIONS,
     TraceOptions,
@@ -21,8 +23,6 @@ from radtree.engines.numpy.engine import (
     scene_optics,
 )
 from radtree.engines.numpy.qmc import FirstDirections
-from radtree.engines.numpy.sampling import cosine_directions as cosine_from
-from radtree.engines.numpy.streams import SUN_DISC, PathStreams, stream_key
 from radtree.engines.numpy.tally import SensorTally
 from radtree.errors import EngineError
 from radtree.light.sky import SkyState
@@ -65,7 +65,7 @@ def _trace_grid(tracer: _Tracer, grid: SensorGrid, n_paths: int, rng: np.random.
     total = n_s * n_paths
     first = FirstDirections(n_s, n_paths, rng) if sampling == "sobol" else None
     tally = SensorTally(n_s, cols, first)
-    key = stream_key(rng)  # each path's stream: (key, path number) (engines.numpy.streams)
+    key = stream_key(rng)  # each path's stream: (key, path number) (engines.common.streams)
     batch = max(1, int(tracer.opts.batch_paths))
     for start in range(0, total, batch):
         pid = np.arange(start, min(total, start + batch))

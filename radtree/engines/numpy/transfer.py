@@ -18,10 +18,10 @@ from dataclasses import dataclass
 import numpy as np
 
 from radtree.config import EngineParams
+from radtree.engines.common.geometry import scene_geometry, scene_optics
+from radtree.engines.common.streams import PathStreams, stream_key
 from radtree.engines.numpy.engine import TraceOptions, _Tracer
-from radtree.engines.numpy.geometry import scene_geometry, scene_optics
 from radtree.engines.numpy.scenes import sky_state
-from radtree.engines.numpy.streams import PathStreams, stream_key
 from radtree.errors import EngineError
 from radtree.scene import Scene
 

@@ -35,6 +35,7 @@ from pathlib import Path
 import numpy as np
 
 from radtree.engines.radiance.binaries import FIXED_SEED, run
+from radtree.engines.radiance.materials import material_text
 from radtree.errors import EngineError
 from radtree.fileio import write_text
 from radtree.optics import KLEMS_FULL_RINGS, Material
@@ -92,7 +93,7 @@ def _polygon(mat: str, name: str, corners: np.ndarray) -> str:
 def cell_text(polygons: dict[str, np.ndarray], materials: dict[str, Material]) -> str:
     """The cell: its materials and every polygon (``MAT polygon MAT.i``)."""
     out = ["# one periodic cell of the crown layer (radtree.trees.slab)\n"]
-    out += [materials[name].to_radiance() for name in polygons]
+    out += [material_text(materials[name]) for name in polygons]
     for name, polys in polygons.items():
         out += [_polygon(name, f"{name}.{i}", p) for i, p in enumerate(polys)]
     return "\n".join(out)

@@ -25,8 +25,9 @@ from jinja2 import Template
 
 import radtree
 from radtree.config import EngineParams
-from radtree.engines.numpy.turbid import refuse_media
+from radtree.engines.common.turbid import refuse_media
 from radtree.engines.radiance.binaries import FIXED_SEED, RadianceInstall
+from radtree.engines.radiance.materials import material_text
 from radtree.engines.radiance.meshes import (
     as_compiled_mesh,
     mesh_primitive_text,
@@ -73,7 +74,7 @@ def prototype_octree(name: str) -> str:
 def materials_text(materials: Mapping[str, Material], ground: str | None = None) -> str:
     """``materials.rad``: every material's Radiance entry (as in ``materials/*.rad``), without
     holes (not written) and without the ground ``ground`` (written per hour in ``skies/``)."""
-    entries = [m.to_radiance() for name, m in materials.items()
+    entries = [material_text(m) for name, m in materials.items()
                if not isinstance(m, Hole) and name != ground]
     return "# materials (ground: per hour in skies/)\n\n" + "\n".join(entries)
 
@@ -200,7 +201,7 @@ def write_build(scene: Scene, states: list[SkyState], params: EngineParams, ab: 
             gm = with_reflectance(ground, st.ground_reflectance)
             rel = f"skies/{st.label}_ground.rad"
             _write(folder / rel, f"# ground reflectance at {st.time} "
-                       f"(sun altitude {st.sun.altitude_deg:.2f}°)\n" + gm.to_radiance())
+                       f"(sun altitude {st.sun.altitude_deg:.2f}°)\n" + material_text(gm))
             files.append(rel)
         files += geometry_files
         rel_sky = f"skies/{st.label}.sky"

@@ -29,6 +29,7 @@ import numpy as np
 import pandas as pd
 
 from radtree.config import Project
+from radtree.engines.registry import photon_engines
 from radtree.figures import new_figure, save_png
 from radtree.measurements import hourly_grid_means
 from radtree.stats import nrmse
@@ -177,7 +178,7 @@ def method_section_data(project: Project, out: Path) -> dict[str, Any] | None:
         (out / "figures").mkdir(parents=True, exist_ok=True)
         _radius_figure(table, m, radii, out / "figures" / FIGURE)
         figure = f"figures/{FIGURE}"
-    photons = sorted(set(table.loc[table["engine"] == "forward", "photons"].astype(int)))
+    photons = sorted(set(table.loc[table["engine"].isin(photon_engines()), "photons"].astype(int)))
     return {"hours": hours, "measured": [f"{x:.0f}" for x in m], "radius": f"{base:g}",
             "rows": rows, "orders": orders, "findings": findings, "scan": scan,
             "scan_orders": scan_orders, "figure": figure,

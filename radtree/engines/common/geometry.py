@@ -16,8 +16,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from radtree.engines.numpy.raycast import RayCaster, make_caster
-from radtree.engines.numpy.turbid import MediumTracer
+from radtree.engines.common.raycast import RayCaster, make_caster
+from radtree.engines.common.turbid import MediumTracer
 from radtree.errors import EngineError
 from radtree.light.sky import SkyState, sky_luminance
 from radtree.optics import Glass, Hole, Plastic, Trans

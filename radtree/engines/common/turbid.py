@@ -33,8 +33,8 @@ import math
 
 import numpy as np
 
-from radtree.engines.numpy.raycast import make_caster
-from radtree.engines.numpy.streams import Draws, PathStreams
+from radtree.engines.common.raycast import make_caster
+from radtree.engines.common.streams import Draws, PathStreams
 from radtree.errors import EngineError
 from radtree.media import TurbidCrowns
 from radtree.optics import Material, Trans

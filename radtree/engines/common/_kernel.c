@@ -1,4 +1,4 @@
-/* radtree.engines.numpy._kernel — the shadow-ray loop's per-crossing arithmetic in one pass.
+/* radtree.engines.common._kernel — the shadow-ray loop's per-crossing arithmetic in one pass.
  *
  * An optional accelerator of radtree/engines/numpy/shadow.py (the NumPy code there is the
  * reference and the fallback). Every number is the one the NumPy code computes: the same IEEE
@@ -7,7 +7,7 @@
  * transcendental functions. tests/test_numpy_kernel.py compares both paths with array_equal.
  *
  * Arrays arrive through the buffer protocol (no NumPy headers at build time); the Python side
- * (radtree/engines/numpy/kernel.py) checks dtypes and shapes before calling.
+ * (radtree/engines/common/kernel.py) checks dtypes and shapes before calling.
  *
  *   cross(tri, idx, vis, roulette, pack, sun_cos, n_tri, hour, hours, suns, eps, o, frame,
  *         o32) -> (hits, m, faint)

@@ -1,4 +1,4 @@
-"""The NumPy engine's optional compiled kernel (``radtree.engines.numpy._kernel``, built from
+"""The in-process engines' optional compiled kernel (``radtree.engines.common._kernel``, built from
 ``_kernel.c`` at install when a C compiler is at hand).
 
 It runs the shadow-ray loop's per-crossing arithmetic (:mod:`radtree.engines.numpy.shadow`) in
@@ -30,9 +30,9 @@ def _load() -> tuple[ModuleType | None, str]:
     global _loaded
     if _loaded is None:
         try:
-            # by name: ``from radtree.engines.numpy import _kernel`` would import the package
-            # (engine → shadow → kernel), a cycle for the layer check (tests/test_layers.py)
-            _kernel = importlib.import_module("radtree.engines.numpy._kernel")
+            # by name (a static ``from … import _kernel`` would put the compiled module in the
+            # import graph the layer check walks, tests/test_layers.py; it was a cycle once)
+            _kernel = importlib.import_module("radtree.engines.common._kernel")
         except ImportError as exc:
             _loaded = (None, f"not built ({exc})")
         else:
@@ -73,7 +73,7 @@ def describe() -> str:
     mod, why = _load()
     if mod is None:
         return f"shadow-ray kernel numpy (the C kernel is {why})"
-    return "shadow-ray kernel c (radtree.engines.numpy._kernel)"
+    return "shadow-ray kernel c (radtree.engines.common._kernel)"
 
 
 def triangle_rows(normals: np.ndarray, v0: np.ndarray) -> np.ndarray:

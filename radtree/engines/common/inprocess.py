@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 from radtree.engines.base import Engine
-from radtree.engines.numpy.raycast import embree_available
+from radtree.engines.common.raycast import embree_available
 
 
 class InProcessEngine(Engine):

@@ -20,7 +20,7 @@ from typing import Protocol
 
 import numpy as np
 
-from radtree.engines.numpy.kernel import kernel, triangle_rows
+from radtree.engines.common.kernel import kernel, triangle_rows
 
 BACKENDS = ("embree", "numpy-bvh")
 
