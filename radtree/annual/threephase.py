@@ -113,16 +113,34 @@ GROUP_TILE_M = 1.5
 #: dropped when its share stays below VISIBLE_SHARE for every sensor
 TILE_SHARE = 2e-3
 VISIBLE_SHARE = 1e-4
+#: facet grouping of the annual runs (:func:`group_directions` level) and whether each
+#: group's Klems frame takes its ``BSDF`` material's up vector (module text)
+GROUP_LEVEL = 0
+GROUP_MATERIAL_UP = False
+
+
+def group_directions(level: int) -> np.ndarray:
+    """Unit directions facets are grouped by: level 0 the 14 of :data:`_DIRS`; level k ≥ 1
+    the vertices of an icosphere of k − 1 subdivisions (12, 42, 162, 642 directions: a
+    facet's normal within ≈ 37°, 19°, 10°, 5° of its group's direction)."""
+    if level <= 0:
+        return _DIRS
+    import trimesh
+
+    v = np.asarray(trimesh.creation.icosphere(subdivisions=level - 1).vertices, float)
+    return v / np.linalg.norm(v, axis=1)[:, None]
 
 
 @dataclass
 class FacetGroup:
-    """Shell facets of one material and orientation; ``triangles`` wound to the sensors."""
+    """Shell facets of one material and orientation; ``triangles`` wound to the sensors;
+    ``up`` the world up vector of the group's Klems frame (None: rfluxmtx's default)."""
 
     material: str
     triangles: np.ndarray  # (k, 3, 3)
     normal: np.ndarray     # unit mean normal, towards the sensors
-    direction: int = -1    # index of the nearest of the 14 directions
+    direction: int = -1    # index of the nearest grouping direction
+    up: tuple[float, float, float] | None = None
 
     @property
     def area(self) -> float:
@@ -136,22 +154,26 @@ class FacetGroup:
 
 
 def facet_groups(model: TreeModel, sensors_inside: bool, tile_m: float = 0.0,
-                 tiled: tuple[str, ...] | None = None) -> list[FacetGroup]:
+                 tiled: tuple[str, ...] | None = None, level: int = 0,
+                 material_up: bool = False) -> list[FacetGroup]:
     """The shell's facets grouped by BSDF material, by the nearest of 14 directions and
     (``tile_m`` > 0, for the materials in ``tiled`` or all when None) by the cell of a world
     grid of ``tile_m`` holding their centroid; each triangle wound so that its normal points
     to the sensors (the shell's own normals point inwards: to the sensors inside a dome,
     away from them for free crowns)."""
     groups = []
+    dirs = group_directions(level)
     for mesh in model.meshes:
         if not mesh.material.startswith(BSDF_SHELL):
             continue
+        mat = model.materials.get(mesh.material)
+        up = tuple(float(u) for u in mat.up) if material_up and isinstance(mat, Bsdf) else None
         tri = mesh.triangles if sensors_inside else mesh.triangles[:, ::-1]
         n = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
         area = np.linalg.norm(n, axis=1)
         keep = area > 1e-12
         tri, n = tri[keep], n[keep] / area[keep][:, None]
-        which = direction = np.argmax(n @ _DIRS.T, axis=1)
+        which = direction = np.argmax(n @ dirs.T, axis=1)
         if tile_m > 0 and (tiled is None or mesh.material in tiled):
             cell = np.floor(tri.mean(axis=1) / tile_m).astype(np.int64)
             _, which = np.unique(np.column_stack([which, cell]), axis=0, return_inverse=True)
@@ -160,7 +182,7 @@ def facet_groups(model: TreeModel, sensors_inside: bool, tile_m: float = 0.0,
             pick = which == d
             mean = (n[pick] * area[keep][pick][:, None]).sum(axis=0)
             groups.append(FacetGroup(mesh.material, tri[pick], mean / np.linalg.norm(mean),
-                                     int(direction[pick][0])))
+                                     int(direction[pick][0]), up))
     return groups
 
 
@@ -223,13 +245,15 @@ class ThreePhase:
 
     def __init__(self, folder: Path, bare: Scene, models: dict[str, TreeModel], form: str,
                  grids: list[str], rho: float, mf: int, trace: TraceParams,
-                 echo: Callable[[str], None], samples: int = 400):
+                 echo: Callable[[str], None], samples: int = 400,
+                 level: int = 0, material_up: bool = False):
         self.folder, self.samples = folder, samples
         folder.mkdir(parents=True, exist_ok=True)
         self.bare, self.models, self.grids, self.rho, self.mf = bare, models, grids, rho, mf
         self.inside = form == "dome"
         self.trace, self.echo = trace, echo
-        self.groups = facet_groups(models["leaf_on"], self.inside, GROUP_TILE_M, (WALL_CAP,))
+        self.groups = facet_groups(models["leaf_on"], self.inside, GROUP_TILE_M, (WALL_CAP,),
+                                   level, material_up)
         self.points = points_text(bare, grids)
         self.n = sum(len(bare.grids[g]) for g in grids)
         self.timing: dict[str, float] = {}
@@ -247,7 +271,8 @@ class ThreePhase:
         """The view matrix of each of ``groups`` (default: every tile; files
         ``view_<tag><k>.vmx``) and V_sky (sensors, patches, 3)."""
         groups = self.groups if groups is None else groups
-        receivers = (rad3.group_receivers_text([(g.triangles, g.normal) for g in groups])
+        receivers = (rad3.group_receivers_text([(g.triangles, g.normal) for g in groups],
+                                               [g.up for g in groups])
                      + "\n" + rad3.sky_receivers_text(self.mf))
         scene = _without_shell(_scene_with(self.bare, self.models["leaf_on"]))  # trunks stay
         octree_text = scene_text(scene, self.rho)
@@ -293,7 +318,8 @@ class ThreePhase:
             mean = np.sum([self.groups[k].normal * self.groups[k].area for k in ks], axis=0)
             groups.append(FacetGroup(material, np.concatenate([self.groups[k].triangles
                                                                for k in ks]),
-                                     mean / np.linalg.norm(mean), direction))
+                                     mean / np.linalg.norm(mean), direction,
+                                     self.groups[ks[0]].up))
         return groups
 
     def daylight(self, state: str, groups: list[FacetGroup], room_side: bool = False
@@ -315,7 +341,7 @@ class ThreePhase:
         tag = "r" if room_side else "g"
         out: list[Path] = []
         for k, g in enumerate(groups):
-            sender = rad3.sender_text(g.triangles, g.normal, room_side)
+            sender = rad3.sender_text(g.triangles, g.normal, room_side, g.up)
             key = "|".join([sender, text, " ".join(ambient), str(self.samples), str(self.mf)])
 
             def compute(k: int = k, sender: str = sender) -> Path:
@@ -428,7 +454,7 @@ def compute_annual_3phase(project: Project, options: AnnualOptions,
 
     echo(f"  3-phase: {form} crown, BSDFs {', '.join(sorted({Path(b[2]).name for s in STATES for b in xmls[s]}))}")
     tp = ThreePhase(work / "threephase", bare, models, form, grids, rho, options.mf, trace,
-                    echo, options.daylight_samples)
+                    echo, options.daylight_samples, GROUP_LEVEL, GROUP_MATERIAL_UP)
     t1 = time.perf_counter()
     views, v_sky = tp.view()
     timing["view_s"] = time.perf_counter() - t1
