@@ -16,7 +16,8 @@ the XML is applied in by rtrace) prints
     transmitted, reflected (each a mean over the grid's sensors, irradiance per unit radiance)
 
 Run: ``nice .venv/bin/python benchmarks/threephase_closure.py [--work DIR] [--samples 50]
-[--daylight-samples 100] [--levels 0,2,3] [--up default,material] [--ad 1024] [-j 2]``.
+[--daylight-samples 100] [--levels 0,2,3] [--up default,material] [--ad 1024] [--xml X]
+[-j 2]``.
 """
 
 from __future__ import annotations
@@ -52,12 +53,19 @@ def main() -> None:
     ap.add_argument("--ab", type=int, default=6)
     ap.add_argument("--ad", type=int, default=1024)
     ap.add_argument("--states", default="leaf_on,leaf_off")
+    ap.add_argument("--xml", type=Path, default=None,
+                    help="tree.bsdf.xml: one given crown XML for every band (no crown BSDF "
+                         "computed; the closure compares the chain with a trace of the same "
+                         "XML, so any XML serves)")
     ap.add_argument("-j", "--processes", type=int, default=2)
     args = ap.parse_args()
     work = args.work / args.project.name
     if not work.exists():
         shutil.copytree(args.project, work, ignore=shutil.ignore_patterns("build", "results"))
-    project = load_project(work, overrides={"tree.bsdf.samples": args.samples})
+    over: dict = {"tree.bsdf.samples": args.samples}
+    if args.xml is not None:
+        over["tree.bsdf.xml"] = str(args.xml.resolve())
+    project = load_project(work, overrides=over)
     sc = next(s for s in project.scenarios if s.model == "louvers")
     print(f"closure on {args.project} (scenario {sc.name}) → {work}; load {os.getloadavg()}",
           flush=True)
@@ -69,6 +77,13 @@ def main() -> None:
         from radtree.pipeline.crown_bsdf import scenario_xmls
 
         on = scenario_xmls(project, sc, lambda s: print(s, flush=True))
+        if args.xml is not None:   # a free crown reaching the wall: its cap too
+            from radtree.pipeline.crown_bsdf import scenario_tree, wall_half_chord
+            from radtree.trees.bsdf_shell import WALL_BAND
+
+            tree, form = scenario_tree(project, sc)
+            if form != "dome" and wall_half_chord(tree, project.sensors, project.street) > 0:
+                on = [*on, (*WALL_BAND, args.xml.resolve())]
         xmls = {"leaf_on": on, "leaf_off": on}
     models, form = crown_models(project, sc, xmls)
     print(f"BSDFs {time.perf_counter() - t0:.0f} s", flush=True)

@@ -36,6 +36,9 @@ length_m = 40.0
 facade_azimuth_deg = 0.0
 ground_reflectance = 0.15
 
+[light]
+direct_normal = "dni.csv"
+
 [tree]
 form = "free"
 
@@ -66,6 +69,13 @@ model = "louvers"
 """
 
 
+def write_project(root: Path) -> Path:
+    """:data:`PROJECT` and its (unused: no sun is traced) DNI table written to ``root``."""
+    (root / "radtree.toml").write_text(PROJECT)
+    (root / "dni.csv").write_text("time,direct_normal_lux\n12:30,0\n")
+    return root
+
+
 def closure_checks(folder: Path | None = None, ad: int = 1024, samples: int = 200,
                    progress: Callable[[str], None] | None = None) -> list[Check]:
     """The façade's uniform-sky closure (leaf-on), ``ad`` ambient rays per sensor for V and
@@ -81,7 +91,7 @@ def closure_checks(folder: Path | None = None, ad: int = 1024, samples: int = 20
     with tempfile.TemporaryDirectory(prefix="radtree-verify-3phase-") as tmp:
         root = Path(folder) if folder is not None else Path(tmp)
         root.mkdir(parents=True, exist_ok=True)
-        (root / "radtree.toml").write_text(PROJECT)
+        write_project(root)
         project = load_project(root)
         sc = project.scenario("with")
         on = scenario_xmls(project, sc)
