@@ -30,12 +30,17 @@ import time
 from dataclasses import replace
 from pathlib import Path
 
+import numpy as np
 import pandas as pd
 
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
-from radtree.annual.closure import ClosureSettings, closure_table  # noqa: E402
+from radtree.annual.closure import (  # noqa: E402
+    ClosureSettings,
+    closure_sensors,
+    closure_table,
+)
 from radtree.annual.coefficients import TraceParams  # noqa: E402
 from radtree.annual.run import annual_ground_reflectance  # noqa: E402
 from radtree.annual.threephase import crown_models, state_xmls  # noqa: E402
@@ -57,6 +62,10 @@ def main() -> None:
                     help="tree.bsdf.xml: one given crown XML for every band (no crown BSDF "
                          "computed; the closure compares the chain with a trace of the same "
                          "XML, so any XML serves)")
+    ap.add_argument("--tile", type=float, default=0.0,
+                    help="the wall cap's tile size, m (0: GROUP_TILE_M)")
+    ap.add_argument("--rows", action="store_true",
+                    help="also the ratio per sensor row (height) of each grid, uniform sky")
     ap.add_argument("-j", "--processes", type=int, default=2)
     args = ap.parse_args()
     work = args.work / args.project.name
@@ -100,10 +109,30 @@ def main() -> None:
             table = closure_table(bare, models, form, grids, rho,
                                   project.results_dir / "closure",
                                   ClosureSettings(trace, args.daylight_samples, level,
-                                                  up == "material"), tuple(states),
+                                                  up == "material", args.tile),
+                                  tuple(states),
                                   lambda s: print(s, flush=True))
             print(f"\nlevel {level}, up {up} ({time.perf_counter() - t1:.0f} s):")
             print(table.round(4).to_string(index=False), flush=True)
+            if args.rows:     # per sensor row (height), uniform sky, from the cached matrices
+                ref, parts, _ = closure_sensors(bare, models, form, grids, rho,
+                                                project.results_dir / "closure",
+                                                ClosureSettings(trace, args.daylight_samples,
+                                                                level, up == "material",
+                                                                args.tile),
+                                                states[0])
+                chain = sum(parts.values())
+                start = 0
+                for g in grids:
+                    pts = bare.grids[g].points
+                    sel = slice(start, start + len(pts))
+                    start += len(pts)
+                    r = ref[sel, 1:].sum(axis=1)
+                    c = chain[sel, 1:].sum(axis=1)
+                    for z in np.unique(pts[:, 2].round(2)):
+                        k = pts[:, 2].round(2) == z
+                        print(f"    {g} z {z:5.2f} m: reference {r[k].mean():.4f}, chain "
+                              f"{c[k].mean():.4f}, ratio {c[k].mean() / r[k].mean():.3f}")
     print(f"load now {os.getloadavg()}")
 
 

@@ -429,3 +429,44 @@ def test_cross_tool_with_the_sun(sun_build, tmp_path):
           f"{100 * rel.max():.3f} %; total mean radtree {A.mean():.1f}, honeybee "
           f"{B.mean():.1f} lx ({100 * diff / A.mean():+.2f} %, {diff / se:+.2f} SE)")
     assert abs(diff) <= max(0.02 * A.mean(), 3.0 * se)
+
+
+def test_annual_results_load_in_honeybee_radiance_postprocess(tmp_path):
+    """radtree's annual folder (write_annual_results) read by honeybee-radiance-postprocess
+    gives radtree's own DA300 and UDI per sensor (occupied 8–18 h, sun-down hours dark)."""
+    pytest.importorskip("honeybee_radiance_postprocess")
+    from honeybee_radiance_postprocess.results.annual_daylight import AnnualDaylight
+
+    from radtree.annual.metrics import daylight_autonomy, udi
+    from radtree.annual.schedule import occupied
+    from radtree.config.honeybee import HoneybeeSite
+    from radtree.export.honeybee import write_annual_results
+    from radtree.site.honeybee_model import model_grids
+
+    model = office_model()
+    grids, _ = model_grids(model, HoneybeeSite(tmp_path / "m.hbjson", 0.8, 1.0))
+    assert len(grids["office"]) == 15
+    days = np.repeat(np.arange(365), 24)
+    ends = np.cumsum([31, 28, 31, 30, 31, 30, 31, 31, 30, 31, 30, 31])
+    month = np.searchsorted(ends, days, side="right") + 1
+    day = days - np.concatenate([[0], ends[:-1]])[month - 1] + 1
+    hour = np.tile(np.arange(24) + 0.5, 365)
+    up = (hour > 6) & (hour < 19)
+    rng = np.random.default_rng(7)              # every UDI band reached, no value on a limit
+    lux = np.where(up, np.exp(rng.uniform(np.log(20.0), np.log(9000.0), (15, hour.size))),
+                   0.0).round(1)               # as the .ill files write them (0.1 lx)
+    lux[np.isin(lux, [100.0, 300.0, 3000.0])] += 0.1
+    path = tmp_path / "hourly.npz"
+    np.savez(path, month=month, day=day, hour=hour, total__with__office=lux,
+             direct__with__office=lux / 2)
+    folder = write_annual_results(path, model, tmp_path / "annual")[0]
+    occ = occupied(hour, (8.0, 18.0))
+    res = AnnualDaylight(str(folder), schedule=occ.astype(int).tolist())
+    da, _, u, lower, upper, info = res.annual_metrics(threshold=300, min_t=100, max_t=3000)
+    assert [g["full_id"] for g in info] == ["office"]
+    ours = udi(lux, occ)
+    assert np.allclose(np.asarray(da[0]), daylight_autonomy(lux, occ), atol=1e-6)
+    assert np.allclose(np.asarray(lower[0]), ours["udi_below_100"], atol=1e-6)
+    assert np.allclose(np.asarray(u[0]), ours["udi_100_300"] + ours["udi_300_3000"], atol=1e-6)
+    assert np.allclose(np.asarray(upper[0]), ours["udi_above_3000"], atol=1e-6)
+    assert 5.0 < ours["udi_above_3000"].mean() < 60.0 and ours["udi_below_100"].mean() > 20.0

@@ -33,12 +33,14 @@ COLUMNS = ["grid", "state", "light", "reference", "chain", "ratio", "bypass", "t
 class ClosureSettings:
     """``trace``: the view matrix's and the reference's rcontrib settings; ``samples``: rays per
     Klems patch of the daylight matrices (``-c``); ``level``, ``material_up``: the facet
-    grouping of :func:`radtree.annual.threephase.facet_groups`."""
+    grouping of :func:`radtree.annual.threephase.facet_groups`; ``tile_m`` the wall cap's
+    tile size (0: :data:`radtree.annual.threephase.GROUP_TILE_M`)."""
 
     trace: TraceParams
     samples: int = 100
     level: int = 0
     material_up: bool = False
+    tile_m: float = 0.0
 
     def __post_init__(self) -> None:
         if self.samples < 1 or self.level < 0:
@@ -63,24 +65,35 @@ def chain_parts(tp: ThreePhase, state: str) -> tuple[dict[str, np.ndarray], int]
     return {"bypass": vs.mean(axis=2), "transmitted": trans, "reflected": refl}, len(groups)
 
 
+def closure_sensors(bare: Scene, models: dict[str, TreeModel], form: str, grids: list[str],
+                    rho: float, folder: Path, settings: ClosureSettings, state: str,
+                    echo=None) -> tuple[np.ndarray, dict[str, np.ndarray], int]:
+    """(sensors, patches) grey coefficients of the reference (rcontrib on the BSDF-crown
+    scene, MF 1) and of the chain's parts (:func:`chain_parts`), the number of groups.
+    Matrices are cached in ``folder`` by their inputs."""
+    tag = (f"l{settings.level}_{'material' if settings.material_up else 'default'}"
+           + (f"_t{settings.tile_m:g}" if settings.tile_m else ""))
+    tp = ThreePhase(folder / f"chain_{tag}", bare, models, form, grids, rho, 1,
+                    settings.trace, echo or (lambda _s: None), settings.samples,
+                    settings.level, settings.material_up, settings.tile_m)
+    runner = CoefficientRunner(_scene_with(bare, models[state]), grids,
+                               folder / f"reference_{state}", rho)
+    ref = runner.sky(1, settings.trace).mean(axis=2)
+    parts, n_groups = chain_parts(tp, state)
+    return ref, parts, n_groups
+
+
 def closure_table(bare: Scene, models: dict[str, TreeModel], form: str, grids: list[str],
                   rho: float, folder: Path, settings: ClosureSettings,
                   states: tuple[str, ...] = ("leaf_on",), echo=None) -> pd.DataFrame:
     """One row per grid × state × light (:data:`COLUMNS`): the grid's mean of the reference
-    (rcontrib on the BSDF-crown scene, MF 1) and of the chain, their ratio and the chain's
-    parts. Matrices are cached in ``folder`` by their inputs."""
+    and of the chain (:func:`closure_sensors`), their ratio and the chain's parts."""
     sizes = [len(bare.grids[g]) for g in grids]
     cuts = np.cumsum([0, *sizes])
-    tag = f"l{settings.level}_{'material' if settings.material_up else 'default'}"
-    tp = ThreePhase(folder / f"chain_{tag}", bare, models, form, grids, rho, 1,
-                    settings.trace, echo or (lambda _s: None), settings.samples,
-                    settings.level, settings.material_up)
     rows = []
     for state in states:
-        runner = CoefficientRunner(_scene_with(bare, models[state]), grids,
-                                   folder / f"reference_{state}", rho)
-        ref = runner.sky(1, settings.trace).mean(axis=2)
-        parts, n_groups = chain_parts(tp, state)
+        ref, parts, n_groups = closure_sensors(bare, models, form, grids, rho, folder,
+                                               settings, state, echo)
         for light, cols in LIGHTS.items():
             for k, g in enumerate(grids):
                 rs = slice(cuts[k], cuts[k + 1])

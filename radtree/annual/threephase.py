@@ -246,14 +246,14 @@ class ThreePhase:
     def __init__(self, folder: Path, bare: Scene, models: dict[str, TreeModel], form: str,
                  grids: list[str], rho: float, mf: int, trace: TraceParams,
                  echo: Callable[[str], None], samples: int = 400,
-                 level: int = 0, material_up: bool = False):
+                 level: int = 0, material_up: bool = False, tile_m: float = 0.0):
         self.folder, self.samples = folder, samples
         folder.mkdir(parents=True, exist_ok=True)
         self.bare, self.models, self.grids, self.rho, self.mf = bare, models, grids, rho, mf
         self.inside = form == "dome"
         self.trace, self.echo = trace, echo
-        self.groups = facet_groups(models["leaf_on"], self.inside, GROUP_TILE_M, (WALL_CAP,),
-                                   level, material_up)
+        self.groups = facet_groups(models["leaf_on"], self.inside, tile_m or GROUP_TILE_M,
+                                   (WALL_CAP,), level, material_up)
         self.points = points_text(bare, grids)
         self.n = sum(len(bare.grids[g]) for g in grids)
         self.timing: dict[str, float] = {}
