@@ -7,7 +7,7 @@ in it (issue 40, item 2).
 Copies the project (default ``examples/office-block``) into ``--work`` once (kept: the crown
 BSDFs and every matrix are cached there, so a rerun only traces what a changed setting
 needs), computes the crown BSDFs with ``tree.bsdf.samples = --samples``, and for each facet
-grouping in ``--levels`` (:func:`radtree.annual.threephase.group_directions`: 0 = the 14
+grouping in ``--levels`` (:func:`radtree.annual.facets.group_directions`: 0 = the 14
 cube directions; k ≥ 1 an icosphere of k − 1 subdivisions) and each ``--up`` choice
 (``default``: rfluxmtx's default up; ``material``: the ``BSDF`` material's up vector, the frame
 the XML is applied in by rtrace) prints

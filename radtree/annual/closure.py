@@ -33,7 +33,7 @@ COLUMNS = ["grid", "state", "light", "reference", "chain", "ratio", "bypass", "t
 class ClosureSettings:
     """``trace``: the view matrix's and the reference's rcontrib settings; ``samples``: rays per
     Klems patch of the daylight matrices (``-c``); ``level``, ``material_up``: the facet
-    grouping of :func:`radtree.annual.threephase.facet_groups`; ``tile_m`` the wall cap's
+    grouping of :func:`radtree.annual.facets.facet_groups`; ``tile_m`` the wall cap's
     tile size (0: :data:`radtree.annual.threephase.GROUP_TILE_M`)."""
 
     trace: TraceParams

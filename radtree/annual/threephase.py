@@ -48,6 +48,29 @@ crown's gaps twice (the BSDF's ``-ab N`` run carries them) and was no better tha
 (README). The scene without the tree is computed as the default
 method does.
 
+**Closure (issue 40): the chain against a direct trace of the same BSDF scene.**
+:mod:`radtree.annual.closure` and ``benchmarks/threephase_closure.py`` compare Σ V·T·D (+ the
+reflection and the by-pass) with ``rcontrib`` of the BSDF-crown scene under a uniform sky and
+a uniform ground hemisphere. Measured:
+
+* one planar window (a room behind a crown-BSDF window, ``tests/test_frads_crosscheck.py``):
+  the chain 0.9994 × rtrace, LBNL's frads 0.9994 × — the matrices, the XML's front/back, the
+  Klems basis orientation and the sky discretisation are right for a planar group;
+* the office example's crowns (``--xml``: the small test crown's XML on every band and the
+  wall cap, so that no crown BSDF is computed; ``-ad 512``, ``-c 100``; façade / work plane):
+  rfluxmtx's default up (+Z, or +Y for normals within 45° of vertical) 1.083 / 1.034; the
+  ``BSDF`` material's own up vector (+z, −z on the lower half) 1.024 / 1.008; that and
+  0.5 m cap tiles 1.032 / 1.010. Per façade row (z 4.0 … 6.0 m) the default up read
+  1.28, 1.26, 1.04, 0.99, 0.94 and the material's up 1.08, 1.11, 1.04, 0.99, 0.94: the
+  excess sat in the two lowest rows, which see the lower band (its XML mirrored, up −z)
+  through Klems patches turned by 180° when the matrices used +Z.
+
+Hence :data:`GROUP_MATERIAL_UP` (each group's Klems frame is its material's: the XML is
+applied in that frame by rtrace). What remains is the groups' curvature (a group's facets
+lie within 55° of its direction at level 0; the frame is the group's mean) and the daylight
+matrix's mean over its sender's area (the two lowest façade rows, 5 mm from the cap, see the
+cap's local light).
+
 A second weather file reruns ``gendaymtx`` and the products only (the sun coefficients
 are reused when the sun positions are the same, i.e. the same site); a second leaf state
 reuses ``V`` (and the dome's ``D``). Not ray traced: light crossing the shell is turned
@@ -61,12 +84,13 @@ import hashlib
 import os
 import time
 from collections.abc import Callable
-from dataclasses import dataclass, replace
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
 
 from radtree.annual.coefficients import CoefficientRunner, TraceParams, points_text, scene_text
+from radtree.annual.facets import FacetGroup, facet_groups
 from radtree.annual.phenology import crown_year, phenology_of
 from radtree.annual.run import (
     LUX,
@@ -93,11 +117,6 @@ from radtree.trees.model import TreeModel
 
 STATES = ("leaf_on", "leaf_off")
 KLEMS = 145
-#: facet orientations: the 14 directions of a cube's faces and corners (a facet's normal is
-#: within 55° of its group's direction)
-_DIRS = np.array([(i, j, k) for i in (-1, 0, 1) for j in (-1, 0, 1) for k in (-1, 0, 1)
-                  if abs(i) + abs(j) + abs(k) in (1, 3)], float)
-_DIRS /= np.linalg.norm(_DIRS, axis=1)[:, None]
 #: the daylight matrices' ray weight limit (path tracing, -ad 2)
 D_LW_MIN = 1e-3
 #: a free crown's wall cap is cut into tiles of this size (m, cells of a world grid): a
@@ -113,77 +132,10 @@ GROUP_TILE_M = 1.5
 #: dropped when its share stays below VISIBLE_SHARE for every sensor
 TILE_SHARE = 2e-3
 VISIBLE_SHARE = 1e-4
-#: facet grouping of the annual runs (:func:`group_directions` level) and whether each
+#: facet grouping of the annual runs (:func:`radtree.annual.facets.group_directions` level) and whether each
 #: group's Klems frame takes its ``BSDF`` material's up vector (module text)
 GROUP_LEVEL = 0
-GROUP_MATERIAL_UP = False
-
-
-def group_directions(level: int) -> np.ndarray:
-    """Unit directions facets are grouped by: level 0 the 14 of :data:`_DIRS`; level k ≥ 1
-    the vertices of an icosphere of k − 1 subdivisions (12, 42, 162, 642 directions: a
-    facet's normal within ≈ 37°, 19°, 10°, 5° of its group's direction)."""
-    if level <= 0:
-        return _DIRS
-    import trimesh
-
-    v = np.asarray(trimesh.creation.icosphere(subdivisions=level - 1).vertices, float)
-    return v / np.linalg.norm(v, axis=1)[:, None]
-
-
-@dataclass
-class FacetGroup:
-    """Shell facets of one material and orientation; ``triangles`` wound to the sensors;
-    ``up`` the world up vector of the group's Klems frame (None: rfluxmtx's default)."""
-
-    material: str
-    triangles: np.ndarray  # (k, 3, 3)
-    normal: np.ndarray     # unit mean normal, towards the sensors
-    direction: int = -1    # index of the nearest grouping direction
-    up: tuple[float, float, float] | None = None
-
-    @property
-    def area(self) -> float:
-        t = self.triangles
-        return float(0.5 * np.linalg.norm(np.cross(t[:, 1] - t[:, 0], t[:, 2] - t[:, 0]),
-                                          axis=1).sum())
-
-    @property
-    def key(self) -> str:
-        return f"{self.material}_{len(self.triangles)}"
-
-
-def facet_groups(model: TreeModel, sensors_inside: bool, tile_m: float = 0.0,
-                 tiled: tuple[str, ...] | None = None, level: int = 0,
-                 material_up: bool = False) -> list[FacetGroup]:
-    """The shell's facets grouped by BSDF material, by the nearest of 14 directions and
-    (``tile_m`` > 0, for the materials in ``tiled`` or all when None) by the cell of a world
-    grid of ``tile_m`` holding their centroid; each triangle wound so that its normal points
-    to the sensors (the shell's own normals point inwards: to the sensors inside a dome,
-    away from them for free crowns)."""
-    groups = []
-    dirs = group_directions(level)
-    for mesh in model.meshes:
-        if not mesh.material.startswith(BSDF_SHELL):
-            continue
-        mat = model.materials.get(mesh.material)
-        up = tuple(float(u) for u in mat.up) if material_up and isinstance(mat, Bsdf) else None
-        tri = mesh.triangles if sensors_inside else mesh.triangles[:, ::-1]
-        n = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
-        area = np.linalg.norm(n, axis=1)
-        keep = area > 1e-12
-        tri, n = tri[keep], n[keep] / area[keep][:, None]
-        which = direction = np.argmax(n @ dirs.T, axis=1)
-        if tile_m > 0 and (tiled is None or mesh.material in tiled):
-            cell = np.floor(tri.mean(axis=1) / tile_m).astype(np.int64)
-            _, which = np.unique(np.column_stack([which, cell]), axis=0, return_inverse=True)
-            which = which.ravel()
-        for d in np.unique(which):
-            pick = which == d
-            mean = (n[pick] * area[keep][pick][:, None]).sum(axis=0)
-            groups.append(FacetGroup(mesh.material, tri[pick], mean / np.linalg.norm(mean),
-                                     int(direction[pick][0]), up))
-    return groups
+GROUP_MATERIAL_UP = True
 
 
 def _without_shell(scene: Scene) -> Scene:
