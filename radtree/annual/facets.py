@@ -68,7 +68,8 @@ def facet_groups(model: TreeModel, sensors_inside: bool, tile_m: float = 0.0,
         if not mesh.material.startswith(BSDF_SHELL):
             continue
         mat = model.materials.get(mesh.material)
-        up = tuple(float(u) for u in mat.up) if material_up and isinstance(mat, Bsdf) else None
+        up = ((float(mat.up[0]), float(mat.up[1]), float(mat.up[2]))
+              if material_up and isinstance(mat, Bsdf) else None)
         tri = mesh.triangles if sensors_inside else mesh.triangles[:, ::-1]
         n = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
         area = np.linalg.norm(n, axis=1)

@@ -198,7 +198,8 @@ class ThreePhase:
     def __init__(self, folder: Path, bare: Scene, models: dict[str, TreeModel], form: str,
                  grids: list[str], rho: float, mf: int, trace: TraceParams,
                  echo: Callable[[str], None], samples: int = 400,
-                 level: int = 0, material_up: bool = False, tile_m: float = 0.0):
+                 level: int = GROUP_LEVEL, material_up: bool = GROUP_MATERIAL_UP,
+                 tile_m: float = 0.0):
         self.folder, self.samples = folder, samples
         folder.mkdir(parents=True, exist_ok=True)
         self.bare, self.models, self.grids, self.rho, self.mf = bare, models, grids, rho, mf
