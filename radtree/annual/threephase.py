@@ -54,22 +54,28 @@ reflection and the by-pass) with ``rcontrib`` of the BSDF-crown scene under a un
 a uniform ground hemisphere. Measured:
 
 * one planar window (a room behind a crown-BSDF window, ``tests/test_frads_crosscheck.py``):
-  the chain 0.9994 × rtrace, LBNL's frads 0.9994 × — the matrices, the XML's front/back, the
-  Klems basis orientation and the sky discretisation are right for a planar group;
+  the chain 0.9994 × rtrace, LBNL's frads 0.9994 × — the matrices, the Klems basis
+  orientation and the sky discretisation are right for a planar group; turned round (the
+  light entering the XML's back side, as it leaves a free crown) the chain with
+  :func:`~radtree.engines.radiance.threephase.turned_xml` 1.0024 × rtrace;
 * the office example's crowns (``--xml``: the small test crown's XML on every band and the
   wall cap, so that no crown BSDF is computed; ``-ad 512``, ``-c 100``; façade / work plane):
   rfluxmtx's default up (+Z, or +Y for normals within 45° of vertical) 1.083 / 1.034; the
   ``BSDF`` material's own up vector (+z, −z on the lower half) 1.024 / 1.008; that and
-  0.5 m cap tiles 1.032 / 1.010. Per façade row (z 4.0 … 6.0 m) the default up read
+  0.5 m cap tiles 1.032 / 1.010; that and 42 grouping directions (level 2: facets within
+  ≈ 19° of their group's) 1.029 / 1.0005. Per façade row (z 4.0 … 6.0 m) the default up read
   1.28, 1.26, 1.04, 0.99, 0.94 and the material's up 1.08, 1.11, 1.04, 0.99, 0.94: the
   excess sat in the two lowest rows, which see the lower band (its XML mirrored, up −z)
   through Klems patches turned by 180° when the matrices used +Z.
 
 Hence :data:`GROUP_MATERIAL_UP` (each group's Klems frame is its material's: the XML is
-applied in that frame by rtrace). What remains is the groups' curvature (a group's facets
-lie within 55° of its direction at level 0; the frame is the group's mean) and the daylight
-matrix's mean over its sender's area (the two lowest façade rows, 5 mm from the cap, see the
-cap's local light).
+applied in that frame by rtrace); level 0 kept (level 2 doubles the daylight matrices for no
+gain here). What remains: the two lowest façade rows still read 1.08–1.11 (5 mm from the
+cap's lower edge, next to the curved lower band: a daylight matrix is a mean over its
+sender's area and a curved group has one frame), and the small single crown of
+``radtree verify`` (12 segments, facets ≈ 1.5 m across) reads 0.94–0.96 on its façade
+(0.955 at level 0, 0.941 at level 2 with the material's up; rcontrib's own noise at
+``-ad 512`` moved its reference by 1.8 % between two runs).
 
 A second weather file reruns ``gendaymtx`` and the products only (the sun coefficients
 are reused when the sun positions are the same, i.e. the same site); a second leaf state
