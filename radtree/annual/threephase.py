@@ -61,7 +61,8 @@ a uniform ground hemisphere. Measured:
 * the office example's crowns (``--xml``: the small test crown's XML on every band and the
   wall cap, so that no crown BSDF is computed; ``-ad 512``, ``-c 100``; façade / work plane):
   rfluxmtx's default up (+Z, or +Y for normals within 45° of vertical) 1.083 / 1.034; the
-  ``BSDF`` material's own up vector (+z, −z on the lower half) 1.024 / 1.008; that and
+  ``BSDF`` material's own up vector (+z, −z on the lower half) 1.024 / 1.008 (at
+  ``-ad 1024``: 1.024 / 0.9996); that and
   0.5 m cap tiles 1.032 / 1.010; that and 42 grouping directions (level 2: facets within
   ≈ 19° of their group's) 1.029 / 1.0005. Per façade row (z 4.0 … 6.0 m) the default up read
   1.28, 1.26, 1.04, 0.99, 0.94 and the material's up 1.08, 1.11, 1.04, 0.99, 0.94: the
