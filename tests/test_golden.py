@@ -34,3 +34,26 @@ def test_numpy_tables_unchanged(name, tmp_path):
 @pytest.mark.parametrize("name", ["mendoza_radiance", "office_radiance"])
 def test_radiance_tables_unchanged(name, tmp_path):
     assert_table_unchanged(name, tmp_path)
+
+
+@needs_radiance
+@pytest.mark.radiance
+@pytest.mark.slow
+@pytest.mark.parametrize("name", ["office_radiance_full", "mendoza_radiance_full"])
+def test_radiance_tables_at_the_examples_settings_within_standard_errors(name, tmp_path):
+    """Every hour of the examples at their own settings (tests/golden_full.py): each row
+    within Z_MAX combined standard errors of the golden table (the same platform: equal)."""
+    import time
+
+    import numpy as np
+
+    from tests.golden_full import Z_MAX, read_golden, run_table, z_scores
+
+    if not (GOLDEN / f"{name}.csv").exists():
+        pytest.skip(f"tests/golden/{name}.csv not generated yet: python -m tests.golden_full")
+    t0 = time.perf_counter()
+    z = z_scores(read_golden(name), run_table(name, tmp_path))
+    worst = z.abs().idxmax()
+    print(f"{name}: {len(z)} rows, max |z| {np.abs(z).max():.2f} at {worst}, "
+          f"{time.perf_counter() - t0:.0f} s")
+    assert np.abs(z).max() <= Z_MAX, z[np.abs(z) > Z_MAX].head(20)

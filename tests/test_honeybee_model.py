@@ -9,7 +9,10 @@ material and ground plane → the work-plane illuminances must agree within 1 %.
 The sky is the hour's Perez sky without the sun (direct normal 0): with ``-u-`` both octrees
 then draw the same ambient samples and the comparison measures the translation, not noise
 (measured: 4e-5 at -ad 256 to 8192), so a modest -ab 2 -ad 256 suffices. With the sun in, its small floor patch is sampled differently by the two
-octrees and single sensors differ by 5 % at ``-ab 1 -ad 8192``.
+octrees and single sensors differ by 5 % at ``-ab 1 -ad 8192``. The check with the sun
+(:func:`test_cross_tool_with_the_sun`, winter solstice 12:30: the sun on the work plane) compares
+the direct sun per sensor at ``-ab 0`` (0.5 %) and the mean total over eight independent
+fixed-seed estimates per octree (2 % or 3 combined standard errors).
 """
 
 from __future__ import annotations
@@ -356,3 +359,114 @@ def test_example_model_is_the_scripts_and_loads():
     # interior pair), not twice
     walls = 2 * (4 * 3 * 0.6 + 4 * 3) + 2 * 6 * 3 + 6 * 3
     assert scene.mesh("hb_generic_wall_0.50").area() == pytest.approx(walls)
+
+
+@pytest.fixture(scope="module")
+def sun_build(tmp_path_factory):
+    """The one-room model built by radtree on the winter solstice at 12:30 (sun 33° up, 5°
+    from north: it falls through the north window onto the work plane), its octree made."""
+    from radtree.engines.radiance.binaries import require_radiance
+    from radtree.pipeline.build import build_project
+
+    toml = TOML.replace('date = "2024-12-22"', 'date = "2024-06-21"').replace(
+        'hours = ["13:30"]', 'hours = ["12:30"]')
+    folder = write_project(tmp_path_factory.mktemp("hbsun") / "p", toml=toml)
+    (folder / "dni.csv").write_text("time,direct_normal_lux\n12:30,80000\n")
+    project = load_project(folder)
+    build_project(project, echo=lambda s: None, progress=False, pictures=False)
+    build = project.build_dir / "open"
+    subprocess.run(["make", "octrees/1230.oct"], cwd=build, env=require_radiance().env(),
+                   check=True, capture_output=True)
+    return project, build
+
+
+def _rtrace_repeats(build: Path, octree: Path, opts: list[str], repeats: int) -> np.ndarray:
+    """(repeats, sensors) lux: the office grid fed ``repeats`` times to one fixed-seed rtrace
+    (each copy draws its own random numbers: independent, reproducible estimates)."""
+    from radtree.engines.radiance.binaries import require_radiance
+    from radtree.engines.radiance.writer import rgb_to_lux
+
+    pts = (build / "grids" / "office.pts").read_text()
+    out = subprocess.run(["rtrace", *opts, str(octree)], cwd=build, input=(pts * repeats).encode(),
+                         capture_output=True, check=True, env=require_radiance().env()).stdout
+    return rgb_to_lux(np.loadtxt(out.decode().splitlines()).reshape(-1, 3)).reshape(repeats, -1)
+
+
+@needs_radiance
+def test_cross_tool_with_the_sun(sun_build, tmp_path):
+    """With the sun: radtree's octree and honeybee-radiance's translation of the same model
+    (same sky, ground and options): the direct sun (-ab 0) per sensor within 0.5 % (of the
+    sunlit sensors' values; the others both 0), and the total (-ab 2 -ad 1024, eight
+    independent fixed-seed estimates each) mean within 2 % or 3 combined standard errors."""
+    from honeybee.model import Model
+    from honeybee_radiance.writer import model_to_rad
+
+    from radtree.engines.radiance.binaries import FIXED_SEED, require_radiance
+
+    project, build = sun_build
+    model = Model.from_hbjson(str(project.honeybee.model))
+    geometry, modifiers = model_to_rad(model)
+    (tmp_path / "modifiers.rad").write_text(modifiers)
+    (tmp_path / "model.rad").write_text(geometry)
+    hb = tmp_path / "hb.oct"
+    with hb.open("wb") as fh:
+        subprocess.run(["oconv", str(tmp_path / "modifiers.rad"), str(tmp_path / "model.rad"),
+                        "skies/1230_ground.rad", "geometry/ground.rad", "skies/1230.sky"],
+                       cwd=build, stdout=fh, check=True, env=require_radiance().env())
+    ours_oct = build / "octrees" / "1230.oct"
+    direct = ["-h", "-I", FIXED_SEED, "-ab", "0"]
+    a, b = (_rtrace_repeats(build, o, direct, 1)[0] for o in (ours_oct, hb))
+    lit = a > 1.0
+    assert lit.sum() >= 3 and (~lit).sum() >= 1      # the sun patch covers some sensors
+    assert np.all(b[~lit] <= 1e-3 * a.max())
+    rel = np.abs(b[lit] / a[lit] - 1.0)
+    assert rel.max() < 0.005, rel
+    total = ["-h", "-I", FIXED_SEED, "-ab", "2", "-ad", "1024", "-aa", "0", "-lw", "1e-4"]
+    A, B = (_rtrace_repeats(build, o, total, 8).mean(axis=1) for o in (ours_oct, hb))
+    se = float(np.hypot(A.std(ddof=1), B.std(ddof=1)) / np.sqrt(len(A)))
+    diff = float(B.mean() - A.mean())
+    print(f"with the sun: direct {int(lit.sum())} sunlit sensors, max |Δ| "
+          f"{100 * rel.max():.3f} %; total mean radtree {A.mean():.1f}, honeybee "
+          f"{B.mean():.1f} lx ({100 * diff / A.mean():+.2f} %, {diff / se:+.2f} SE)")
+    assert abs(diff) <= max(0.02 * A.mean(), 3.0 * se)
+
+
+def test_annual_results_load_in_honeybee_radiance_postprocess(tmp_path):
+    """radtree's annual folder (write_annual_results) read by honeybee-radiance-postprocess
+    gives radtree's own DA300 and UDI per sensor (occupied 8–18 h, sun-down hours dark)."""
+    pytest.importorskip("honeybee_radiance_postprocess")
+    from honeybee_radiance_postprocess.results.annual_daylight import AnnualDaylight
+
+    from radtree.annual.metrics import daylight_autonomy, udi
+    from radtree.annual.schedule import occupied
+    from radtree.config.honeybee import HoneybeeSite
+    from radtree.export.honeybee import write_annual_results
+    from radtree.site.honeybee_model import model_grids
+
+    model = office_model()
+    grids, _ = model_grids(model, HoneybeeSite(tmp_path / "m.hbjson", 0.8, 1.0))
+    assert len(grids["office"]) == 15
+    days = np.repeat(np.arange(365), 24)
+    ends = np.cumsum([31, 28, 31, 30, 31, 30, 31, 31, 30, 31, 30, 31])
+    month = np.searchsorted(ends, days, side="right") + 1
+    day = days - np.concatenate([[0], ends[:-1]])[month - 1] + 1
+    hour = np.tile(np.arange(24) + 0.5, 365)
+    up = (hour > 6) & (hour < 19)
+    rng = np.random.default_rng(7)              # every UDI band reached, no value on a limit
+    lux = np.where(up, np.exp(rng.uniform(np.log(20.0), np.log(9000.0), (15, hour.size))),
+                   0.0).round(1)               # as the .ill files write them (0.1 lx)
+    lux[np.isin(lux, [100.0, 300.0, 3000.0])] += 0.1
+    path = tmp_path / "hourly.npz"
+    np.savez(path, month=month, day=day, hour=hour, total__with__office=lux,
+             direct__with__office=lux / 2)
+    folder = write_annual_results(path, model, tmp_path / "annual")[0]
+    occ = occupied(hour, (8.0, 18.0))
+    res = AnnualDaylight(str(folder), schedule=occ.astype(int).tolist())
+    da, _, u, lower, upper, info = res.annual_metrics(threshold=300, min_t=100, max_t=3000)
+    assert [g["full_id"] for g in info] == ["office"]
+    ours = udi(lux, occ)
+    assert np.allclose(np.asarray(da[0]), daylight_autonomy(lux, occ), atol=1e-6)
+    assert np.allclose(np.asarray(lower[0]), ours["udi_below_100"], atol=1e-6)
+    assert np.allclose(np.asarray(u[0]), ours["udi_100_300"] + ours["udi_300_3000"], atol=1e-6)
+    assert np.allclose(np.asarray(upper[0]), ours["udi_above_3000"], atol=1e-6)
+    assert 5.0 < ours["udi_above_3000"].mean() < 60.0 and ours["udi_below_100"].mean() > 20.0

@@ -9,69 +9,18 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from radtree.verify.threephase import PROJECT
 from tests.conftest import needs_radiance
 
 ROOT = Path(__file__).resolve().parents[1]
 EPW = ROOT / "examples" / "office-block" / "data" / "mendoza_generated.epw"
 
-TOML = """
-[project]
-name = "tiny three-phase test"
-
-[site]
-latitude = -32.89
-longitude = -68.83
-elevation_m = 750
-utc_offset_hours = -3
-date = "2024-12-22"
-hours = ["12:30"]
-
-[street]
-width_m = 20.0
-length_m = 40.0
-facade_azimuth_deg = 0.0
-ground_reflectance = 0.15
-
-[light]
-epw = "{epw}"
-
-[tree]
-form = "free"
-
-[tree.crown]
-count = 1
-radius_m = 3.0
-vertical_radius_m = 3.0
-base_height_m = 2.5
-trunk_distance_m = 3.5
-segments = 12
-
-[tree.louvers]
-arrangement = "volume"
-crossings = 4
-slat_size_m = 0.6
-
-[tree.bsdf]
-samples = 10
-tiles = 5
-bands = 1
-
-[sensors]
-dense_grid = false
-
-[engine]
-ab = 4
-ad = 192
-lw = 0.001
-
-[[scenario]]
-name = "with"
-model = "louvers"
-
-[[scenario]]
-name = "without"
-model = "none"
-"""
+# the small free crown of radtree verify's three-phase check, with an EPW year, the engine's
+# quick settings and a scenario without the tree
+TOML = (PROJECT.replace('name = "verify: three-phase closure"', 'name = "tiny three-phase test"')
+        .replace('direct_normal = "dni.csv"', 'epw = "{epw}"')
+        .replace("[sensors]", "[engine]\nab = 4\nad = 192\nlw = 0.001\n\n[sensors]")
+        + '\n[[scenario]]\nname = "without"\nmodel = "none"\n')
 
 
 @pytest.fixture(scope="module")
@@ -133,6 +82,7 @@ def test_three_phase_sky_matches_rcontrib_on_the_same_bsdf_crown(runs):
                                    folder.parent / f"check_{state}", rho)
         ref = (runner.sky(1, trace) * sky[None]) @ LUX
         ratio = three.sum(axis=1).mean() / ref.sum(axis=1).mean()
+        print(f"{state}: 3-phase / rcontrib, year's sky, façade mean {ratio:.4f}")
         assert ratio == pytest.approx(1.0, abs=0.12), (state, ratio)
     # the bare crown passes more sky light than the leafed one
     on = (tp.coefficients("leaf_on", views, v_sky) * sky[None]) @ LUX

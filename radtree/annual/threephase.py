@@ -48,6 +48,36 @@ crown's gaps twice (the BSDF's ``-ab N`` run carries them) and was no better tha
 (README). The scene without the tree is computed as the default
 method does.
 
+**Closure (issue 40): the chain against a direct trace of the same BSDF scene.**
+:mod:`radtree.annual.closure` and ``benchmarks/threephase_closure.py`` compare Σ V·T·D (+ the
+reflection and the by-pass) with ``rcontrib`` of the BSDF-crown scene under a uniform sky and
+a uniform ground hemisphere. Measured:
+
+* one planar window (a room behind a crown-BSDF window, ``tests/test_frads_crosscheck.py``):
+  the chain 0.9994 × rtrace, LBNL's frads 0.9994 × — the matrices, the Klems basis
+  orientation and the sky discretisation are right for a planar group; turned round (the
+  light entering the XML's back side, as it leaves a free crown) the chain with
+  :func:`~radtree.engines.radiance.threephase.turned_xml` 1.0024 × rtrace;
+* the office example's crowns (``--xml``: the small test crown's XML on every band and the
+  wall cap, so that no crown BSDF is computed; ``-ad 512``, ``-c 100``; façade / work plane):
+  rfluxmtx's default up (+Z, or +Y for normals within 45° of vertical) 1.083 / 1.034; the
+  ``BSDF`` material's own up vector (+z, −z on the lower half) 1.024 / 1.008 (at
+  ``-ad 1024``: 1.024 / 0.9996); that and
+  0.5 m cap tiles 1.032 / 1.010; that and 42 grouping directions (level 2: facets within
+  ≈ 19° of their group's) 1.029 / 1.0005. Per façade row (z 4.0 … 6.0 m) the default up read
+  1.28, 1.26, 1.04, 0.99, 0.94 and the material's up 1.08, 1.11, 1.04, 0.99, 0.94: the
+  excess sat in the two lowest rows, which see the lower band (its XML mirrored, up −z)
+  through Klems patches turned by 180° when the matrices used +Z.
+
+Hence :data:`GROUP_MATERIAL_UP` (each group's Klems frame is its material's: the XML is
+applied in that frame by rtrace); level 0 kept (level 2 doubles the daylight matrices for no
+gain here). What remains: the two lowest façade rows still read 1.08–1.11 (5 mm from the
+cap's lower edge, next to the curved lower band: a daylight matrix is a mean over its
+sender's area and a curved group has one frame), and the small single crown of
+``radtree verify`` (12 segments, facets ≈ 1.5 m across) reads 0.94–0.96 on its façade
+(0.955 at level 0, 0.941 at level 2 with the material's up; rcontrib's own noise at
+``-ad 512`` moved its reference by 1.8 % between two runs).
+
 A second weather file reruns ``gendaymtx`` and the products only (the sun coefficients
 are reused when the sun positions are the same, i.e. the same site); a second leaf state
 reuses ``V`` (and the dome's ``D``). Not ray traced: light crossing the shell is turned
@@ -61,12 +91,13 @@ import hashlib
 import os
 import time
 from collections.abc import Callable
-from dataclasses import dataclass, replace
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
 
 from radtree.annual.coefficients import CoefficientRunner, TraceParams, points_text, scene_text
+from radtree.annual.facets import FacetGroup, facet_groups
 from radtree.annual.phenology import crown_year, phenology_of
 from radtree.annual.run import (
     LUX,
@@ -94,11 +125,6 @@ from radtree.trees.model import TreeModel
 
 STATES = ("leaf_on", "leaf_off")
 KLEMS = 145
-#: facet orientations: the 14 directions of a cube's faces and corners (a facet's normal is
-#: within 55° of its group's direction)
-_DIRS = np.array([(i, j, k) for i in (-1, 0, 1) for j in (-1, 0, 1) for k in (-1, 0, 1)
-                  if abs(i) + abs(j) + abs(k) in (1, 3)], float)
-_DIRS /= np.linalg.norm(_DIRS, axis=1)[:, None]
 #: the daylight matrices' ray weight limit (path tracing, -ad 2)
 D_LW_MIN = 1e-3
 #: a free crown's wall cap is cut into tiles of this size (m, cells of a world grid): a
@@ -114,55 +140,10 @@ GROUP_TILE_M = 1.5
 #: dropped when its share stays below VISIBLE_SHARE for every sensor
 TILE_SHARE = 2e-3
 VISIBLE_SHARE = 1e-4
-
-
-@dataclass
-class FacetGroup:
-    """Shell facets of one material and orientation; ``triangles`` wound to the sensors."""
-
-    material: str
-    triangles: np.ndarray  # (k, 3, 3)
-    normal: np.ndarray     # unit mean normal, towards the sensors
-    direction: int = -1    # index of the nearest of the 14 directions
-
-    @property
-    def area(self) -> float:
-        t = self.triangles
-        return float(0.5 * np.linalg.norm(np.cross(t[:, 1] - t[:, 0], t[:, 2] - t[:, 0]),
-                                          axis=1).sum())
-
-    @property
-    def key(self) -> str:
-        return f"{self.material}_{len(self.triangles)}"
-
-
-def facet_groups(model: TreeModel, sensors_inside: bool, tile_m: float = 0.0,
-                 tiled: tuple[str, ...] | None = None) -> list[FacetGroup]:
-    """The shell's facets grouped by BSDF material, by the nearest of 14 directions and
-    (``tile_m`` > 0, for the materials in ``tiled`` or all when None) by the cell of a world
-    grid of ``tile_m`` holding their centroid; each triangle wound so that its normal points
-    to the sensors (the shell's own normals point inwards: to the sensors inside a dome,
-    away from them for free crowns)."""
-    groups = []
-    for mesh in model.meshes:
-        if not mesh.material.startswith(BSDF_SHELL):
-            continue
-        tri = mesh.triangles if sensors_inside else mesh.triangles[:, ::-1]
-        n = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
-        area = np.linalg.norm(n, axis=1)
-        keep = area > 1e-12
-        tri, n = tri[keep], n[keep] / area[keep][:, None]
-        which = direction = np.argmax(n @ _DIRS.T, axis=1)
-        if tile_m > 0 and (tiled is None or mesh.material in tiled):
-            cell = np.floor(tri.mean(axis=1) / tile_m).astype(np.int64)
-            _, which = np.unique(np.column_stack([which, cell]), axis=0, return_inverse=True)
-            which = which.ravel()
-        for d in np.unique(which):
-            pick = which == d
-            mean = (n[pick] * area[keep][pick][:, None]).sum(axis=0)
-            groups.append(FacetGroup(mesh.material, tri[pick], mean / np.linalg.norm(mean),
-                                     int(direction[pick][0])))
-    return groups
+#: facet grouping of the annual runs (:func:`radtree.annual.facets.group_directions` level) and whether each
+#: group's Klems frame takes its ``BSDF`` material's up vector (module text)
+GROUP_LEVEL = 0
+GROUP_MATERIAL_UP = True
 
 
 def _without_shell(scene: Scene) -> Scene:
@@ -224,13 +205,16 @@ class ThreePhase:
 
     def __init__(self, folder: Path, bare: Scene, models: dict[str, TreeModel], form: str,
                  grids: list[str], rho: float, mf: int, trace: TraceParams,
-                 echo: Callable[[str], None], samples: int = 400):
+                 echo: Callable[[str], None], samples: int = 400,
+                 level: int = GROUP_LEVEL, material_up: bool = GROUP_MATERIAL_UP,
+                 tile_m: float = 0.0):
         self.folder, self.samples = folder, samples
         folder.mkdir(parents=True, exist_ok=True)
         self.bare, self.models, self.grids, self.rho, self.mf = bare, models, grids, rho, mf
         self.inside = form == "dome"
         self.trace, self.echo = trace, echo
-        self.groups = facet_groups(models["leaf_on"], self.inside, GROUP_TILE_M, (WALL_CAP,))
+        self.groups = facet_groups(models["leaf_on"], self.inside, tile_m or GROUP_TILE_M,
+                                   (WALL_CAP,), level, material_up)
         self.points = points_text(bare, grids)
         self.n = sum(len(bare.grids[g]) for g in grids)
         self.timing: dict[str, float] = {}
@@ -248,7 +232,8 @@ class ThreePhase:
         """The view matrix of each of ``groups`` (default: every tile; files
         ``view_<tag><k>.vmx``) and V_sky (sensors, patches, 3)."""
         groups = self.groups if groups is None else groups
-        receivers = (rad3.group_receivers_text([(g.triangles, g.normal) for g in groups])
+        receivers = (rad3.group_receivers_text([(g.triangles, g.normal) for g in groups],
+                                               [g.up for g in groups])
                      + "\n" + rad3.sky_receivers_text(self.mf))
         scene = _without_shell(_scene_with(self.bare, self.models["leaf_on"]))  # trunks stay
         octree_text = scene_text(scene, self.rho)
@@ -294,7 +279,8 @@ class ThreePhase:
             mean = np.sum([self.groups[k].normal * self.groups[k].area for k in ks], axis=0)
             groups.append(FacetGroup(material, np.concatenate([self.groups[k].triangles
                                                                for k in ks]),
-                                     mean / np.linalg.norm(mean), direction))
+                                     mean / np.linalg.norm(mean), direction,
+                                     self.groups[ks[0]].up))
         return groups
 
     def daylight(self, state: str, groups: list[FacetGroup], room_side: bool = False
@@ -316,7 +302,7 @@ class ThreePhase:
         tag = "r" if room_side else "g"
         out: list[Path] = []
         for k, g in enumerate(groups):
-            sender = rad3.sender_text(g.triangles, g.normal, room_side)
+            sender = rad3.sender_text(g.triangles, g.normal, room_side, g.up)
             key = "|".join([sender, text, " ".join(ambient), str(self.samples), str(self.mf)])
 
             def compute(k: int = k, sender: str = sender) -> Path:
@@ -430,7 +416,7 @@ def compute_annual_3phase(project: Project, options: AnnualOptions,
 
     echo(f"  3-phase: {form} crown, BSDFs {', '.join(sorted({Path(b[2]).name for s in STATES for b in xmls[s]}))}")
     tp = ThreePhase(work / "threephase", bare, models, form, grids, rho, options.mf, trace,
-                    echo, options.daylight_samples)
+                    echo, options.daylight_samples, GROUP_LEVEL, GROUP_MATERIAL_UP)
     t1 = time.perf_counter()
     views, v_sky = tp.view()
     timing["view_s"] = time.perf_counter() - t1

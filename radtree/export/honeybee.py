@@ -31,7 +31,7 @@ import pandas as pd
 
 from radtree.errors import RadtreeError
 from radtree.export.transmittance import HOURS, CrownSchedule
-from radtree.fileio import write_text
+from radtree.fileio import atomic_path, write_text
 from radtree.optics import Glass, Material, Plastic, Trans
 
 CSV_NAME = "crown_transmittance"
@@ -175,7 +175,8 @@ def write_annual_results(hourly: Path, model: Any, out: Path) -> list[Path]:
     in honeybee-radiance's annual layout, one folder per variant (``with``, ``without``,
     ``leaf_on``, ``leaf_off``): ``grids_info.json``, ``sun-up-hours.txt`` (hours of the year at
     the hours' middles, e.g. 12.5) and ``__static_apertures__/default/{total,direct}/<grid>.ill``
-    (one row per sensor, one column per sun-up hour, lux)."""
+    (one row per sensor, one column per sun-up hour, lux) and the same as ``<grid>.npy``
+    (float32, what honeybee-radiance-postprocess's ``AnnualDaylight`` loads)."""
     from radtree.annual.schedule import day_of_year
 
     data = np.load(hourly)
@@ -200,5 +201,9 @@ def write_annual_results(hourly: Path, model: Any, out: Path) -> list[Path]:
                 text = "\n".join(" ".join(f"{v:.1f}" for v in row) for row in values)
                 write_text(folder / "__static_apertures__" / "default" / kind / f"{g}.ill",
                            text + "\n")
+                # honeybee-radiance-postprocess reads the same values as NumPy arrays
+                with atomic_path(folder / "__static_apertures__" / "default" / kind /
+                                 f"{g}.npy") as tmp, open(tmp, "wb") as fh:
+                    np.save(fh, np.round(values, 1).astype(np.float32))
         folders.append(folder)
     return folders

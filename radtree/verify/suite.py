@@ -31,7 +31,8 @@ from radtree.verify.turbid import turbid_checks
 FULL_PLANS = {"numpy": BackwardPlan(points=64, rays=128),
               "radiance": BackwardPlan(points=32, ad=1024, hours=("12:30",))}
 
-COLUMNS = ["check", "engine", "expected", "got", "tolerance", "passed"]
+COLUMNS = ["check", "engine", "expected", "got", "tolerance", "claim", "status", "passed",
+           "reference"]
 
 
 @dataclass
@@ -42,7 +43,11 @@ class VerifyOutcome:
 
     @property
     def failed(self) -> list[Check]:
-        return [c for c in self.checks if not c.passed]
+        return [c for c in self.checks if c.status == "fail"]
+
+    @property
+    def unresolved(self) -> list[Check]:
+        return [c for c in self.checks if c.status == "unresolved"]
 
     @property
     def table(self) -> pd.DataFrame:
@@ -66,6 +71,12 @@ def run_verify(out: Path, full: bool = False, backward: list[str] | None = None,
             checks += agreement_checks(hours=("10:30", "12:30", "14:30"), scenarios=("A", "B"),
                                        photons=40_000_000, backward=backward, crown=crown,
                                        plans=FULL_PLANS, progress=echo)
+        from radtree.engines.radiance.binaries import find_radiance
+
+        if find_radiance() is not None:
+            from radtree.verify.threephase import closure_checks
+
+            checks += closure_checks(progress=echo)
     else:
         checks += transmission_checks(progress=echo)
         checks += sphere_checks(progress=echo)

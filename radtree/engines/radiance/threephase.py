@@ -47,6 +47,19 @@ def default_up(normal: np.ndarray) -> str:
     return "+Y" if abs(float(normal[2])) >= 0.7 else "+Z"
 
 
+def up_text(normal: np.ndarray, up: tuple[float, float, float] | None) -> str:
+    """rfluxmtx's ``u=`` of a hemisphere of ``normal``: ``up`` (a world vector, e.g. the
+    ``BSDF`` material's, so that the Klems patches of the matrices are the material's) or,
+    when None or within 0.1° of ``normal``, :func:`default_up`."""
+    if up is None:
+        return default_up(normal)
+    u = np.asarray(up, float)
+    n = np.asarray(normal, float)
+    if np.linalg.norm(np.cross(u, n)) < 2e-3 * np.linalg.norm(u) * np.linalg.norm(n):
+        return default_up(normal)
+    return ",".join(f"{v:.6g}" for v in u)
+
+
 def _polygons(modifier: str, name: str, triangles: np.ndarray) -> str:
     out = []
     for i, t in enumerate(triangles):
@@ -64,17 +77,21 @@ def sky_receivers_text(mf: int) -> str:
             "tp_sky source tp_sky_src\n0\n0\n4 0 0 1 180\n")
 
 
-def group_receivers_text(groups: list[tuple[np.ndarray, np.ndarray]]) -> str:
+def group_receivers_text(groups: list[tuple[np.ndarray, np.ndarray]],
+                         ups: list[tuple[float, float, float] | None] | None = None) -> str:
     """One Klems receiver per facet group: ``(triangles (k, 3, 3), mean normal)``, each
-    triangle wound so its normal points to the room (the sensors' side)."""
+    triangle wound so its normal points to the room (the sensors' side); ``ups``: each
+    group's up vector (:func:`up_text`)."""
     out = []
-    for g, (tri, normal) in enumerate(groups):
-        out.append(f"#@rfluxmtx h=kf u={default_up(normal)}\nvoid glow tp_win{g}\n0\n0\n"
+    ups = ups if ups is not None else [None] * len(groups)
+    for g, ((tri, normal), up) in enumerate(zip(groups, ups)):
+        out.append(f"#@rfluxmtx h=kf u={up_text(normal, up)}\nvoid glow tp_win{g}\n0\n0\n"
                    f"4 1 1 1 0\n\n" + _polygons(f"tp_win{g}", f"tp_win{g}", tri))
     return "\n".join(out)
 
 
-def sender_text(triangles: np.ndarray, normal: np.ndarray, room_side: bool = False) -> str:
+def sender_text(triangles: np.ndarray, normal: np.ndarray, room_side: bool = False,
+                up: tuple[float, float, float] | None = None) -> str:
     """The daylight-matrix sender of one group: its facets moved :data:`SENDER_OFFSET_M`
     away from the room, ``h=-kf`` (rays leave away from the room: the light the group
     transmits); ``room_side``: moved towards the room, ``h=+kf`` (rays leave into the room:
@@ -82,7 +99,7 @@ def sender_text(triangles: np.ndarray, normal: np.ndarray, room_side: bool = Fal
     n = np.asarray(normal, float)
     sign, hemi = (1.0, "+kf") if room_side else (-1.0, "-kf")
     moved = np.asarray(triangles, float) + sign * SENDER_OFFSET_M * n
-    return f"#@rfluxmtx h={hemi} u={default_up(n)}\n\n" + _polygons("void", "tp_sender", moved)
+    return f"#@rfluxmtx h={hemi} u={up_text(n, up)}\n\n" + _polygons("void", "tp_sender", moved)
 
 
 def read_matrix(data: bytes, what: str) -> np.ndarray:

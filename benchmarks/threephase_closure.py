@@ -1,0 +1,143 @@
+"""Three-phase closure: the chain Σ_g V_g·T_g·D_g (+ reflection + by-pass) against a direct
+``rcontrib`` of the *same* BSDF-crown scene, on a uniform sky (radiance 1 above the horizon,
+0 below: the ``h=u`` ground column 0) and on a uniform ground hemisphere (the ground column 1,
+the sky 0), per grid and leaf state — the matrices' own error, with no crown representation
+in it (issue 40, item 2).
+
+Copies the project (default ``examples/office-block``) into ``--work`` once (kept: the crown
+BSDFs and every matrix are cached there, so a rerun only traces what a changed setting
+needs), computes the crown BSDFs with ``tree.bsdf.samples = --samples``, and for each facet
+grouping in ``--levels`` (:func:`radtree.annual.facets.group_directions`: 0 = the 14
+cube directions; k ≥ 1 an icosphere of k − 1 subdivisions) and each ``--up`` choice
+(``default``: rfluxmtx's default up; ``material``: the ``BSDF`` material's up vector, the frame
+the XML is applied in by rtrace) prints
+
+    grid, state, sky/ground, reference (rcontrib on the BSDF scene), chain, ratio, by-pass,
+    transmitted, reflected (each a mean over the grid's sensors, irradiance per unit radiance)
+
+Run: ``nice .venv/bin/python benchmarks/threephase_closure.py [--work DIR] [--samples 50]
+[--daylight-samples 100] [--levels 0,2,3] [--up default,material] [--ad 1024] [--xml X]
+[-j 2]``.
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import shutil
+import sys
+import time
+from dataclasses import replace
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT))
+
+from radtree.annual.closure import (  # noqa: E402
+    ClosureSettings,
+    closure_sensors,
+    closure_table,
+)
+from radtree.annual.coefficients import TraceParams  # noqa: E402
+from radtree.annual.run import annual_ground_reflectance  # noqa: E402
+from radtree.annual.threephase import crown_models, state_xmls  # noqa: E402
+from radtree.config import load_project  # noqa: E402
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("--project", type=Path, default=ROOT / "examples" / "office-block")
+    ap.add_argument("--work", type=Path, default=Path("/tmp/threephase_closure"))
+    ap.add_argument("--samples", type=int, default=50, help="tree.bsdf.samples")
+    ap.add_argument("--daylight-samples", type=int, default=100, help="rfluxmtx -c of D")
+    ap.add_argument("--levels", default="0,2,3")
+    ap.add_argument("--up", default="default,material")
+    ap.add_argument("--ab", type=int, default=6)
+    ap.add_argument("--ad", type=int, default=1024)
+    ap.add_argument("--states", default="leaf_on,leaf_off")
+    ap.add_argument("--xml", type=Path, default=None,
+                    help="tree.bsdf.xml: one given crown XML for every band (no crown BSDF "
+                         "computed; the closure compares the chain with a trace of the same "
+                         "XML, so any XML serves)")
+    ap.add_argument("--tile", type=float, default=0.0,
+                    help="the wall cap's tile size, m (0: GROUP_TILE_M)")
+    ap.add_argument("--rows", action="store_true",
+                    help="also the ratio per sensor row (height) of each grid, uniform sky")
+    ap.add_argument("-j", "--processes", type=int, default=2)
+    args = ap.parse_args()
+    work = args.work / args.project.name
+    if not work.exists():
+        shutil.copytree(args.project, work, ignore=shutil.ignore_patterns("build", "results"))
+    over: dict = {"tree.bsdf.samples": args.samples}
+    if args.xml is not None:
+        over["tree.bsdf.xml"] = str(args.xml.resolve())
+    project = load_project(work, overrides=over)
+    sc = next(s for s in project.scenarios if s.model == "louvers")
+    print(f"closure on {args.project} (scenario {sc.name}) → {work}; load {os.getloadavg()}",
+          flush=True)
+    t0 = time.perf_counter()
+    states = args.states.split(",")
+    if "leaf_off" in states:
+        xmls = state_xmls(project, sc, lambda s: print(s, flush=True))
+    else:     # leaf-on only: the bare crown's XML is not computed (its model is not traced)
+        from radtree.pipeline.crown_bsdf import scenario_xmls
+
+        on = scenario_xmls(project, sc, lambda s: print(s, flush=True))
+        if args.xml is not None:   # a free crown reaching the wall: its cap too
+            from radtree.pipeline.crown_bsdf import scenario_tree, wall_half_chord
+            from radtree.trees.bsdf_shell import WALL_BAND
+
+            tree, form = scenario_tree(project, sc)
+            if form != "dome" and wall_half_chord(tree, project.sensors, project.street) > 0:
+                on = [*on, (*WALL_BAND, args.xml.resolve())]
+        xmls = {"leaf_on": on, "leaf_off": on}
+    models, form = crown_models(project, sc, xmls)
+    print(f"BSDFs {time.perf_counter() - t0:.0f} s", flush=True)
+    from radtree.pipeline.assemble import make_scene
+
+    bare = make_scene(project, replace(sc, model="none"), dense_grid=False).scene
+    grids = [g for g in bare.grids if g != "facade_map"]
+    rho = annual_ground_reflectance(project)
+    trace = TraceParams(ab=args.ab, ad=args.ad, lw=1e-3, nproc=args.processes)
+    pd.set_option("display.width", 200)
+    for level in [int(x) for x in args.levels.split(",")]:
+        for up in args.up.split(","):
+            t1 = time.perf_counter()
+            table = closure_table(bare, models, form, grids, rho,
+                                  project.results_dir / "closure",
+                                  ClosureSettings(trace, args.daylight_samples, level,
+                                                  up == "material", args.tile),
+                                  tuple(states),
+                                  lambda s: print(s, flush=True))
+            print(f"\nlevel {level}, up {up} ({time.perf_counter() - t1:.0f} s):")
+            print(table.round(4).to_string(index=False), flush=True)
+            if args.rows:     # per sensor row (height), uniform sky, from the cached matrices
+                ref, parts, _ = closure_sensors(bare, models, form, grids, rho,
+                                                project.results_dir / "closure",
+                                                ClosureSettings(trace, args.daylight_samples,
+                                                                level, up == "material",
+                                                                args.tile),
+                                                states[0])
+                chain = sum(parts.values())
+                start = 0
+                for g in grids:
+                    pts = bare.grids[g].points
+                    sel = slice(start, start + len(pts))
+                    start += len(pts)
+                    r = ref[sel, 1:].sum(axis=1)
+                    c = chain[sel, 1:].sum(axis=1)
+                    for z in np.unique(pts[:, 2].round(2)):
+                        k = pts[:, 2].round(2) == z
+                        print(f"    {g} z {z:5.2f} m: reference {r[k].mean():.4f}, chain "
+                              f"{c[k].mean():.4f}, ratio {c[k].mean() / r[k].mean():.3f}")
+    print(f"load now {os.getloadavg()}")
+
+
+if __name__ == "__main__":
+    from _common import print_resources_at_exit  # benchmarks/_common.py
+
+    print_resources_at_exit()
+    main()

@@ -1,0 +1,115 @@
+"""The three-phase check of ``radtree verify --full``: on a small free crown (one volume-louvers
+crown in front of the façade sensors), the chain V·T·D of ``radtree annual --method 3phase``
+against a direct ``rcontrib`` of the same BSDF-crown scene on a uniform sky
+(:mod:`radtree.annual.closure`): façade mean within :data:`CLAIM` (issue 40, item 2). The
+crown's BSDF is computed with few rays (``tree.bsdf.samples = 10``): both sides trace the
+same XML, so its own accuracy is not what is checked.
+"""
+
+from __future__ import annotations
+
+import tempfile
+from collections.abc import Callable
+from dataclasses import replace
+from pathlib import Path
+
+from radtree.verify.checks import Check
+
+#: the relative agreement the chain claims with a direct trace of the same BSDF scene
+CLAIM = 0.03
+
+PROJECT = """
+[project]
+name = "verify: three-phase closure"
+
+[site]
+latitude = -32.89
+longitude = -68.83
+elevation_m = 750
+utc_offset_hours = -3
+date = "2024-12-22"
+hours = ["12:30"]
+
+[street]
+width_m = 20.0
+length_m = 40.0
+facade_azimuth_deg = 0.0
+ground_reflectance = 0.15
+
+[light]
+direct_normal = "dni.csv"
+
+[tree]
+form = "free"
+
+[tree.crown]
+count = 1
+radius_m = 3.0
+vertical_radius_m = 3.0
+base_height_m = 2.5
+trunk_distance_m = 3.5
+segments = 12
+
+[tree.louvers]
+arrangement = "volume"
+crossings = 4
+slat_size_m = 0.6
+
+[tree.bsdf]
+samples = 10
+tiles = 5
+bands = 1
+
+[sensors]
+dense_grid = false
+
+[[scenario]]
+name = "with"
+model = "louvers"
+"""
+
+
+def write_project(root: Path) -> Path:
+    """:data:`PROJECT` and its (unused: no sun is traced) DNI table written to ``root``."""
+    (root / "radtree.toml").write_text(PROJECT)
+    (root / "dni.csv").write_text("time,direct_normal_lux\n12:30,0\n")
+    return root
+
+
+def closure_checks(folder: Path | None = None, ad: int = 1024, samples: int = 200,
+                   progress: Callable[[str], None] | None = None) -> list[Check]:
+    """The façade's uniform-sky closure (leaf-on), ``ad`` ambient rays per sensor for V and
+    the reference, ``samples`` rays per Klems patch for D; work files in ``folder`` (default
+    a temporary one)."""
+    from radtree.annual.closure import ClosureSettings, closure_table
+    from radtree.annual.coefficients import TraceParams
+    from radtree.annual.threephase import GROUP_LEVEL, GROUP_MATERIAL_UP, crown_models
+    from radtree.config import load_project
+    from radtree.pipeline.assemble import make_scene
+    from radtree.pipeline.crown_bsdf import scenario_xmls
+
+    with tempfile.TemporaryDirectory(prefix="radtree-verify-3phase-") as tmp:
+        root = Path(folder) if folder is not None else Path(tmp)
+        root.mkdir(parents=True, exist_ok=True)
+        write_project(root)
+        project = load_project(root)
+        sc = project.scenario("with")
+        on = scenario_xmls(project, sc)
+        models, form = crown_models(project, sc, {"leaf_on": on, "leaf_off": on})
+        bare = make_scene(project, replace(sc, model="none"), dense_grid=False).scene
+        settings = ClosureSettings(TraceParams(ab=6, ad=ad, lw=1e-3), samples, GROUP_LEVEL,
+                                   GROUP_MATERIAL_UP)
+        table = closure_table(bare, models, form, ["facade"],
+                              project.street.ground_reflectance, root / "closure", settings)
+    out = []
+    for _, row in table.iterrows():
+        if row["light"] != "sky":
+            continue
+        name = (f"three-phase chain vs rcontrib, same BSDF crown, uniform sky, "
+                f"{row['grid']} mean ({row['state']})")
+        out.append(Check(name, "radiance", float(row["reference"]), float(row["chain"]),
+                         CLAIM * float(row["reference"]),
+                         reference="rcontrib on the same BSDF-crown scene"))
+        if progress:
+            progress(f"{name}: reference {row['reference']:.4f}, chain {row['chain']:.4f}")
+    return out
