@@ -15,7 +15,7 @@ DEMO_ENGINE ?= numpy
 $(STAMP): pyproject.toml
 	$(PYTHON) -m venv $(VENV)
 	$(BIN)/pip install --quiet --upgrade pip
-	$(BIN)/pip install --quiet -e ".[dev,sweep,honeybee]"
+	$(BIN)/pip install --quiet -e ".[dev,sweep,honeybee,crosscheck]"
 	touch $(STAMP)
 
 install: $(STAMP)
