@@ -46,7 +46,7 @@ from radtree.light.weather import read_epw
 from radtree.site.inventory import read_features
 
 TEMPLATES = ("street", "office", "district")
-#: the site without an EPW or geographic inputs: the reference study (SPEC.md §1)
+#: the site without an EPW or geographic inputs: the reference study (reference case §1)
 MENDOZA = {"name": "Mendoza, Argentina (reference site)", "latitude": -32.89,
            "longitude": -68.83, "elevation_m": 750.0, "utc_offset_hours": -3.0}
 HOURS = ["10:30", "11:30", "12:30", "13:30", "14:30", "15:30", "16:30"]
