@@ -56,7 +56,7 @@ demo-report: demo-convergence demo-hemi
 	$(RUN) $(BIN)/radtree report $(EXAMPLE)
 
 lint: $(STAMP)
-	$(BIN)/ruff check radtree tests benchmarks
+	$(BIN)/ruff check radtree tests benchmarks docs
 	$(BIN)/lint-imports
 
 typecheck: $(STAMP)
@@ -71,7 +71,7 @@ test: lint typecheck pytest docs
 # (offline: no fonts or scripts from the network); open site/index.html
 docs: $(STAMP)
 	$(BIN)/python docs/gen_reference.py --check
-	$(BIN)/mkdocs build --strict --quiet
+	NO_MKDOCS_2_WARNING=1 $(BIN)/mkdocs build --strict --quiet
 
 bench: $(STAMP)
 	for b in benchmarks/*.py; do $(BIN)/python $$b || exit 1; done
