@@ -75,15 +75,9 @@ def _field_comments(cls: type) -> dict[str, str]:
     return out
 
 
-def _from_docstring(cls: type, name: str, key: str) -> str:
-    """The first sentence of the class docstring that names the field, unless it names many
-    (then it is the table's introduction, shown above the table)."""
-    doc = " ".join(inspect.cleandoc(cls.__doc__ or "").split())
-    for sentence in re.split(r"(?<=\.)\s+(?=[A-Z`(])", doc):
-        if (f"``{name}``" in sentence or f"``{key}``" in sentence) and sentence.count(
-                "``") <= 8:
-            return re.sub(r":\w+:`~?([\w.]+)`", r"`\1`", sentence.replace("``", "`"))
-    return ""
+def _prose(text: str) -> str:
+    """Docstring text as one Markdown paragraph (roles and double backquotes made plain)."""
+    return re.sub(r":\w+:`~?([\w.]+)`", r"`\1`", " ".join(text.replace("``", "`").split()))
 
 
 def _type_text(spec: Any) -> str:
@@ -110,7 +104,8 @@ def _bounds(spec: Any) -> str:
 
 
 def field_rows(table_name: str, cls: type) -> list[list[str]]:
-    """One row per field of the table: name, type, unit, default, bounds, description."""
+    """One row per field of the table: name, type, unit, default, bounds and the comment
+    written beside the field (the class docstring, shown above the table, says the rest)."""
     from radtree.site import starter  # the units and defaults `radtree new` writes
 
     comments = _field_comments(cls)
@@ -119,13 +114,12 @@ def field_rows(table_name: str, cls: type) -> list[list[str]]:
         spec = spec_of(cls, f.name)
         if spec is None:
             continue
-        key = toml_name(cls, f.name)
         default = starter._default(cls, f.name)
         shown = "required" if default is MISSING else starter._shown(default)
         unit = starter._unit(f.name, spec.kind, spec.lo == 0 and spec.hi == 1)
-        about = comments.get(f.name) or _from_docstring(cls, f.name, key)
-        rows.append([f"`{key}`", _type_text(spec), unit, f"`{shown}`" if shown not in (
-            "required", "(unset)") else shown, _bounds(spec), about])
+        rows.append([f"`{toml_name(cls, f.name)}`", _type_text(spec), unit,
+                     f"`{shown}`" if shown not in ("required", "(unset)") else shown,
+                     _bounds(spec), comments.get(f.name, "")])
     return rows
 
 
@@ -148,12 +142,16 @@ def project_file_page() -> str:
              "value (exit code 2). `radtree new` writes the same list as commented lines.\n\n",
              "`[project]`: `name` (text), `measured` (CSV `time,measured_lux`), "
              "`measured_rows` (CSV `row,sensors,measured_mean_lux`) — file paths relative to "
-             "the project folder.\n\n"]
+             "the project folder.\n\n"
+             "Each table below starts with its dataclass's docstring (what the fields mean); "
+             "the table gives each field's type, unit, default and bounds as the reader checks "
+             "them, and the note written beside the field in the code.\n\n"]
     for name, cls in _tables().items():
-        doc = inspect.cleandoc(cls.__doc__ or "").split("\n\n")[0]
+        doc = inspect.cleandoc(cls.__doc__ or "")
         parts.append(f"## `[{name.split(' ')[0]}]`" + (
             " (inventory district)" if " " in name else "") + "\n\n")
-        parts.append(re.sub(r":\w+:`~?([\w.]+)`", r"`\1`", " ".join(doc.replace("``", "`").split())) + "\n\n")
+        for para in doc.split("\n\n"):
+            parts.append(_prose(para) + "\n\n")
         parts.append(table(["field", "type", "unit", "default", "bounds", "description"],
                            field_rows(name, cls)))
         parts.append("\n")

@@ -66,7 +66,7 @@ def test_block_parsing():
 
 @pytest.mark.slow
 @pytest.mark.parametrize("page", RUN_PAGES)
-def test_page_commands_run(page, tmp_path):
+def test_page_commands_run(page, tmp_path, record_property):
     text = (DOCS / page).read_text(encoding="utf-8")
     env = {**os.environ, "PATH": f"{Path(sys.executable).parent}{os.pathsep}"
            f"{os.environ.get('PATH', '')}", "MPLBACKEND": "Agg"}
@@ -74,6 +74,8 @@ def test_page_commands_run(page, tmp_path):
         helptext = subprocess.run(["radtree", command, "--help"], env=env,
                                   capture_output=True, text=True).stdout
         if option not in helptext:
+            record_property("docs_blocks", (page, 0, len(blocks(page)), f"skipped: needs "
+                                            f"`radtree {command} {option}`"))
             pytest.skip(f"{page}: needs `radtree {command} {option}`, not in this build")
     shutil.copytree(ROOT / "examples", tmp_path / "examples",
                     ignore=shutil.ignore_patterns("build", "results", "report", "diagnose",
@@ -91,5 +93,5 @@ def test_page_commands_run(page, tmp_path):
         for name in named_files(code):
             assert (tmp_path / name).exists(), f"{page}: {name} not written by:\n{code}"
         ran += 1
-    print(f"\n{page}: {ran} blocks run, {skipped} marked norun")
+    record_property("docs_blocks", (page, ran, skipped, ""))
     assert ran + skipped > 0
