@@ -2,6 +2,7 @@
 
 * The generated reference pages (``docs/gen_reference.py``) equal the committed ones.
 * Every ``*COLUMNS`` list in radtree is either a documented results table or named as not one.
+* The Python blocks of the worked API example run, in order, in one interpreter.
 * Every ``bash`` block of Getting started and the how-to guides runs (``bash -e``) in a scratch
   folder holding a copy of ``examples/``, blocks of a page in order; every file a block names
   with ``# → PATH`` exists afterwards. ``<!-- norun: why -->`` before a block skips it (said
@@ -95,3 +96,16 @@ def test_page_commands_run(page, tmp_path, record_property):
         ran += 1
     record_property("docs_blocks", (page, ran, skipped, ""))
     assert ran + skipped > 0
+
+
+@pytest.mark.slow
+def test_api_example_runs(tmp_path):
+    text = (DOCS / "api" / "example.md").read_text(encoding="utf-8")
+    code = "\n".join(re.findall(r"```python\n(.*?)```", text, re.S))
+    shutil.copytree(ROOT / "examples" / "mendoza-street", tmp_path / "examples" / "mendoza-street",
+                    ignore=shutil.ignore_patterns("build", "results", "report", "diagnose"))
+    proc = subprocess.run([sys.executable, "-c", code], cwd=tmp_path, capture_output=True,
+                          text=True, timeout=600, env={**os.environ, "MPLBACKEND": "Agg"})
+    assert proc.returncode == 0, proc.stderr[-3000:]
+    assert (tmp_path / "examples/mendoza-street/results/illuminance.csv").exists()
+    assert "0.0721" in proc.stdout   # the nRMSE the page quotes
