@@ -1,6 +1,7 @@
 # radtree — two commands do everything on a fresh machine:
 #   make demo   create .venv, install radtree, build + simulate + report the Mendoza example
-#   make test   same install, then lint, type check and the whole test suite
+#   make test   same install, then lint, type check, the whole test suite and the guide
+#   make docs   the user guide → site/index.html
 PYTHON ?= python3
 VENV   := .venv
 BIN    := $(VENV)/bin
@@ -15,7 +16,7 @@ DEMO_ENGINE ?= numpy
 $(STAMP): pyproject.toml
 	$(PYTHON) -m venv $(VENV)
 	$(BIN)/pip install --quiet --upgrade pip
-	$(BIN)/pip install --quiet -e ".[dev,sweep,honeybee,crosscheck]"
+	$(BIN)/pip install --quiet -e ".[dev,sweep,honeybee,docs,crosscheck]"
 	touch $(STAMP)
 
 install: $(STAMP)
@@ -29,7 +30,7 @@ RUN ?=
 DEMO_STEPS := demo-doctor demo-build demo-simulate demo-convergence demo-permeability \
               demo-diagnose demo-hemi demo-report
 
-.PHONY: install demo $(DEMO_STEPS) test lint typecheck pytest bench clean
+.PHONY: install demo $(DEMO_STEPS) test lint typecheck pytest docs bench clean
 
 demo: $(STAMP)
 	@$(MAKE) --no-print-directory -j2 -O demo-report
@@ -55,7 +56,7 @@ demo-report: demo-convergence demo-hemi
 	$(RUN) $(BIN)/radtree report $(EXAMPLE)
 
 lint: $(STAMP)
-	$(BIN)/ruff check radtree tests benchmarks
+	$(BIN)/ruff check radtree tests benchmarks docs
 	$(BIN)/lint-imports
 
 typecheck: $(STAMP)
@@ -64,7 +65,13 @@ typecheck: $(STAMP)
 pytest: $(STAMP)
 	$(BIN)/python -m pytest -q -x -n 2 --durations=15
 
-test: lint typecheck pytest
+test: lint typecheck pytest docs
+
+# the user guide: reference pages checked against the code, then the site built into site/
+# (offline: no fonts or scripts from the network); open site/index.html
+docs: $(STAMP)
+	$(BIN)/python docs/gen_reference.py --check
+	NO_MKDOCS_2_WARNING=1 $(BIN)/mkdocs build --strict --quiet
 
 bench: $(STAMP)
 	for b in benchmarks/*.py; do $(BIN)/python $$b || exit 1; done

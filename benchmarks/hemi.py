@@ -13,7 +13,7 @@ import tempfile
 import time
 from pathlib import Path
 
-# the real photo (../shared), or the byte-identical copy the Mendoza example ships
+# the real photo (the shared data folder, for developers), or the byte-identical copy the Mendoza example ships
 PHOTO = next((p for p in (Path(__file__).resolve().parents[2] / "shared/data/fisheye/chestnut_coolpix4500_fc-e8.jpg",
                           Path(__file__).resolve().parents[1] / "examples/mendoza-street/data/fisheye_chestnut_standin.jpg") if p.exists()),
              Path(__file__).resolve().parents[1] / "examples/mendoza-street/data/fisheye_chestnut_standin.jpg")

@@ -1,4 +1,4 @@
-"""Office-block results per hour and grid (SPEC.md §5): statistics, false-colour maps, report data.
+"""Office-block results per hour and grid (reference case §5): statistics, false-colour maps, report data.
 
 Reads only the tidy results table ``PROJECT/results/illuminance.csv`` and writes
 

@@ -1,4 +1,4 @@
-"""Statistics between simulated and measured façade illuminance (SPEC.md §3).
+"""Statistics between simulated and measured façade illuminance (reference case §3).
 
 With E_m the measured and E_s the simulated hourly mean of the façade grid over n hours:
 

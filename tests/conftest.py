@@ -92,3 +92,17 @@ def open_street(tmp_path: Path) -> Path:
     text = re.sub(r'model = "\w+"', 'model = "none"', text)
     (p / "radtree.toml").write_text(text)
     return p
+
+
+def pytest_terminal_summary(terminalreporter):
+    """The guide's shell blocks run by tests/test_docs.py, page by page, and their count."""
+    rows = [v for key in ("passed", "skipped", "failed")
+            for r in terminalreporter.stats.get(key, [])
+            for k, v in getattr(r, "user_properties", []) if k == "docs_blocks"]
+    if not rows:
+        return
+    terminalreporter.write_sep("-", "user guide: shell blocks run (tests/test_docs.py)")
+    for page, ran, skipped, note in sorted(rows):
+        terminalreporter.write_line(f"{page}: {ran} run, {skipped} not run {note}".rstrip())
+    terminalreporter.write_line(f"total: {sum(r[1] for r in rows)} blocks run, "
+                                f"{sum(r[2] for r in rows)} not run")

@@ -12,7 +12,7 @@ Growth rule (deterministic for a seed):
   the way to the crown top, diameter ``leader_diameter_ratio`` × trunk diameter;
 * ``primaries`` **scaffold branches** leave the trunk top and the leader at heights spread
   evenly over its lower part, at azimuths following the golden angle (± ``jitter``), each
-  climbing at the **branch inclination** (SPEC §1: peripheral branches ≈ 40° from
+  climbing at the **branch inclination** (reference case §1: peripheral branches ≈ 40° from
   horizontal; ± ``inclination_jitter_deg``);
 * every branch segment covers ``reach`` of the distance left to the envelope along its
   direction, then **forks** into ``fork`` children spread ``azimuth_spread_deg`` apart in

@@ -39,13 +39,13 @@ default method's sun runs on its explicit scenes of each leaf state (slats, bare
 its folders and cache, so a project that ran ``--method dc`` reuses them); ``"bsdf"`` traces
 both on the BSDF-crown scene (a Klems BSDF passes no sun at ``-ab 0``, measured: 0.0 lx on
 the office example; the sun through the crown, gaps included, comes from the ``-ab N`` run,
-smeared over Klems patches). Measured on the office example (README,
+smeared over Klems patches). Measured on the office example (CHANGELOG.md,
 three-phase section): the sun scattered by the BSDF crown is where the two methods differed
 most (work-plane UDI > 3000 lx +5.4 pp, façade +9.6 pp with ``"bsdf"``; +0.7 / +0.9 pp with
 ``"explicit"``, for 214 s more of sun runs through the slats). Tracing only the ``-ab 0``
 direct sun through the explicit crown and the reflected sun on the BSDF crown counts the
 crown's gaps twice (the BSDF's ``-ab N`` run carries them) and was no better than ``"bsdf"``
-(README). The scene without the tree is computed as the default
+(CHANGELOG.md). The scene without the tree is computed as the default
 method does.
 
 **Closure (issue 40): the chain against a direct trace of the same BSDF scene.**

@@ -221,7 +221,7 @@ def _calibrate_louvers(project: Project, goal: float, source: str, form: str,
                      f"{100 * abs(best.traced - goal):.2f} percentage points from it.")
         if form == "free":
             notes.append("Near-horizontal and downward views from façade sensors cross few "
-                         "layers of a free louvers crown (SPEC, first physical check, point 2), "
+                         "layers of a free louvers crown (the reference case, first physical check, point 2), "
                          "so density alone cannot bring its direct permeability down to the "
                          "target; the sensor-dome form can.")
     notes.insert(0, f"Louvers ({form} form), slat specular transmittance {ts:.3f}: analytic "

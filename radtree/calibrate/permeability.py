@@ -1,6 +1,6 @@
 """Global crown permeability, as the study measured it, and the layer count that matches it.
 
-SPEC.md defines the measured canopy permeability (5–6 %) as *vertical illuminance under the
+The reference case defines the measured canopy permeability (5–6 %) as *vertical illuminance under the
 crown / unobstructed vertical global illuminance*. :func:`global_permeability` computes the
 same ratio in the model: the façade sensors' illuminance with the crown, divided by the same
 sensors' illuminance in the open street (no crown), both traced with the ground-reflected light
@@ -9,7 +9,7 @@ traced, summed over the project's hours. Unlike the direct (specular) permeabili
 between slats and the white wall, and light reflected by the street.
 
 :func:`calibrate_layers` picks the integer number of louvers layers whose global permeability is
-closest (in log terms) to the target: this is SPEC's own rule "light must meet about 4 layers
+closest (in log terms) to the target: this is the reference case's own rule "light must meet about 4 layers
 (0.5⁴ ≈ 6 %)", evaluated with every light path instead of the direct one. It uses the measured
 permeability only — no hourly façade measurement.
 

@@ -1,6 +1,6 @@
 """How a scenario's fit depends on the crown's global permeability — a scan, not a fit.
 
-The measured canopy permeability (5–6 %, SPEC.md §1) bounds how much light a crown model may
+The measured canopy permeability (5–6 %, reference case §1) bounds how much light a crown model may
 pass. This scan varies one crown field (default: the louvers' slat transmittance, continuous and
 free of sunflecks), and for each value reports
 
@@ -8,7 +8,7 @@ free of sunflecks), and for each value reports
   same canyon), light as the project sets it — what ``radtree calibrate --global`` matches;
 * ``permeability_unobstructed``: the same numerator under sun **and** the stated clear sky, over
   an *unobstructed* vertical reference (no canyon: a flat ground to the horizon, sun + sky) —
-  SPEC's literal definition "vertical illuminance under the crown / unobstructed vertical global
+  the reference case's literal definition "vertical illuminance under the crown / unobstructed vertical global
   illuminance";
 * the scenario's normalised RMSE, MBE and r against the measured hourly means.
 
@@ -38,7 +38,7 @@ from radtree.pipeline.processes import spawned_map, usable_cores, with_threads
 from radtree.pipeline.trace import facade_total, trace_scenario
 from radtree.stats import nmbe, nrmse, pearson_r
 
-MEASURED_BAND = (0.05, 0.06)   # SPEC.md §1: canopy permeability 5–6 %
+MEASURED_BAND = (0.05, 0.06)   # reference case §1: canopy permeability 5–6 %
 TARGET_NRMSE = 0.10            # the reference study's scenario A reached 0.09
 UNOBSTRUCTED_WIDTH_M = 2000.0  # a flat ground this wide is "to the horizon" for a 5 m sensor
 
@@ -67,7 +67,7 @@ class PermeabilityScan:
     def summary(self) -> list[str]:
         lines = []
         for col, label in (("permeability_street", "street reference, project light"),
-                           ("permeability_unobstructed", "SPEC's unobstructed global reference")):
+                           ("permeability_unobstructed", "the reference case's unobstructed global reference")):
             band = self.band_nrmse(col)
             if band is None:
                 lines.append(f"{label}: the scan does not span the measured band "
@@ -91,7 +91,7 @@ class PermeabilityScan:
 
 
 def unobstructed_project(project: Project) -> Project:
-    """SPEC's reference for the permeability: a vertical sensor with nothing in front of it —
+    """The reference case's reference for the permeability: a vertical sensor with nothing in front of it —
     no opposite building, a flat ground of the project's reflectance to the horizon — lit by
     the sun and the stated clear sky (``light.sky = "perez"``: *global* illuminance)."""
     st = replace(project.street, width_m=UNOBSTRUCTED_WIDTH_M,
@@ -210,7 +210,7 @@ def write_scan(scan: PermeabilityScan, folder: Path) -> tuple[Path, Path]:
                label="measured permeability 5–6 %")
     ax.axhline(TARGET_NRMSE, color="k", ls=":", lw=1, label=f"target nRMSE {TARGET_NRMSE:g}")
     ax.plot(100 * t["permeability_unobstructed"], t["nrmse"], "o-", color="tab:green",
-            label="vs unobstructed global reference (SPEC)")
+            label="vs unobstructed global reference (reference case)")
     ax.plot(100 * t["permeability_street"], t["nrmse"], "s--", color="tab:blue",
             label="vs open street, project light")
     for _, r in t.iterrows():

@@ -1,4 +1,4 @@
-"""``radtree diagnose``: name the missing physical effect, add it, re-simulate (SPEC §6).
+"""``radtree diagnose``: name the missing physical effect, add it, re-simulate (reference case §6).
 
     radtree diagnose PROJECT [--measured FILE.csv] [--scenario B] [--engine numpy] [--units lux]
     radtree diagnose PROJECT --campaign FILE          # against a campaign's readings

@@ -42,7 +42,7 @@ def permeability_command(project: Path, scenario: str, field: str, values_text: 
     """How a scenario's fit depends on the crown's global permeability (measured: 5–6 %).
 
     For each value of FIELD: the crown's global permeability against the open street
-    (what `radtree calibrate --global` matches) and against SPEC's unobstructed global
+    (what `radtree calibrate --global` matches) and against the reference case's unobstructed global
     reference (flat ground to the horizon, sun + the stated clear sky), and the scenario's
     nRMSE / nMBE / r. Writes PROJECT/results/permeability_scan.csv and .png; `radtree report`
     shows them. Example:

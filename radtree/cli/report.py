@@ -18,7 +18,7 @@ def report_command(project: str, open_: bool) -> None:
     PROJECT/report/
       index.html  index.md      the report (tables, figures, provenance)
       statistics.csv            scenario, model, reflection, rmse, rmse_low, rmse_high,
-                                mbe, r, r2, n_hours (normalised as SPEC.md §3)
+                                mbe, r, r2, n_hours (normalised as reference case §3)
       hourly.csv                time, measured_lux, one column per scenario (lux)
       figures/  models/         150 dpi PNG figures, crown-model pictures
     Needs PROJECT/results/illuminance.csv (run `radtree simulate PROJECT` first).

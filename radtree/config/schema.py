@@ -254,7 +254,7 @@ class Sensors(Checked):
 
 @dataclass(frozen=True)
 class Office(Checked):
-    """A block of offices in the studied façade (the building application, SPEC.md §5).
+    """A block of offices in the studied façade (the building application, reference case §5).
 
     ``bays`` × ``storeys`` identical offices (any counts, even too), each ``width_m`` wide,
     ``height_m`` high (floor to ceiling) and ``depth_m`` deep, with a glazed façade towards

@@ -1,4 +1,4 @@
-"""Model–measurement discrepancy workflow (SPEC §6): ``radtree diagnose``.
+"""Model–measurement discrepancy workflow (reference case §6): ``radtree diagnose``.
 
 Find where simulation and measurement disagree (by hour, by sensor row, by sun altitude), name
 the physical effect most likely missing, add it to the model, re-simulate, and show the gap

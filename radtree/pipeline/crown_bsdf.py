@@ -56,9 +56,8 @@ from radtree.trees.slab import RingSamples, SlabSample, chord_samples, dome_slab
 from radtree.trees.volume import recommended_volume_ab
 
 #: -ab of a scene with a BSDF crown: every pass through the shell's Klems BSDF is an ambient
-#: bounce. Measured on the Mendoza dome (scenario B, -ad 8192, façade mean): 12:30 / 14:30
-#: read 1162 / 1169 lx at -ab 6 and 1148 / 1160 lx at -ab 8; -ab 4 (-ad 2048) read 1060 lx
-#: at 14:30, ≈ 9 % low
+#: bounce, and the Mendoza dome's façade mean settles by -ab 6 (-ab 4 reads ≈ 9 % low);
+#: `radtree simulate PROJECT --convergence` prints the ladder, figures in CHANGELOG.md
 BSDF_SCENE_AB = 6
 #: thinnest chord-ring slab, in slat sizes (a thinner slab is no random medium of slats)
 CHORD_MIN_SLATS = 2.0

@@ -54,7 +54,7 @@ from radtree.report.sections.results import (
 from radtree.report.tables import Table
 from radtree.stats import STATS_COLUMNS
 
-#: The columns of statistics.csv every reader may rely on (SPEC.md §3, normalised).
+#: The columns of statistics.csv every reader may rely on (reference case §3, normalised).
 STATISTICS_CONTRACT = ["scenario", "model", "reflection", "rmse", "rmse_low", "rmse_high", "mbe",
                        "r", "r2", "n_hours"]
 STATISTICS_EXTRA = ["rmse_lux", "mbe_lux", "rmse_mc_se", "form"]

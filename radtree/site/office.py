@@ -1,4 +1,4 @@
-"""The office block of the building application (SPEC.md §5): rooms behind the studied façade.
+"""The office block of the building application (reference case §5): rooms behind the studied façade.
 
 ``bays`` × ``storeys`` identical offices (default 3 × 3 in elevation; any counts, even ones
 too) sit behind the façade plane n = 0 of the street canyon, in the façade frame (u along the

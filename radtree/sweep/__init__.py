@@ -1,4 +1,4 @@
-"""Parameter sweeps over the unknowns of a project (SPEC §1), run on dask.distributed.
+"""Parameter sweeps over the unknowns of a project (reference case §1), run on dask.distributed.
 
     from radtree.sweep import run_sweep
     out = run_sweep("examples/mendoza-street", ["tree.crown.trunk_distance_m=2:6:5",

@@ -4,7 +4,7 @@ Per case × scenario (``metrics.csv``):
 
 * ``facade_mean_lux`` — the daily mean of the hourly ``facade`` grid mean (lux), and
   ``facade_lux_HH:MM`` — the hourly façade grid mean at each hour (lux);
-* ``nrmse``, ``nmbe`` — against the project's measurements (SPEC §3; over the measured hours that
+* ``nrmse``, ``nmbe`` — against the project's measurements (reference case §3; over the measured hours that
   the sweep simulated) when the project has ``measured``.
 
 Per scenario × parameter × metric (``sensitivity.csv``):

@@ -12,7 +12,7 @@ and, counting diffusely transmitted light as if it went on forward (an upper bou
 first-order energy), τ'_layer = (1 − f) + f·T. Slat positions are independent between layers,
 so for random (jittered) placement the stack's expected transmission is exactly τ_layer^N.
 
-Two readings of the study's "slat-layer transmittance 0.5" (SPEC, "first physical check"):
+Two readings of the study's "slat-layer transmittance 0.5" (the reference case, "first physical check"):
 
 * **study reading** — cover 1 and a slat material with T = 0.5 (R 0.11): the 0.5 is an
   *effective per-layer* transmission (gaps + leaf), put into the material.
@@ -294,7 +294,7 @@ def build_louvers(tree: Tree, sensors: Sensors, street: Street, frame: FacadeFra
             f"square slats inclined {lv.inclination_deg:g}°, in branches of {BRANCH_SLATS} "
             f"climbing at {lv.branch_inclination_deg:g}°; {slats} slats "
             f"({int(ginfo['slats_cut'])} cut at the wall-side or shared planes). Near-"
-            "horizontal views cross fewer layers than vertical ones (SPEC: first physical "
+            "horizontal views cross fewer layers than vertical ones (the reference case: first physical "
             "check, point 2).")
     meshes.insert(0, Mesh("tree_leaves", LEAF, frame.to_world(verts), faces, owners))
     if volume:

@@ -2,7 +2,7 @@
 
 Why: the layered free crowns stack ``layers`` lens-shaped slat layers, so every *vertical* line
 crosses ``layers`` slats, but a vertical façade sensor looks out near-horizontally, *along* the
-layers, and crosses far fewer (SPEC, "first physical check", point 2). A leaf canopy is closer
+layers, and crosses far fewer (the reference case, "first physical check", point 2). A leaf canopy is closer
 to a turbid medium: leaves scattered through the crown volume, so the number of leaves met
 depends on the path length through the crown and on the projected leaf area along the path,
 not on a layer structure.
@@ -69,11 +69,10 @@ from radtree.trees.leaf_angles import draw_inclinations, mean_projection, mean_t
 
 MAX_VOLUME_SLATS = 200_000
 DRAW_BLOCK = 1024  # slats drawn per block (nested realisations, see _draw_nested)
-# Radiance -ab for volume crowns. Measured (radtree.convergence, Radiance rtrace -ad 2048 -aa 0
-# -as 0 -lw 1e-4) on Mendoza scenario F, crossings 15, Perez sky, seed 1, façade sensor mean:
-#   13:30  -ab 1 867, 2 1198, 3 1373, 4 1439, 6 1457, 8 1456 lx  (6 → 8: −0.1 %)
-#   10:30  -ab 3 1025, 4 1067, 5 1077, 6 1089, 8 1089, 12 1090 lx (6 → 12: +0.1 %)
-# so -ab 6 is converged to ≈ 0.1 %; -ab 17 (crossings + 2) would only cost time.
+# Radiance -ab for volume crowns: light crossing many slats does so mostly by specular
+# transmission, which needs no ambient bounce, so the façade mean converges by -ab 6 (within
+# 0.1 % on Mendoza F); `radtree simulate examples/mendoza-street --convergence -s F` prints the
+# ladder, figures in docs/benchmarks.md.
 VOLUME_AB_CAP = 6
 
 
@@ -112,9 +111,8 @@ def volume_slat_bound(spec: CrownRowSpec, lv: Louvers) -> int:
 def recommended_volume_ab(lv: Louvers) -> int:
     """Radiance -ab for volume crowns: ⌈crossings⌉ + 2, capped at :data:`VOLUME_AB_CAP` (6).
 
-    Measured on Mendoza scenario F (crossings 15, see the figures at :data:`VOLUME_AB_CAP`): the
-    façade mean moves 0.1 % from -ab 6 to 8 (13:30) and to 12 (10:30), because most light
-    crossing many slats does so by specular transmission, which needs no ambient bounce.
+    Why the cap suffices: see the comment at :data:`VOLUME_AB_CAP` (figures in the guide's
+    Validation page).
     """
     return int(min(math.ceil(crossings_of(lv)) + 2, VOLUME_AB_CAP))
 

@@ -1,5 +1,5 @@
 """What the study's numbers owe to its method: the Mendoza scenes A–E traced the study's way
-(SPEC §7) and with one setting changed at a time, and the dome-radius scan.
+(reference case §7) and with one setting changed at a time, and the dome-radius scan.
 
 :func:`run_method_study` writes ``PROJECT/method/hourly.csv`` — one row per (variant, dome
 radius, scenario, hour): the façade mean of the 8 sensors (lux), its standard error, the engine

@@ -1,7 +1,7 @@
 """The report section "what the study's numbers owe to its method" — from ``PROJECT/method/
 *.csv`` (written by ``radtree method``, :mod:`radtree.verify.method`); absent without them.
 
-For each finding of SPEC §7 the section states a measurable test (below), evaluates it under
+For each finding of reference case §7 the section states a measurable test (below), evaluates it under
 every variant and names the setting that makes it appear or vanish: the variants form a chain
 in which each step changes one setting (study → threshold 0.005 → no threshold → whole-scene
 sun → free crown), so the first step at which the test flips names the cause. Then the

@@ -93,7 +93,7 @@ def hourly_table(data: ReportData) -> Table:
 def statistics_table(data: ReportData) -> Table:
     level = int(BOOTSTRAP["level"] * 100)
     t = Table("statistics",
-              "Statistics per scenario against the measured hourly means (SPEC.md §3): "
+              "Statistics per scenario against the measured hourly means (reference case §3): "
               "normalised RMSE and MBE (fractions of the mean measured value; MBE > 0 = the "
               f"model under-predicts), {level} % bootstrap interval on nRMSE (resampling hours), "
               "Pearson r, R² = 1 − SS_res/SS_tot, RMSE and MBE in lux, and the Monte Carlo "
@@ -184,7 +184,7 @@ def timing_table(data: ReportData) -> Table | None:
 
 
 def reflection_table(data: ReportData) -> Table:
-    t = Table("reflection", "Ground-reflected light per scenario (SPEC.md §2): traced through "
+    t = Table("reflection", "Ground-reflected light per scenario (reference case §2): traced through "
               "the scene, or calculated as E_refl = ρ(α)·E_ground·F with a black ground in the "
               "traced part.",
               ["scenario", "mode", "handling"], [False, False, False])
