@@ -83,8 +83,9 @@ def _prose(text: str) -> str:
 def _type_text(spec: Any) -> str:
     words = {"float": "number", "int": "integer", "bool": "true/false", "str": "text",
              "path": "file path", "times": "list of \"HH:MM\"", "date": "YYYY-MM-DD",
-             "mask": "[cx, cy, r] px"}
-    text = words[spec.kind]
+             "mask": "[cx, cy, r] px", "numbers": "list of numbers",
+             "rooms": "\"all\" or list of \"STOREY-BAY\"", "line": "[[x1, y1], [x2, y2]] m"}
+    text = words.get(spec.kind, spec.kind)
     if spec.choices:
         text = " / ".join(f"`{c}`" for c in spec.choices)
     if spec.path_ok:
@@ -227,20 +228,27 @@ RESULT_TABLES: list[tuple[str, list[str], str, str]] = [
                                  "radtree.pipeline.results:OPTIONAL_COLUMNS"],
      "radtree simulate", "one scenario × hour × grid × sensor; then `lux_traced`, "
      "`lux_reflected_calc`, `reflection` (and `lux_realisation_sd`, `realisations` for crown "
-     "realisations); `building`, `facade`, `storey` only for inventory districts"),
+     "realisations); `building`, `facade`, `storey` for inventory districts, `storey`, `room` "
+     "for office rooms and a street's sensor heights"),
     ("results/summary.csv", ["radtree.office_summary:SUMMARY_COLUMNS"], "radtree report "
-     "(office projects)", "one scenario × tree × hour × grid of the central office"),
+     "(office projects)", "one scenario × tree × hour × grid × room"),
+    ("results/tree_impact.csv", ["radtree.pipeline.tree_impact:COLUMNS"], "radtree simulate "
+     "(a project with trees and a scenario without)", "one scenario × hour × tree × façade "
+     "(or room): the light that tree alone removes (lux) and its share of the change"),
+    ("results/annual/standards.csv", ["radtree.annual.standards:COLUMNS"], "radtree annual",
+     "one scenario × grid (or room) × metric: EN 17037 daylight provision and sunlight "
+     "exposure, LEED v4.1 sDA and ASE, with its definition"),
     ("results/direct_sun.csv", ["radtree.pipeline.sunreach:DIRECT_SUN_COLUMNS"],
      "radtree simulate (perforated crowns)", "one hour × sensor: does the sun reach it"),
     ("results/photo_check.csv", ["radtree.photo.check:CHECK_COLUMNS"], "radtree hemi check",
      "one scenario × ring × segment: gap fraction of the photo and of the model"),
     ("results/photo_check_metrics.csv", ["radtree.photo.check:METRIC_COLUMNS"],
      "radtree hemi check", "one scenario × fisheye image (photo or model render)"),
-    ("results/annual.csv", ["radtree.annual.run:ANNUAL_COLUMNS"], "radtree annual",
+    ("results/annual.csv", ["radtree.annual.tables:ANNUAL_COLUMNS"], "radtree annual",
      "one grid × sensor × tree state: UDI bands, DA, ASE"),
-    ("results/annual_summary.csv", ["radtree.annual.run:SUMMARY_COLUMNS"], "radtree annual",
+    ("results/annual_summary.csv", ["radtree.annual.tables:SUMMARY_COLUMNS"], "radtree annual",
      "one grid × tree state: sDA, ASE, monthly mean"),
-    ("results/annual_monthly.csv", ["radtree.annual.run:MONTHLY_COLUMNS"], "radtree annual",
+    ("results/annual_monthly.csv", ["radtree.annual.tables:MONTHLY_COLUMNS"], "radtree annual",
      "one grid × tree state × month"),
     ("report/statistics.csv", ["radtree.stats:STATS_COLUMNS"], "radtree report",
      "one scenario: nRMSE (bootstrap interval), nMBE, r, R² against the measurements"),
@@ -266,7 +274,9 @@ RESULT_TABLES: list[tuple[str, list[str], str, str]] = [
 ]
 #: column lists that are not a written table of their own (checked by tests/test_docs.py)
 NOT_TABLES = {"radtree.pipeline.results:REQUIRED_COLUMNS", "radtree.annual.metrics:UDI_COLUMNS",
-              "radtree.office_summary:GRID_COLUMNS", "radtree.measurements:_VALUE_COLUMNS"}
+              "radtree.office_summary:GRID_COLUMNS", "radtree.measurements:_VALUE_COLUMNS",
+              "radtree.results_schema:RESULT_COLUMNS", "radtree.results_schema:OPTIONAL_COLUMNS",
+              "radtree.results_schema:REQUIRED_COLUMNS", "radtree.office_rooms:ROOM_COLUMNS"}
 
 
 def _columns(ref: str) -> list[str]:
