@@ -30,7 +30,7 @@ def main() -> int:
     from radtree.lidar.scanner import AlsScan
     from radtree.lidar.segment import segment_tile
     from radtree.lidar.tile import read_tile
-    from radtree.lidar.voxels import tree_voxels
+    from radtree.lidar.voxels import DEFAULT_SPACINGS, tree_voxels
     from radtree.trees.synthetic_scan import (
         STREET_LOUVERS,
         scan_street,
@@ -83,7 +83,7 @@ def main() -> int:
         print(f"{name}: max |error| {scale * v.max():.2f} {unit}, median "
               f"{scale * np.median(v):.2f} {unit}, within ±{scale * lim:g} {unit}: "
               f"{int(np.sum(v <= lim))}/{len(v)} — {'met' if v.max() <= lim else 'NOT met'}")
-    print(f"voxel size {rows[0][5]:g} m (5 point spacings); total leaf area true "
+    print(f"voxel size {rows[0][5]:g} m ({DEFAULT_SPACINGS:g} point spacings); total leaf area true "
           f"{sum(areas.values()):.0f} m², from the scan {sum(r[3] for r in rows):.0f} m²")
     return 0
 

@@ -60,7 +60,7 @@ def lidar_command() -> None:
 
     \b
     A street inventory from a city's ALS tile:
-      radtree lidar segment tile.laz --species tilia_cordata --crs EPSG:25833 --out trees.geojson
+      radtree lidar segment tile.laz --species morus_alba --crs EPSG:25833 --out trees.geojson
       radtree new street-study --trees trees.geojson --buildings footprints.geojson
     One tree's points (for a crown built from its points):
       radtree lidar clip tile.laz --tree L007 --out tree.laz
@@ -76,7 +76,7 @@ def lidar_command() -> None:
               help="The inventory GeoJSON to write.")
 @click.option("--species", required=True,
               help="Species of every tree (an airborne scan cannot tell it; edit the file per "
-                   "tree afterwards), e.g. tilia_cordata.")
+                   "tree afterwards), e.g. morus_alba.")
 @click.option("--crs", default=None,
               help="CRS of the tile's x, y when the tile records none, e.g. EPSG:25833, or "
                    "'local' when they are already metres from the site origin (x east, "
@@ -87,17 +87,18 @@ def segment_command(tile: Path, out: Path, species: str, crs: str | None, **sett
 
     \b
     Steps: heights above ground (ground points: classification 2, or --ground) → canopy
-    height model (highest point per --cell, smoothed by --smooth) → tree tops (local maxima
-    in a window widening with height, --window, rising --prominence above their saddles)
-    → crowns (marker-controlled watershed from
-    the tops, --crown-ratio) → per tree: position (the crown's area centroid), top, height_m,
+    height model (highest point per --cell, smoothed by --smooth; roofs and noise left out
+    by their class) → tree tops (local maxima in a window widening with height, --window,
+    rising --prominence above their saddles) → crowns (marker-controlled watershed from the
+    tops, --crown-ratio) → per tree: position (the crown's area centroid), top, height_m,
     crown_diameter_m (equal-area circle), crown_base_m (5 % quantile of the crown's returns
     above --min-height: biased high, as ALS sees little under a crown), points, and the
     crown's outline (property crown_outline).
 
     \b
-    The file is what `radtree new --trees` reads. A tile without a CRS keeps its metres:
-    give --crs (or [site] crs) before it meets longitude/latitude data.
+    The file is what `radtree new --trees` reads, in longitude/latitude when the tile's CRS
+    (or --crs) is known. A tile without a CRS keeps its metres: give --crs (or [site] crs)
+    before it meets longitude/latitude data.
     """
     from radtree.lidar.geojson import crs_name, write_inventory
     from radtree.lidar.segment import segment_tile
@@ -123,10 +124,14 @@ def segment_command(tile: Path, out: Path, species: str, crs: str | None, **sett
               help="The point file to write (.laz or .las).")
 @_settings
 def clip_command(tile: Path, tree_id: str, out: Path, **settings) -> None:  # type: ignore[no-untyped-def]
-    """Write one tree's points (those in its crown's cells, ground included) to LAS/LAZ.
+    """Write one tree's points (its crown and the ground around it) to LAS/LAZ.
 
     The tile is segmented again with the same options as `radtree lidar segment`, so the
-    same options give the same ids. The header (point format, scales, CRS) is the tile's.
+    same options give the same ids. Kept: the points of the tree's watershed region and of
+    the cells 2 m around it that belong to no other tree (its ground, so heights can be
+    found again; the beams that passed beside the crown). The header (point format, scales,
+    CRS) is the tile's. Use the file as [tree] points = "tree.laz" (free louvers crowns
+    filled voxel by voxel with its plant area density).
     """
     from radtree.lidar.clip import clip_tree
 

@@ -5,8 +5,12 @@
   or already normalised);
 * :mod:`~radtree.lidar.segment` canopy height model, tree tops, crowns (watershed);
 * :mod:`~radtree.lidar.geojson` the inventory GeoJSON ``radtree new --trees`` reads;
-* :mod:`~radtree.lidar.clip` one tree's points to a file;
-* :mod:`~radtree.lidar.evaluate` detected trees against reference trees.
+* :mod:`~radtree.lidar.clip` one tree's points to a file (and points to LAS/LAZ);
+* :mod:`~radtree.lidar.evaluate` detected trees against reference trees;
+* :mod:`~radtree.lidar.voxels` plant area density of one tree on voxels (Beer–Lambert), which
+  :mod:`radtree.trees.points_crown` fills with slats (``[tree] points``);
+* :mod:`~radtree.lidar.scanner` a synthetic airborne scanner (ray casting) for round trips
+  (:mod:`radtree.trees.synthetic_scan` scans radtree's own crowns).
 
 Units: metres, x east, y north, z up.
 """

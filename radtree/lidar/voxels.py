@@ -31,7 +31,7 @@ scans (beams from a scanner on the ground) break the vertical-beam assumption.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
@@ -57,6 +57,30 @@ class VoxelGrid:
     pad: np.ndarray
     g: float
     spacing_m: float
+    returns: np.ndarray = field(default_factory=lambda: np.zeros((0, 3)))  # x, y, height
+
+    def returns_in(self, i: np.ndarray, j: np.ndarray, k: np.ndarray,
+                   rng: np.random.Generator) -> tuple[np.ndarray, np.ndarray]:
+        """For voxels (i, j, k): the x, y of one of their returns drawn at random, and
+        whether the voxel has any (where not, x, y are NaN)."""
+        r = self.returns
+        ri = np.floor((r[:, 0] - self.x0) / self.size_m).astype(np.int64)
+        rj = np.floor((r[:, 1] - self.y0) / self.size_m).astype(np.int64)
+        rk = np.floor(r[:, 2] / self.size_m).astype(np.int64)
+        shape = self.pad.shape
+        ok = (ri >= 0) & (ri < shape[0]) & (rj >= 0) & (rj < shape[1]) & (rk >= 0) & (
+            rk < shape[2])
+        lin = np.ravel_multi_index((ri[ok], rj[ok], rk[ok]), shape)
+        order = np.argsort(lin, kind="stable")
+        lin_sorted, xy = lin[order], r[ok][order, :2]
+        want = np.ravel_multi_index((i, j, k), shape)
+        start = np.searchsorted(lin_sorted, want, side="left")
+        count = np.searchsorted(lin_sorted, want, side="right") - start
+        pick = start + np.floor(rng.random(len(want)) * count).astype(np.int64)
+        has = count > 0
+        out = np.full((len(want), 2), np.nan)
+        out[has] = xy[pick[has]]
+        return out, has
 
     @property
     def leaf_area_m2(self) -> float:
@@ -128,4 +152,5 @@ def tree_voxels(path: str | Path, g: float, size_m: float | None = None,
                           f"default {default_voxel_m(spacing):g} m", source=tile.source,
                           field=field)
     x0, y0, pad = plant_area_density(tile.xyz[:, :2], heights, size, g)
-    return VoxelGrid(x0, y0, size, pad, g, spacing)
+    returns = np.column_stack([tile.xyz[veg, :2], heights[veg]])
+    return VoxelGrid(x0, y0, size, pad, g, spacing, returns)

@@ -8,7 +8,9 @@ the species fills — so inversion and crown use the same leaves; wood counted a
 
 Every voxel of density PAD (m²/m³) and volume v³ receives PAD·v³ / s² slats of side s
 (``louvers.slat_size_m``; one-sided leaf area s² each; the fraction rounded up with a seeded
-draw), centres uniform in the voxel, normals at random azimuths and the louvers' inclination
+draw), centres at the heights uniform in the voxel and horizontally at one of the voxel's
+returns drawn at random ± half a point spacing (kept in the voxel; uniform where the voxel
+holds no return), so the crown keeps its shape inside a voxel; normals at random azimuths and the louvers' inclination
 (fixed or drawn from the ellipsoidal distribution). So the crown's leaf area is the scan's,
 voxel by voxel; ``cover_fraction`` plays no part (the slats' optics do: the gap reading, with
 near-opaque real leaves, is the consistent one). The cloud is placed on every trunk of the
@@ -65,6 +67,13 @@ def voxel_slats(grid: VoxelGrid, lv: Louvers, rng: np.random.Generator,
     cxy = grid.centroid_xy()
     corner = np.column_stack([grid.x0 + i * v - cxy[0], grid.y0 + j * v - cxy[1], k * v])
     centres = origin + corner + rng.random((len(idx), 3)) * v
+    # horizontally, slats go where the voxel's returns are (± half a point spacing), so the
+    # crown keeps its shape inside a voxel (a rim by the wall stays a rim)
+    xy, has = grid.returns_in(i, j, k, rng)
+    jitter = (rng.random((len(idx), 2)) - 0.5) * grid.spacing_m
+    lo = np.column_stack([grid.x0 + i * v, grid.y0 + j * v])
+    near = np.clip(xy + jitter, lo, lo + v)
+    centres[has, :2] = origin[:2] + near[has] - cxy
     phi = rng.uniform(0.0, 2.0 * math.pi, len(idx))
     tilt: Any = math.radians(lv.inclination_deg)
     if lv.inclination_distribution == "ellipsoidal":
