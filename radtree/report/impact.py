@@ -112,7 +112,8 @@ def impact_frame(results: pd.DataFrame, pairs: list[Pair]) -> pd.DataFrame:
     for p in pairs:
         w = _means(tagged[tagged["scenario"].astype(str) == p.trees])
         o = _means(tagged[tagged["scenario"].astype(str) == p.baseline])
-        both = w.join(o, lsuffix="_w", rsuffix="_o", how="inner").reset_index()
+        both = w.reset_index().merge(o.reset_index(), on=["level", "target", "time"],
+                                     suffixes=("_w", "_o"))
         if both.empty:
             continue
         both = both.sort_values(["level", "target", "time"], key=lambda c: c.map(
