@@ -255,8 +255,46 @@ def test_district_report_in_headless_chromium(district, tmp_path):
         probe.unlink()
     top = int(re.search(r'data-table-top="(-?\d+)"', run.stdout).group(1))
     assert 0 < top < 900 - 150, top          # the table starts in the first screen
-    console = [ln for ln in run.stderr.splitlines() if "CONSOLE" in ln or "Uncaught" in ln]
+    # Chromium logs every console message (log, error, uncaught exception) as INFO:CONSOLE;
+    # its own notes on software WebGL (a 3-D view on a machine without GPU) are not the page's
+    console = [ln for ln in run.stderr.splitlines() if ("CONSOLE" in ln or "Uncaught" in ln)
+               and "software WebGL" not in ln and "GL Driver Message" not in ln]
     assert not console, console
     from PIL import Image
 
     assert Image.open(shot).size == (1280, 900)
+
+
+def test_trees_ranked_and_standards_from_the_contract_files(district):
+    """results/tree_impact.csv and results/annual/standards.csv (written by the attribution
+    and the annual standards): the trees ranked by light removed, the standards with the
+    difference with − without."""
+    project, _, _ = district
+    trees = [t for t in json.loads((project.root / "data" / "trees.geojson").read_text())[
+        "features"]][:3]
+    ids = [str(t.get("id", t["properties"].get("id"))) for t in trees]
+    rows = []
+    for k, (tid, lux) in enumerate(zip(ids, (50.0, 400.0, 120.0))):
+        for time in ("10:30", "13:30"):
+            rows.append({"scenario": "trees", "time": time, "tree": tid, "target": "B05:3",
+                         "grid": "g", "lux_removed": lux, "lux_removed_stderr": 3.0,
+                         "share": 0.1 * (k + 1)})
+    pd.DataFrame(rows).to_csv(project.results_dir / "tree_impact.csv", index=False)
+    (project.results_dir / "annual").mkdir(exist_ok=True)
+    pd.DataFrame([
+        {"scenario": "trees", "target": "B05:3", "metric": "sDA300_50", "value": 40.0,
+         "unit": "%", "definition": "share of the area with DA300 ≥ 50 %"},
+        {"scenario": "bare", "target": "B05:3", "metric": "sDA300_50", "value": 55.0,
+         "unit": "%", "definition": "share of the area with DA300 ≥ 50 %"},
+    ]).to_csv(project.results_dir / "annual" / "standards.csv", index=False)
+    try:
+        parser = parse(build_report(project, echo=lambda s: None))
+    finally:
+        (project.results_dir / "tree_impact.csv").unlink()
+        shutil.rmtree(project.results_dir / "annual")
+    ranked = body(table(parser, "tree_ranking"))
+    assert [r[1][2] for r in ranked] == [ids[1], ids[2], ids[0]]
+    assert [r[2][2] for r in ranked] == ["800 ± 4", "240 ± 4", "100 ± 4"]
+    assert ranked[0][5][2] == "20"
+    std = body(table(parser, "impact_standards"))
+    assert [c[2] for c in std[0][:6]] == ["B05:3", "sDA300_50", "40.0", "55.0", "-15.0", "%"]
