@@ -3,15 +3,14 @@
 ``report/view3d.html`` is one self-contained page — a small WebGL viewer
 (``templates/view3d.html.j2``, no library: plotly's 4.6 MB bundle alone broke the report's
 2 MB budget, issue 38) with the scene inline as quantised triangles — no network, no CDN,
-opened from the report folder and embedded in ``index.html``. :func:`view_figure` (plotly)
-stays for notebooks. The scene
+opened from the report folder and embedded in ``index.html``. The scene
 of every simulated scenario that has a build folder is rebuilt
 (:func:`radtree.pipeline.assemble.make_scene`): what all
 scenarios share (street, rooms, glazing) is drawn once; each scenario's crown meshes and its
 grids, coloured by the results table's ``lux`` at the shown hour, are toggled by one button per
 scenario. Meshes are coloured like the glTF export (:func:`radtree.export.scene_files.
-material_rgba`); a mesh of more than :data:`MAX_TRIANGLES` triangles (dense slat crowns) is
-drawn with an even subset of them, and the section says so. The colour scale is logarithmic in
+material_rgba`); the scene keeps at most :data:`TRIANGLE_BUDGET` triangles, each mesh an
+even subset in proportion to its size (dense slat crowns are thinned), and the section says so. The colour scale is logarithmic in
 lux (rooms and façades differ by orders of magnitude), shared by all scenarios, from the 2nd to
 the 98th percentile of the shown values.
 """
@@ -28,7 +27,6 @@ from radtree.config import Project
 from radtree.fileio import write_text
 from radtree.scene import Mesh, Scene
 
-MAX_TRIANGLES = 20000
 GROUND_MARGIN_M = 3.0
 """The ground is drawn as a light, half-transparent quad reaching this far beyond the rest."""
 SHELL_OPACITY = 0.45
@@ -61,91 +59,6 @@ def _display(scene: Scene, mesh: Mesh, others: np.ndarray) -> tuple[Mesh, list[i
     if rgba[3] == 255:
         rgba[3] = int(255 * SHELL_OPACITY)
     return mesh, rgba
-
-
-def _mesh_trace(go: Any, mesh: Mesh, rgba: list[int], visible: bool) -> tuple[Any, int]:
-    faces = mesh.faces
-    shown = len(faces)
-    if shown > MAX_TRIANGLES:
-        faces = faces[np.linspace(0, len(faces) - 1, MAX_TRIANGLES).astype(int)]
-        shown = MAX_TRIANGLES
-    v = mesh.vertices
-    trace = go.Mesh3d(x=v[:, 0], y=v[:, 1], z=v[:, 2], i=faces[:, 0], j=faces[:, 1],
-                      k=faces[:, 2], color=f"rgb({rgba[0]},{rgba[1]},{rgba[2]})",
-                      opacity=rgba[3] / 255.0, flatshading=True, name=mesh.name,
-                      hoverinfo="name", showlegend=False, visible=visible)
-    return trace, shown
-
-
-def view_figure(scenes: dict[str, Scene], table: pd.DataFrame, hour: str) -> tuple[Any, dict]:
-    """The plotly figure and facts about it (triangles drawn, scenarios, colour range)."""
-    import plotly.graph_objects as go
-
-    names = list(scenes)
-    keyed = {n: {(m.name, m.material, m.n_triangles) for m in s.solid_meshes()}
-             for n, s in scenes.items()}
-    common = set.intersection(*keyed.values()) if keyed else set()
-    at = table[table["time"].astype(str) == hour]
-    shown_lux = np.maximum(at["lux"].to_numpy(float), 1.0)
-    lo, hi = (np.log10(np.percentile(shown_lux, [2, 98])) if len(shown_lux) else (0.0, 1.0))
-    hi = max(hi, lo + 0.5)
-    ticks = [10.0 ** k for k in range(int(np.floor(lo)), int(np.ceil(hi)) + 1)]
-    colorbar = {"title": {"text": "lux"}, "tickvals": [np.log10(v) for v in ticks],
-                "ticktext": [f"{v:g}" for v in ticks]}
-    cmax = 10.0 ** hi
-    traces: list[Any] = []
-    owner: list[str | None] = []
-    facts: dict[str, Any] = {"subsampled": [], "triangles": 0, "sensors": 0}
-    first = names[0]
-    others = np.vstack([m.vertices for s in scenes.values() for m in s.solid_meshes()
-                        if m.material != s.ground_material and m.n_triangles]
-                       + [g.points for s in scenes.values() for g in s.grids.values()])
-    for m in scenes[first].solid_meshes():
-        if (m.name, m.material, m.n_triangles) in common and m.n_triangles:
-            tr, n = _mesh_trace(go, *_display(scenes[first], m, others), True)
-            traces.append(tr)
-            owner.append(None)
-            facts["triangles"] += n
-    start = next((n for n in names if len(keyed[n] - common)), first)
-    for name in names:
-        scene = scenes[name]
-        for m in scene.solid_meshes():
-            if (m.name, m.material, m.n_triangles) in common or not m.n_triangles:
-                continue
-            tr, n = _mesh_trace(go, *_display(scene, m, others), name == start)
-            if n < m.n_triangles:
-                facts["subsampled"].append(f"{name}: {m.name} {n} of {m.n_triangles}")
-            traces.append(tr)
-            owner.append(name)
-            facts["triangles"] += n
-        part = at[at["scenario"] == name]
-        for gname, rows in part.groupby("grid", sort=False):
-            if gname not in scene.grids:
-                continue
-            rows = rows.sort_values("sensor")
-            traces.append(go.Scatter3d(
-                x=rows["x"], y=rows["y"], z=rows["z"], mode="markers",
-                name=f"{name}: {gname}", visible=name == start,
-                marker={"size": 4, "color": np.log10(np.maximum(rows["lux"], 1.0)),
-                        "colorscale": "Viridis", "cmin": lo, "cmax": hi, "colorbar": colorbar},
-                text=[f"{gname} #{s}: {v:.0f} lx" for s, v in zip(rows["sensor"], rows["lux"])],
-                hoverinfo="text", showlegend=False))
-            owner.append(name)
-            facts["sensors"] += len(rows)
-    buttons = [{"label": n, "method": "update",
-                "args": [{"visible": [o is None or o == n for o in owner]},
-                         {"title": {"text": f"{n} — illuminance at {hour}"}}]} for n in names]
-    fig = go.Figure(traces)
-    fig.update_layout(
-        title={"text": f"{start} — illuminance at {hour}"}, paper_bgcolor="white",
-        margin={"l": 0, "r": 0, "t": 40, "b": 0}, height=640,
-        scene={"aspectmode": "data", "xaxis_title": "x east (m)", "yaxis_title": "y north (m)",
-               "zaxis_title": "z (m)"},
-        updatemenus=[{"buttons": buttons, "direction": "right", "x": 0.0, "y": 1.0,
-                      "xanchor": "left", "yanchor": "top", "type": "buttons"}])
-    facts.update({"scenarios": names, "start": start, "hour": hour, "cmax": cmax,
-                  "cmin": 10.0 ** lo})
-    return fig, facts
 
 
 def write_view(project: Project, table: pd.DataFrame, out: Path) -> dict[str, Any] | None:

@@ -26,8 +26,7 @@ def view3d_data(project: Project, table: pd.DataFrame, out: Path,
 
     data = write_view(project, table, out)
     if data is None:
-        echo("  3-D view skipped: no scenario built with `radtree build` (or plotly not "
-             "installed: pip install 'radtree[honeybee]')")
+        echo("  3-D view skipped: no simulated scenario has a build folder (`radtree build`)")
     else:
         echo(f"  3-D view: {data['triangles']} triangles, {data['sensors']} sensors → "
              f"{project.report_dir / data['file']}")   # out is the folder renamed into place
