@@ -298,3 +298,74 @@ def test_trees_ranked_and_standards_from_the_contract_files(district):
     assert ranked[0][5][2] == "20"
     std = body(table(parser, "impact_standards"))
     assert [c[2] for c in std[0][:6]] == ["B05:3", "sDA300_50", "40.0", "55.0", "-15.0", "%"]
+
+
+def test_annual_metrics_with_without_and_rooms_csv(tmp_path):
+    """annual.csv / annual_summary.csv (radtree annual's layout) → with, without, difference
+    per grid, and the rows rooms.csv carries for them."""
+    from types import SimpleNamespace
+
+    from radtree.report.sections.impact import annual_rows, rooms_frame
+
+    res = tmp_path / "results"
+    res.mkdir()
+    pd.DataFrame({"grid": ["office"] * 4, "sensor": [0, 1, 0, 1],
+                  "tree": ["with", "with", "without", "without"],
+                  "udi_below_100": [10.0, 20.0, 5.0, 5.0], "udi_100_300": [0.0] * 4,
+                  "udi_300_3000": [90.0, 80.0, 95.0, 95.0], "udi_above_3000": [0.0] * 4,
+                  "da_300": [60.0, 40.0, 80.0, 70.0], "ase_hours": [0.0, 10.0, 100.0, 300.0]}
+                 ).to_csv(res / "annual.csv", index=False)
+    pd.DataFrame({"grid": ["office"] * 2, "tree": ["with", "without"], "sda_300_50": [50.0, 100.0],
+                  "ase_1000_250": [0.0, 50.0], "month": [1, 1], "mean_lux": [1.0, 2.0]}
+                 ).to_csv(res / "annual_summary.csv", index=False)
+    rows = annual_rows(SimpleNamespace(results_dir=res)).set_index("metric")
+    assert (rows.loc["sDA300/50%", "with"], rows.loc["sDA300/50%", "without"],
+            rows.loc["sDA300/50%", "difference"]) == (50.0, 100.0, -50.0)
+    assert rows.loc["DA300", "with"] == 50.0 and rows.loc["DA300", "without"] == 75.0
+    assert rows.loc["direct-sun hours > 1000 lx", "difference"] == -195.0
+    impact = impact_frame(pd.DataFrame({
+        "scenario": ["t", "o"], "time": ["12:00"] * 2, "grid": ["office"] * 2, "sensor": [0, 0],
+        "lux": [300.0, 400.0], "lux_stderr": [np.nan] * 2}), [Pair("t", "o")])
+    csv = rooms_frame(impact, rows.reset_index(), None, Pair("t", "o"))
+    day = csv[(csv["time"] == "day")].iloc[0]
+    assert (day["with"], day["without"], day["change"], day["change_pct"]) == (
+        300.0, 400.0, -100.0, -25.0)
+    sda = csv[csv["quantity"] == "sDA300/50%"].iloc[0]
+    assert (sda["time"], sda["change"], sda["change_pct"], sda["trees"]) == (
+        "annual", -50.0, -50.0, "t")
+
+
+def test_stand_in_scenario_is_marked_and_off_the_scale(tmp_path, monkeypatch):
+    """A photo scenario from the stand-in photo (F-photo): marked in the scenario table, dotted
+    and not setting the headline figure's vertical scale."""
+    from radtree.report.data import collect
+    from radtree.report.figures import hourly_plot
+
+    from .conftest import copy_project
+    from .test_report import write_results
+
+    folder = copy_project(tmp_path / "proj", photo=True)
+    p = load_project(folder)
+    write_results(p)
+    table_ = pd.read_csv(p.results_dir / "illuminance.csv", dtype={"scenario": str})
+    fphoto = table_[table_["scenario"] == "F"].assign(
+        scenario="F-photo", params_hash=p.params_hash(p.scenario("F-photo")))
+    fphoto["lux"] *= 6.0
+    pd.concat([table_, fphoto]).to_csv(p.results_dir / "illuminance.csv", index=False)
+    data = collect(p, echo=lambda s: None)
+    assert [s.name for s in data.scenarios if s.stand_in] == ["F-photo"]
+    from matplotlib.figure import Figure
+
+    seen = {}
+    original = Figure.savefig
+
+    def spy(fig, *a, **k):
+        seen["ylim"] = fig.axes[0].get_ylim()
+        return original(fig, *a, **k)
+
+    monkeypatch.setattr(Figure, "savefig", spy)
+    caption = hourly_plot(data, tmp_path / "h.png")
+    top = max(data.hourly_sim[data.hourly_sim["scenario"] != "F-photo"]["lux"].max(),
+              data.measured["measured_lux"].max())
+    assert "stand-in scenario(s) F-photo" in caption
+    assert seen["ylim"][1] < 1.2 * top < data.hourly_sim["lux"].max()

@@ -330,7 +330,8 @@ def build_report(project: Project, echo: Callable[[str], None] = print) -> Path:
         ctx = PageContext(
             title=f"radtree report — {p.name}",
             subtitle=_subtitle(data, light),
-            created=created, headline=_headline(data), notes=data.notes,
+            created=created, headline=(impact["lines"] if impact else []) + _headline(data),
+            notes=data.notes,
             has_measured=data.comparison is not None, tables=tables,
             models=model_pictures(data), map_reason=data.map_time_reason,
             method={

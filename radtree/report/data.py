@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import json
 import math
+import re
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -210,8 +211,8 @@ def light_description(records: list[dict[str, Any]]) -> str:
 def is_stand_in(sc: Any) -> bool:
     """A scenario whose crown comes from a stand-in input (its description says "stand-in",
     or a switch names a ``standin`` file): shown, marked, never the scale of a figure."""
-    words = [sc.description, *(str(v) for v in sc.switches.values())]
-    return any("stand-in" in w.lower() or "standin" in w.lower() for w in words)
+    return ("stand-in" in sc.description.lower()
+            or any(re.search(r"standin\b|stand-in", str(v).lower()) for v in sc.switches.values()))
 
 
 def is_reference_study(project: Project) -> bool:

@@ -12,6 +12,7 @@ it; the one named ``trees`` comes first. No baseline → no pair → no tree-imp
   ``facade`` column); otherwise the façade sensor grid ``facade``;
 * ``storey`` — in an inventory project each building's storey (``BUILDING storey N``, 0 =
   ground floor), over all its simulated façades;
+* ``building`` — in an inventory project each building, over all its simulated façade sensors;
 * ``room`` — every other sensor grid (office rooms' work planes, Honeybee sensor grids), by its
   name; the dense façade map ``facade_map`` is left out (the same façade as ``facade``).
 
@@ -35,7 +36,7 @@ from radtree.config import Project
 
 #: the grids that are façades (not rooms) in a non-inventory project
 FACADE_GRIDS = ("facade", "facade_map")
-LEVELS = ("façade", "storey", "room")
+LEVELS = ("façade", "storey", "building", "room")
 DAY = "day"
 IMPACT_COLUMNS = ["trees", "baseline", "level", "target", "time", "n_sensors", "with_lux",
                   "without_lux", "change_lux", "change_stderr", "change_pct"]
@@ -87,6 +88,9 @@ def target_rows(results: pd.DataFrame) -> pd.DataFrame:
             st = fac[fac["storey"].notna()]
             parts.append(st.assign(level="storey", target=[
                 f"{b} storey {int(float(s))}" for b, s in zip(st["building"], st["storey"])]))
+        if "building" in fac.columns and fac["building"].notna().any():
+            bd = fac[fac["building"].notna()]
+            parts.append(bd.assign(level="building", target=bd["building"].astype(str)))
         rest = results[results["facade"].isna()]
     else:
         fac = results[results["grid"].astype(str) == "facade"]

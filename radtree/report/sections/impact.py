@@ -30,7 +30,7 @@ from radtree.report.tables import Table, lux, num
 PLAN_FILE = "figures/tree_impact_plan.png"
 ROOMS_COLUMNS = ["room", "quantity", "time", "unit", "with", "without", "change", "change_pct",
                  "trees", "baseline"]
-LEVEL_TITLES = {"façade": "façade", "storey": "storey", "room": "room"}
+LEVEL_TITLES = {"façade": "façade", "storey": "storey", "building": "building", "room": "room"}
 #: results/annual.csv columns → (label, unit); means over the grid's sensors
 ANNUAL_SENSOR = {"udi_below_100": ("UDI < 100 lx", "% of occupied hours"),
                  "udi_100_300": ("UDI 100–300 lx", "% of occupied hours"),
@@ -335,7 +335,7 @@ def impact_data(project: Project, results: pd.DataFrame, pairs: list[Pair], out:
     over = f"mean over the {n_hours} simulated hour(s)"
     tables: dict[str, Table] = {}
     for level, key in (("façade", "impact_facades"), ("storey", "impact_storeys"),
-                       ("room", "impact_rooms")):
+                       ("building", "impact_buildings"), ("room", "impact_rooms")):
         tb = daily_table(impact, level, key, (
             f"What the trees do per {LEVEL_TITLES[level]}: mean illuminance of its sensors with "
             f"trees ({', '.join(p.trees for p in pairs)}) and without ({pair.baseline}), "
@@ -345,7 +345,7 @@ def impact_data(project: Project, results: pd.DataFrame, pairs: list[Pair], out:
         if tb is not None:
             tables[key] = tb
     hourly = {lv: hourly_table(impact, lv, f"impact_hourly_{i}")
-              for i, lv in enumerate(("façade", "storey", "room"))}
+              for i, lv in enumerate(("façade", "storey", "building", "room"))}
     annual = annual_rows(project)
     standards = standards_rows(project, pair)
     ranking = tree_ranking(project, pair)
@@ -377,10 +377,11 @@ def impact_data(project: Project, results: pd.DataFrame, pairs: list[Pair], out:
         d = day[(day["level"] == level) & day["change_pct"].notna()]
         if len(d):
             worst = d.loc[d["change_pct"].idxmin()]
-            lines.append(f"Over the day the trees ({pair.trees}) change the light on "
-                         f"{len(d)} {LEVEL_TITLES[level]}{'s' if len(d) > 1 else ''} by "
-                         f"{pct(d['change_pct'].min())} to {pct(d['change_pct'].max())} %; "
-                         f"most on {worst['target']} ({lux(worst['with_lux'])} lx with, "
+            lines.append(f"What the trees do ({pair.trees} against {pair.baseline}): the "
+                         f"mean illuminance over the day changes by {pct(d['change_pct'].min())} "
+                         f"% to {pct(d['change_pct'].max())} % across {len(d)} "
+                         f"{LEVEL_TITLES[level]}{'s' if len(d) > 1 else ''}; most on "
+                         f"{worst['target']} ({lux(worst['with_lux'])} lx with trees, "
                          f"{lux(worst['without_lux'])} lx without).")
     return {"pairs": [{"trees": p.trees, "baseline": p.baseline} for p in pairs],
             "baseline": pair.baseline, "lines": lines, "tables": tables,
