@@ -207,6 +207,13 @@ def test_baseline_marks_the_pair_and_leaves_hashes(tmp_path):
     assert [s.baseline for s in p.scenarios] == [False, True]
     assert p.params_hash(p.scenarios[1]) == q.params_hash(q.scenarios[1])
     assert tree_pairs(p, ["with", "without"]) == [Pair("with", "without")]
+    text = (folder / "radtree.toml").read_text().replace('name = "with"\n',
+                                                          'name = "with"\nbaseline = true\n')
+    (folder / "radtree.toml").write_text(text)
+    from radtree.errors import ConfigError
+
+    with pytest.raises(ConfigError, match=r"field 'scenario.baseline'.*with, without: mark one"):
+        load_project(folder)
 
 
 def test_impact_of_a_known_table():
