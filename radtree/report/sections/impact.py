@@ -377,12 +377,18 @@ def impact_data(project: Project, results: pd.DataFrame, pairs: list[Pair], out:
         d = day[(day["level"] == level) & day["change_pct"].notna()]
         if len(d):
             worst = d.loc[d["change_pct"].idxmin()]
-            lines.append(f"What the trees do ({pair.trees} against {pair.baseline}): the "
-                         f"mean illuminance over the day changes by {pct(d['change_pct'].min())} "
-                         f"% to {pct(d['change_pct'].max())} % across {len(d)} "
-                         f"{LEVEL_TITLES[level]}{'s' if len(d) > 1 else ''}; most on "
-                         f"{worst['target']} ({lux(worst['with_lux'])} lx with trees, "
-                         f"{lux(worst['without_lux'])} lx without).")
+            head = f"What the trees do ({pair.trees} against {pair.baseline}): "
+            vals = (f"{lux(worst['with_lux'])} lx with trees, {lux(worst['without_lux'])} lx "
+                    "without")
+            if len(d) == 1:
+                lines.append(head + f"the mean illuminance over the day on the "
+                             f"{LEVEL_TITLES[level]} {worst['target']} changes by "
+                             f"{pct(worst['change_pct'])} % ({vals}).")
+            else:
+                lines.append(head + f"the mean illuminance over the day changes by "
+                             f"{pct(d['change_pct'].min())} % to {pct(d['change_pct'].max())} % "
+                             f"across {len(d)} {LEVEL_TITLES[level]}s; most on "
+                             f"{worst['target']} ({vals}).")
     return {"pairs": [{"trees": p.trees, "baseline": p.baseline} for p in pairs],
             "baseline": pair.baseline, "lines": lines, "tables": tables,
             "hourly": [t for t in hourly.values() if t is not None],
