@@ -438,11 +438,7 @@ def office_section_data(project: Project, image_prefix: str = "office/") -> dict
             f"{o.grid_spacing_m:g} m cells, {o.wall_offset_m:g} m from the walls. "
             "Area bands use equal-area cells: < 300 lx, 300–2000 lx (both bounds "
             "included, 'useful'), > 2000 lx. U₀ = min/mean.")
-    sky = None
-    if project.light.sky == "perez":
-        sky = ("Sky: clear-sky Perez (gendaylit) with a stated diffuse horizontal illuminance of "
-               f"{project.light.diffuse_horizontal_lux:,.0f} lx (a substitute: the study gives "
-               "no hourly diffuse values), plus the measured direct normal illuminance.")
+    sky = None   # the light of each hour: the report's "light traced" section (manifest)
     grids = []
     for grid, g in summary.groupby("grid", sort=False):
         times = sorted(g["time"].astype(str).unique())

@@ -375,8 +375,10 @@ def test_minimal_results_layout(project: Project):
     shutil.rmtree(project.build_dir)
     parser = parse(build_report(project, echo=lambda s: None))
     text = " ".join(parser.text)
-    assert "No façade map" in text and "No timing table" in text
-    assert "No convergence run" in text and "no build manifest" in text
+    assert "No façade map" in text and "no build manifest" in text
+    html = (project.report_dir / "index.html").read_text()   # sections without data: absent
+    assert 'id="timing"' not in html and 'id="convergence"' not in html
+    assert "light not recorded" in text   # no manifest: no weather record, no default string
     assert sorted(parser.images) == ["figures/hourly.png", "figures/scatter.png"]
     stats = pd.read_csv(project.report_dir / "statistics.csv", keep_default_na=False)
     assert list(stats["reflection"]) == [SCENARIOS[n][1] for n in stats["scenario"]]

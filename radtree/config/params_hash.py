@@ -44,9 +44,16 @@ def params_hashes(project: Any, scenarios: list[Any]) -> dict[str, str]:
     """``{scenario name: 12-hex-digit hash}`` of a ``Project``'s scenarios; the project's part
     is read once for all (typed ``Any``: :mod:`.schema` imports this module)."""
     base = _project_payload(project)
-    return {sc.name: hashlib.sha256(json.dumps({**base, "scenario": plain(sc)}, sort_keys=True,
+    return {sc.name: hashlib.sha256(json.dumps({**base, "scenario": _scenario(sc)}, sort_keys=True,
                                                default=str).encode()).hexdigest()[:12]
             for sc in scenarios}
+
+
+def _scenario(sc: Any) -> dict[str, Any]:
+    """A scenario's part; ``baseline`` (what the report compares against) changes no number."""
+    d = plain(sc)
+    d.pop("baseline", None)
+    return d
 
 
 def _project_payload(project: Any) -> dict[str, Any]:

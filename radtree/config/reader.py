@@ -283,4 +283,9 @@ def _scenarios(top: _Reader, src: str) -> tuple[Scenario, ...]:
     names = [sc.name for sc in scenarios]
     if len(set(names)) != len(names):
         raise ConfigError(f"scenario names repeat: {names}", source=src, field="scenario")
+    marked = [sc.name for sc in scenarios if sc.baseline]
+    if len(marked) > 1:
+        raise ConfigError(f"baseline = true on scenarios {', '.join(marked)}: mark one (the "
+                          "scenario the report measures the trees against)", source=src,
+                          field="scenario.baseline")
     return tuple(scenarios)

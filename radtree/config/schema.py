@@ -390,6 +390,9 @@ class Scenario(Checked):
     form: str | None = field(default=None, metadata=meta(choices=TREE_FORMS))
     description: str = ""
     switches: dict[str, Any] = field(default_factory=dict)
+    #: the scenario without trees the report measures the trees' effect against (issue 38);
+    #: default: the one scenario of model ``none``
+    baseline: bool = field(default=False, metadata=meta(switch=False))
 
     #: the registry's check of a ``switches`` table; :mod:`radtree.config.switches` installs
     #: it on import (the registry is built from these dataclasses, so it cannot be imported here)

@@ -11,7 +11,7 @@ import radtree
 from radtree.fileio import file_sha256
 from radtree.light.weather import weather_record
 
-__all__ = ["file_sha256", "input_files", "manifest"]
+__all__ = ["file_sha256", "input_files", "manifest", "weather_record"]
 
 
 def input_files(project) -> dict[str, str]:
@@ -51,3 +51,36 @@ def manifest(project, extra: dict[str, Any] | None = None,
     if extra:
         d.update(extra)
     return d
+
+
+def _light_sources(light: Any, sky: str) -> tuple[str, str]:
+    """Where an hour's direct normal and diffuse horizontal illuminance came from (the order
+    of :func:`radtree.light.hours.hour_states`: a DNI table, else the EPW file for both)."""
+    if light.direct_normal_table is not None:
+        dni = f"DNI table {Path(light.direct_normal_table).name}"
+        dhi = f"[light] diffuse_horizontal_lux = {light.diffuse_horizontal_lux:g} lx (constant)"
+    else:
+        dni = dhi = f"weather file {Path(light.epw).name}" if light.epw else "not recorded"
+    return dni, (dhi if sky == "perez" else "no sky (sun only)")
+
+
+def weather_record(project: Any, states: dict[str, list[Any]]) -> dict[str, list[dict[str, Any]]]:
+    """The light each scenario was traced under, per hour, from its hour states
+    (``radtree.light.sky.SkyState``): ``{scenario: [{time, source, direct_normal_lux,
+    diffuse_horizontal_lux, sky}]}``, illuminances in lux as traced (the report describes the
+    light from this, issue 38)."""
+    from radtree.config import effective_project
+
+    out: dict[str, list[dict[str, Any]]] = {}
+    for name, sts in states.items():
+        sc = next((s for s in project.scenarios if s.name == name), None)
+        light = (effective_project(project, sc) if sc is not None else project).light
+        out[name] = []
+        for st in sts:
+            dni, dhi = _light_sources(light, st.sky_model)
+            out[name].append({"time": st.time, "source": f"direct normal: {dni}; diffuse "
+                              f"horizontal: {dhi}", "direct_normal_lux": round(
+                                  float(st.direct_normal_lux), 1),
+                              "diffuse_horizontal_lux": round(float(st.diffuse_horizontal_lux), 1),
+                              "sky": st.sky_model})
+    return out

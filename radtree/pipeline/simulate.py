@@ -35,7 +35,7 @@ from radtree.pipeline.build import (
     progress_bar,
 )
 from radtree.pipeline.limits import check_memory
-from radtree.pipeline.manifest import manifest
+from radtree.pipeline.manifest import manifest, weather_record
 from radtree.pipeline.parts import check_part, write_part
 from radtree.pipeline.processes import usable_cores, with_threads
 from radtree.pipeline.realisations import merge_realisations, parent_name, selected
@@ -298,10 +298,27 @@ def simulate_project(project: Project, engine: str | Engine = "auto",
             echo(f"  tree impact: {write_tree_impact(project, impact)}")
         _merge_timing(project.results_dir / "timing.csv", tdf)
         write_text(project.results_dir / "manifest.json", json.dumps(
-            manifest(project, extra={"engine": eng.name, "scenarios": [s.name for s in chosen]}),
+            manifest(project, extra={"engine": eng.name, "scenarios": [s.name for s in chosen],
+                                     "weather": _weather(project, prepared)}),
             indent=2, default=str))
     return SimulationOutcome(pd.read_csv(out), out, tdf, sum(len(j.parts) for j in todo),
                              reused, eng.name)
+
+
+def _weather(project: Project, prepared: dict[str, _Prepared]) -> dict[str, Any]:
+    """The manifest's weather record: this run's scenarios' hour states, and the earlier
+    runs' record of the scenarios the results table still holds."""
+    old: dict[str, Any] = {}
+    path = project.results_dir / "manifest.json"
+    if path.is_file():
+        try:
+            old = json.loads(path.read_text(encoding="utf-8")).get("weather") or {}
+        except (OSError, ValueError):
+            old = {}
+    states: dict[str, list[SkyState]] = {}
+    for name, prep in prepared.items():
+        states.setdefault(parent_name(name), prep.states)
+    return {**old, **weather_record(project, states)}
 
 
 def engine_trace(eng: Engine, plan: Any, sc: Scenario, states: list[SkyState],

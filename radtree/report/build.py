@@ -10,10 +10,20 @@ Writes, atomically (the whole folder is assembled beside it and renamed into pla
     PROJECT/report/rows.csv         per-row daily means (simulated vs measured)
     PROJECT/report/figures/*.png    150 dpi figures
     PROJECT/report/models/*.png     the crown-model pictures copied from build/<scenario>/
+    PROJECT/report/impact.csv       what the trees do, per façade / storey / room and hour
+                                    (:mod:`radtree.report.impact`; with a with/without pair)
+
+The page is one ordered list of sections (:func:`page_sections`), rendered alike by
+``report.html.j2`` and ``report.md.j2``: what the trees do first (when the project has a
+with/without-trees pair), the light traced (from the manifest's weather record), the results
+the project has (measurement statistics only with measurements, sensor rows only in the
+reference study, façades for an inventory, rooms for an office), then an appendix with the
+research sections (ground reflection, convergence, timing, provenance).
 """
 
 from __future__ import annotations
 
+import json
 import multiprocessing
 import shutil
 from collections.abc import Callable
@@ -31,9 +41,18 @@ from radtree.config import Project
 from radtree.fileio import atomic_dir
 from radtree.lock import PUBLISH_NAME, folder_lock
 from radtree.pipeline.processes import usable_cores
-from radtree.report.data import ReportData, collect
+from radtree.pipeline.results import read_results
+from radtree.report.data import (
+    ReportData,
+    collect,
+    is_reference_study,
+    light_description,
+    weather_records,
+)
+from radtree.report.impact import tree_pairs
 from radtree.report.sections import Section, environment
 from radtree.report.sections.extras import extra_sections
+from radtree.report.sections.impact import impact_data
 from radtree.report.sections.provenance import (
     ModelPicture,
     model_pictures,
@@ -54,6 +73,8 @@ from radtree.report.sections.results import (
 from radtree.report.tables import Table
 from radtree.stats import STATS_COLUMNS
 
+COMPASS = ("north", "north-east", "east", "south-east", "south", "south-west", "west",
+           "north-west")
 #: The columns of statistics.csv every reader may rely on (reference case §3, normalised).
 STATISTICS_CONTRACT = ["scenario", "model", "reflection", "rmse", "rmse_low", "rmse_high", "mbe",
                        "r", "r2", "n_hours"]
@@ -87,8 +108,7 @@ class PageContext:
     map_reason: str = ""
     method: dict[str, str] = field(default_factory=dict)
     parameters: Table | None = None
-    extras: list[Section] = field(default_factory=list)      # optional HTML sections, in order
-    extras_md: list[Section] = field(default_factory=list)   # their Markdown counterparts
+    sections: list[Section] = field(default_factory=list)    # the page, in order (html = md)
 
 
 # --------------------------------------------------------------------------- CSV outputs
@@ -201,6 +221,74 @@ class _Figures:
         return figs, self.problems
 
 
+def light_data(data: ReportData) -> dict[str, Any]:
+    """The light section: a line from the manifest's weather record and its hours."""
+    records = weather_records(data.results_manifest)
+    shown = {n: records[n] for n in data.names if n in records}
+    groups: dict[str, list[str]] = {}
+    for name, recs in shown.items():
+        groups.setdefault(json.dumps(recs, sort_keys=True), []).append(name)
+    first = next(iter(shown.values()), [])
+    if len(groups) <= 1:
+        description = "Every scenario: " + light_description(first) + "."
+    else:
+        description = "; ".join(f"scenario(s) {', '.join(names)}: "
+                                f"{light_description(json.loads(key))}"
+                                for key, names in groups.items()) + "."
+    table = None
+    if shown:
+        table = Table("light", "The light of each hour traced, as recorded by `radtree "
+                      "simulate` in results/manifest.json: direct normal and diffuse horizontal "
+                      "illuminance (lx), sky model and source.",
+                      ["scenarios", "hour", "direct normal (lx)", "diffuse horizontal (lx)",
+                       "sky", "source"], [False, False, True, True, False, False])
+        for key, names in groups.items():
+            for r in json.loads(key):
+                table.add(", ".join(names), r["time"], f"{float(r['direct_normal_lux']):,.0f}",
+                          f"{float(r['diffuse_horizontal_lux']):,.0f}", r["sky"], r["source"])
+    return {"description": description, "table": table, "first": light_description(first)
+            if len(groups) <= 1 else "per scenario (see 'The light traced')"}
+
+
+def _subtitle(data: ReportData, light: dict[str, Any]) -> str:
+    p = data.project
+    if p.district is not None:
+        where = "every façade of the inventory's buildings"
+    else:
+        az = p.street.facade_azimuth_deg
+        where = f"façade facing {COMPASS[round(az / 45) % 8]} (azimuth {az:g}°)"
+    return f"{p.site.name}, {p.site.date}; {where}; light: {light['first']}"
+
+
+def page_sections(data: ReportData, tables: dict[str, Table], impact: dict[str, Any] | None,
+                  light: dict[str, Any], extras: list[Section], has_maps: bool
+                  ) -> list[Section]:
+    """The page's sections in order, each only when the project has its data."""
+    reference = is_reference_study(data.project)
+    out: list[Section] = []
+    if impact is not None:
+        out.append(Section("impact", impact, "What the trees do"))
+    out.append(Section("light", light, "The light traced"))
+    out.append(Section("scenarios", {}, "Scenarios"))
+    out.append(Section("hourly", {}, "Hourly façade illuminance"))
+    if data.comparison is not None:
+        out.append(Section("statistics", {}, "Statistics against measurement"))
+    if "rows" in tables and (reference or data.rows_measured):
+        out.append(Section("rows", {}, "Sensor rows"))
+    if has_maps:
+        out.append(Section("maps", {}, "False-colour façade maps"))
+    out.extend(extras)
+    if any(s.model != "none" for s in data.scenarios):
+        out.append(Section("models", {}, "Crown models"))
+    out.append(Section("reflection", {}, "Ground-reflected light", appendix=True))
+    if "convergence" in tables:
+        out.append(Section("convergence", {}, "-ab convergence", appendix=True))
+    if "timing" in tables:
+        out.append(Section("timing", {}, "Timing", appendix=True))
+    out.append(Section("provenance", {}, "Provenance", appendix=True))
+    return out
+
+
 def build_report(project: Project, echo: Callable[[str], None] = print) -> Path:
     """Write ``PROJECT/report/`` (index.html, index.md, CSVs, figures); return index.html.
 
@@ -211,6 +299,7 @@ def build_report(project: Project, echo: Callable[[str], None] = print) -> Path:
     with folder_lock(project.results_dir, "radtree report", wait=True, name=PUBLISH_NAME,
                      shared=True):                 # one simulate's table, timing and manifest
         data = collect(project, echo=echo)
+        raw = read_results(project)
     created = datetime.now(timezone.utc).isoformat(timespec="seconds")
     target = project.report_dir
     with atomic_dir(target) as tmp:
@@ -231,15 +320,18 @@ def build_report(project: Project, echo: Callable[[str], None] = print) -> Path:
         if conv is not None and conv_summary is not None:
             tables["convergence"], tables["convergence_summary"] = conv, conv_summary
         tables.update(provenance_tables(data, created))
+        pairs = tree_pairs(project, data.names)
+        impact = impact_data(project, raw, pairs, tmp) if pairs else None
+        if impact is not None:
+            echo(f"  what the trees do: {', '.join(p.trees for p in pairs)} against "
+                 f"{pairs[0].baseline}")
+        light = light_data(data)
         p = project
         ctx = PageContext(
             title=f"radtree report — {p.name}",
-            subtitle=(f"{p.site.name}, {p.site.date}; façade looking "
-                      f"{p.street.facade_azimuth_deg:g}° (compass); " + (
-                          f"light: {data.scenarios[0].sky}"
-                          if len({s.sky for s in data.scenarios}) == 1
-                          else "light per scenario (Table 1)")),
-            created=created, headline=_headline(data), notes=data.notes,
+            subtitle=_subtitle(data, light),
+            created=created, headline=(impact["lines"] if impact else []) + _headline(data),
+            notes=data.notes,
             has_measured=data.comparison is not None, tables=tables,
             models=model_pictures(data), map_reason=data.map_time_reason,
             method={
@@ -249,8 +341,12 @@ def build_report(project: Project, echo: Callable[[str], None] = print) -> Path:
             },
             parameters=parameters_table(data),
         )
-        ctx.extras, ctx.extras_md = extra_sections(project, tmp, echo)
+        extras = extra_sections(project, tmp, echo, raw)
         ctx.figs, ctx.figure_problems = drawing.results()
+        if data.map_time is None and project.district is None:
+            ctx.notes.append(f"No façade map: {data.map_time_reason}.")
+        ctx.sections = page_sections(data, tables, impact, light, extras,
+                                     "facade_map" in ctx.figs)
         statistics_frame(data).to_csv(tmp / "statistics.csv", index=False)
         hourly_frame(data).to_csv(tmp / "hourly.csv", index=False)
         rf = rows_frame(data)
@@ -263,4 +359,3 @@ def build_report(project: Project, echo: Callable[[str], None] = print) -> Path:
     index = target / "index.html"
     echo(f"report written to {index}")
     return index
-

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import json
 import math
+import re
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -65,6 +66,7 @@ class ScenarioInfo:
     build_manifest_found: bool = False
     picture: Path | None = None
     picture_problem: str = ""
+    stand_in: bool = False   # a crown from a stand-in input (see :func:`is_stand_in`)
 
     @property
     def form_label(self) -> str:
@@ -172,13 +174,52 @@ def _reflection_notes(project: Project, notes: list[str]) -> dict[str, str]:
         return out
 
 
+SKY_LABELS = {"none": "sun only", "perez": "sun + Perez sky"}
+
+
 def _sky_label(project: Project, sky: str) -> str:
-    if sky == "none":
-        return "sun only"
-    if sky == "perez":
-        return (f"sun + clear-sky Perez sky ({project.light.diffuse_horizontal_lux:g} lx "
-                "diffuse horizontal)")
-    return sky
+    """The sky model in words (its values per hour: the manifest's weather record)."""
+    return SKY_LABELS.get(sky, sky)
+
+
+def weather_records(manifest: dict[str, Any] | None) -> dict[str, list[dict[str, Any]]]:
+    """The manifest's weather record (``{scenario: [{time, source, direct_normal_lux,
+    diffuse_horizontal_lux, sky}]}``, :func:`radtree.pipeline.manifest.weather_record`);
+    empty when the results predate it."""
+    rec = (manifest or {}).get("weather")
+    return rec if isinstance(rec, dict) else {}
+
+
+def light_description(records: list[dict[str, Any]]) -> str:
+    """One line on the light of the hours traced, from their weather records."""
+    if not records:
+        return ("light not recorded (results written before radtree recorded the weather in "
+                "results/manifest.json: run `radtree simulate` again)")
+
+    def span(key: str) -> str:
+        v = [float(r[key]) for r in records]
+        return f"{min(v):,.0f} lx" if max(v) - min(v) < 0.5 else f"{min(v):,.0f}–{max(v):,.0f} lx"
+
+    skies = sorted({str(r["sky"]) for r in records})
+    text = f"{', '.join(SKY_LABELS.get(s, s) for s in skies)}: direct normal {span('direct_normal_lux')}"
+    if any(float(r["diffuse_horizontal_lux"]) > 0 for r in records):
+        text += f", diffuse horizontal {span('diffuse_horizontal_lux')}"
+    sources = sorted({str(r["source"]) for r in records})
+    return text + f" ({'; '.join(sources)})"
+
+
+def is_stand_in(sc: Any) -> bool:
+    """A scenario whose crown comes from a stand-in input (its description says "stand-in",
+    or a switch names a ``standin`` file): shown, marked, never the scale of a figure."""
+    return ("stand-in" in sc.description.lower()
+            or any(re.search(r"standin\b|stand-in", str(v).lower()) for v in sc.switches.values()))
+
+
+def is_reference_study(project: Project) -> bool:
+    """The reference study's project (``examples/mendoza-*``): the sensor-dome crown form, or
+    measured daily means per sensor row. Only its report shows the study's sections."""
+    return (project.measured_rows is not None or project.tree.form == "dome"
+            or any(s.form == "dome" for s in project.scenarios))
 
 
 def scenario_infos(project: Project, results: pd.DataFrame,
@@ -240,6 +281,7 @@ def scenario_infos(project: Project, results: pd.DataFrame,
             engine=", ".join(engines), params_hash=", ".join(hashes), current_hash=current,
             in_project=sc is not None, build=build, build_manifest_found=mf is not None,
             picture=picture, picture_problem=problem,
+            stand_in=sc is not None and is_stand_in(sc),
         ))
 
     def key(info: ScenarioInfo) -> tuple[int, str, int, str]:
@@ -310,12 +352,23 @@ def _row_tables(project: Project, results: pd.DataFrame, measured: pd.DataFrame 
 # --------------------------------------------------------------------------- assembly
 
 
+def _no_map_reason(project: Project) -> str:
+    """Why the results hold no dense façade grid, and what to do — from the project."""
+    if project.district is not None:
+        return ("an inventory project traces every façade's sensors instead of one dense "
+                "façade map; the site plan and the per-façade tables show every façade")
+    if project.sensors.dense_grid:
+        return ("the results hold no dense façade grid ('facade_map') although "
+                "sensors.dense_grid is on: they predate it, or none of sensors.dense_hours was "
+                "simulated — run `radtree simulate` again")
+    return "sensors.dense_grid is off (set it to true and simulate again for a façade map)"
+
+
 def _map_time(results: pd.DataFrame, measured: pd.DataFrame | None,
-              hourly_sim: pd.DataFrame) -> tuple[str | None, str]:
+              hourly_sim: pd.DataFrame, project: Project) -> tuple[str | None, str]:
     maps = results[results["grid"].astype(str) == MAP_GRID]
     if maps.empty:
-        return None, ("the results hold no dense façade grid ('facade_map'; set "
-                      "sensors.dense_grid = true and simulate again)")
+        return None, _no_map_reason(project)
     times = set(maps["time"])
     if measured is not None:
         m = measured[measured["time"].isin(times)]
@@ -426,7 +479,7 @@ def collect(project: Project, echo: Callable[[str], None] = print) -> ReportData
     if convergence is not None:
         convergence = convergence.assign(scenario=convergence["scenario"].astype(str))
     manifest = _read_json(project.results_dir / "manifest.json", notes)
-    map_time, reason = _map_time(results, measured, hourly_sim)
+    map_time, reason = _map_time(results, measured, hourly_sim, project)
     return ReportData(
         project=project, results=results, scenarios=scenarios, hourly_sim=hourly_sim,
         hourly=hourly, measured=measured, measured_shape=measured_shape, comparison=comparison,

@@ -101,22 +101,33 @@ def hourly_plot(data: ReportData, path: Path) -> str:
     times = sorted(set(data.hourly["time"]))
     with_bars: list[str] = []
     without: list[str] = []
+    scale: list[float] = []          # the values that set the y axis (no stand-in)
     for info in data.scenarios:
         h = data.hourly_sim[data.hourly_sim["scenario"] == info.name].sort_values("time")
         x = [decimal_hour(t) for t in h["time"]]
         se = h["lux_stderr"].to_numpy(dtype=float)
         have_se = bool(np.isfinite(se).all() and len(se))
         (with_bars if have_se else without).append(info.name)
-        ax.errorbar(x, h["lux"].to_numpy(dtype=float), yerr=se if have_se else None,
-                    color=colours[info.name], linestyle=_style(info), marker="s",
-                    markersize=4, linewidth=1.4, capsize=3, label=info.label)
+        y = h["lux"].to_numpy(dtype=float)
+        if not info.stand_in:
+            scale.extend(y + (np.nan_to_num(se) if have_se else 0.0))
+        ax.errorbar(x, y, yerr=se if have_se else None,
+                    color=colours[info.name], linestyle=":" if info.stand_in else _style(info),
+                    marker="s", markersize=4, linewidth=1.0 if info.stand_in else 1.4,
+                    capsize=3, label=info.label + (" (stand-in)" if info.stand_in else ""))
     if data.measured is not None:
         m = data.measured.sort_values("time")
         ax.plot([decimal_hour(t) for t in m["time"]], m["measured_lux"], label="measured",
                 **MEASURED_STYLE)
+        scale.extend(m["measured_lux"].to_numpy(dtype=float))
     _time_axis(ax, times, data.project.site.utc_offset_hours)
     ax.set_ylabel(LUX_LABEL)
-    ax.set_ylim(bottom=0)
+    finite = [v for v in scale if np.isfinite(v)]
+    stand_ins = [s.name for s in data.scenarios if s.stand_in]
+    if stand_ins and finite:
+        ax.set_ylim(0, 1.1 * max(finite))   # a stand-in does not set the scale
+    else:
+        ax.set_ylim(bottom=0)
     ax.grid(True, alpha=0.3)
     fig.legend(*_measured_first(ax), fontsize=7.5, loc="outside right upper", frameon=False)
     ax.set_title(f"{data.project.site.name}, {data.project.site.date}", fontsize=10)
@@ -133,6 +144,10 @@ def hourly_plot(data: ReportData, path: Path) -> str:
                     "(the engine gives none).")
     if data.measured is None:
         caption += " No measurements in this project."
+    if stand_ins:
+        caption += (f" Dotted: stand-in scenario(s) {', '.join(stand_ins)} (a crown from a "
+                    "stand-in input, not the studied tree); they do not set the vertical scale "
+                    "and may run off it.")
     return caption
 
 

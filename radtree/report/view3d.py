@@ -1,14 +1,16 @@
 """The report's interactive 3-D view: crowns, buildings and sensor grids coloured by illuminance.
 
-``report/view3d.html`` is one self-contained page (plotly with its JavaScript bundle inline —
-no network, no CDN), opened from the report folder and embedded in ``index.html``. The scene
+``report/view3d.html`` is one self-contained page — a small WebGL viewer
+(``templates/view3d.html.j2``, no library: plotly's 4.6 MB bundle alone broke the report's
+2 MB budget, issue 38) with the scene inline as quantised triangles — no network, no CDN,
+opened from the report folder and embedded in ``index.html``. The scene
 of every simulated scenario that has a build folder is rebuilt
 (:func:`radtree.pipeline.assemble.make_scene`): what all
 scenarios share (street, rooms, glazing) is drawn once; each scenario's crown meshes and its
 grids, coloured by the results table's ``lux`` at the shown hour, are toggled by one button per
 scenario. Meshes are coloured like the glTF export (:func:`radtree.export.scene_files.
-material_rgba`); a mesh of more than :data:`MAX_TRIANGLES` triangles (dense slat crowns) is
-drawn with an even subset of them, and the section says so. The colour scale is logarithmic in
+material_rgba`); the scene keeps at most :data:`TRIANGLE_BUDGET` triangles, each mesh an
+even subset in proportion to its size (dense slat crowns are thinned), and the section says so. The colour scale is logarithmic in
 lux (rooms and façades differ by orders of magnitude), shared by all scenarios, from the 2nd to
 the 98th percentile of the shown values.
 """
@@ -25,7 +27,6 @@ from radtree.config import Project
 from radtree.fileio import write_text
 from radtree.scene import Mesh, Scene
 
-MAX_TRIANGLES = 20000
 GROUND_MARGIN_M = 3.0
 """The ground is drawn as a light, half-transparent quad reaching this far beyond the rest."""
 SHELL_OPACITY = 0.45
@@ -60,100 +61,14 @@ def _display(scene: Scene, mesh: Mesh, others: np.ndarray) -> tuple[Mesh, list[i
     return mesh, rgba
 
 
-def _mesh_trace(go: Any, mesh: Mesh, rgba: list[int], visible: bool) -> tuple[Any, int]:
-    faces = mesh.faces
-    shown = len(faces)
-    if shown > MAX_TRIANGLES:
-        faces = faces[np.linspace(0, len(faces) - 1, MAX_TRIANGLES).astype(int)]
-        shown = MAX_TRIANGLES
-    v = mesh.vertices
-    trace = go.Mesh3d(x=v[:, 0], y=v[:, 1], z=v[:, 2], i=faces[:, 0], j=faces[:, 1],
-                      k=faces[:, 2], color=f"rgb({rgba[0]},{rgba[1]},{rgba[2]})",
-                      opacity=rgba[3] / 255.0, flatshading=True, name=mesh.name,
-                      hoverinfo="name", showlegend=False, visible=visible)
-    return trace, shown
-
-
-def view_figure(scenes: dict[str, Scene], table: pd.DataFrame, hour: str) -> tuple[Any, dict]:
-    """The plotly figure and facts about it (triangles drawn, scenarios, colour range)."""
-    import plotly.graph_objects as go
-
-    names = list(scenes)
-    keyed = {n: {(m.name, m.material, m.n_triangles) for m in s.solid_meshes()}
-             for n, s in scenes.items()}
-    common = set.intersection(*keyed.values()) if keyed else set()
-    at = table[table["time"].astype(str) == hour]
-    shown_lux = np.maximum(at["lux"].to_numpy(float), 1.0)
-    lo, hi = (np.log10(np.percentile(shown_lux, [2, 98])) if len(shown_lux) else (0.0, 1.0))
-    hi = max(hi, lo + 0.5)
-    ticks = [10.0 ** k for k in range(int(np.floor(lo)), int(np.ceil(hi)) + 1)]
-    colorbar = {"title": {"text": "lux"}, "tickvals": [np.log10(v) for v in ticks],
-                "ticktext": [f"{v:g}" for v in ticks]}
-    cmax = 10.0 ** hi
-    traces: list[Any] = []
-    owner: list[str | None] = []
-    facts: dict[str, Any] = {"subsampled": [], "triangles": 0, "sensors": 0}
-    first = names[0]
-    others = np.vstack([m.vertices for s in scenes.values() for m in s.solid_meshes()
-                        if m.material != s.ground_material and m.n_triangles]
-                       + [g.points for s in scenes.values() for g in s.grids.values()])
-    for m in scenes[first].solid_meshes():
-        if (m.name, m.material, m.n_triangles) in common and m.n_triangles:
-            tr, n = _mesh_trace(go, *_display(scenes[first], m, others), True)
-            traces.append(tr)
-            owner.append(None)
-            facts["triangles"] += n
-    start = next((n for n in names if len(keyed[n] - common)), first)
-    for name in names:
-        scene = scenes[name]
-        for m in scene.solid_meshes():
-            if (m.name, m.material, m.n_triangles) in common or not m.n_triangles:
-                continue
-            tr, n = _mesh_trace(go, *_display(scene, m, others), name == start)
-            if n < m.n_triangles:
-                facts["subsampled"].append(f"{name}: {m.name} {n} of {m.n_triangles}")
-            traces.append(tr)
-            owner.append(name)
-            facts["triangles"] += n
-        part = at[at["scenario"] == name]
-        for gname, rows in part.groupby("grid", sort=False):
-            if gname not in scene.grids:
-                continue
-            rows = rows.sort_values("sensor")
-            traces.append(go.Scatter3d(
-                x=rows["x"], y=rows["y"], z=rows["z"], mode="markers",
-                name=f"{name}: {gname}", visible=name == start,
-                marker={"size": 4, "color": np.log10(np.maximum(rows["lux"], 1.0)),
-                        "colorscale": "Viridis", "cmin": lo, "cmax": hi, "colorbar": colorbar},
-                text=[f"{gname} #{s}: {v:.0f} lx" for s, v in zip(rows["sensor"], rows["lux"])],
-                hoverinfo="text", showlegend=False))
-            owner.append(name)
-            facts["sensors"] += len(rows)
-    buttons = [{"label": n, "method": "update",
-                "args": [{"visible": [o is None or o == n for o in owner]},
-                         {"title": {"text": f"{n} — illuminance at {hour}"}}]} for n in names]
-    fig = go.Figure(traces)
-    fig.update_layout(
-        title={"text": f"{start} — illuminance at {hour}"}, paper_bgcolor="white",
-        margin={"l": 0, "r": 0, "t": 40, "b": 0}, height=640,
-        scene={"aspectmode": "data", "xaxis_title": "x east (m)", "yaxis_title": "y north (m)",
-               "zaxis_title": "z (m)"},
-        updatemenus=[{"buttons": buttons, "direction": "right", "x": 0.0, "y": 1.0,
-                      "xanchor": "left", "yanchor": "top", "type": "buttons"}])
-    facts.update({"scenarios": names, "start": start, "hour": hour, "cmax": cmax,
-                  "cmin": 10.0 ** lo})
-    return fig, facts
-
-
 def write_view(project: Project, table: pd.DataFrame, out: Path) -> dict[str, Any] | None:
-    """Write ``out/view3d.html`` and return the section's data (None without plotly, or when
-    no simulated scenario has a build folder with geometry — results not made by
-    ``radtree build`` + ``simulate``)."""
-    try:
-        import plotly  # noqa: F401
-    except ImportError:
-        return None
+    """Write ``out/view3d.html`` (the light viewer: ``templates/view3d.html.j2``, WebGL, no
+    library, data inline) and return the section's data (None when no simulated scenario
+    has a build folder with geometry — results not made by ``radtree build`` + ``simulate``)."""
+    import json
+
     from radtree.pipeline.build import built_scene
+    from radtree.resources import template_environment
 
     names = list(dict.fromkeys(table["scenario"].astype(str)))
     scenes = {sc.name: built_scene(project, sc).scene for sc in project.scenarios
@@ -161,9 +76,88 @@ def write_view(project: Project, table: pd.DataFrame, out: Path) -> dict[str, An
     if not scenes:
         return None
     hour = shown_hour(table)
-    fig, facts = view_figure(scenes, table, hour)
-    html = fig.to_html(full_html=True, include_plotlyjs=True, div_id=DIV_ID,
-                       config={"displaylogo": False})
+    payload, facts = scene_payload(scenes, table, hour)
+    html = template_environment(autoescape=False).get_template("view3d.html.j2").render(
+        data=json.dumps(payload, separators=(",", ":")), div_id=DIV_ID)
     write_text(out / VIEW_FILE, html)
     return {"file": VIEW_FILE, **facts,
-            "cmax_text": f"{facts['cmax']:.0f}", "cmin_text": f"{facts['cmin']:.0f}", "subsampled_text": "; ".join(facts["subsampled"])}
+            "cmax_text": f"{facts['cmax']:.0f}", "cmin_text": f"{facts['cmin']:.0f}",
+            "subsampled_text": "; ".join(facts["subsampled"])}
+
+
+# --------------------------------------------------------------------------- light viewer
+#: the light viewer's triangle budget over the whole scene (issue 38: a report ≤ 2 MB): each
+#: mesh keeps an even subset of its triangles in proportion to its size
+TRIANGLE_BUDGET = 24000
+
+
+def _quantised(tri: np.ndarray, lo: np.ndarray, span: float) -> str:
+    """Triangle corners (k, 3, 3) m as little-endian uint16 over the scene box, base64."""
+    import base64
+
+    q = np.clip(np.rint((tri.reshape(-1, 3) - lo) / span * 65535), 0, 65535).astype("<u2")
+    return base64.b64encode(q.tobytes()).decode("ascii")
+
+
+def scene_payload(scenes: dict[str, Scene], table: pd.DataFrame, hour: str
+                  ) -> tuple[dict[str, Any], dict[str, Any]]:
+    """The light viewer's data (meshes as quantised triangle soups with their colour and
+    owning scenario, sensors with log10 lux) and the facts the section states."""
+    names = list(scenes)
+    keyed = {n: {(m.name, m.material, m.n_triangles) for m in s.solid_meshes()}
+             for n, s in scenes.items()}
+    common = set.intersection(*keyed.values()) if keyed else set()
+    at = table[table["time"].astype(str) == hour]
+    shown_lux = np.maximum(at["lux"].to_numpy(float), 1.0)
+    lo_l, hi_l = (np.log10(np.percentile(shown_lux, [2, 98])) if len(shown_lux) else (0.0, 1.0))
+    hi_l = max(hi_l, lo_l + 0.5)
+    others = np.vstack([m.vertices for s in scenes.values() for m in s.solid_meshes()
+                        if m.material != s.ground_material and m.n_triangles]
+                       + [g.points for s in scenes.values() for g in s.grids.values()])
+    first = names[0]
+    start = next((n for n in names if len(keyed[n] - common)), first)
+    chosen: list[tuple[str | None, Mesh, list[int]]] = []
+    for m in scenes[first].solid_meshes():
+        if (m.name, m.material, m.n_triangles) in common and m.n_triangles:
+            chosen.append((None, *_display(scenes[first], m, others)))
+    for name in names:
+        for m in scenes[name].solid_meshes():
+            if (m.name, m.material, m.n_triangles) not in common and m.n_triangles:
+                chosen.append((name, *_display(scenes[name], m, others)))
+    allv = np.vstack([others] + [m.vertices for _, m, _ in chosen])
+    lo = allv.min(axis=0)
+    span = float(max(np.ptp(allv, axis=0).max(), 1e-6))
+    total = sum(len(m.faces) for _, m, _ in chosen)
+    keep = min(1.0, TRIANGLE_BUDGET / max(total, 1))
+    meshes, drawn, thinned = [], 0, []
+    for owner, m, rgba in chosen:
+        faces = m.faces
+        n = max(1, int(round(len(faces) * keep)))
+        if n < len(faces):
+            faces = faces[np.linspace(0, len(faces) - 1, n).astype(int)]
+            if owner is not None:
+                thinned.append(f"{owner}: {m.name} {n} of {len(m.faces)}")
+        drawn += len(faces)
+        meshes.append({"owner": owner, "rgba": rgba, "tri": _quantised(m.vertices[faces], lo,
+                                                                        span)})
+    points, sensors = [], 0
+    for name in names:
+        part = at[at["scenario"] == name]
+        for gname, rows in part.groupby("grid", sort=False):
+            if gname not in scenes[name].grids:
+                continue
+            rows = rows.sort_values("sensor")
+            xyz = rows[["x", "y", "z"]].to_numpy(float)
+            points.append({"owner": name, "grid": str(gname),
+                           "xyz": [round(float(v), 2) for v in xyz.ravel()],
+                           "lux": [round(float(v), 1) for v in rows["lux"]]})
+            sensors += len(rows)
+    focus = np.vstack([others.min(axis=0), others.max(axis=0)])   # buildings, crowns, grids
+    payload = {"scenarios": names, "start": start, "hour": hour, "lo": lo.tolist(),
+               "span": span, "centre": focus.mean(axis=0).round(3).tolist(),
+               "extent": float(max(np.ptp(focus, axis=0).max(), 1e-3)), "meshes": meshes, "points": points, "log_lo": float(lo_l),
+               "log_hi": float(hi_l)}
+    facts = {"scenarios": names, "start": start, "hour": hour, "triangles": drawn,
+             "sensors": sensors, "subsampled": thinned, "cmin": 10.0 ** lo_l,
+             "cmax": 10.0 ** hi_l}
+    return payload, facts

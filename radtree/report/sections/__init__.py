@@ -25,6 +25,10 @@ from radtree.resources import template_environment
 OPTIONAL = ("office", "sweep", "realisations", "permeability_scan", "diagnose", "annual",
             "direct_sun", "photo_check", "method", "facades")
 OPTIONAL += ("honeybee", "view3d")  # type: ignore[assignment]  # issue 19 (own line: merges)
+#: issue 38: the tree impact (first), the light traced, and the core sections by name (their
+#: templates read the page context ``c``; ``data`` is then empty)
+OPTIONAL += ("impact", "light", "scenarios", "hourly", "statistics", "rows", "maps",  # type: ignore[assignment]
+             "models", "reflection", "convergence", "timing", "provenance")
 
 
 @dataclass(frozen=True)
@@ -34,6 +38,8 @@ class Section:
 
     name: str
     data: dict[str, Any]
+    title: str = ""          # the contents' entry (default: from the name)
+    appendix: bool = False   # research sections after the results
 
     def __post_init__(self) -> None:
         if self.name not in OPTIONAL:

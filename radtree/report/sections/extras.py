@@ -80,12 +80,12 @@ def diagnose_data(folder: Path) -> dict[str, Any]:
     } for _, r in steps.iterrows()]}
 
 
-def extra_sections(project: Project, out: Path, echo: Callable[[str], None]
-                   ) -> tuple[list[Section], list[Section]]:
-    """The HTML and the Markdown sections of the studies that exist for this project, in page
-    order. Their figures are written into ``out`` (the report folder)."""
-    html: list[Section] = []
-    md: list[Section] = []
+def extra_sections(project: Project, out: Path, echo: Callable[[str], None],
+                   table: pd.DataFrame | None = None) -> list[Section]:
+    """The sections of the studies that exist for this project, in page order (the HTML and
+    the Markdown report show the same). Their figures are written into ``out`` (the report
+    folder). ``table``: the results table, when already read."""
+    secs: list[Section] = []
     if project.office is not None:
         from radtree.office_summary import (
             office_section_data,
@@ -97,69 +97,60 @@ def extra_sections(project: Project, out: Path, echo: Callable[[str], None]
         )
 
         write_summary(project, maps=False)
-        table = read_results(project)
-        write_maps(project, table, out / "office")
-        write_hourly_charts(project, summarise(table), out / "office")
-        html.append(Section("office", office_section_data(project)))
+        office_table = read_results(project)
+        write_maps(project, office_table, out / "office")
+        write_hourly_charts(project, summarise(office_table), out / "office")
+        secs.append(Section("office", office_section_data(project), "Office block"))
         echo("  office block: summary table and false-colour maps")
-    from radtree.sweep.sensitivity import sweep_section_data
-
-    sweep = sweep_section_data(project.root)
-    if sweep is not None:
-        html.append(Section("sweep", sweep))
-        echo("  sweep: sensitivity section")
-    crowns = realisations_data(project)
-    if crowns is not None:
-        html.append(Section("realisations", crowns))
-        md.append(Section("realisations", crowns))
-        echo("  crown realisations section")
-    from radtree.calibrate.scan import scan_section_data
-
-    scan = scan_section_data(project, out)
-    if scan is not None:
-        html.append(Section("permeability_scan", scan))
-        md.append(Section("permeability_scan", scan))
-        echo("  permeability scan section")
-    diagnosis = diagnose_data(project.root / "diagnose")
-    if (project.root / "diagnose" / "index.html").exists():
-        html.append(Section("diagnose", diagnosis))
-    if diagnosis["steps"] is not None:
-        md.append(Section("diagnose", diagnosis))
-    if (project.results_dir / "annual_summary.csv").exists():
-        from radtree.annual.report import annual_section_data
-
-        html.append(Section("annual", annual_section_data(project)))
-        echo("  annual: metric maps and month × hour heat maps")
-    from radtree.pipeline.results import read_results
-    from radtree.report.sections.models3d import honeybee_data, view3d_data
-
-    table = read_results(project)
-    for name, make in (("honeybee", honeybee_data), ("view3d", view3d_data)):
-        data = make(project, table, out, echo)
-        if data is not None:
-            html.append(Section(name, data))
-            md.append(Section(name, data))
-
-    from radtree.report.sections.photo import photo_sections
-
-    p_html, p_md = photo_sections(project, out)
-    html += p_html
-    md += p_md
-
-    from radtree.report.sections.method import method_section_data
-
-    method = method_section_data(project, out)
-    if method is not None:
-        html.append(Section("method", method))
-        md.append(Section("method", method))
-        echo("  the study's method: variants, findings, dome-radius scan")
-
     if project.district is not None:
         from radtree.report.sections.facades import facades_data
 
         facades = facades_data(project, out)
         if facades is not None:
-            html.append(Section("facades", facades))
-            md.append(Section("facades", facades))
+            secs.append(Section("facades", facades, "Every façade"))
             echo(f"  every façade: site plan of {facades['features']} façades")
-    return html, md
+    if (project.results_dir / "annual_summary.csv").exists():
+        from radtree.annual.report import annual_section_data
+
+        secs.append(Section("annual", annual_section_data(project), "Annual daylight"))
+        echo("  annual: metric maps and month × hour heat maps")
+    from radtree.pipeline.results import read_results
+    from radtree.report.sections.models3d import honeybee_data, view3d_data
+
+    table = read_results(project) if table is None else table
+    for name, title, make in (("honeybee", "Honeybee model", honeybee_data),
+                              ("view3d", "3-D view", view3d_data)):
+        data = make(project, table, out, echo)
+        if data is not None:
+            secs.append(Section(name, data, title))
+    from radtree.sweep.sensitivity import sweep_section_data
+
+    sweep = sweep_section_data(project.root)
+    if sweep is not None:
+        secs.append(Section("sweep", sweep, "Sensitivity sweep"))
+        echo("  sweep: sensitivity section")
+    crowns = realisations_data(project)
+    if crowns is not None:
+        secs.append(Section("realisations", crowns, "Crown realisations"))
+        echo("  crown realisations section")
+    from radtree.calibrate.scan import scan_section_data
+
+    scan = scan_section_data(project, out)
+    if scan is not None:
+        secs.append(Section("permeability_scan", scan, "Permeability scan"))
+        echo("  permeability scan section")
+    diagnosis = diagnose_data(project.root / "diagnose")
+    if diagnosis["steps"] is not None:
+        secs.append(Section("diagnose", diagnosis, "Diagnosis"))
+
+    from radtree.report.sections.photo import photo_sections
+
+    secs += photo_sections(project, out)
+
+    from radtree.report.sections.method import method_section_data
+
+    method = method_section_data(project, out)
+    if method is not None:
+        secs.append(Section("method", method, "The study's method"))
+        echo("  the study's method: variants, findings, dome-radius scan")
+    return secs

@@ -26,10 +26,10 @@ def view3d_data(project: Project, table: pd.DataFrame, out: Path,
 
     data = write_view(project, table, out)
     if data is None:
-        echo("  3-D view skipped: plotly is not installed (pip install 'radtree[honeybee]')")
+        echo("  3-D view skipped: no simulated scenario has a build folder (`radtree build`)")
     else:
         echo(f"  3-D view: {data['triangles']} triangles, {data['sensors']} sensors → "
-             f"{out / data['file']}")
+             f"{project.report_dir / data['file']}")   # out is the folder renamed into place
     return data
 
 
@@ -54,7 +54,7 @@ def honeybee_data(project: Project, table: pd.DataFrame, out: Path,
     if hourly.exists():
         folders += write_annual_results(hourly, parts.model, out / "honeybee" / "annual")
     echo(f"  Honeybee results: {len(folders)} folders in honeybee-radiance's layout → "
-         f"{out / 'honeybee'}")
+         f"{project.report_dir / 'honeybee'}")
     grids = [g.identifier for g in parts.model.properties.radiance.sensor_grids]
     return {"model": project.honeybee.model.name, "grids": grids,
             "folders": [str(f.relative_to(out)) for f in folders], "notes": parts.notes,

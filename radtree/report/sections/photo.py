@@ -72,16 +72,13 @@ def photo_check_data(project: Project, out: Path) -> dict[str, Any] | None:
     return {"scenarios": scenarios}
 
 
-def photo_sections(project: Project, out: Path) -> tuple[list[Section], list[Section]]:
-    """The HTML and Markdown photo sections that exist for this project."""
-    html: list[Section] = []
-    md: list[Section] = []
+def photo_sections(project: Project, out: Path) -> list[Section]:
+    """The photo sections that exist for this project (HTML and Markdown alike)."""
+    secs: list[Section] = []
     sun = direct_sun_data(project)
     if sun is not None:
-        html.append(Section("direct_sun", sun))
-        md.append(Section("direct_sun", sun))
+        secs.append(Section("direct_sun", sun, "Direct sun through the gaps"))
     check = photo_check_data(project, out)
     if check is not None:
-        html.append(Section("photo_check", check))
-        md.append(Section("photo_check", check))
-    return html, md
+        secs.append(Section("photo_check", check, "Crown against its photo"))
+    return secs

@@ -57,7 +57,8 @@ def scenario_table(data: ReportData) -> Table:
                "engine", "-ab", "triangles", "description"],
               [False, False, False, False, False, False, True, True, False])
     _add_grouped(t, data, data.names, lambda s: [[
-        s.name, s.model_label, s.form_label + ("" if s.form_source != "project file"
+        s.name + (" (stand-in)" if s.stand_in else ""), s.model_label,
+        s.form_label + ("" if s.form_source != "project file"
                                                else " (from the project file)"),
         s.reflection or "—", s.sky, text(s.engine), num(s.build.get("ab")),
         num(s.build.get("triangles")), text(s.description)]])
