@@ -96,5 +96,5 @@ def test_madrid_from_radtree_new(tmp_path: Path) -> None:
     facade = table[table.grid == "facade"].groupby("time").lux.mean()
     assert set(facade.index) == set(p.site.hours) and (facade > 500).all(), facade
     manifest = json.loads((folder / "results" / "manifest.json").read_text())
-    nine_w = next(w for w in manifest["weather"] if w["time"] == "09:00")
-    assert nine_w["source"].startswith("clear sky") and nine_w["direct_normal_lux"] > 40000
+    nine_w = next(w for w in manifest["weather"]["open"] if w["time"] == "09:00")
+    assert "clear sky (pvlib" in nine_w["source"] and nine_w["direct_normal_lux"] > 40000

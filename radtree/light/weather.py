@@ -209,8 +209,7 @@ def hour_weather(project, hours: list[str]) -> dict[str, HourWeather]:
     when = pd.DatetimeIndex([pd.Timestamp(local_datetime(site.date, h, site.tzinfo))
                              .tz_convert("UTC") for h in hours])
     cs = clear_sky_illuminance(when, site.latitude, site.longitude, site.elevation_m)
-    return {h: HourWeather(float(d), float(f), "clear sky (pvlib Ineichen-Perez, Linke "
-                           "turbidity climatology; Perez 1990 luminous efficacy)")
+    return {h: HourWeather(float(d), float(f), CLEAR_SKY_SOURCE)
             for h, d, f in zip(hours, cs["dni_lux"], cs["dhi_lux"])}
 
 
@@ -265,16 +264,20 @@ def find_weather(project, epw: Path | None = None, echo=None) -> WeatherSource:
     return WeatherSource(out, True, f"{out.name} (GENERATED clear sky for the site)")
 
 
-def weather_record(project, hours: list[str] | None = None) -> list[dict]:
-    """The weather each hour was traced with, for the manifest and the report: time, source,
-    direct normal and diffuse horizontal illuminance (lux), the sky model."""
-    hours = list(project.site.hours) if hours is None else list(hours)
-    rows = []
-    for h, w in hour_weather(project, hours).items():
-        dhi = (project.light.diffuse_horizontal_lux if w.diffuse_horizontal_lux is None
-               else w.diffuse_horizontal_lux)
-        rows.append({"time": h, "date": project.site.date, "time_zone": project.site.time_zone,
-                     "source": w.source, "direct_normal_lux": round(w.direct_normal_lux, 1),
-                     "diffuse_horizontal_lux": round(dhi, 1) if project.light.sky == "perez"
-                     else 0.0, "sky": project.light.sky})
-    return rows
+
+#: how the clear sky is made, for records and reports (:mod:`radtree.light.clearsky`)
+CLEAR_SKY_SOURCE = ("clear sky (pvlib Ineichen-Perez, Linke turbidity climatology; Perez 1990 "
+                    "luminous efficacy)")
+
+
+def weather_sources(light) -> tuple[str, str]:
+    """Where an hour's direct normal and diffuse horizontal illuminance come from, in words,
+    for ``[light]`` (``weather``: clear sky, an EPW, or a DNI table and the constant
+    ``diffuse_horizontal_lux``)."""
+    if light.weather == "table":
+        return (f"DNI table {Path(light.direct_normal_table).name}",
+                f"[light] diffuse_horizontal_lux = {light.diffuse_horizontal_lux:g} lx (constant)")
+    if light.weather == "epw":
+        name = f"EPW {Path(light.epw).name}"
+        return name, name
+    return CLEAR_SKY_SOURCE, CLEAR_SKY_SOURCE

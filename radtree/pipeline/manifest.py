@@ -9,7 +9,7 @@ from typing import Any
 
 import radtree
 from radtree.fileio import file_sha256
-from radtree.light.weather import weather_record
+from radtree.light.weather import weather_sources
 
 __all__ = ["file_sha256", "input_files", "manifest", "weather_record"]
 
@@ -46,7 +46,6 @@ def manifest(project, extra: dict[str, Any] | None = None,
         "seeds": {"engine": project.engine.seed, "louvers": project.tree.louvers.seed},
         "inputs": input_files(project),
         "params_hash": project.params_hashes(project.scenarios),
-        "weather": weather_record(project),
     })
     if extra:
         d.update(extra)
@@ -54,13 +53,9 @@ def manifest(project, extra: dict[str, Any] | None = None,
 
 
 def _light_sources(light: Any, sky: str) -> tuple[str, str]:
-    """Where an hour's direct normal and diffuse horizontal illuminance came from (the order
-    of :func:`radtree.light.hours.hour_states`: a DNI table, else the EPW file for both)."""
-    if light.direct_normal_table is not None:
-        dni = f"DNI table {Path(light.direct_normal_table).name}"
-        dhi = f"[light] diffuse_horizontal_lux = {light.diffuse_horizontal_lux:g} lx (constant)"
-    else:
-        dni = dhi = f"weather file {Path(light.epw).name}" if light.epw else "not recorded"
+    """Where an hour's direct normal and diffuse horizontal illuminance came from
+    (:func:`radtree.light.weather.weather_sources`); no sky: no diffuse light."""
+    dni, dhi = weather_sources(light)
     return dni, (dhi if sky == "perez" else "no sky (sun only)")
 
 
