@@ -42,3 +42,18 @@ def test_the_examples_photo_fit_is_good() -> None:
     p = load_project(ROOT / "examples" / "mendoza-street")
     notes = built_scene(p, p.scenario("F-photo")).notes
     assert not any("POOR PHOTO FIT" in n for n in notes)
+
+
+def test_the_report_says_so_on_its_first_page() -> None:
+    """The accepted poor fit's build note becomes the report's first headline line."""
+    from types import SimpleNamespace
+
+    from radtree.report.build import _warnings
+
+    p, sc = _scenario(True)
+    notes = built_scene(p, sc).notes
+    data = SimpleNamespace(names=["F-photo", "A"], scenario=lambda n: SimpleNamespace(
+        build={"notes": notes} if n == "F-photo" else {}))
+    lines = _warnings(data)
+    assert len(lines) == 1 and lines[0].startswith("WARNING — scenario F-photo: POOR PHOTO FIT "
+                                                   "ACCEPTED ([tree] accept_poor_fit = true)")

@@ -170,7 +170,7 @@ def test_office_report_rooms(office):
     html = index.read_text()
     assert '<section id="statistics"' in html          # the office has measurements
     assert '<section id="rows"' not in html            # not the reference study
-    assert "Office block: the central office" in _same_sections(index)   # md has it too
+    assert "Office block: the sensed offices" in _same_sections(index)   # md has it too
     _light_matches_manifest(project, index, "with")
     _reference_free(project, index)
     _printed_paths_exist(printed)

@@ -142,6 +142,18 @@ def rows_frame(data: ReportData) -> pd.DataFrame | None:
 # --------------------------------------------------------------------------- assembly
 
 
+def _warnings(data: ReportData) -> list[str]:
+    """First-page warnings from the builds: a crown built from a photo fit the user accepted
+    although it does not describe the photo (``[tree] accept_poor_fit``)."""
+    out = []
+    for name in data.names:
+        for note in data.scenario(name).build.get("notes", []) or []:
+            if str(note).startswith("POOR PHOTO FIT ACCEPTED"):
+                out.append(f"WARNING — scenario {name}: {note} Its crown is not what the "
+                           "photo shows; read its results with that in mind.")
+    return out
+
+
 def _headline(data: ReportData) -> list[str]:
     p = data.project
     hours = sorted(set(data.hourly["time"]))
@@ -330,7 +342,8 @@ def build_report(project: Project, echo: Callable[[str], None] = print) -> Path:
         ctx = PageContext(
             title=f"radtree report — {p.name}",
             subtitle=_subtitle(data, light),
-            created=created, headline=(impact["lines"] if impact else []) + _headline(data),
+            created=created, headline=(_warnings(data) + (impact["lines"] if impact else [])
+                                       + _headline(data)),
             notes=data.notes,
             has_measured=data.comparison is not None, tables=tables,
             models=model_pictures(data), map_reason=data.map_time_reason,

@@ -327,7 +327,7 @@ def facade_maps(data: ReportData, path: Path) -> str:
     scale = "logarithmic" if isinstance(norm, LogNorm) else "linear"
     return ("False-colour vertical illuminance (lx) on the dense façade grid at "
             f"{data.map_time_reason}; one panel per scenario, one common colour scale "
-            f"({scale}); white dots mark the study's sensors. Horizontal axis: distance along "
+            f"({scale}); white dots mark the façade sensors. Horizontal axis: distance along "
             "the façade (m, to the right seen from the street); vertical: height above the "
             "street (m).")
 
