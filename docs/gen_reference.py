@@ -224,8 +224,8 @@ def cli_page() -> str:
 # ---------------------------------------------------------------- results tables
 #: (file, "module:CONSTANT" column lists, written by, what one row is)
 RESULT_TABLES: list[tuple[str, list[str], str, str]] = [
-    ("results/illuminance.csv", ["radtree.pipeline.results:RESULT_COLUMNS",
-                                 "radtree.pipeline.results:OPTIONAL_COLUMNS"],
+    ("results/illuminance.csv", ["radtree.results_schema:RESULT_COLUMNS",
+                                 "radtree.results_schema:OPTIONAL_COLUMNS"],
      "radtree simulate", "one scenario × hour × grid × sensor; then `lux_traced`, "
      "`lux_reflected_calc`, `reflection` (and `lux_realisation_sd`, `realisations` for crown "
      "realisations); `building`, `facade`, `storey` for inventory districts, `storey`, `room` "
@@ -235,6 +235,13 @@ RESULT_TABLES: list[tuple[str, list[str], str, str]] = [
     ("results/tree_impact.csv", ["radtree.pipeline.tree_impact:COLUMNS"], "radtree simulate "
      "(a project with trees and a scenario without)", "one scenario × hour × tree × façade "
      "(or room): the light that tree alone removes (lux) and its share of the change"),
+    ("report/impact.csv", ["radtree.report.impact:IMPACT_COLUMNS"], "radtree report "
+     "(a with-trees scenario and a baseline)", "one with-trees scenario × level (façade, storey, "
+     "building, room) × target × time (HH:MM or `day`): mean illuminance with and without the "
+     "trees (lux), the change in lux and %, its standard error"),
+    ("results/rooms.csv", ["radtree.report.sections.impact:ROOMS_COLUMNS"], "radtree report "
+     "(rooms, with a baseline)", "one room × quantity × time: `illuminance` (lux) at each hour "
+     "and over the `day`, then each annual metric at time `annual`; with, without, change"),
     ("results/annual/standards.csv", ["radtree.annual.standards:COLUMNS"], "radtree annual",
      "one scenario × grid (or room) × metric: EN 17037 daylight provision and sunlight "
      "exposure, LEED v4.1 sDA and ASE, with its definition"),
