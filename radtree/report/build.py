@@ -46,10 +46,9 @@ from radtree.report.data import (
     ReportData,
     collect,
     is_reference_study,
-    light_description,
-    weather_records,
 )
 from radtree.report.impact import tree_pairs
+from radtree.report.light import light_description, weather_records
 from radtree.report.sections import Section, environment
 from radtree.report.sections.extras import extra_sections
 from radtree.report.sections.impact import impact_data
