@@ -7,7 +7,7 @@ by a dead process is never in the way. The file carries the holder's pid, host a
 line, so a second run is refused with one message naming them (or, with ``wait=True``, waits
 for them to finish). Within one process the lock is re-entrant (``simulate`` → ``build``).
 
-    with folder_lock(project.results_dir, "radtree simulate examples/mendoza-street"):
+    with folder_lock(project.results_dir, "radtree simulate my-street"):
         ...
 """
 

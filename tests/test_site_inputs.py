@@ -51,6 +51,7 @@ def test_inventory_spread_over_10_km_is_refused(tmp_path: Path) -> None:
     res = CliRunner().invoke(main, ["new", str(tmp_path / "p"), *MADRID, "--trees",
                                     str(_csv(tmp_path, rows)), "--template", "district"])
     _refused(res, "trees.csv", "the trees spread over 13.", "split the inventory")
+    assert not (tmp_path / "p").exists()
 
 
 def test_all_inputs_far_from_the_given_site(tmp_path: Path) -> None:
@@ -60,6 +61,7 @@ def test_all_inputs_far_from_the_given_site(tmp_path: Path) -> None:
                                     "--template", "district"])
     _refused(res, "trees.csv", "km from the site (latitude 40.42, longitude -3.7",
              "longitude and latitude swapped")
+    assert not (tmp_path / "p").exists()
 
 
 def test_new_checks_the_inventory_as_build_does(tmp_path: Path) -> None:

@@ -23,7 +23,7 @@ Growth rule (deterministic for a seed):
 * every segment is an opaque prism of ``sides`` faces (bark, reflectance 0.2).
 
 Twigs thinner than the last order are not modelled, so the bare crown built here is on the
-open side of a real leafless *Morus alba* (the notes give its vertical cover so the reader
+open side of a real leafless street tree (the notes give its vertical cover so the reader
 can judge). The structure is plain data (:class:`BranchParams`) so it can be calibrated
 against a measured winter permeability.
 """

@@ -17,7 +17,7 @@ vertical view), so the share of the leafed-minus-bare difference the hour takes 
     w(f) = (1 − exp(−k·f·L)) / (1 − exp(−k·L))        (w(0) = 0, w(1) = 1)
 
 and E(h) = E_bare(h) + w(f(h)) · (E_leaf(h) − E_bare(h)). Leaves first added block more
-than the last ones (w > f in between): half the leaf area of a Morus alba crown
+than the last ones (w > f in between): half the leaf area of the reference case's crown
 (L = 5.80 − 1.39 = 4.41) already blocks 75 % of what the full crown blocks over the bare one.
 """
 

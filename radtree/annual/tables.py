@@ -9,7 +9,7 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
-from radtree.annual import metrics
+import radtree.annual.metrics as metrics
 
 TREES = ("with", "without")
 ANNUAL_COLUMNS = ["grid", "sensor", "tree", "udi_below_100", "udi_100_300", "udi_300_3000",

@@ -121,7 +121,7 @@ def calibrate_crossings(project: Project, target: float | None = None,
 
     ``seeds``: crown realisations (``louvers.seed`` values; default the project's). The eight
     façade sensors sit within 0.25 m, so the slats just in front of them weigh heavily and one
-    realisation's permeability scatters by ≈ 14 % (s.d., Mendoza, crossings 16); the
+    realisation's permeability scatters by ≈ 14 % (s.d., reference case, crossings 16); the
     permeability is the mean over the realisations (the same seeds at every crossings value,
     and a larger crossings adds slats to the same realisation, so the mean curve is smooth).
     ``stderr`` is the tracing (Monte Carlo) error used by the stopping rule;

@@ -18,7 +18,7 @@ the centre traced through its own part of the curved dome (the part near the wal
 grazing light along the wall differently from the part facing the street). ``segments``: the
 dome's BSDF shell is meshed with this many segments around (``segments`` / 4 rings; 0: the
 dome's ``tree.dome.segments``). Defaults 5 sectors and 192 segments (48 rings): on the
-Mendoza dome (scenario B, 7 hours, 24 runs) every hourly façade mean within 4.1 % of the
+reference-case dome (scenario B, 7 hours, 24 runs) every hourly façade mean within 4.1 % of the
 explicit slats', where 1 sector on the dome's 12 rings is 8.6 % off at 10:30 (CHANGELOG.md, crown
 BSDFs) — the curvature rows then take ≈ 100 s once instead of ≈ 9 s, a 7-hour trace 26–41 s
 instead of 10–14 s.

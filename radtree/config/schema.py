@@ -344,7 +344,7 @@ class EngineParams(Checked):
     # forward engine: focused launch, innermost disc radius (m) around the target grid (None =
     # start points uniform over the launch disc)
     # (default 1 m, with forward_guide 0.8: the variance reduction that makes the precision target
-    # affordable — on Mendoza A/B at 12:30 10–20× less time to a 2 % *estimated* error than the
+    # affordable — on reference-case A/B at 12:30 10–20× less time to a 2 % *estimated* error than the
     # uniform launch, whose 64 M photons still left 3.5 %: benchmarks/forward.py)
     forward_focus_m: float | None = field(default=1.0, metadata=meta(0.0, lo_open=True))
     # forward engine: children per diffuse event near the target grid (1 = none), and how near

@@ -18,8 +18,8 @@ use it); the crown side lives in :mod:`radtree.trees.species`, which re-exports 
 import them from there in layer 4 and above::
 
     from radtree.trees.species import load_species, known_species
-    sp = load_species("Morus alba")            # or "morus_alba", or "white mulberry"
-    sp.leaf_area_fraction(355, -32.89)          # 1.0: full leaf at the Mendoza solstice
+    sp = load_species("Platanus x acerifolia")  # or "platanus_x_acerifolia", or "London plane"
+    sp.leaf_area_fraction(355, -32.89)          # 1.0: full leaf at the southern summer solstice
 """
 
 from __future__ import annotations
@@ -48,7 +48,7 @@ LEAF_ANGLE_DISTRIBUTIONS: dict[str, float | None] = {
 }
 #: Crown shapes: vertical semi-axis / horizontal radius of the crown spheroid. Documented
 #: defaults (shape classes, not measurements): "spherical" 1, "oblate" (wider than tall, the
-#: vaulted crowns of Mendoza's plane and mulberry alignments) 0.75, "prolate" (taller than
+#: vaulted crowns of street alignments) 0.75, "prolate" (taller than
 #: wide: limes, young ash) 1.3. radtree's [tree.crown] default 4.75/5 = 0.95 is near spherical.
 CROWN_SHAPES: dict[str, float] = {"spherical": 1.0, "oblate": 0.75, "prolate": 1.3}
 SOUTHERN_SHIFT_DAYS = 182
@@ -270,7 +270,7 @@ def _library() -> dict[str, Species]:
 
 
 def known_species() -> list[str]:
-    """The keys of the shipped species, sorted (e.g. ``"morus_alba"``)."""
+    """The keys of the shipped species, sorted (e.g. ``"platanus_x_acerifolia"``)."""
     return sorted(_library())
 
 
@@ -297,8 +297,8 @@ def unknown_species_message(key_or_name: str) -> str:
 
 
 def load_species(key_or_name: str) -> Species:
-    """The species of key (``"morus_alba"``), scientific name (``"Platanus × acerifolia"``,
-    ``"platanus x acerifolia"``) or common name (``"white mulberry"``), case-insensitive.
+    """The species of key (``"tilia_cordata"``), scientific name (``"Platanus × acerifolia"``,
+    ``"platanus x acerifolia"``) or common name (``"London plane"``), case-insensitive.
     Unknown → :class:`ConfigError` listing the known species."""
     sp = find_species(key_or_name)
     if sp is None:

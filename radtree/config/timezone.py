@@ -1,7 +1,7 @@
 """The site's time zone: an IANA name (daylight saving applied) or a fixed UTC offset.
 
 ``[site] time_zone`` is written either as an IANA time-zone name (``"Europe/Madrid"``,
-``"America/Argentina/Mendoza"``; the standard library's :mod:`zoneinfo`, with the ``tzdata``
+``"America/Argentina/Buenos_Aires"``; the standard library's :mod:`zoneinfo`, with the ``tzdata``
 package as its database where the system has none) or as a fixed offset from UTC
 (``"UTC+1"``, ``"UTC-3"``, ``"UTC+05:30"``, ``"+09:30"``; no daylight saving). The older
 ``utc_offset_hours = -3`` is the fixed offset ``"UTC-3"``.

@@ -16,7 +16,7 @@
 
 *Why total by default:* an EnergyPlus shading surface stops what its schedule does not pass,
 and scattered light passes the crown: with ``beam`` every crown without gaps exports as opaque
-(Mendoza's homogeneous dome, sun at the zenith, 60° and 40° altitude: beam 0.2–0.6 %, total
+(the reference case's homogeneous dome, sun at the zenith, 60° and 40° altitude: beam 0.2–0.6 %, total
 3.9–5.1 %, benchmarks/schedule_total.py) and all scattered light is dropped. Remaining caveats (printed by the export): EnergyPlus applies the
 value to the beam *and* diffuse solar on the shade and passes it on undeviated, as solar and
 visible alike (its issue #992: "the solar and visible transmittance is the same and … the

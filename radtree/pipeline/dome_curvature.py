@@ -2,7 +2,7 @@
 
 The dome's BSDF is computed on a planar stack of its slat shells (:mod:`radtree.trees.slab`):
 same slats and spacing, but flat. In the dome the shells are concentric spheres (radii
-1.6–3.82 m for the Mendoza example): light scattered in a shell and travelling outwards meets
+1.6–3.82 m for the reference-case example): light scattered in a shell and travelling outwards meets
 the next shell more nearly along its normal than the flat stack's next layer, and light
 travelling inwards meets the inner, smaller shells ever more obliquely or misses them, so
 the curved stack passes more scattered light than the flat one.

@@ -2,7 +2,7 @@
 
     from radtree.config import load_project
     from radtree.report import build_report
-    build_report(load_project("examples/mendoza-street"))   # → Path to report/index.html
+    build_report(load_project("my-street"))   # → Path to report/index.html
 
 Reads only the results layout (``results/illuminance.csv``, ``timing.csv``, ``manifest.json``,
 ``convergence.csv``, ``build/<scenario>/manifest.json`` and ``model.png``) and the project's

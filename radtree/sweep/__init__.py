@@ -1,7 +1,7 @@
 """Parameter sweeps over the unknowns of a project (reference case §1), run on dask.distributed.
 
     from radtree.sweep import run_sweep
-    out = run_sweep("examples/mendoza-street", ["tree.crown.trunk_distance_m=2:6:5",
+    out = run_sweep("my-street", ["tree.crown.trunk_distance_m=2:6:5",
                                                "tree.louvers.layers=3,4,5"], scenarios=["A"])
     out.table        # every case's tidy rows + case_id, case_hash and parameter columns
     out.sensitivity  # per scenario × parameter × metric: main-effect range, Spearman ρ

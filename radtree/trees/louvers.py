@@ -315,7 +315,7 @@ def build_louvers(tree: Tree, sensors: Sensors, street: Street, frame: FacadeFra
         ab = recommended_volume_ab(lv)
         notes.append(f"Radiance: -ab {ab} (crossings + 2, capped at 6: light crossing many "
                      "slats does so mostly by specular transmission, which needs no ambient "
-                     "bounce; on Mendoza scenario F, crossings 15, the façade mean moved 0.1 % "
+                     "bounce; on reference-case scenario F, crossings 15, the façade mean moved 0.1 % "
                      "from -ab 6 to -ab 8 at 13:30 (1457 → 1456 lx) and to -ab 12 at 10:30 "
                      "(1089 → 1090 lx), and −1.1 % from -ab 6 to -ab 5 — check with radtree "
                      "simulate --convergence).")

@@ -15,7 +15,7 @@ more face-on to the centre (|cos| = sin(α + |elevation|), never below 0.3). Sla
 s × s (sides within about ±35 % of s near the cube-face seams; a shell of radius r holds
 ≈ 2π r² f / (s² c̄) slats, c̄ ≈ 0.75 at α = 30°). Each slat is 2 triangles; the slat count is
 bounded by :func:`dome_slat_bound` = 1.5 · 2π f Σ r_k² / (s² · max(0.3, min(sin α, cos α)))
-+ 40·layers (≈ 3 000 slats, 6 000 triangles for the Mendoza dome of 4 m with 0.3 m slats).
++ 40·layers (≈ 3 000 slats, 6 000 triangles for the reference-case dome of 4 m with 0.3 m slats).
 """
 
 from __future__ import annotations

@@ -32,7 +32,7 @@ crosses on average
 slats (Poisson distributed; fixed total count → binomial, indistinguishable at these counts).
 G = cos α for vertical Ω and (2/π)·sin α for horizontal Ω (:func:`projection_g`). With slat
 specular transmittance T_s the undeviated (direct) transmission is exp(−λ·(1 − T_s)) — the
-turbid-medium Beer–Lambert law. For the Mendoza crowns (a 5 m, b 4.75 m, s 0.3 m, α 30°) the
+turbid-medium Beer–Lambert law. For the reference-case crowns (a 5 m, b 4.75 m, s 0.3 m, α 30°) the
 horizontal diameter crosses λ_h = 0.387 · crossings slats, the vertical axis ``crossings``.
 
 Clumping (``louvers.clumping`` Ω < 1). The same slats (same count, sizes, inclinations,
@@ -48,7 +48,7 @@ crossing count: min(crossings + 2, :data:`VOLUME_AB_CAP`), measured with
 ``radtree simulate --convergence`` (figures at :data:`VOLUME_AB_CAP`).
 
 Realisations. A façade sensor sees the slats just in front of it at large solid angles, so one
-realisation (one ``louvers.seed``) of the Mendoza crowns scatters in global permeability by
+realisation (one ``louvers.seed``) of the reference-case crowns scatters in global permeability by
 ≈ 10 % (s.d. over 24 seeds at crossings 15; see :func:`radtree.calibrate.permeability.calibrate_crossings`,
 which calibrates the mean over seeds). Slats are drawn in fixed blocks, so with one seed a
 larger ``crossings`` adds slats to the same crown instead of redrawing it.
@@ -71,7 +71,7 @@ MAX_VOLUME_SLATS = 200_000
 DRAW_BLOCK = 1024  # slats drawn per block (nested realisations, see _draw_nested)
 # Radiance -ab for volume crowns: light crossing many slats does so mostly by specular
 # transmission, which needs no ambient bounce, so the façade mean converges by -ab 6 (within
-# 0.1 % on Mendoza F); `radtree simulate examples/mendoza-street --convergence -s F` prints the
+# 0.1 % on reference-case F); `radtree simulate examples/mendoza-street --convergence -s F` prints the
 # ladder, figures in docs/benchmarks.md.
 VOLUME_AB_CAP = 6
 

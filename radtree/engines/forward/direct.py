@@ -2,7 +2,7 @@
 
 A patch detector reports the illuminance averaged over its square; the backward engines and
 Radiance report it at the sensor point. Where sun flecks through a crown are smaller than the
-patch the two differ by far more than any noise: on the Mendoza perforated dome at 12:30 the
+patch the two differ by far more than any noise: on the reference-case perforated dome at 12:30 the
 NumPy engine reads 586 lx at the 8 sensor points and 3 304 lx averaged over their 0.5 m squares
 (+464 %), 1 064 lx over 0.1 m squares (+81 %) (benchmarks/forward.py ``--patch-bias``).
 

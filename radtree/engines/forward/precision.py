@@ -19,7 +19,7 @@ and every further round adds as many, so the error estimate's degrees of freedom
 photons (for normal batch means z = (ḡ − g)/SE follows Student's t with B − 1 ≥ 31 degrees of
 freedom: s.d. 1.03, P(|z| > 3) = 0.5 %). Measured (benchmarks/forward.py ``--zscores``): on a
 translucent shell 60 seeded runs give z s.d. 0.97 (32 batches of 250 photons; 16 batches:
-1.29); on the Mendoza louvers dome, scenario A at 12:30 with *rounds of 50 000 photons* (1 600
+1.29); on the reference-case louvers dome, scenario A at 12:30 with *rounds of 50 000 photons* (1 600
 a batch) and a 5 % target, 50 runs give z s.d. 1.51 and |z| > 3 in 6 %: with that few photons
 a batch the error is understated by about half. The default rounds (1 M photons, 31 250 a
 batch) were not put through the same 50 repeats on this machine.

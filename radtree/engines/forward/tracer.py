@@ -166,7 +166,7 @@ class ForwardTracer:
         met = None
         if geo.media is not None:   # a leaf of a turbid crown first? (engines.common.turbid)
             met, t = geo.media.collide(ph.o, ph.d, t, GeneratorDraws(self.rng))
-            tri = np.where(met >= 0, 0, tri)   # a stand-in row, replaced below
+            tri = np.where(met >= 0, 0, tri)   # a placeholder row, replaced below
         self.segments += len(ph)
         if ph.direct.any():
             seen = ~ph.direct

@@ -305,7 +305,7 @@ class _Tracer:
             met = None
             if self.media is not None:   # a leaf of a turbid crown before the surface?
                 met, t = self.media.collide(o, d, t, rng.rows(alive, bounce, 5), parallel)
-                tri = np.where(met >= 0, max(self.n_tri - 1, 0), tri)   # a stand-in row
+                tri = np.where(met >= 0, max(self.n_tri - 1, 0), tri)   # a placeholder row
             miss = tri < 0
             if segments is not None:
                 segments(alive, o, d, np.where(miss, np.inf, t))

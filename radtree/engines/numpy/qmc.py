@@ -14,7 +14,7 @@ then an unbiased, independent estimate of the sensor's value, and the standard e
 spread of the ``R`` replicate means (L'Ecuyer & Lemieux 2002, "Recent advances in randomized
 quasi-Monte Carlo methods") — not the per-path spread, which would ignore the stratification.
 
-Measured on the Mendoza louvers dome (scenario A, 13:30, 1024 paths per sensor, 8 repeats):
+Measured on the reference-case louvers dome (scenario A, 13:30, 1024 paths per sensor, 8 repeats):
 per-sensor standard deviation 2.71 % → 1.78 % (variance ÷ 2.3) at the same cost; on a free
 volume crown (scenario F) 6.5 % → 5.2–6.0 % (``benchmarks/noise.py``).
 """

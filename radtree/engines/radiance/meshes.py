@@ -66,6 +66,6 @@ def mesh_primitive_text(mesh: Mesh, rtm: str) -> str:
 def obj2mesh_command(obj: str) -> list[str]:
     """``obj2mesh -n 4 <obj>`` (the compiled mesh goes to stdout). ``-n`` (surfaces per voxel,
     default 9, "below 6 not recommended" as the median vertex valence of a connected mesh):
-    crown slats share no vertices (valence ≤ 2), and at ``-n 4`` rtrace runs the Mendoza crowns
+    crown slats share no vertices (valence ≤ 2), and at ``-n 4`` rtrace runs the reference-case crowns
     as fast as their polygon text, at ``-n 9`` about 20 % slower (CHANGELOG.md, benchmark notes)."""
     return ["obj2mesh", "-n", str(MESH_OBJLIM), obj]

@@ -1,7 +1,7 @@
 """Numbers as text, vectorised: the bytes of ``"%.Nf"`` / ``"%d"`` for whole arrays.
 
 Formatting 10⁵–10⁶ numbers one by one (``"%.5f" % tuple(...)``) took most of a cold
-``radtree build``'s OBJ writing (≈ 1.3 s for the Mendoza crowns). Here the digits are computed
+``radtree build``'s OBJ writing (≈ 1.3 s for the reference-case crowns). Here the digits are computed
 with integer arithmetic on whole arrays and laid out in a byte table, giving the same text as
 printf to the byte:
 

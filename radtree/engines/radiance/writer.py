@@ -148,7 +148,7 @@ def _write(path: Path, text: str) -> None:
     """Write a build file in place: :func:`write_build` fills a folder that is made whole at
     once (``radtree build``'s temporary folder, renamed when complete) or a scratch folder, and
     a folder without its ``manifest.json`` is never taken as built — so no file of it needs its
-    own temporary name (452 of them cost 0.5 s of ``mkstemp`` per Mendoza build)."""
+    own temporary name (452 of them cost 0.5 s of ``mkstemp`` per reference-case build)."""
     path.write_text(text, encoding="utf-8")
 
 
