@@ -40,6 +40,8 @@ ground_reflectance = 0.15
 direct_normal = "dni.csv"
 
 [tree]
+leaf_on = "10-15"
+leaf_off = "06-01"
 form = "free"
 
 [tree.crown]
