@@ -27,3 +27,15 @@ def save_png(fig: Figure, path: Path, dpi: int) -> Path:
     with atomic_path(path) as tmp:
         fig.savefig(tmp, dpi=dpi, format="png", metadata={"Software": None})
     return path
+
+
+def compact_png(src: Path, dst: Path, max_px: int = 700, colors: int = 128) -> Path:
+    """A copy of the PNG ``src`` for a report: at most ``max_px`` on its longer side and an
+    adaptive palette of ``colors`` (Pillow), so that a report of many pictures stays light."""
+    from PIL import Image
+
+    with Image.open(src) as opened:
+        rgb = opened.convert("RGB")
+    rgb.thumbnail((max_px, max_px))
+    rgb.quantize(colors=colors, method=Image.Quantize.MEDIANCUT).save(dst, optimize=True)
+    return dst

@@ -25,7 +25,6 @@ from __future__ import annotations
 
 import json
 import multiprocessing
-import shutil
 from collections.abc import Callable
 from concurrent.futures import Future, ProcessPoolExecutor
 from dataclasses import dataclass, field
@@ -38,6 +37,7 @@ import pandas as pd
 
 import radtree.report.figures as figures
 from radtree.config import Project
+from radtree.figures import compact_png
 from radtree.fileio import atomic_dir
 from radtree.lock import PUBLISH_NAME, folder_lock
 from radtree.pipeline.processes import usable_cores
@@ -318,7 +318,7 @@ def build_report(project: Project, echo: Callable[[str], None] = print) -> Path:
         (tmp / "models").mkdir()
         for s in data.scenarios:
             if s.picture is not None:
-                shutil.copyfile(s.picture, tmp / "models" / f"{s.name}.png")
+                compact_png(s.picture, tmp / "models" / f"{s.name}.png")
         tables: dict[str, Table] = {
             "scenarios": scenario_table(data), "hourly": hourly_table(data),
             "statistics": statistics_table(data), "reflection": reflection_table(data),
@@ -368,6 +368,8 @@ def build_report(project: Project, echo: Callable[[str], None] = print) -> Path:
         md = environment(html=False).get_template("report.md.j2").render(c=ctx)
         (tmp / "index.html").write_text(html, encoding="utf-8")
         (tmp / "index.md").write_text(md, encoding="utf-8")
+        for png in sorted((tmp / "figures").glob("*.png")) if (tmp / "figures").is_dir() else []:
+            compact_png(png, png, max_px=1800, colors=256)   # charts: a palette, same size
     index = target / "index.html"
     echo(f"report written to {index}")
     return index

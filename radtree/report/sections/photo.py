@@ -5,7 +5,6 @@ shown only when its file exists."""
 
 from __future__ import annotations
 
-import shutil
 from pathlib import Path
 from typing import Any
 
@@ -13,6 +12,7 @@ import numpy as np
 import pandas as pd
 
 from radtree.config import Project
+from radtree.figures import compact_png
 from radtree.report.sections import Section
 from radtree.report.tables import num
 
@@ -66,7 +66,7 @@ def photo_check_data(project: Project, out: Path) -> dict[str, Any] | None:
         for kind in ("photo", "model"):
             src = project.results_dir / "photo_check" / f"{sc}_{kind}.png"
             if src.is_file():
-                shutil.copyfile(src, out / f"photo_check_{sc}_{kind}.png")
+                compact_png(src, out / f"photo_check_{sc}_{kind}.png")
                 item["images"].append({"kind": kind, "file": f"photo_check_{sc}_{kind}.png"})
         scenarios.append(item)
     return {"scenarios": scenarios}
