@@ -61,8 +61,11 @@ class LazyGroup(RadtreeGroup):
 @click.group(cls=LazyGroup, context_settings=CONTEXT)
 @click.version_option(__version__, prog_name="radtree")
 @click.option("--debug", is_flag=True, help="Show full tracebacks on errors.")
+@click.option("-v", "--verbose", is_flag=True, help="Also print detail messages (DEBUG).")
+@click.option("-q", "--quiet", is_flag=True,
+              help="Print only warnings and the results; no progress bars.")
 @click.pass_context
-def main(ctx: click.Context, debug: bool) -> None:
+def main(ctx: click.Context, debug: bool, verbose: bool, quiet: bool) -> None:
     """radtree — daylight through street trees onto façades and into rooms.
 
     \b
@@ -79,3 +82,16 @@ def main(ctx: click.Context, debug: bool) -> None:
     """
     ctx.ensure_object(dict)
     ctx.obj["debug"] = debug
+    _talk(ctx, verbose=verbose, quiet=quiet)
+
+
+def _talk(ctx: click.Context, *, verbose: bool, quiet: bool) -> None:
+    """Install radtree's message handler and progress bars for this command
+    (:mod:`radtree.log`); the library alone stays quiet once the command ends."""
+    import logging
+
+    from radtree import log
+
+    level = logging.DEBUG if verbose else logging.WARNING if quiet else logging.INFO
+    log.enable(level, progress=not quiet)
+    ctx.call_on_close(log.disable)
