@@ -30,7 +30,7 @@ RUN ?=
 DEMO_STEPS := demo-doctor demo-build demo-simulate demo-convergence demo-permeability \
               demo-diagnose demo-hemi demo-report
 
-.PHONY: install demo $(DEMO_STEPS) test lint typecheck pytest docs bench clean
+.PHONY: install demo $(DEMO_STEPS) test lint shape typecheck pytest docs bench clean
 
 demo: $(STAMP)
 	@$(MAKE) --no-print-directory -j2 -O demo-report
@@ -58,6 +58,10 @@ demo-report: demo-convergence demo-hemi
 lint: $(STAMP)
 	$(BIN)/ruff check radtree tests benchmarks docs
 	$(BIN)/lint-imports
+
+# the code's shape: the longest and widest functions (the ratchet of tests/test_layers.py)
+shape: $(STAMP)
+	$(BIN)/python -m tests.shape
 
 typecheck: $(STAMP)
 	$(BIN)/mypy radtree

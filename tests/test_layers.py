@@ -85,6 +85,33 @@ def test_modules_are_small():
     assert big == {}
 
 
+#: the ratchet (issue 42): at most this many functions over ``tests.shape.MAX_LINES`` lines and
+#: with more than ``tests.shape.MAX_POSITIONAL`` positional parameters. Lower the figures when a
+#: change shortens the lists (``python -m tests.shape`` prints them); never raise them.
+MAX_LONG_FUNCTIONS = 17
+MAX_WIDE_FUNCTIONS = 33
+
+
+def test_function_ratchet():
+    from tests.shape import long_functions, wide_functions
+
+    longs, wides = long_functions(), wide_functions()
+    assert len(longs) <= MAX_LONG_FUNCTIONS, [f"{f.where} ({f.lines} lines)" for f in longs]
+    assert len(wides) <= MAX_WIDE_FUNCTIONS, [f"{f.where} ({f.positional})" for f in wides]
+
+
+def test_shape_counts_what_it_says(tmp_path):
+    from tests.shape import functions
+
+    pkg = tmp_path / "radtree"
+    pkg.mkdir()
+    body = "\n".join(f"    x{i} = {i}" for i in range(85))
+    (pkg / "m.py").write_text(f"class C:\n    def wide(self, a, b, c, d, e, f, g, h, i, *, j):\n"
+                              f"        return a\n\ndef long():\n{body}\n", encoding="utf-8")
+    got = {f.where: (f.lines, f.positional) for f in functions(pkg)}
+    assert got == {"radtree/m.py:C.wide": (2, 9), "radtree/m.py:long": (86, 0)}
+
+
 def _engine_name_pattern(names: list[str]) -> re.Pattern[str]:
     """A comparison with, an assignment of, or a tuple of quoted engine names."""
     name = rf"""["'](?:{'|'.join(map(re.escape, names))})["']"""
