@@ -26,25 +26,24 @@ class Function:
     positional: int
 
 
+def _visit(node: ast.AST, rel: str, prefix: str, out: list[Function]) -> None:
+    for child in ast.iter_child_nodes(node):
+        if isinstance(child, (ast.FunctionDef, ast.AsyncFunctionDef)):
+            args = child.args.posonlyargs + child.args.args
+            n = len(args) - (1 if args and args[0].arg in ("self", "cls") else 0)
+            length = (child.end_lineno or child.lineno) - child.lineno + 1
+            out.append(Function(f"{rel}:{prefix}{child.name}", length, n))
+            _visit(child, rel, f"{prefix}{child.name}.", out)
+        elif isinstance(child, ast.ClassDef):
+            _visit(child, rel, f"{prefix}{child.name}.", out)
+
+
 def functions(root: pathlib.Path = ROOT) -> list[Function]:
     """Every function and method under ``root`` with its length and positional count."""
     out: list[Function] = []
     for path in sorted(root.rglob("*.py")):
         tree = ast.parse(path.read_text(encoding="utf-8"))
-        rel = path.relative_to(root.parent).as_posix()
-
-        def visit(node: ast.AST, prefix: str) -> None:
-            for child in ast.iter_child_nodes(node):
-                if isinstance(child, (ast.FunctionDef, ast.AsyncFunctionDef)):
-                    args = child.args.posonlyargs + child.args.args
-                    n = len(args) - (1 if args and args[0].arg in ("self", "cls") else 0)
-                    length = (child.end_lineno or child.lineno) - child.lineno + 1
-                    out.append(Function(f"{rel}:{prefix}{child.name}", length, n))
-                    visit(child, f"{prefix}{child.name}.")
-                elif isinstance(child, ast.ClassDef):
-                    visit(child, f"{prefix}{child.name}.")
-
-        visit(tree, "")
+        _visit(tree, path.relative_to(root.parent).as_posix(), "", out)
     return out
 
 
