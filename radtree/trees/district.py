@@ -269,7 +269,7 @@ def _one_tree(t: InventoryTree, *, slv: Louvers, ref: tuple[float, float] | None
     clip plane."""
     a, b = t.crown_radius_m, t.vertical_radius_m
     placed = ref is not None and clip is None      # an instance of the shared crown
-    if placed:
+    if ref is not None and clip is None:
         b = (t.crown_radius_m / ref[0]) * ref[1]
     rt = (t.trunk_diameter_m / 2.0) if t.trunk_diameter_m else default_rt
     spec = single_spec(np.array([t.x, t.y, t.crown_base_m + b]), a, b, rt,

@@ -12,6 +12,7 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -72,7 +73,7 @@ def render_model_png(model: TreeModel, scene: Scene | None, path: str | Path,
 
 
 def _crown_triangles(model: TreeModel, frame: FacadeFrame, *, max_triangles: int, seed: int
-                     ) -> tuple[list[tuple[np.ndarray, tuple[float, float, float]]], float]:
+                     ) -> tuple[list[tuple[Any, tuple[float, float, float]]], float]:
     """The crown's triangles in the façade frame with their colours, large meshes thinned
     at random (``seed``) to about ``max_triangles``; and the share kept."""
     rng = np.random.default_rng(seed)
