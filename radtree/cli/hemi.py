@@ -99,16 +99,14 @@ def _lens(value: str | None) -> Projection | None:
               help="Gaps and holes smaller than this many pixels are not outlined.")
 @click.option("--no-overlay", is_flag=True, help="Do not draw the overlay PNGs.")
 @click.option("--keep-going", is_flag=True,
-              help="In a folder, skip images that fail (reported on stderr) instead of stopping.")
+              help="In a folder, skip images that fail (each a warning) instead of stopping.")
 @click.argument("source", metavar="IMAGE_OR_FOLDER",
                 type=click.Path(exists=True, path_type=Path))
 def _hemi(*, source: Path, out_dir: Path, no_overlay: bool, keep_going: bool,
           **options: Any) -> None:
     config = _config(**options)
     report = run_batch(
-        source, out_dir, config, overlay=not no_overlay, keep_going=keep_going,
-        on_error=lambda f, msg: click.echo(f"skipped {msg}", err=True),
-    )
+        source, out_dir, config, overlay=not no_overlay, keep_going=keep_going)
     for row in report.rows:
         click.echo(
             f"{row['image']}: threshold {row['threshold']:.1f}  gap {row['gap_fraction']:.4f}  "
