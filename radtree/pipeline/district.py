@@ -87,8 +87,7 @@ def district_scene(project: Project, scenario: Scenario, dense_grid: bool | None
 
             tree = inventory_turbid(project, inputs.trees, tr)
         else:
-            tree = inventory_crowns(project, trees=inputs.trees, tree=tr, instancing=d.instancing,
-                                    clips=clips)
+            tree = inventory_crowns(project, inputs.trees, tr, instancing=d.instancing, clips=clips)
         clash = set(tree.materials) & set(materials)
         if clash:
             raise RadtreeError(f"crown materials clash with the buildings': {clash}")

@@ -169,7 +169,7 @@ class _Crowns:
         self.trunk_owners.append(np.full(len(tf), tree_id))
 
 
-def inventory_crowns(project: Project, *, trees: list[InventoryTree], tree: Tree,
+def inventory_crowns(project: Project, trees: list[InventoryTree], tree: Tree, *,
                      instancing: str = "auto", clips: dict[str, WallClip] | None = None
                      ) -> TreeModel:
     """The crowns of every inventory tree (louvers model, free form) as one TreeModel;
