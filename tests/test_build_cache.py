@@ -15,7 +15,6 @@ from radtree.config import load_project
 from radtree.pipeline import build as build_mod
 from radtree.pipeline.assemble import facade_frame
 from radtree.pipeline.build import SCENE_FILE, build_project, folder_files
-from radtree.trees import build as trees_build
 from radtree.trees.build import crown_in_cache
 from tests.conftest import copy_project
 
@@ -52,7 +51,7 @@ def test_a_fresh_build_takes_its_crowns_from_the_cache(tmp_path, cache_dir, monk
     def broken(*args, **kwargs):
         raise AssertionError("the crown was built again")
 
-    monkeypatch.setattr(trees_build, "build_louvers", broken)
+    monkeypatch.setattr("radtree.trees.louvers.build_louvers", broken)  # the registry's
     assert crown_in_cache(p, b, facade_frame(p)) and build_mod._weight(p, b) == 0
     lines.clear()
     again = build_project(p, ["B", "E"], echo=lines.append, progress=False, pictures=False,

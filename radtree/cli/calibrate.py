@@ -10,6 +10,7 @@ from radtree.calibrate.direct import PERMEABILITY_DEFINITION, calibrate, write_c
 from radtree.cli.options import CONTEXT
 from radtree.config import load_project
 from radtree.errors import RadtreeError
+from radtree.trees.registry import calibrated_models
 
 
 @click.command("calibrate", context_settings=CONTEXT)
@@ -17,7 +18,7 @@ from radtree.errors import RadtreeError
 @click.option("--target", type=float, default=None,
               help="Target permeability as a fraction (default: tree.homogeneous.permeability "
                    "of the project, e.g. 0.055).")
-@click.option("--model", "model", type=click.Choice(["louvers", "perforated", "homogeneous"]),
+@click.option("--model", "model", type=click.Choice(calibrated_models()),
               default="louvers", show_default=True, help="Crown model to calibrate.")
 @click.option("--form", type=click.Choice(["dome", "free"]), default=None,
               help="Crown form (default: tree.form of the project).")

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 from pathlib import Path
+from typing import Any
 
 import click
 
@@ -98,25 +99,14 @@ def _lens(value: str | None) -> Projection | None:
               help="Gaps and holes smaller than this many pixels are not outlined.")
 @click.option("--no-overlay", is_flag=True, help="Do not draw the overlay PNGs.")
 @click.option("--keep-going", is_flag=True,
-              help="In a folder, skip images that fail (reported on stderr) instead of stopping.")
+              help="In a folder, skip images that fail (each a warning) instead of stopping.")
 @click.argument("source", metavar="IMAGE_OR_FOLDER",
                 type=click.Path(exists=True, path_type=Path))
-def _hemi(
-    source: Path, out_dir: Path, preset: str | None, lens_name: str | None,
-    polynomial: str | None, mask_text: str, full_frame: bool, channel: str, gamma: float,
-    threshold: str, rings: int, segments: int, zenith_text: str, north: float,
-    mirror: bool | None, axis: str, gap_floor: float, outline_tolerance: float,
-    min_gap_area: float, no_overlay: bool, keep_going: bool,
-) -> None:
-    config = _config(
-        preset, lens_name, polynomial, mask_text, full_frame, channel, gamma, threshold,
-        rings, segments, zenith_text, north, mirror, axis, gap_floor, outline_tolerance,
-        min_gap_area,
-    )
+def _hemi(*, source: Path, out_dir: Path, no_overlay: bool, keep_going: bool,
+          **options: Any) -> None:
+    config = _config(**options)
     report = run_batch(
-        source, out_dir, config, overlay=not no_overlay, keep_going=keep_going,
-        on_error=lambda f, msg: click.echo(f"skipped {msg}", err=True),
-    )
+        source, out_dir, config, overlay=not no_overlay, keep_going=keep_going)
     for row in report.rows:
         click.echo(
             f"{row['image']}: threshold {row['threshold']:.1f}  gap {row['gap_fraction']:.4f}  "
@@ -130,11 +120,12 @@ def _hemi(
 
 
 def _config(
-    preset: str | None, lens_name: str | None, polynomial: str | None, mask_text: str,
+    *, preset: str | None, lens_name: str | None, polynomial: str | None, mask_text: str,
     full_frame: bool, channel: str, gamma: float, threshold: str, rings: int, segments: int,
     zenith_text: str, north: float, mirror: bool | None, axis: str, gap_floor: float,
     outline_tolerance: float, min_gap_area: float,
 ) -> HemiConfig:
+    """The analysis settings from the command's options (keywords as click names them)."""
     lens = parse_polynomial(polynomial) if polynomial else _lens(lens_name)
     mask = None if mask_text.strip().lower() == "auto" else parse_mask(mask_text)
     try:

@@ -80,7 +80,7 @@ def render_command(project: str, scenarios: tuple[str, ...], size: int,
 
             hdr, bmp = radiance_picture(p, sc, radiance_hour, radiance_size,
                                         out / f"{sc.name}_{radiance_hour.replace(':', '')}",
-                                        echo=click.echo, ab=radiance_ab)
+                                        ab=radiance_ab)
             click.echo(f"{sc.name}: Radiance fisheye {hdr} and {bmp}")
 
 

@@ -36,8 +36,8 @@ _FILE = click.Path(exists=True, dir_okay=False, path_type=Path)
 @click.option("--template", type=click.Choice(["street", "office", "district"]),
               help="street canyon, office block, or inventory district (default: district "
                    "with --buildings, else street).")
-def new_command(folder: Path, latitude: float | None, longitude: float | None, tz: str | None,
-                utc: float | None, elevation: float | None, date: str | None,
+def new_command(*, folder: Path, latitude: float | None, longitude: float | None,
+                tz: str | None, utc: float | None, elevation: float | None, date: str | None,
                 trees: Path | None, buildings: Path | None, honeybee: Path | None,
                 epw: Path | None, template: str | None) -> None:
     """Write FOLDER/radtree.toml — every field with its unit and default — and copy the

@@ -14,6 +14,7 @@ from typing import Any, ClassVar
 
 from radtree.config.bsdf import REPRESENTATIONS, CrownBsdf
 from radtree.config.clumping import clumping_fields
+from radtree.config.crown_models import CROWN_MODELS
 from radtree.config.honeybee import HoneybeeSite
 from radtree.config.limits import Limits
 from radtree.config.params_hash import params_hashes, plain
@@ -29,7 +30,6 @@ from radtree.config.place import (
 from radtree.config.spec import TIME_RE, Checked, meta
 from radtree.errors import ConfigError
 
-CROWN_MODELS = ("homogeneous", "perforated", "louvers", "none")
 TREE_FORMS = ("dome", "free")
 LOUVER_ARRANGEMENTS = ("layers", "volume")
 _PHOTO = photo_fields()

@@ -257,7 +257,7 @@ def _analyse(image: LoadedImage, config: HemiConfig) -> HemiResult:
     outlines: list[GapOutline] = []
     if config.outlines:
         outlines = trace_gaps(
-            cls.sky, pf, geometry, tolerance_px=config.outline_tolerance_px,
+            cls.sky, field_=pf, geometry=geometry, tolerance_px=config.outline_tolerance_px,
             min_area_px=config.outline_min_area_px,
         )
     t4 = time.perf_counter()

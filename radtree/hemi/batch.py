@@ -19,6 +19,7 @@ from __future__ import annotations
 
 import csv
 import io
+import logging
 import math
 import os
 from collections.abc import Callable
@@ -47,6 +48,8 @@ RING_COLUMNS = (
     "gap_fraction", "gap_fraction_cos", "pixels", "sky_pixels", "solid_angle_sr", "weight_openness", "weight_svf",
     "threshold",
 )
+
+log = logging.getLogger(__name__)
 
 
 # -- CSV --------------------------------------------------------------------------------------
@@ -84,12 +87,12 @@ def run_batch(
     overlay: bool = True,
     keep_going: bool = False,
     on_result: Callable[[HemiResult], None] | None = None,
-    on_error: Callable[[str, str], None] | None = None,
 ) -> BatchReport:
     """Analyse one image or every image of a folder and write the outputs into ``out_dir``.
 
-    Fails on the first bad image unless ``keep_going`` (then bad images are reported through
-    ``on_error`` and the report; an error is raised only if no image could be analysed).
+    Fails on the first bad image unless ``keep_going`` (then bad images are logged as
+    warnings and listed in the report; an error is raised only if no image could be
+    analysed).
     """
     config = config or HemiConfig()
     src = Path(source)
@@ -107,8 +110,7 @@ def run_batch(
             if not keep_going:
                 raise
             report.failures.append((str(f), str(exc)))
-            if on_error:
-                on_error(str(f), str(exc))
+            log.warning("skipped %s", exc)
             continue
         report.rows.append(result.summary_row())
         ring_rows.extend(result.ring_rows())

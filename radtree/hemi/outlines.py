@@ -107,9 +107,9 @@ def _contour_label(c: NDArray[np.float64], padded: NDArray[np.bool_], labels: ND
 
 def trace_gaps(
     sky: NDArray[np.bool_],
+    *,
     field_: PixelField,
     geometry: FisheyeGeometry,
-    *,
     tolerance_px: float = 1.0,
     min_area_px: float = 4.0,
 ) -> list[GapOutline]:
@@ -118,17 +118,58 @@ def trace_gaps(
     ``sky`` covers ``field_`` (the bounding box of the valid pixels). ``tolerance_px`` is the
     simplification tolerance (0 keeps every contour vertex).
     """
-    from skimage.measure import approximate_polygon, find_contours, label
+    regions = _sky_regions(sky, field_, min_area_px)
+    if regions is None:
+        return []
+    sizes, solid, groups = regions
+    gaps = _gap_rings(groups, field_, tolerance_px=tolerance_px, min_area_px=min_area_px)
+    if not gaps:
+        return []
+    all_xy, angles = _ring_angles(gaps, geometry)
+    out: list[GapOutline] = []
+    k = 0
+    for lab, ext_xy, holes_xy in gaps:
+        rings_xy, rings_ang = [], []
+        for r in (ext_xy, *holes_xy):
+            rings_xy.append(all_xy[k : k + len(r)])
+            rings_ang.append(angles[k : k + len(r)])
+            k += len(r)
+        out.append(
+            GapOutline(
+                exterior=rings_ang[0],
+                holes=tuple(rings_ang[1:]),
+                solid_angle_sr=float(solid[lab]),
+                pixels=int(sizes[lab]),
+                contains_zenith=_contains_centre(rings_xy[0], rings_xy[1:], geometry.mask.cx,
+                                                 geometry.mask.cy),
+                axis=geometry.axis,
+                exterior_px=rings_xy[0],
+                holes_px=tuple(rings_xy[1:]),
+            )
+        )
+    out.sort(key=lambda g: -g.solid_angle_sr)
+    return out
+
+
+#: a sky region's contours: (|area| in px², contour in (row, col) index space)
+_Rings = list[tuple[float, NDArray[np.float64]]]
+
+
+def _sky_regions(sky: NDArray[np.bool_], field_: PixelField, min_area_px: float
+                 ) -> tuple[NDArray, NDArray, dict[int, _Rings]] | None:
+    """The 4-connected sky regions: pixels and solid angle (sr) per label, and the contours
+    of every region of at least ``min_area_px`` pixels; None when there is no sky."""
+    from skimage.measure import find_contours, label
 
     padded = np.pad(sky & field_.valid, 1)
     labels = label(padded, connectivity=1)
     n_labels = int(labels.max())
     if n_labels == 0:
-        return []
+        return None
     sizes = np.bincount(labels.ravel(), minlength=n_labels + 1)
     weights = np.pad(field_.weight, 1)
     solid = np.bincount(labels.ravel(), weights=weights.ravel(), minlength=n_labels + 1)
-    groups: dict[int, list[tuple[float, NDArray[np.float64]]]] = {}
+    groups: dict[int, _Rings] = {}
     for c in find_contours(padded.astype(np.float32), 0.5):
         if len(c) < 4:
             continue
@@ -136,18 +177,25 @@ def trace_gaps(
         if lab == 0 or sizes[lab] < min_area_px:
             continue
         groups.setdefault(lab, []).append((abs(_signed_area(c)), c))
+    return sizes, solid, groups
+
+
+def _gap_rings(groups: dict[int, _Rings], field_: PixelField, *, tolerance_px: float,
+               min_area_px: float
+               ) -> list[tuple[int, NDArray[np.float64], list[NDArray[np.float64]]]]:
+    """Per region, its largest contour (the exterior) and its holes of at least
+    ``min_area_px``, simplified and in image pixel coordinates (x, y)."""
+    from skimage.measure import approximate_polygon
 
     # pixel coordinates (x, y) of contour vertices: index space has pixel centres at integers
     x0 = field_.cols.start - 1 + 0.5
     y0 = field_.rows.start - 1 + 0.5
-    cx, cy, radius = geometry.mask.cx, geometry.mask.cy, geometry.mask.radius
 
     def to_xy(c: NDArray[np.float64]) -> NDArray[np.float64]:
         if tolerance_px > 0 and len(c) > SIMPLIFY_MIN_VERTICES:
             c = approximate_polygon(c, tolerance_px)
         return c[:, ::-1] + (x0, y0)  # (row, col) -> (x, y)
 
-    # simplify every ring first, then convert all vertices to angles in one vectorised call
     gaps: list[tuple[int, NDArray[np.float64], list[NDArray[np.float64]]]] = []
     for lab, rings in groups.items():
         rings.sort(key=lambda t: -t[0])
@@ -156,42 +204,22 @@ def trace_gaps(
             continue
         holes_xy = [to_xy(c) for area, c in rings[1:] if area >= min_area_px]
         gaps.append((lab, ext_xy, [h for h in holes_xy if len(h) >= 4]))
-    if not gaps:
-        return []
+    return gaps
+
+
+def _ring_angles(gaps: list[tuple[int, NDArray[np.float64], list[NDArray[np.float64]]]],
+                 geometry: FisheyeGeometry) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """Every ring vertex, rings in order: pixel (x, y) pulled onto the image circle where
+    outside it (the rim is 90°), and its (zenith, azimuth) in degrees, in one vectorised
+    call of the lens model."""
+    cx, cy, radius = geometry.mask.cx, geometry.mask.cy, geometry.mask.radius
     all_xy = np.concatenate([r for _, e, hs in gaps for r in (e, *hs)])
     d = all_xy - (cx, cy)
     dist = np.hypot(d[:, 0], d[:, 1])
     scale = np.where(dist > radius, radius / np.maximum(dist, 1e-12), 1.0)  # rim onto 90°
     all_xy = (cx, cy) + d * scale[:, None]
     zen, azi = geometry.to_direction(all_xy[:, 0], all_xy[:, 1])
-    angles = np.c_[zen, azi]
-
-    out: list[GapOutline] = []
-    k = 0
-    for lab, ext_xy, holes_xy in gaps:
-        n = len(ext_xy)
-        ext_xy, ext_ang = all_xy[k : k + n], angles[k : k + n]
-        k += n
-        hole_xy, hole_ang = [], []
-        for h in holes_xy:
-            n = len(h)
-            hole_xy.append(all_xy[k : k + n])
-            hole_ang.append(angles[k : k + n])
-            k += n
-        out.append(
-            GapOutline(
-                exterior=ext_ang,
-                holes=tuple(hole_ang),
-                solid_angle_sr=float(solid[lab]),
-                pixels=int(sizes[lab]),
-                contains_zenith=_contains_centre(ext_xy, hole_xy, cx, cy),
-                axis=geometry.axis,
-                exterior_px=ext_xy,
-                holes_px=tuple(hole_xy),
-            )
-        )
-    out.sort(key=lambda g: -g.solid_angle_sr)
-    return out
+    return all_xy, np.c_[zen, azi]
 
 
 def gap_polygons(outlines: list[GapOutline], *, include_holes: bool = False) -> list[NDArray]:

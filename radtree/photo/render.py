@@ -14,6 +14,7 @@ it with the same ring × segment grid as the photo.
 
 from __future__ import annotations
 
+import logging
 import time
 from dataclasses import dataclass
 from typing import Any
@@ -34,6 +35,8 @@ from radtree.pipeline.assemble import facade_frame, make_scene
 from radtree.pipeline.build import built_scene
 from radtree.trees.build import apply_switches, resolve_form
 from radtree.trees.photo import AXIS_OF, PhotoSource, lens_of, photo_source
+
+log = logging.getLogger(__name__)
 
 DEFAULT_SIZE = 1000
 
@@ -140,7 +143,7 @@ def render_scenario(project: Project, sc: Scenario, size: int = DEFAULT_SIZE,
 
 
 def radiance_picture(project: Project, sc: Scenario, hour: str, size: int, out: Any,
-                     echo: Any = print, ab: int | None = None) -> tuple[Any, Any]:
+                     ab: int | None = None) -> tuple[Any, Any]:
     """A Radiance ``rpict -vta`` fisheye of the scenario at ``hour`` (HH:MM) from its photo
     point along its photo's axis, lit by the hour's sun and sky (``ab``: ambient bounces,
     default the crown's): (HDR path, BMP path)."""
@@ -156,7 +159,7 @@ def radiance_picture(project: Project, sc: Scenario, hour: str, size: int, out: 
         raise ConfigError(f"unknown hour {hour!r} (site.hours: {', '.join(project.site.hours)})",
                           source=str(project.source), field="--hour")
     built = make_scene(project, sc)
-    folder = ensure_built(project, sc, echo)
+    folder = ensure_built(project, sc, log.info)
     params = effective_project(project, sc).engine
     plan = RadianceEngine().prepare(built.scene, states, params, built.ab, folder)
     frame = facade_frame(project)

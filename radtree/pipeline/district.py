@@ -87,7 +87,7 @@ def district_scene(project: Project, scenario: Scenario, dense_grid: bool | None
 
             tree = inventory_turbid(project, inputs.trees, tr)
         else:
-            tree = inventory_crowns(project, inputs.trees, tr, d.instancing, clips)
+            tree = inventory_crowns(project, inputs.trees, tr, instancing=d.instancing, clips=clips)
         clash = set(tree.materials) & set(materials)
         if clash:
             raise RadtreeError(f"crown materials clash with the buildings': {clash}")

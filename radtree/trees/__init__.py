@@ -1,4 +1,5 @@
-"""Crown models (homogeneous, perforated, louvers) in two forms (sensor dome, free-standing).
+"""Crown models (homogeneous, perforated, louvers) in two forms (sensor dome, free-standing),
+registered by name in :mod:`radtree.trees.registry`.
 
 Entry point: :func:`radtree.trees.build.build_tree` (``build_tree(project, scenario, frame)``
 → :class:`TreeModel`). Also: :func:`radtree.trees.build.build_crown` (a model/form without a

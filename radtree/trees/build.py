@@ -1,7 +1,9 @@
 """Build the crown of a scenario: ``build_tree(project, scenario, frame) -> TreeModel``.
 
 The form is ``scenario.form or project.tree.form`` (``"dome"`` | ``"free"``), the model
-``scenario.model`` (``"homogeneous"`` | ``"perforated"`` | ``"louvers"`` | ``"none"``).
+``scenario.model``, one of the registered crown models (:mod:`radtree.trees.registry`:
+``homogeneous``, ``perforated``, ``louvers``, ``none``), built by the registry's builder for
+``[tree] representation``.
 
 Scenario ``switches`` override crown parameters with dotted keys naming a table of ``[tree]``
 and one of its fields, e.g. ``"louvers.layers" = 6``, ``"louvers.specular_fraction" = 0``,
@@ -31,10 +33,8 @@ from radtree.config import (
 )
 from radtree.errors import ConfigError
 from radtree.site.frame import FacadeFrame
-from radtree.trees.homogeneous import build_homogeneous
-from radtree.trees.louvers import build_louvers
 from radtree.trees.model import TreeModel
-from radtree.trees.perforated import build_perforated
+from radtree.trees.registry import crown_builder
 from radtree.trees.species import load_species
 
 __all__ = ["TreeModel", "apply_switches", "build_crown", "build_tree", "resolve_form"]
@@ -85,23 +85,9 @@ def build_crown(project: Project, model: str, form: str, frame: FacadeFrame,
     tree = tree or project.tree
     source = str(project.source)
     t0 = time.perf_counter()
-    if model == "none":
-        result = TreeModel(meshes=[], materials={}, notes=[
-            "No crown (model 'none'): the unobstructed reference."], recommended_ab=2,
-            form=form, model="none")
-    elif model == "homogeneous":
-        result = build_homogeneous(tree, project.sensors, project.street, frame, form, source)
-    elif model == "perforated":
-        result = build_perforated(tree, project.sensors, project.street, frame, form, source)
-    elif model == "louvers" and tree.representation == "turbid":
-        from radtree.trees.turbid import build_turbid
-
-        result = build_turbid(tree, project.sensors, project.street, frame, form, source)
-    elif model == "louvers":
-        result = build_louvers(tree, project.sensors, project.street, frame, form, source)
-    else:
-        raise ConfigError(f"got {model!r}, expected homogeneous, perforated, louvers or none",
-                          source=source, field="scenario.model")
+    builder = crown_builder(model, tree.representation, source)
+    result = builder(tree, sensors=project.sensors, street=project.street, frame=frame,
+                     form=form, source=source)
     if tree.species is not None and model != "none":
         sp = load_species(tree.species)
         result.notes.insert(0, f"Species {sp.name} ({sp.common_name}, "
@@ -110,7 +96,6 @@ def build_crown(project: Project, model: str, form: str, frame: FacadeFrame,
     result.build_seconds = time.perf_counter() - t0
     result.frame = frame
     result.triangles = sum(m.n_triangles for m in result.meshes)
-    result.info.setdefault("triangles", float(result.triangles))
     result.info["triangles"] = float(result.triangles)
     return result
 

@@ -29,7 +29,7 @@ from __future__ import annotations
 
 import math
 import zlib
-from dataclasses import replace
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
@@ -138,108 +138,153 @@ def yaw_of(tree_id: str) -> float:
     return float(zlib.crc32(tree_id.encode()) % 3600) / 10.0
 
 
-def inventory_crowns(project: Project, trees: list[InventoryTree], tree: Tree,
+def leaf_material(slv: Louvers, key: str, source: str) -> tuple[str, LouverOptics, Trans]:
+    """A species' slat material ``leaf_<key>`` (fields checked first): (name, optics,
+    material)."""
+    check_louvers(slv, source)
+    mat = f"leaf_{key}"
+    o = LouverOptics.of(slv)
+    return mat, o, Trans(mat, o.reflectance, o.t_diffuse, o.t_specular)
+
+
+@dataclass
+class _Crowns:
+    """What :func:`inventory_crowns` gathers species by species."""
+
+    materials: dict = field(default_factory=lambda: {TRUNK: Plastic(TRUNK, BARK_REFLECTANCE)})
+    leaves: list[Mesh] = field(default_factory=list)
+    prototypes: dict[str, list[Mesh]] = field(default_factory=dict)
+    instances: list[Instance] = field(default_factory=list)
+    trunks_v: list[np.ndarray] = field(default_factory=list)
+    trunks_f: list[np.ndarray] = field(default_factory=list)
+    trunk_owners: list[np.ndarray] = field(default_factory=list)  # each face's tree
+    notes: list[str] = field(default_factory=list)
+    ab: int = 2
+    off: int = 0   # trunk vertices so far
+
+    def add_trunk(self, tree_id: str, tv: np.ndarray, tf: np.ndarray) -> None:
+        self.trunks_v.append(tv)
+        self.trunks_f.append(tf + self.off)
+        self.off += len(tv)
+        self.trunk_owners.append(np.full(len(tf), tree_id))
+
+
+def inventory_crowns(project: Project, trees: list[InventoryTree], tree: Tree, *,
                      instancing: str = "auto", clips: dict[str, WallClip] | None = None
                      ) -> TreeModel:
     """The crowns of every inventory tree (louvers model, free form) as one TreeModel;
     ``tree``: the project's [tree] after the scenario's switches. A crown in ``clips``
     (:func:`wall_clips`) is built in place in its wall's frame, cut at the clip plane."""
-    clips = clips or {}
-    lv = tree.louvers
     source = str(project.source)
     species = species_of(trees, source)
     keys = list(dict.fromkeys(str(species[t.id].key) for t in trees))
     by_key = {k: [t for t in trees if species[t.id].key == k] for k in keys}
-    default_rt = project.tree.crown.trunk_diameter_m / 2.0
-    materials: dict = {TRUNK: Plastic(TRUNK, BARK_REFLECTANCE)}
-    leaves: list[Mesh] = []
-    prototypes: dict[str, list[Mesh]] = {}
-    instances: list[Instance] = []
-    trunks_v, trunks_f, off = [], [], 0
-    trunk_owners: list[np.ndarray] = []  # the tree of each face (Mesh.owners)
-    notes: list[str] = []
-    ab = 2
     index = {t.id: i for i, t in enumerate(trees)}
+    acc = _Crowns()
     for j, key in enumerate(keys):
         group = by_key[key]
-        slv = species_louvers(tree, species[group[0].id])
-        check_louvers(slv, source)
-        mat = f"leaf_{key}"
-        o = LouverOptics.of(slv)
-        materials[mat] = Trans(mat, o.reflectance, o.t_diffuse, o.t_specular)
-        if slv.arrangement == "volume":
-            ab = max(ab, recommended_volume_ab(slv))
-        else:
-            ab = max(ab, slv.layers + 2)
-        free = [t for t in group if t.id not in clips]
-        shared = instancing == "auto" and len(free) > 1
-        if shared:
-            a_ref = float(np.median([t.crown_radius_m for t in free]))
-            aspect = float(np.median([t.vertical_radius_m / t.crown_radius_m for t in free]))
-            b_ref = a_ref * aspect
-            rt_ref = default_rt
-            pspec = single_spec(np.zeros(3), a_ref, b_ref, rt_ref, -b_ref + 0.5 * b_ref)
-            seed = lv.seed + PROTOTYPE_SEED_STEP * (j + 1)
-            v, f = polygons_to_mesh(_slats(pspec, replace(slv, seed=seed), source))
-            name = f"crown_{key}_s{lv.seed}"
-            prototypes[name] = [Mesh(f"{name}_leaves", mat, v, f)]
-            dz = []
-            for t in free:
-                k = t.crown_radius_m / a_ref
-                b_eff = b_ref * k
-                instances.append(Instance(name, (t.x, t.y, t.crown_base_m + b_eff),
-                                          yaw_of(t.id), k, owner=str(t.id)))
-                dz.append(t.crown_base_m + 2 * b_eff - t.height_m)
-            notes.append(f"{key}: {len(free)} trees share one crown (instanced; median "
-                         f"radius {a_ref:.2f} m, aspect b/a {aspect:.2f}, {len(f)} triangles); "
-                         f"crown tops differ from the inventory heights by "
-                         f"{min(dz):+.2f}…{max(dz):+.2f} m.")
-        polys: list[np.ndarray] = []
-        leaf_owners: list[np.ndarray] = []
-        for t in group:
-            a, b = t.crown_radius_m, t.vertical_radius_m
-            placed = shared and t.id not in clips      # an instance of the shared crown
-            if placed:
-                b = (t.crown_radius_m / a_ref) * b_ref
-            rt = (t.trunk_diameter_m / 2.0) if t.trunk_diameter_m else default_rt
-            spec = single_spec(np.array([t.x, t.y, t.crown_base_m + b]), a, b, rt,
-                               t.crown_base_m + 0.5 * b)
-            wf = None
-            if t.id in clips:                          # in the wall's frame, cut at the plane
-                contact, n_clip = clips[t.id]
-                wf = _wall_frame(contact)
-                u, n, _ = wf.to_local(np.array([t.x, t.y, 0.0]))
-                spec = replace(single_spec(np.array([u, n, t.crown_base_m + b]), a, b, rt,
-                                           t.crown_base_m + 0.5 * b), n_clip=n_clip)
-            if not placed:
-                seed = lv.seed + TREE_SEED_STEP * index[t.id]
-                slats = _slats(spec, replace(slv, seed=seed), source)
-                polys.extend(slats if wf is None else [wf.to_world(p) for p in slats])
-                leaf_owners.append(np.full(sum(len(q) - 2 for q in slats if len(q) >= 3),
-                                           str(t.id)))
-            tv, tf = spec.trunks()
-            if wf is not None:
-                tv = wf.to_world(tv)
-            trunks_v.append(tv)
-            trunks_f.append(tf + off)
-            trunk_owners.append(np.full(len(tf), str(t.id)))
-            off += len(tv)
-        if polys:
-            v, f = polygons_to_mesh(polys)
-            leaves.append(Mesh(f"tree_leaves_{key}", mat, v, f, np.concatenate(leaf_owners)))
-            if len(free) < len(group) or not shared:
-                built = len(group) - (len(free) if shared else 0)
-                notes.append(f"{key}: {built} crown(s) built in place ({len(f)} triangles).")
-        notes.append(f"{key} leaves: " + o.describe_slat() + f"; slats {slv.slat_size_m:g} m "
-                     f"at {slv.inclination_deg:g}° (species leaf tilt), permeability "
-                     f"{species[group[0].id].permeability_leaf_on:g}.")
-    meshes = leaves + [Mesh("tree_trunks", TRUNK, np.vstack(trunks_v), np.vstack(trunks_f),
-                            np.concatenate(trunk_owners))]
-    notes.insert(0, f"Tree inventory: {len(trees)} trees of {len(keys)} species "
-                    f"({', '.join(f'{k} {len(v)}' for k, v in by_key.items())}); "
-                    f"{len(instances)} instanced from {len(prototypes)} prototype crown(s).")
+        _species_crowns(acc, tree, key=key, j=j, group=group, sp=species[group[0].id],
+                        shared=instancing == "auto", clips=clips or {}, index=index,
+                        default_rt=project.tree.crown.trunk_diameter_m / 2.0, source=source)
+    meshes = acc.leaves + [Mesh("tree_trunks", TRUNK, np.vstack(acc.trunks_v),
+                                np.vstack(acc.trunks_f), np.concatenate(acc.trunk_owners))]
+    acc.notes.insert(0, f"Tree inventory: {len(trees)} trees of {len(keys)} species "
+                        f"({', '.join(f'{k} {len(v)}' for k, v in by_key.items())}); "
+                        f"{len(acc.instances)} instanced from {len(acc.prototypes)} prototype "
+                        "crown(s).")
     info = {"trees": float(len(trees)), "species": float(len(keys)),
-            "instances": float(len(instances)), "prototypes": float(len(prototypes))}
-    return TreeModel(meshes=meshes, materials=materials, notes=notes, recommended_ab=ab,
-                     info=info, form="free", model="louvers", prototypes=prototypes,
-                     instances=instances)
+            "instances": float(len(acc.instances)), "prototypes": float(len(acc.prototypes))}
+    return TreeModel(meshes=meshes, materials=acc.materials, notes=acc.notes,
+                     recommended_ab=acc.ab, info=info, form="free", model="louvers",
+                     prototypes=acc.prototypes, instances=acc.instances)
+
+
+def _species_crowns(acc: _Crowns, tree: Tree, *, key: str, j: int, group: list[InventoryTree],
+                    sp: Species, shared: bool, clips: dict[str, WallClip],
+                    index: dict[str, int], default_rt: float, source: str) -> None:
+    """The crowns and trunks of one species (``j``: its index): a shared crown for its
+    unclipped trees when ``shared`` and there are several, the others built in place."""
+    seed = tree.louvers.seed
+    slv = species_louvers(tree, sp)
+    mat, o, material = leaf_material(slv, key, source)
+    acc.materials[mat] = material
+    ab = recommended_volume_ab(slv) if slv.arrangement == "volume" else slv.layers + 2
+    acc.ab = max(acc.ab, ab)
+    free = [t for t in group if t.id not in clips]
+    shared = shared and len(free) > 1
+    ref = (_shared_crown(acc, free, replace(slv, seed=seed + PROTOTYPE_SEED_STEP * (j + 1)),
+                         key=key, name=f"crown_{key}_s{seed}", mat=mat, default_rt=default_rt,
+                         source=source) if shared else None)
+    polys: list[np.ndarray] = []
+    leaf_owners: list[np.ndarray] = []
+    for t in group:
+        slats, tv, tf = _one_tree(t, slv=replace(slv, seed=seed + TREE_SEED_STEP * index[t.id]),
+                                  ref=ref, clip=clips.get(t.id), default_rt=default_rt,
+                                  source=source)
+        if slats is not None:
+            polys.extend(slats)
+            leaf_owners.append(np.full(sum(len(q) - 2 for q in slats if len(q) >= 3),
+                                       str(t.id)))
+        acc.add_trunk(str(t.id), tv, tf)
+    if polys:
+        v, f = polygons_to_mesh(polys)
+        acc.leaves.append(Mesh(f"tree_leaves_{key}", mat, v, f, np.concatenate(leaf_owners)))
+        if len(free) < len(group) or not shared:
+            built = len(group) - (len(free) if shared else 0)
+            acc.notes.append(f"{key}: {built} crown(s) built in place ({len(f)} triangles).")
+    acc.notes.append(f"{key} leaves: " + o.describe_slat() + f"; slats {slv.slat_size_m:g} m "
+                     f"at {slv.inclination_deg:g}° (species leaf tilt), permeability "
+                     f"{sp.permeability_leaf_on:g}.")
+
+
+def _shared_crown(acc: _Crowns, free: list[InventoryTree], slv: Louvers, *, key: str,
+                  name: str, mat: str, default_rt: float, source: str) -> tuple[float, float]:
+    """One prototype crown at the trees' median radius and aspect, placed per tree
+    (instances scaled to each crown radius); (its semi-axes a, b in m)."""
+    a_ref = float(np.median([t.crown_radius_m for t in free]))
+    aspect = float(np.median([t.vertical_radius_m / t.crown_radius_m for t in free]))
+    b_ref = a_ref * aspect
+    pspec = single_spec(np.zeros(3), a_ref, b_ref, default_rt, -b_ref + 0.5 * b_ref)
+    v, f = polygons_to_mesh(_slats(pspec, slv, source))
+    acc.prototypes[name] = [Mesh(f"{name}_leaves", mat, v, f)]
+    dz = []
+    for t in free:
+        k = t.crown_radius_m / a_ref
+        b_eff = b_ref * k
+        acc.instances.append(Instance(name, (t.x, t.y, t.crown_base_m + b_eff), yaw_of(t.id),
+                                      k, owner=str(t.id)))
+        dz.append(t.crown_base_m + 2 * b_eff - t.height_m)
+    acc.notes.append(f"{key}: {len(free)} trees share one crown (instanced; median "
+                     f"radius {a_ref:.2f} m, aspect b/a {aspect:.2f}, {len(f)} triangles); "
+                     f"crown tops differ from the inventory heights by "
+                     f"{min(dz):+.2f}…{max(dz):+.2f} m.")
+    return a_ref, b_ref
+
+
+def _one_tree(t: InventoryTree, *, slv: Louvers, ref: tuple[float, float] | None,
+              clip: WallClip | None, default_rt: float, source: str
+              ) -> tuple[list[np.ndarray] | None, np.ndarray, np.ndarray]:
+    """One tree: its slats in world space (None: an instance of the shared crown ``ref``),
+    its trunk's vertices and faces. A clipped crown is built in its wall's frame, cut at the
+    clip plane."""
+    a, b = t.crown_radius_m, t.vertical_radius_m
+    placed = ref is not None and clip is None      # an instance of the shared crown
+    if ref is not None and clip is None:
+        b = (t.crown_radius_m / ref[0]) * ref[1]
+    rt = (t.trunk_diameter_m / 2.0) if t.trunk_diameter_m else default_rt
+    spec = single_spec(np.array([t.x, t.y, t.crown_base_m + b]), a, b, rt,
+                       t.crown_base_m + 0.5 * b)
+    wf = None
+    if clip is not None:                           # in the wall's frame, cut at the plane
+        contact, n_clip = clip
+        wf = _wall_frame(contact)
+        u, n, _ = wf.to_local(np.array([t.x, t.y, 0.0]))
+        spec = replace(single_spec(np.array([u, n, t.crown_base_m + b]), a, b, rt,
+                                   t.crown_base_m + 0.5 * b), n_clip=n_clip)
+    slats = None
+    if not placed:
+        slats = _slats(spec, slv, source)
+        if wf is not None:
+            slats = [wf.to_world(p) for p in slats]
+    tv, tf = spec.trunks()
+    return slats, (tv if wf is None else wf.to_world(tv)), tf

@@ -54,6 +54,8 @@ import math
 from dataclasses import dataclass
 from typing import Any
 
+import numpy as np
+
 from radtree.config import LOUVER_ARRANGEMENTS, Louvers, Sensors, Street, Tree
 from radtree.errors import ConfigError
 from radtree.optics import Plastic, Trans
@@ -66,7 +68,12 @@ from radtree.trees.louvers_free import BRANCH_SLATS, build_free_louvers
 from radtree.trees.model import BARK_REFLECTANCE, LEAF, TRUNK, TreeModel
 from radtree.trees.photo import photo_source, require_direction, with_source
 from radtree.trees.photo_cut import dome_from_photo
-from radtree.trees.volume import build_volume_louvers, recommended_volume_ab, volume_note
+from radtree.trees.volume import (
+    build_volume_louvers,
+    recommended_volume_ab,
+    volume_ab_note,
+    volume_note,
+)
 
 
 # ---------------------------------------------------------------- optics
@@ -184,123 +191,190 @@ def check_louvers(lv: Louvers, source: str | None = None) -> None:
 
 
 # ---------------------------------------------------------------- entry point
-def build_louvers(tree: Tree, sensors: Sensors, street: Street, frame: FacadeFrame, form: str,
-                  source: str | None = None) -> TreeModel:
+@dataclass
+class _Slats:
+    """One form's slats before assembly: local-frame mesh (``verts`` m, ``faces``), the crown
+    each face belongs to (free crowns), what was built (``ginfo``), notes, the louvers in
+    force (a photo fit replaces the configured ones), and whether slats fill the volume."""
+
+    verts: np.ndarray
+    faces: np.ndarray
+    count: int
+    ginfo: dict[str, float]
+    notes: list[str]
+    lv: Louvers
+    volume: bool
+    owners: np.ndarray | None = None
+    photo: dict | None = None
+    trunks: Mesh | None = None
+
+
+def build_louvers(tree: Tree, *, sensors: Sensors, street: Street, frame: FacadeFrame,
+                  form: str, source: str | None = None) -> TreeModel:
+    """The louvers crown of ``tree`` in ``form`` (``dome`` | ``free``), in world space
+    (``frame``: the façade frame; x east, y north, z up, m): check, build the form's slats,
+    then assemble the model with its notes, recommended ``-ab`` and info."""
     lv = tree.louvers
     check_louvers(lv, source)
+    _check_form(tree, form, source)
     optics = LouverOptics.of(lv)
+    if form == "dome":
+        part = _dome_slats(tree, sensors=sensors, street=street, source=source)
+    else:
+        part = _free_slats(tree, sensors=sensors, street=street, frame=frame, source=source)
     materials: dict = {LEAF: optics.material()}
-    meshes: list[Mesh] = []
-    notes: list[str] = []
-    if form == "dome" and lv.arrangement == "volume":
+    meshes = [Mesh("tree_leaves", LEAF, frame.to_world(part.verts), part.faces, part.owners)]
+    if part.trunks is not None:
+        materials[TRUNK] = Plastic(TRUNK, BARK_REFLECTANCE)
+        meshes.append(part.trunks)
+    from_points = tree.points is not None
+    notes = [*part.notes, *_arrangement_notes(tree, part, optics, form=form)]
+    volume = part.volume or from_points  # slats through the volume: its optics and -ab
+    notes.extend(_optics_notes(optics, volume=volume))
+    ab, ab_note = _recommended_ab(part.lv, volume=volume)
+    notes.append(ab_note)
+    info = _louvers_info(part, optics, volume=volume, from_points=from_points)
+    return TreeModel(meshes=meshes, materials=materials, notes=notes, recommended_ab=ab,
+                     info=info, form=form, model="louvers", photo=part.photo)
+
+
+def _check_form(tree: Tree, form: str, source: str | None) -> None:
+    """The form and arrangement go together: the dome keeps its shells; a crown from points
+    is free-standing and fitted to no photo."""
+    if form == "dome" and tree.louvers.arrangement == "volume":
         raise ConfigError("got arrangement 'volume' with the sensor-dome form: the dome keeps "
                           "its concentric slat shells; use arrangement = 'layers' or form "
                           "'free'", source=source, field="tree.louvers.arrangement")
-    volume = form != "dome" and lv.arrangement == "volume"
-    from_points = tree.points is not None
-    if from_points and (form == "dome" or tree.photo is not None):
+    if tree.points is not None and (form == "dome" or tree.photo is not None):
         raise ConfigError("a crown from points is free-standing and fitted to no photo: use "
                           "form = 'free' and no [tree] photo", source=source,
                           field="tree.points")
-    photo: dict | None = None
-    owners = None   # the free crowns' faces: which crown of the row (C1 …)
-    if form == "dome":
-        spec = dome_spec(tree, sensors, street, source)
-        quads, ginfo = build_dome_louvers(spec, lv, sensors, source)
-        src = photo_source(tree) if tree.photo is not None else None
-        if src is None:
-            verts, faces = quads_to_mesh(quads)
-        else:
-            points, corners, photo_info, photo = dome_from_photo(quads, spec.centre, src,
-                                                                 source)
-            verts, faces = flat_polygons_to_mesh(points, corners)
-            ginfo.update(photo_info)
-        slats = len(quads)
-        notes.extend(dome_notes(spec))
-        if src is not None:
-            notes.append(
-                f"Cut by the façade photo {src.path.name} ({src.lens} lens; {tree.photo}): in "
-                f"every shell the slats are removed where the photo shows sky along the line "
-                f"from the dome centre ({int(photo_info['photo_slats_removed'])} slats removed, "
-                f"{int(photo_info['photo_slats_cut'])} cut, "
-                f"{int(photo_info['photo_slats_whole'])} whole; photo openness "
-                f"{photo_info['photo_openness']:.4f}).")
-        notes.append(
-            f"Louvers: {lv.layers} concentric shells of slats at radii "
-            f"{ginfo['layer_radius_min_m']:.2f}–{ginfo['layer_radius_max_m']:.2f} m; each "
-            f"shell covers {100 * lv.cover_fraction:.1f} % of the directions from the dome "
-            f"centre, so every direction from it crosses {lv.layers} filtration stages. "
-            f"{slats} slats of ≈ {lv.slat_size_m:g} m (sides "
-            f"{ginfo['slat_side_min_m']:.2f}–{ginfo['slat_side_max_m']:.2f} m), inclined "
-            f"{lv.inclination_deg:g}° from horizontal, rows sheared along "
-            f"{lv.branch_inclination_deg:g}° branches.")
+
+
+def _dome_slats(tree: Tree, *, sensors: Sensors, street: Street,
+                source: str | None) -> _Slats:
+    """The sensor dome's concentric shells of slats, cut by the façade photo if any."""
+    lv = tree.louvers
+    spec = dome_spec(tree, sensors, street, source)
+    quads, ginfo = build_dome_louvers(spec, lv, sensors, source)
+    src = photo_source(tree) if tree.photo is not None else None
+    photo = None
+    notes = list(dome_notes(spec))
+    if src is None:
+        verts, faces = quads_to_mesh(quads)
     else:
-        spec_r = crown_row_spec(tree, sensors, street, source)
-        src = photo_source(tree) if tree.photo is not None else None
-        if src is not None:
-            try:
-                require_direction(src, "upward", "the free louvers crowns")
-            except ConfigError as exc:
-                raise with_source(exc, source) from None
-            from radtree.trees.photo_fit import camera_point, fitted_louvers
+        points, corners, photo_info, photo = dome_from_photo(quads, spec.centre, src, source)
+        verts, faces = flat_polygons_to_mesh(points, corners)
+        ginfo.update(photo_info)
+        notes.append(
+            f"Cut by the façade photo {src.path.name} ({src.lens} lens; {tree.photo}): in "
+            f"every shell the slats are removed where the photo shows sky along the line "
+            f"from the dome centre ({int(photo_info['photo_slats_removed'])} slats removed, "
+            f"{int(photo_info['photo_slats_cut'])} cut, "
+            f"{int(photo_info['photo_slats_whole'])} whole; photo openness "
+            f"{photo_info['photo_openness']:.4f}).")
+    notes.append(
+        f"Louvers: {lv.layers} concentric shells of slats at radii "
+        f"{ginfo['layer_radius_min_m']:.2f}–{ginfo['layer_radius_max_m']:.2f} m; each "
+        f"shell covers {100 * lv.cover_fraction:.1f} % of the directions from the dome "
+        f"centre, so every direction from it crosses {lv.layers} filtration stages. "
+        f"{len(quads)} slats of ≈ {lv.slat_size_m:g} m (sides "
+        f"{ginfo['slat_side_min_m']:.2f}–{ginfo['slat_side_max_m']:.2f} m), inclined "
+        f"{lv.inclination_deg:g}° from horizontal, rows sheared along "
+        f"{lv.branch_inclination_deg:g}° branches.")
+    return _Slats(verts, faces, len(quads), ginfo, notes, lv, volume=False, photo=photo)
 
-            lv, fit, photo = fitted_louvers(lv, src, spec_r, camera_point(tree, sensors),
-                                            frame, source, tree.accept_poor_fit)
-            if fit.problems():
-                notes.append("POOR PHOTO FIT ACCEPTED ([tree] accept_poor_fit = true): "
-                             + "; ".join(fit.problems()) + ".")
-            volume = True
-            tilt = (f"leaf inclinations from Campbell's ellipsoidal distribution, x = "
-                    f"{fit.x:.3g} (mean tilt {fit.mean_tilt_deg:.1f}°)" if fit.x is not None
-                    else f"slats fixed at {lv.inclination_deg:g}°")
-            notes.append(
-                f"Fitted to the upward photo {src.path.name} ({src.lens} lens; camera "
-                f"{tree.photo_x_m:g} m along the façade from the sensors, "
-                f"{tree.photo_distance_m:g} m out, {tree.photo_height_m:g} m high; zenith "
-                f"0–{src.zenith_deg:g}°): leaf area density {fit.lad:.3f} m²/m³, {tilt}; "
-                f"vertical crossings {lv.crossings:.2f}; gap-fraction RMS {fit.rms:.4f} "
-                f"(cells), {fit.ring_rms:.4f} (rings); the photo's LAI_eff "
-                f"{fit.lai_photo:.3f}, clumping {fit.clumping_photo:.3f} "
-                + _clumping_fit_text(fit) + _spread_text(fit.spread()))
-        if from_points:
-            from radtree.trees.points_crown import build_points_louvers
 
-            polys, ginfo, _ = build_points_louvers(spec_r, tree, source)
-        elif volume:
-            polys, ginfo = build_volume_louvers(spec_r, lv, source)
-        else:
-            polys, ginfo = build_free_louvers(spec_r, lv, source)
-        verts, faces = polygons_to_mesh(polys)
-        owners = spec_r.crown_ids(verts[faces].mean(axis=1)) if len(faces) else None
-        slats = len(polys)
-        tv, tf = spec_r.trunks()
-        materials[TRUNK] = Plastic(TRUNK, BARK_REFLECTANCE)
-        meshes.append(Mesh("tree_trunks", TRUNK, frame.to_world(tv), tf,
-                           spec_r.trunk_ids(len(tf))))
-        notes.extend(row_notes(spec_r, tree, sensors))
-        ginfo["clip_plane_n_m"] = spec_r.n_clip
-    if from_points:
+def _free_slats(tree: Tree, *, sensors: Sensors, street: Street, frame: FacadeFrame,
+                source: str | None) -> _Slats:
+    """The free-standing crown row: slats from points, through the volume (also when fitted
+    to an upward photo) or in nested layers; trunks; each face's crown."""
+    lv = tree.louvers
+    volume = lv.arrangement == "volume"
+    spec_r = crown_row_spec(tree, sensors, street, source)
+    notes: list[str] = []
+    photo = None
+    src = photo_source(tree) if tree.photo is not None else None
+    if src is not None:
+        lv, photo, fit_notes = _fit_to_photo(tree, src, spec_r, sensors=sensors, frame=frame,
+                                             source=source)
+        notes.extend(fit_notes)
+        volume = True
+    if tree.points is not None:
+        from radtree.trees.points_crown import build_points_louvers
+
+        polys, ginfo, _ = build_points_louvers(spec_r, tree, source)
+    elif volume:
+        polys, ginfo = build_volume_louvers(spec_r, lv, source)
+    else:
+        polys, ginfo = build_free_louvers(spec_r, lv, source)
+    verts, faces = polygons_to_mesh(polys)
+    owners = spec_r.crown_ids(verts[faces].mean(axis=1)) if len(faces) else None
+    tv, tf = spec_r.trunks()
+    trunks = Mesh("tree_trunks", TRUNK, frame.to_world(tv), tf, spec_r.trunk_ids(len(tf)))
+    notes.extend(row_notes(spec_r, tree, sensors))
+    ginfo["clip_plane_n_m"] = spec_r.n_clip
+    return _Slats(verts, faces, len(polys), ginfo, notes, lv, volume=volume, owners=owners,
+                  photo=photo, trunks=trunks)
+
+
+def _fit_to_photo(tree: Tree, src: Any, spec_r: Any, *, sensors: Sensors, frame: FacadeFrame,
+                  source: str | None) -> tuple[Louvers, dict, list[str]]:
+    """The free crowns' louvers fitted to an upward photo (:mod:`radtree.trees.photo_fit`):
+    (fitted louvers, the photo's provenance, notes)."""
+    try:
+        require_direction(src, "upward", "the free louvers crowns")
+    except ConfigError as exc:
+        raise with_source(exc, source) from None
+    from radtree.trees.photo_fit import camera_point, fitted_louvers
+
+    lv, fit, photo = fitted_louvers(tree.louvers, src, spec_r, camera_point(tree, sensors),
+                                    frame, source, tree.accept_poor_fit)
+    notes = []
+    if fit.problems():
+        notes.append("POOR PHOTO FIT ACCEPTED ([tree] accept_poor_fit = true): "
+                     + "; ".join(fit.problems()) + ".")
+    tilt = (f"leaf inclinations from Campbell's ellipsoidal distribution, x = "
+            f"{fit.x:.3g} (mean tilt {fit.mean_tilt_deg:.1f}°)" if fit.x is not None
+            else f"slats fixed at {lv.inclination_deg:g}°")
+    notes.append(
+        f"Fitted to the upward photo {src.path.name} ({src.lens} lens; camera "
+        f"{tree.photo_x_m:g} m along the façade from the sensors, "
+        f"{tree.photo_distance_m:g} m out, {tree.photo_height_m:g} m high; zenith "
+        f"0–{src.zenith_deg:g}°): leaf area density {fit.lad:.3f} m²/m³, {tilt}; "
+        f"vertical crossings {lv.crossings:.2f}; gap-fraction RMS {fit.rms:.4f} "
+        f"(cells), {fit.ring_rms:.4f} (rings); the photo's LAI_eff "
+        f"{fit.lai_photo:.3f}, clumping {fit.clumping_photo:.3f} "
+        + _clumping_fit_text(fit) + _spread_text(fit.spread()))
+    return lv, photo, notes
+
+
+def _arrangement_notes(tree: Tree, part: _Slats, optics: LouverOptics, *,
+                       form: str) -> list[str]:
+    """What the free crowns' arrangement built (points, volume or nested layers)."""
+    lv, ginfo, slats = part.lv, part.ginfo, part.count
+    if tree.points is not None:
         from radtree.trees.points_crown import points_note
 
-        notes.append(points_note(tree, ginfo, slats))
-        volume = True   # slats through the volume: the volume crowns' optics and -ab
-    elif volume:
-        notes.append(volume_note(lv, ginfo, slats, optics.t_specular))
-    elif form != "dome":
-        notes.append(
-            f"Louvers: {lv.layers} nested lens-shaped layers per crown (every vertical line "
-            f"through a crown crosses {lv.layers}); each layer covers "
-            f"{100 * lv.cover_fraction:.1f} % of its plan area with {lv.slat_size_m:g} m "
-            f"square slats inclined {lv.inclination_deg:g}°, in branches of {BRANCH_SLATS} "
-            f"climbing at {lv.branch_inclination_deg:g}°; {slats} slats "
-            f"({int(ginfo['slats_cut'])} cut at the wall-side or shared planes). Near-"
-            "horizontal views cross fewer layers than vertical ones (the reference case: first physical "
-            "check, point 2).")
-    meshes.insert(0, Mesh("tree_leaves", LEAF, frame.to_world(verts), faces, owners))
-    if volume:
-        notes.append("Leaf optics, " + optics.describe_slat() + ".")
-    else:
-        notes.append("Leaf optics, " + optics.describe() + ".")
+        return [points_note(tree, ginfo, slats)]
+    if part.volume:
+        return [volume_note(lv, ginfo, slats, optics.t_specular)]
+    if form == "dome":
+        return []
+    return [
+        f"Louvers: {lv.layers} nested lens-shaped layers per crown (every vertical line "
+        f"through a crown crosses {lv.layers}); each layer covers "
+        f"{100 * lv.cover_fraction:.1f} % of its plan area with {lv.slat_size_m:g} m "
+        f"square slats inclined {lv.inclination_deg:g}°, in branches of {BRANCH_SLATS} "
+        f"climbing at {lv.branch_inclination_deg:g}°; {slats} slats "
+        f"({int(ginfo['slats_cut'])} cut at the wall-side or shared planes). Near-"
+        "horizontal views cross fewer layers than vertical ones (the reference case: first "
+        "physical check, point 2)."]
+
+
+def _optics_notes(optics: LouverOptics, *, volume: bool) -> list[str]:
+    """The leaf optics and which reading of the study's 0.5 is in use."""
+    notes = ["Leaf optics, " + (optics.describe_slat() if volume else optics.describe()) + "."]
     if optics.reading == "study":
         unit = "per-slat" if volume else "per-layer"
         notes.append(f"Study reading: the study's 0.5 is treated as an effective {unit} "
@@ -311,21 +385,28 @@ def build_louvers(tree: Tree, sensors: Sensors, street: Street, frame: FacadeFra
         notes.append("Gap reading: leaves are near-opaque real leaves and each layer passes "
                      "light mainly through its gaps (switch louvers.reading = \"study\" for an "
                      "effective slat material: every layer covered, transmittance 0.5).")
+    return notes
+
+
+def _recommended_ab(lv: Louvers, *, volume: bool) -> tuple[int, str]:
+    """Radiance ``-ab`` for the crown and the note saying why."""
     if volume:
         ab = recommended_volume_ab(lv)
-        notes.append(f"Radiance: -ab {ab} (crossings + 2, capped at 6: light crossing many "
-                     "slats does so mostly by specular transmission, which needs no ambient "
-                     "bounce; on reference-case scenario F, crossings 15, the façade mean moved 0.1 % "
-                     "from -ab 6 to -ab 8 at 13:30 (1457 → 1456 lx) and to -ab 12 at 10:30 "
-                     "(1089 → 1090 lx), and −1.1 % from -ab 6 to -ab 5 — check with radtree "
-                     "simulate --convergence).")
-    else:
-        ab = lv.layers + 2
-        notes.append(f"Radiance: slat layers with diffuse transmission pass light only through "
-                     f"ambient bounces; use -ab ≥ {ab} and check convergence.")
+        return ab, volume_ab_note(ab)
+    ab = lv.layers + 2
+    return ab, (f"Radiance: slat layers with diffuse transmission pass light only through "
+                f"ambient bounces; use -ab ≥ {ab} and check convergence.")
+
+
+def _louvers_info(part: _Slats, optics: LouverOptics, *, volume: bool,
+                  from_points: bool) -> dict[str, float]:
+    """Numbers for reports and tests: analytic transmissions (layers: τ_layer^N; volume:
+    the turbid-medium exp(−λ(1 − T_s)) along the vertical through a crown centre), counts,
+    and what the geometry step measured."""
+    lv = part.lv
     info: dict[str, float] = {
         "layers": float(lv.layers), "cover_fraction": lv.cover_fraction,
-        "slat_count": float(slats), "slat_size_m": lv.slat_size_m,
+        "slat_count": float(part.count), "slat_size_m": lv.slat_size_m,
         "slat_reflectance": lv.reflectance, "slat_transmittance": lv.transmittance,
         "slat_specular_transmittance": optics.t_specular,
         "slat_diffuse_transmittance": optics.t_diffuse,
@@ -339,16 +420,14 @@ def build_louvers(tree: Tree, sensors: Sensors, street: Street, frame: FacadeFra
         "arrangement_volume": float(volume),
     }
     if volume and not from_points:
-        # turbid-medium direct transmission along the vertical through a crown centre
-        lam = ginfo["lambda_vertical"]
+        lam = part.ginfo["lambda_vertical"]
         for key in ("tau_crown_direct", "direct_transmission"):
             info[key] = math.exp(-lam * (1.0 - optics.t_specular))
         info["tau_crown_global"] = math.exp(-lam * (1.0 - optics.transmittance))
         for key in ("tau_layer_direct", "tau_layer_global"):
             info.pop(key)
-    info.update(ginfo)
-    return TreeModel(meshes=meshes, materials=materials, notes=notes, recommended_ab=ab,
-                     info=info, form=form, model="louvers", photo=photo)
+    info.update(part.ginfo)
+    return info
 
 
 def _clumping_fit_text(fit: Any) -> str:

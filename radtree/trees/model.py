@@ -51,3 +51,11 @@ class TreeModel:
                 raise ValueError(f"mesh '{m.name}' uses undefined material '{m.material}'")
         if not self.triangles:
             self.triangles = sum(m.n_triangles for m in self.meshes)
+
+
+def no_crown(tree: object, sensors: object, street: object, frame: FacadeFrame, form: str,
+             source: str | None = None) -> TreeModel:
+    """The crown model ``none`` (no meshes): the unobstructed reference."""
+    return TreeModel(meshes=[], materials={}, notes=[
+        "No crown (model 'none'): the unobstructed reference."], recommended_ab=2,
+        form=form, model="none")

@@ -61,7 +61,7 @@ SkyPredicate = Callable[[np.ndarray], np.ndarray]
 OPENNESS_SAMPLES = 200_000
 MAX_RESOLUTION = 256
 DEFAULT_SEED = 1
-PERFORATED_AB = 5  # ambient bounces: -ab 3 reads ≈ 4 % low on the reference-case dome (convergence check)
+PERFORATED_AB = 5  # ambient bounces: as the homogeneous shell (trees.homogeneous.MIN_AB: why)
 
 
 @dataclass(frozen=True)

@@ -12,6 +12,7 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -66,20 +67,15 @@ def render_model_png(model: TreeModel, scene: Scene | None, path: str | Path,
                 nx, ny = float(grid.normals[0, 0]), float(grid.normals[0, 1])
                 frame = FacadeFrame(float(np.degrees(np.arctan2(nx, ny))))
     frame = frame or model.frame or FacadeFrame()
-    return _render(model, Path(path), frame, extra, sensor_points, title, max_triangles, dpi,
-                   seed)
+    return _render(model, path=Path(path), frame=frame, extra_meshes=extra,
+                   sensor_points=sensor_points, title=title, max_triangles=max_triangles,
+                   dpi=dpi, seed=seed)
 
 
-def _render(model: TreeModel, path: Path, frame: FacadeFrame, extra_meshes: Sequence[Mesh],
-            sensor_points: np.ndarray | None, title: str | None, max_triangles: int, dpi: int,
-            seed: int) -> Path:
-    from matplotlib.backends.backend_agg import FigureCanvasAgg
-    from matplotlib.collections import PolyCollection
-    from matplotlib.figure import Figure
-
-    fig = Figure(figsize=(16, 5.4), dpi=dpi)
-    FigureCanvasAgg(fig)
-    axes = fig.subplots(1, 3)
+def _crown_triangles(model: TreeModel, frame: FacadeFrame, *, max_triangles: int, seed: int
+                     ) -> tuple[list[tuple[Any, tuple[float, float, float]]], float]:
+    """The crown's triangles in the façade frame with their colours, large meshes thinned
+    at random (``seed``) to about ``max_triangles``; and the share kept."""
     rng = np.random.default_rng(seed)
     crown = [m for m in model.meshes if m.n_triangles
              and not isinstance(model.materials.get(m.material), Hole)]
@@ -92,6 +88,21 @@ def _render(model: TreeModel, path: Path, frame: FacadeFrame, extra_meshes: Sequ
         if keep_share < 1.0 and m.n_triangles >= SMALL_MESH:
             tri = tri[rng.random(len(tri)) < keep_share]
         local_tris.append((tri, _colour(m.material, model.materials.get(m.material))))
+    return local_tris, keep_share
+
+
+def _render(model: TreeModel, *, path: Path, frame: FacadeFrame, extra_meshes: Sequence[Mesh],
+            sensor_points: np.ndarray | None, title: str | None, max_triangles: int, dpi: int,
+            seed: int) -> Path:
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.collections import PolyCollection
+    from matplotlib.figure import Figure
+
+    fig = Figure(figsize=(16, 5.4), dpi=dpi)
+    FigureCanvasAgg(fig)
+    axes = fig.subplots(1, 3)
+    local_tris, keep_share = _crown_triangles(model, frame, max_triangles=max_triangles,
+                                              seed=seed)
     extras = [frame.to_local(m.vertices)[m.faces] for m in extra_meshes if m.n_triangles]
     sensors = None if sensor_points is None else frame.to_local(np.asarray(sensor_points, float))
     pts = [t.reshape(-1, 3) for t, _ in local_tris]
@@ -128,15 +139,21 @@ def _render(model: TreeModel, path: Path, frame: FacadeFrame, extra_meshes: Sequ
         ax.set_ylabel(yl, fontsize=8)
         ax.tick_params(labelsize=7)
     head = title or f"{model.model} crown, {model.form} form"
-    sub = f"{model.triangles} triangles, built in {model.build_seconds:.2f} s"
-    if keep_share < 1.0:
-        sub += f" ({drawn} of them drawn)"
-    for key in ("tau_crown_direct", "hole_fraction", "crown_transmission"):
-        if key in model.info:
-            sub += f"; {key.replace('_', ' ')} {model.info[key]:.4f}"
-    fig.suptitle(f"{head}\n{sub}", fontsize=11)
+    fig.suptitle(f"{head}\n{_subtitle(model, drawn if keep_share < 1.0 else None)}",
+                 fontsize=11)
     fig.tight_layout()
     target = Path(path)
     with atomic_path(target) as tmp:
         fig.savefig(tmp, format="png", dpi=dpi)
     return target
+
+
+def _subtitle(model: TreeModel, drawn: int | None) -> str:
+    """Triangles, build time, triangles drawn when thinned, and the crown's transmission."""
+    sub = f"{model.triangles} triangles, built in {model.build_seconds:.2f} s"
+    if drawn is not None:
+        sub += f" ({drawn} of them drawn)"
+    for key in ("tau_crown_direct", "hole_fraction", "crown_transmission"):
+        if key in model.info:
+            sub += f"; {key.replace('_', ' ')} {model.info[key]:.4f}"
+    return sub

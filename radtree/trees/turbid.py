@@ -43,12 +43,12 @@ import numpy as np
 from radtree.config import Louvers, Project, Sensors, Street, Tree
 from radtree.errors import ConfigError
 from radtree.media import LeafKind, TurbidCrowns
-from radtree.optics import Plastic, Trans
+from radtree.optics import Plastic
 from radtree.scene import Mesh
 from radtree.site.frame import FacadeFrame
 from radtree.site.inventory import InventoryTree
 from radtree.trees.clumping import clumped_g
-from radtree.trees.district import single_spec, species_louvers, species_of
+from radtree.trees.district import leaf_material, single_spec, species_louvers, species_of
 from radtree.trees.envelope import CrownRowSpec, crown_row_spec, row_notes
 from radtree.trees.leaf_angles import BINS, inclination_pdf
 from radtree.trees.louvers import LouverOptics, check_louvers
@@ -165,10 +165,8 @@ def inventory_turbid(project: Project, trees: list[InventoryTree], tree: Tree) -
     for key in keys:
         group = [t for t in trees if species[t.id].key == key]
         slv = replace(species_louvers(tree, species[group[0].id]), arrangement="volume")
-        check_louvers(slv, source)
-        mat = f"leaf_{key}"
-        o = LouverOptics.of(slv)
-        materials[mat] = Trans(mat, o.reflectance, o.t_diffuse, o.t_specular)
+        mat, o, material = leaf_material(slv, key, source)
+        materials[mat] = material
         kinds.append(leaf_kind(slv, mat))
         lvs[key] = slv
         notes.append(f"{key}: {len(group)} turbid crown(s); leaves " + o.describe_slat()
