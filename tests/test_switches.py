@@ -207,10 +207,10 @@ def test_diagnose_effect_keys():
     from radtree.diagnose.effects import (
         EFFECTS,
         EffectContext,
-        UnfilteredGround,
         check_effect_keys,
         get_effect,
     )
+    from radtree.diagnose.catalogue.light import UnfilteredGround
 
     check_effect_keys(EFFECTS)  # the catalogue's keys are all registered
 
