@@ -13,6 +13,7 @@ from click.testing import CliRunner
 
 from radtree.cli.diagnose import diagnose_command
 from radtree.config import Scenario, load_project
+from radtree.config.step_project import write_step_project
 from radtree.diagnose.attribution import Signature, cosine, fit_candidate
 from radtree.diagnose.effects import (
     EFFECT_NAMES,
@@ -22,7 +23,6 @@ from radtree.diagnose.effects import (
     get_effect,
     parse_effects,
 )
-from radtree.config.step_project import write_step_project
 from radtree.diagnose.measured import load_measurements
 from radtree.diagnose.registry import EFFECT_REGISTRY, effect_class, effect_rows
 from radtree.diagnose.residuals import disagreement_map

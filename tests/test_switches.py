@@ -204,13 +204,13 @@ def test_sweep_tables_unknown_keys(small: Path):
 
 # ---------------------------------------------------------------- diagnose, overrides, scans
 def test_diagnose_effect_keys():
+    from radtree.diagnose.catalogue.light import UnfilteredGround
     from radtree.diagnose.effects import (
         EFFECTS,
         EffectContext,
         check_effect_keys,
         get_effect,
     )
-    from radtree.diagnose.catalogue.light import UnfilteredGround
 
     check_effect_keys(EFFECTS)  # the catalogue's keys are all registered
 

@@ -45,7 +45,7 @@ from radtree.diagnose.campaign import (
 from radtree.diagnose.campaign_sim import CampaignSimulator
 from radtree.diagnose.effects import EFFECTS, Effect, EffectContext, candidates
 from radtree.diagnose.identify import Identifiability, identifiability, noise_sigma
-from radtree.diagnose.options import DiagnoseOptions
+from radtree.diagnose.options import DEFAULT_OPTIONS, DiagnoseOptions
 from radtree.diagnose.outcome import pick_scenario, resolve_project
 from radtree.diagnose.simulate import Run
 from radtree.errors import ConfigError
@@ -252,7 +252,7 @@ def rank_candidates(names: list[str], signatures: np.ndarray, sigma: np.ndarray,
 
 def next_measurement(project: str | os.PathLike | Project, *,
                      candidates_file: str | os.PathLike | None = None,
-                     options: DiagnoseOptions = DiagnoseOptions()) -> Design:
+                     options: DiagnoseOptions = DEFAULT_OPTIONS) -> Design:
     """Rank candidate additions to ``options.campaign`` (default: the project's own
     measurement); ``candidates_file``: a campaign TOML whose groups, hours and days are the
     candidates (default: :func:`default_candidates`). Writes ``next_measurement.csv``,

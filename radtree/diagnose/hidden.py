@@ -62,7 +62,7 @@ from radtree.diagnose.campaign_sim import CampaignSimulator, campaign_synthetic
 from radtree.diagnose.effects import EFFECTS, Effect, EffectContext, candidates
 from radtree.diagnose.identify import DEFAULT_NOISE, nearest_snr, noise_sigma, unique_snr
 from radtree.diagnose.measured import Measured, load_measurements
-from radtree.diagnose.options import DiagnoseOptions
+from radtree.diagnose.options import DEFAULT_OPTIONS, DiagnoseOptions
 from radtree.diagnose.outcome import (
     SNR_MIN,
     HiddenCase,
@@ -235,7 +235,7 @@ class _Plan:
 
 def selftest(project: str | os.PathLike | Project, *, noise: float | None = None,
              noise_lux: float = 0.0, resimulate: bool = False,
-             options: DiagnoseOptions = DiagnoseOptions()) -> SelftestResult:
+             options: DiagnoseOptions = DEFAULT_OPTIONS) -> SelftestResult:
     """Hide each effect of ``options.effects`` (default: the catalogue) in synthetic
     measurements and check the loop names it.
 

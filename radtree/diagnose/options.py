@@ -72,3 +72,7 @@ class DiagnoseOptions(Checked):
     def folder(self, root: Path) -> Path:
         """Where the outputs go: :attr:`out_dir`, else ``root / "diagnose"``."""
         return self.out_dir if self.out_dir is not None else root / "diagnose"
+
+
+#: the options of a call that gives none
+DEFAULT_OPTIONS = DiagnoseOptions()

@@ -22,7 +22,7 @@ from radtree.diagnose.campaign_sim import CampaignSimulator, campaign_readings
 from radtree.diagnose.effects import EFFECTS, EffectContext, candidates
 from radtree.diagnose.loop import LoopResult, OnStep, run_loop
 from radtree.diagnose.measured import Measured, load_measurements
-from radtree.diagnose.options import DiagnoseOptions
+from radtree.diagnose.options import DEFAULT_OPTIONS, DiagnoseOptions
 from radtree.diagnose.outcome import DiagnoseResult, pick_scenario, resolve_project
 from radtree.diagnose.parallel import TracePool
 from radtree.diagnose.simulate import Simulator
@@ -33,7 +33,7 @@ log = logging.getLogger(__name__)
 
 
 def diagnose(project: str | os.PathLike | Project, *, measured: str | os.PathLike | None = None,
-             units: str | None = None, options: DiagnoseOptions = DiagnoseOptions()
+             units: str | None = None, options: DiagnoseOptions = DEFAULT_OPTIONS
              ) -> DiagnoseResult:
     """Run the discrepancy loop from ``options.scenario`` (default: the project's first)
     against the measurements (default: ``[project] measured``; ``units`` when the file does
