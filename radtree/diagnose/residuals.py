@@ -109,6 +109,17 @@ def disagreement_map(times: tuple[str, ...] | list[str], *, measured: np.ndarray
         "mc_se_rms_lux": float(np.sqrt(np.mean(se_ok ** 2))) if se_ok.size else math.nan,
         "mean_measured_lux": mean_m,
     }
+    rows, rows_hourly = _row_tables(simulated_rows, measured_rows, measured_rows_hourly)
+    out = DisagreementMap(hourly, rows, stats, rows_hourly=rows_hourly)
+    out.findings = findings(out)
+    return out
+
+
+def _row_tables(simulated_rows: pd.DataFrame | None, measured_rows: pd.DataFrame | None,
+                measured_rows_hourly: pd.DataFrame | None
+                ) -> tuple[pd.DataFrame | None, pd.DataFrame | None]:
+    """Per-row daily residuals (from the daily means, else from the hourly row values) and
+    the hourly per-row residuals (lx)."""
     rows = None
     rows_hourly = None
     if simulated_rows is not None and measured_rows is not None and len(measured_rows):
@@ -140,9 +151,7 @@ def disagreement_map(times: tuple[str, ...] | list[str], *, measured: np.ndarray
                     "simulated_mean_lux": g["simulated_lux"].mean().values})
                 rows["residual_lux"] = rows["measured_mean_lux"] - rows["simulated_mean_lux"]
                 rows["residual_pct"] = 100 * rows["residual_lux"] / rows["measured_mean_lux"]
-    out = DisagreementMap(hourly, rows, stats, rows_hourly=rows_hourly)
-    out.findings = findings(out)
-    return out
+    return rows, rows_hourly
 
 
 def _r(a: np.ndarray, b: np.ndarray) -> float:
