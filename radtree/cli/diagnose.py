@@ -10,7 +10,8 @@ The old one-command form is an alias of these, with a one-line deprecation note:
 ``radtree diagnose PROJECT`` is ``run``, ``--selftest`` is ``selftest``,
 ``--next-measurement`` is ``next`` and ``--list-effects`` is ``list-effects`` (the flag is
 taken out, everything else is passed on to the subcommand, which refuses the options it does
-not have). Expected failures raise :class:`radtree.errors.RadtreeError` (the one handler of
+not have; a project folder named like a subcommand, e.g. ``next``, is written ``./next``).
+Expected failures raise :class:`radtree.errors.RadtreeError` (the one handler of
 :mod:`radtree.cli.errors` prints one line and exits 2, or 3 for an engine failure); the
 self-test exits 1 when a distinguishable hidden effect was misnamed.
 """
