@@ -10,9 +10,10 @@ from click.testing import CliRunner
 
 from radtree.cli import main
 from radtree.cli.diagnose import LEGACY_FLAGS, diagnose_command, legacy_args
+from radtree.diagnose.loop import LoopOptions
 from radtree.diagnose.options import DiagnoseOptions
 from radtree.diagnose.registry import EFFECT_REGISTRY
-from radtree.errors import ConfigError
+from radtree.errors import ConfigError, RadtreeError
 from tests.conftest import MENDOZA, copy_project
 
 
@@ -135,3 +136,8 @@ def test_options_checked_on_creation():
         DiagnoseOptions(rays=0)
     assert DiagnoseOptions(out_dir="x").folder(Path("/p")) == Path("x")
     assert DiagnoseOptions().folder(Path("/p")) == Path("/p/diagnose")
+    loop = DiagnoseOptions(margin=0.1, max_steps=2).loop(first_step_signatures=True)
+    assert (loop.margin, loop.max_steps, loop.first_step_signatures) == (0.1, 2, True)
+    assert [e.name for e in loop.catalogue] == list(EFFECT_REGISTRY)
+    with pytest.raises(RadtreeError, match=r"margin must be in \[0, 1\), got 1.5"):
+        LoopOptions(margin=1.5)
