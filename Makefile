@@ -49,7 +49,7 @@ demo-convergence: demo-simulate
 demo-permeability: demo-build
 	$(RUN) $(BIN)/radtree permeability $(EXAMPLE) -s A --rays 512
 demo-diagnose: demo-permeability
-	$(RUN) $(BIN)/radtree diagnose $(EXAMPLE) -s A --rays 512
+	$(RUN) $(BIN)/radtree diagnose run $(EXAMPLE) -s A --rays 512
 demo-hemi: demo-diagnose
 	$(RUN) $(BIN)/radtree hemi check $(EXAMPLE)
 demo-report: demo-convergence demo-hemi

@@ -37,7 +37,7 @@ def main(argv: list[str] | None = None) -> int:
                     help="self-test on what this campaign measures (path from the repository)")
     args = ap.parse_args(argv)
 
-    from radtree.diagnose import diagnose, selftest
+    from radtree.diagnose import DiagnoseOptions, diagnose, selftest
     from radtree.diagnose.campaign import load_campaign
     from radtree.diagnose.run import format_steps
 
@@ -46,7 +46,7 @@ def main(argv: list[str] | None = None) -> int:
         shutil.copytree(MENDOZA, proj, ignore=shutil.ignore_patterns(
             "build", "results", "report", "diagnose", "sweep"))
         t0 = time.perf_counter()
-        res = diagnose(proj, scenario=args.scenario, rays=args.rays, echo=None)
+        res = diagnose(proj, options=DiagnoseOptions(scenario=args.scenario, rays=args.rays))
         wall = time.perf_counter() - t0
         print(f"diagnose loop, Mendoza scenario {args.scenario}, NumPy engine, {args.rays} "
               f"rays/sensor, 7 hours:")
@@ -65,7 +65,8 @@ def main(argv: list[str] | None = None) -> int:
             rays = args.selftest_rays or (campaign.rays if campaign is not None and
                                           campaign.rays else 512)
             t0 = time.perf_counter()
-            st = selftest(proj, scenario=args.scenario, rays=rays, echo=None, campaign=campaign)
+            st = selftest(proj, options=DiagnoseOptions(scenario=args.scenario, rays=rays,
+                                                    campaign=campaign))
             wall = time.perf_counter() - t0
             cols = ["hidden_effect", "distinguishable", "named_effect", "rmse_before",
                     "rmse_after", "gap_shrinks"]

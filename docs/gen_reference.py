@@ -272,12 +272,12 @@ RESULT_TABLES: list[tuple[str, list[str], str, str]] = [
     ("verify.csv", ["radtree.verify.suite:COLUMNS"], "radtree verify", "one physics check"),
     ("method/hourly.csv", ["radtree.verify.method:COLUMNS"], "radtree method",
      "one method variant × scenario × hour"),
-    ("diagnose/steps.csv", ["radtree.diagnose.loop:STEP_COLUMNS"], "radtree diagnose",
+    ("diagnose/steps.csv", ["radtree.diagnose.loop:STEP_COLUMNS"], "radtree diagnose run",
      "one step of the discrepancy loop"),
     ("diagnose/selftest.csv", ["radtree.diagnose.outcome:SELFTEST_COLUMNS"],
-     "radtree diagnose --selftest", "one hidden effect"),
+     "radtree diagnose selftest", "one hidden effect"),
     ("diagnose/next_measurement.csv", ["radtree.diagnose.design:DESIGN_COLUMNS"],
-     "radtree diagnose --next-measurement", "one candidate measurement"),
+     "radtree diagnose next", "one candidate measurement"),
 ]
 #: column lists that are not a written table of their own (checked by tests/test_docs.py)
 NOT_TABLES = {"radtree.pipeline.results:REQUIRED_COLUMNS", "radtree.annual.metrics:UDI_COLUMNS",

@@ -13,6 +13,7 @@ from click.testing import CliRunner
 
 from radtree.cli.diagnose import diagnose_command
 from radtree.config import Scenario, load_project
+from radtree.config.step_project import write_step_project
 from radtree.diagnose.attribution import Signature, cosine, fit_candidate
 from radtree.diagnose.effects import (
     EFFECT_NAMES,
@@ -22,7 +23,8 @@ from radtree.diagnose.effects import (
     get_effect,
     parse_effects,
 )
-from radtree.diagnose.loop import load_measurements, write_step_project
+from radtree.diagnose.measured import load_measurements
+from radtree.diagnose.registry import EFFECT_REGISTRY, effect_class, effect_rows
 from radtree.diagnose.residuals import disagreement_map
 from radtree.errors import RadtreeError
 from radtree.measurements import MeasurementError
@@ -112,11 +114,40 @@ def test_parse_effects_errors():
 
 
 def test_list_effects_cli(mendoza):
-    r = CliRunner().invoke(diagnose_command, ["--list-effects"])
+    r = CliRunner().invoke(diagnose_command, ["list-effects"])
     assert r.exit_code == 0, r.output
     for name in EFFECT_NAMES:
         assert name in r.output
     assert r.output.count("physics:") == len(EFFECTS)
+    listed = [line.split(":")[0] for line in r.output.splitlines() if not line.startswith(" ")]
+    assert listed == list(EFFECT_REGISTRY)
+
+
+def test_effect_registry_is_the_catalogue():
+    """The registry names the catalogue, the CLI's --effects help and list-effects; each
+    class's declared capabilities match what it does."""
+    from radtree.diagnose.effects import _static_strength
+
+    assert EFFECT_NAMES == tuple(EFFECT_REGISTRY)
+    assert [e.name for e in EFFECTS] == list(EFFECT_REGISTRY)
+    rows = effect_rows()
+    assert [r[0] for r in rows] == list(EFFECT_REGISTRY)
+    help_text = CliRunner().invoke(diagnose_command, ["run", "--help"],
+                                   terminal_width=400).output
+    assert ", ".join(EFFECT_REGISTRY) in " ".join(help_text.split())
+    ctx = EffectContext(load_project(MENDOZA))
+    homogeneous = Scenario("h", "homogeneous")
+    for e, (name, summary, caps) in zip(EFFECTS, rows):
+        assert summary == e.title
+        st = _static_strength(e)
+        assert caps.startswith(f"strength: {'on/off' if st is None else st.mode}; "), name
+        louvers_only = e.applies(ctx, homogeneous) is not None and "louvers" in str(
+            e.applies(ctx, homogeneous))
+        assert ("crowns: louvers" in caps) == louvers_only, name
+    assert rows[-1] == ("hourly_ground_reflectance", EFFECTS[-1].title,
+                        "strength: on/off; crowns: any; needs a street.ground_reflectance table")
+    with pytest.raises(RadtreeError, match="unknown effect 'sky'.*sky_diffuse"):
+        effect_class("sky")
 
 
 # --------------------------------------------------------------------------- measurements
@@ -174,7 +205,9 @@ def test_disagreement_map_words():
                             index=pd.Index(times, name="time"))
     rows_meas = pd.DataFrame({"row": ["higher", "intermediate", "lower"],
                               "measured_mean_lux": [1400.0, 1400.0, 1400.0]})
-    dm = disagreement_map(times, meas, sim, np.full(7, 5.0), alt, az, rows_sim, rows_meas)
+    dm = disagreement_map(times, measured=meas, simulated=sim, simulated_se=np.full(7, 5.0),
+                          sun_altitude=alt, sun_azimuth=az, simulated_rows=rows_sim,
+                          measured_rows=rows_meas)
     text = " ".join(dm.findings)
     assert "under-predicts at 7 of 7 hours" in text
     assert "grows towards low sun" in text
@@ -182,7 +215,8 @@ def test_disagreement_map_words():
     assert list(dm.hourly["period"]) == ["morning"] * 3 + ["noon"] + ["afternoon"] * 3
     # morning only
     sim2 = meas - np.array([300, 300, 300, 0, 0, 0, 0.0])
-    dm2 = disagreement_map(times, meas, sim2, np.full(7, 5.0), alt, az)
+    dm2 = disagreement_map(times, measured=meas, simulated=sim2, simulated_se=np.full(7, 5.0),
+                           sun_altitude=alt, sun_azimuth=az)
     assert "morning only" in " ".join(dm2.findings)
     assert dm2.stats["nmbe"] == pytest.approx(900 / 7 / 1400)
 
@@ -264,10 +298,11 @@ def test_step_project_file_round_trip(tmp_path):
 def test_selftest_names_hidden_effects(reduced):
     """Hidden-effect self-test on a reduced Mendoza (128 rays, 7 hours, no dense grid): three
     effects hidden in scenario B, candidates from the whole catalogue."""
-    from radtree.diagnose import selftest
+    from radtree.diagnose import DiagnoseOptions, selftest
 
     effects = parse_effects("more_stages,sky_diffuse,unfiltered_ground")
-    res = selftest(reduced, scenario="B", effects=effects, noise=0.03, max_steps=2, echo=None)
+    res = selftest(reduced, noise=0.03,
+                   options=DiagnoseOptions(scenario="B", effects=effects, max_steps=2))
     table = res.table()
     assert list(table.columns[:5]) == ["hidden_effect", "distinguishable", "named_effect",
                                        "rmse_before", "rmse_after"]
@@ -331,8 +366,11 @@ def test_diagnose_cli_errors(reduced, tmp_path):
     r = CliRunner().invoke(diagnose_command, [str(reduced), "--measured", str(bad)])
     assert isinstance(r.exception, RadtreeError)
     assert "line 3" in str(r.exception) and "negative" in str(r.exception)
-    r = CliRunner().invoke(diagnose_command, [])
-    assert r.exit_code != 0 and "PROJECT is required" in r.output
+    r = CliRunner().invoke(diagnose_command, ["run"])
+    assert r.exit_code == 2 and "Missing argument 'PROJECT'" in r.output
+    # the modes are subcommands: an option of another mode is refused by click, not by hand
+    r = CliRunner().invoke(diagnose_command, ["selftest", str(reduced), "--measured", "x.csv"])
+    assert r.exit_code == 2 and "No such option: --measured" in r.output
     r = CliRunner().invoke(diagnose_command, [str(reduced), "--selftest", "--effects", "nope"])
     assert isinstance(r.exception, RadtreeError) and "unknown effect" in str(r.exception)
 

@@ -27,7 +27,7 @@ MEASURED = {"10:30": 1157.0, "13:30": 1592.0}
 def scan(tmp_path_factory):
     p = copy_project(tmp_path_factory.mktemp("scan") / "proj", hours=["10:30", "13:30"])
     proj = load_project(p)
-    return proj, scan_permeability(proj, "A", values=(0.45, 0.5, 0.55), rays=256, echo=lambda s: None)
+    return proj, scan_permeability(proj, "A", values=(0.45, 0.5, 0.55), rays=256)
 
 
 def test_scan_numbers(scan):

@@ -204,10 +204,10 @@ def test_sweep_tables_unknown_keys(small: Path):
 
 # ---------------------------------------------------------------- diagnose, overrides, scans
 def test_diagnose_effect_keys():
+    from radtree.diagnose.catalogue.light import UnfilteredGround
     from radtree.diagnose.effects import (
         EFFECTS,
         EffectContext,
-        UnfilteredGround,
         check_effect_keys,
         get_effect,
     )

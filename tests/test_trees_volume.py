@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 from scipy.stats import poisson
 
-from radtree.calibrate.permeability import calibrate_crossings
+from radtree.calibrate.permeability import CrossingsSearch, calibrate_crossings
 from radtree.config import Louvers, Scenario, load_project
 from radtree.errors import ConfigError
 from radtree.optics import Plastic, Trans
@@ -259,7 +259,7 @@ def test_calibrate_crossings_cheap(project):
     target and stops within 2 % (or 2 s.e.) of it; permeability falls with the crossings."""
     p = replace(project, site=replace(project.site, hours=("13:30",)))
     res = calibrate_crossings(p, target=0.2, switches={"louvers.slat_size_m": 0.6},
-                              start=(2.0, 6.0), rays=96, echo=lambda s: None)
+                              search=CrossingsSearch(start=(2.0, 6.0), rays=96))
     t = res.table
     assert res.converged
     assert abs(math.log(res.permeability / 0.2)) <= max(0.02, 2 * res.stderr / res.permeability)

@@ -149,11 +149,13 @@ def calibrate(project: Project, *, model: str = "louvers", target: float | None 
     form = form or project.tree.form
     frame = FacadeFrame(project.street.facade_azimuth_deg)
     if model == "louvers":
-        return _calibrate_louvers(project, goal, source, form, frame, directions, tolerance,
-                                  max_layers, max_builds)
+        return _calibrate_louvers(project, goal=goal, source=source, form=form, frame=frame,
+                                  directions=directions, tolerance=tolerance,
+                                  max_layers=max_layers, max_builds=max_builds)
     if model == "perforated":
-        return _calibrate_perforated(project, goal, source, form, frame, directions, tolerance,
-                                     max_builds)
+        return _calibrate_perforated(project, goal=goal, source=source, form=form, frame=frame,
+                                     directions=directions, tolerance=tolerance,
+                                     max_builds=max_builds)
     if model == "homogeneous":
         tree = replace(project.tree, homogeneous=replace(project.tree.homogeneous,
                                                          transmittance=None, permeability=goal))
@@ -166,7 +168,7 @@ def calibrate(project: Project, *, model: str = "louvers", target: float | None 
     raise RadtreeError(f"cannot calibrate model {model!r} (louvers, perforated, homogeneous)")
 
 
-def _calibrate_louvers(project: Project, goal: float, source: str, form: str,
+def _calibrate_louvers(project: Project, *, goal: float, source: str, form: str,
                        frame: FacadeFrame, directions: int, tolerance: float, max_layers: int,
                        max_builds: int) -> CalibrationResult:
     lv = project.tree.louvers
@@ -231,7 +233,7 @@ def _calibrate_louvers(project: Project, goal: float, source: str, form: str,
                              notes, reached=reached)
 
 
-def _calibrate_perforated(project: Project, goal: float, source: str, form: str,
+def _calibrate_perforated(project: Project, *, goal: float, source: str, form: str,
                           frame: FacadeFrame, directions: int, tolerance: float,
                           max_builds: int) -> CalibrationResult:
     perf = project.tree.perforated

@@ -19,8 +19,9 @@ engine (Monte Carlo standard errors in the table); Radiance would give the same 
 
 from __future__ import annotations
 
+import logging
 import math
-from collections.abc import Callable, Sequence
+from collections.abc import Sequence
 from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any
@@ -37,6 +38,8 @@ from radtree.measurements import hourly_grid_means
 from radtree.pipeline.processes import spawned_map, usable_cores, with_threads
 from radtree.pipeline.trace import facade_total, trace_scenario
 from radtree.stats import nmbe, nrmse, pearson_r
+
+log = logging.getLogger(__name__)
 
 MEASURED_BAND = (0.05, 0.06)   # reference case §1: canopy permeability 5–6 %
 TARGET_NRMSE = 0.10            # the reference study's scenario A reached 0.09
@@ -125,8 +128,7 @@ def _ratio(num: tuple[float, float], den: tuple[float, float]) -> tuple[float, f
 def scan_permeability(project: Project, scenario: str = "A",
                       field: str = "louvers.transmittance",
                       values: Sequence[float] = (0.45, 0.5, 0.55, 0.6, 0.65),
-                      rays: int = 2048, seed: int = 1,
-                      echo: Callable[[str], None] = print) -> PermeabilityScan:
+                      rays: int = 2048, seed: int = 1) -> PermeabilityScan:
     """Scan ``field`` (a crown switch such as ``louvers.transmittance``) over ``values`` for
     ``scenario`` of ``project``; see the module docstring for the columns."""
     for v in values:  # a switch of the one registry, each value typed and bounded
@@ -150,8 +152,8 @@ def scan_permeability(project: Project, scenario: str = "A",
                            "(the scan compares every project hour)")
     outside = [t for t in m.index if t not in project.site.hours]
     if outside:
-        echo(f"measured hour(s) {', '.join(outside)} are not among the project's hours: "
-             "not compared")
+        log.info("measured hour(s) %s are not among the project's hours: not compared",
+                 ", ".join(outside))
     m = m.reindex(list(project.site.hours))
     if not values:
         raise ConfigError("no values to scan", field=field)
@@ -170,13 +172,13 @@ def scan_permeability(project: Project, scenario: str = "A",
         jobs += [("sum", project, crown), ("sum", sky_project, crown), ("hourly", project, fit)]
     workers = min(usable_cores(), len(jobs))
     threads = max(1, usable_cores() // workers)
-    echo(f"{len(jobs)} traces ({len(values)} values × 3 + 2 references, {rays} rays/sensor) in "
-         f"{workers} process{'es' if workers > 1 else ''}")
+    log.info("%d traces (%d values × 3 + 2 references, %d rays/sensor) in %d process%s",
+             len(jobs), len(values), rays, workers, "es" if workers > 1 else "")
     out = spawned_map(_run_job, [(kind, with_threads(p, threads), sc, rays, seed)
                                  for kind, p, sc in jobs], workers)
     open_street, unob = out[0], out[1]
-    echo(f"open street: Σ façade {open_street[0]:.0f} lx; unobstructed reference (sun + "
-         f"{project.light.diffuse_horizontal_lux:g} lx sky): Σ {unob[0]:.0f} lx")
+    log.info("open street: Σ façade %.0f lx; unobstructed reference (sun + %g lx sky): "
+             "Σ %.0f lx", open_street[0], project.light.diffuse_horizontal_lux, unob[0])
     rows = []
     hours: list[str] = list(m.index)
     for k, v in enumerate(values):
@@ -190,9 +192,9 @@ def scan_permeability(project: Project, scenario: str = "A",
                "nmbe": nmbe(m.to_numpy(), s), "r": pearson_r(m.to_numpy(), s)}
         row.update({t: float(x) for t, x in zip(hours, s, strict=True)})
         rows.append(row)
-        echo(f"  {field} = {v:g}: permeability {100 * p_street[0]:.2f} % (street) / "
-             f"{100 * p_unob[0]:.2f} % (unobstructed); {scenario} nRMSE {row['nrmse']:.3f}, "
-             f"nMBE {row['nmbe']:+.3f}")
+        log.info("  %s = %g: permeability %.2f %% (street) / %.2f %% (unobstructed); %s nRMSE "
+                 "%.3f, nMBE %+.3f", field, v, 100 * p_street[0], 100 * p_unob[0], scenario,
+                 row["nrmse"], row["nmbe"])
     return PermeabilityScan(scenario, field, pd.DataFrame(rows), hours)
 
 

@@ -39,7 +39,7 @@ from radtree.trees.registry import calibrated_models
 @click.option("--write/--no-write", default=False, show_default=True,
               help="Write <project>.calibrated.toml beside the project file (never the project "
                    "file itself).")
-def calibrate_command(project: Path, target: float | None, model: str, form: str | None,
+def calibrate_command(*, project: Path, target: float | None, model: str, form: str | None,
                       photo_openness: bool, directions: int, tolerance: float,
                       global_: bool, realisations: int, write: bool) -> None:
     """Calibrate the crown of PROJECT (a folder with radtree.toml, or the file) to a target
@@ -55,7 +55,7 @@ def calibrate_command(project: Path, target: float | None, model: str, form: str
         from radtree.calibrate.permeability import GLOBAL_DEFINITION, calibrate_global
 
         click.echo(GLOBAL_DEFINITION)
-        click.echo(calibrate_global(proj, target, form, realisations, echo=click.echo).summary())
+        click.echo(calibrate_global(proj, target, form, realisations).summary())
         return
     result = calibrate(proj, model=model, target=target, form=form,
                        photo_openness=photo_openness, directions=directions,

@@ -8,7 +8,7 @@ code  meaning
 ====  ==========================================================================================
 0     success
 1     a bug: an unexpected exception (rerun with ``--debug`` and report the traceback); also
-      ``diagnose --selftest`` when a distinguishable hidden effect was misnamed
+      ``diagnose selftest`` when a distinguishable hidden effect was misnamed
 2     bad input: the project file or an option (:class:`~radtree.errors.ConfigError`, click's
       usage errors), an input file that cannot be read (images, measurements, weather), or any
       other :class:`~radtree.errors.RadtreeError` that is not an engine failure
@@ -39,7 +39,7 @@ from radtree.errors import EngineError, RadtreeError, Terminated
 
 OK = 0
 BUG = 1
-CHECK_FAILED = 1  # diagnose --selftest misnamed a hidden effect; verify: a physics check failed
+CHECK_FAILED = 1  # diagnose selftest misnamed a hidden effect; verify: a physics check failed
 BAD_INPUT = 2
 ENGINE_FAILURE = 3
 INTERRUPTED = 130

@@ -37,7 +37,7 @@ def _values(text: str) -> list[float]:
               help="low:high:n or v1,v2,...")
 @click.option("--rays", type=click.IntRange(64, 65536), default=2048, show_default=True,
               help="NumPy engine paths per sensor.")
-def permeability_command(project: Path, scenario: str, field: str, values_text: str,
+def permeability_command(*, project: Path, scenario: str, field: str, values_text: str,
                          rays: int) -> None:
     """How a scenario's fit depends on the crown's global permeability (measured: 5–6 %).
 
@@ -53,7 +53,7 @@ def permeability_command(project: Path, scenario: str, field: str, values_text: 
 
     values = _values(values_text)
     proj = load_project(project)
-    scan = scan_permeability(proj, scenario, field, values, rays, echo=click.echo)
+    scan = scan_permeability(proj, scenario, field, values, rays)
     csv, png = write_scan(scan, proj.results_dir)
     for line in scan.summary():
         click.echo(line)

@@ -25,8 +25,9 @@ whether two amplitudes can stand in for each other) with the winner's exceeds ``
 
 from __future__ import annotations
 
+import logging
 import math
-from collections.abc import Callable, Iterable
+from collections.abc import Iterable
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -35,6 +36,8 @@ import pandas as pd
 from radtree.config import Scenario
 from radtree.diagnose.effects import EFFECTS, Effect, EffectContext, Strength, candidates
 from radtree.diagnose.simulate import Run, Simulator
+
+log = logging.getLogger(__name__)
 
 TIE_CORR = 0.9
 DEFAULT_MARGIN = 0.05
@@ -154,8 +157,7 @@ class Attribution:
 
 # --------------------------------------------------------------------------- signatures
 def compute_signatures(sim: Simulator, ctx: EffectContext, base: Scenario, base_run: Run,
-                       effects: Iterable[Effect],
-                       echo: Callable[[str], None] | None = None) -> dict[str, Signature]:
+                       effects: Iterable[Effect]) -> dict[str, Signature]:
     """Simulate each effect switched on at its strengths; return the signatures."""
     out: dict[str, Signature] = {}
     row_names = list(base_run.rows.columns)
@@ -170,9 +172,9 @@ def compute_signatures(sim: Simulator, ctx: EffectContext, base: Scenario, base_
         for p in pts:
             sc = e.switch_on(ctx, base, p)
             run = sim.run(sc)
-            if echo is not None and run.seconds > 0.05:
-                echo(f"    {e.name}" + ("" if p is None or st is None else f" @ {st.text(p)}")
-                     + f": simulated in {run.seconds:.1f} s")
+            if run.seconds > 0.05:
+                log.debug("    %s%s: simulated in %.1f s", e.name,
+                         "" if p is None or st is None else f" @ {st.text(p)}", run.seconds)
             hourly.append(run.lux - base_run.lux)
             rows.append(run.row_daily().reindex(row_names).to_numpy(float) - base_rows)
             scs.append(sc)
@@ -246,12 +248,12 @@ def fit_candidate(sig: Signature, r: np.ndarray, ctx: EffectContext, base: Scena
     return fit
 
 
-def attribute(sim: Simulator, ctx: EffectContext, base: Scenario, base_run: Run, measured: np.ndarray,
-              row_residual: np.ndarray | None = None, catalogue: Iterable[Effect] = EFFECTS,
-              margin: float = DEFAULT_MARGIN, echo: Callable[[str], None] | None = None,
+def attribute(sim: Simulator, *, ctx: EffectContext, base: Scenario, base_run: Run,
+              measured: np.ndarray, row_residual: np.ndarray | None = None,
+              catalogue: Iterable[Effect] = EFFECTS, margin: float = DEFAULT_MARGIN,
               exclude: Iterable[str] = (), reuse: dict[str, Signature] | None = None
               ) -> Attribution:
-    """Rank the candidate effects of ``base`` against the residual measured − base.
+    """Rank the candidate effects of ``base`` against the residual measured − base (lx).
 
     ``reuse``: signatures kept from an earlier step (by effect name) are taken from it instead
     of being simulated on ``base``, and the ones simulated are added to it."""
@@ -262,10 +264,10 @@ def attribute(sim: Simulator, ctx: EffectContext, base: Scenario, base_run: Run,
         why[e.name] = "left out (tried at this step and rejected)"
     cands = [c for c in cands if c.name not in skip]
     if reuse is None:
-        sigs = compute_signatures(sim, ctx, base, base_run, cands, echo)
+        sigs = compute_signatures(sim, ctx, base, base_run, cands)
     else:
         reuse.update(compute_signatures(sim, ctx, base, base_run,
-                                        [c for c in cands if c.name not in reuse], echo))
+                                        [c for c in cands if c.name not in reuse]))
         sigs = {c.name: reuse[c.name] for c in cands}
     fits = [fit_candidate(sigs[c.name], r, ctx, base, row_residual) for c in cands]
     baseline = float(np.sqrt(np.mean(r ** 2)))

@@ -25,7 +25,7 @@ import pandas as pd
 from radtree.config import Project, Scenario
 from radtree.diagnose.campaign import Campaign, Layout, SensorGroup
 from radtree.diagnose.identify import noise_sigma
-from radtree.diagnose.loop import Measured
+from radtree.diagnose.measured import Measured
 from radtree.diagnose.simulate import FACADE, Run, Simulator
 from radtree.fileio import write_text
 from radtree.light.ground import ground_terms

@@ -1,5 +1,5 @@
 """What to measure next: rank candidate additions to a campaign by how well they separate the
-effects the present data confound (``radtree diagnose PROJECT --next-measurement``).
+effects the present data confound (``radtree diagnose next PROJECT``).
 
 1. The *superset* campaign — the present campaign merged with every candidate — is simulated
    once per effect (:class:`~radtree.diagnose.campaign_sim.CampaignSimulator`): the base
@@ -16,11 +16,12 @@ effects the present data confound (``radtree diagnose PROJECT --next-measurement
 Outputs (``PROJECT/diagnose/``): ``next_measurement.csv`` (``candidate, description,
 separated_effects, min_correlation_after, rank`` + ``confounded_pairs_after, log_det``),
 ``next_measurement.html`` and ``campaign-next.toml`` — the present campaign plus the top three,
-ready for ``radtree diagnose PROJECT --selftest --campaign diagnose/campaign-next.toml``.
+ready for ``radtree diagnose selftest PROJECT --campaign diagnose/campaign-next.toml``.
 """
 
 from __future__ import annotations
 
+import logging
 import math
 import os
 import time
@@ -44,9 +45,13 @@ from radtree.diagnose.campaign import (
 from radtree.diagnose.campaign_sim import CampaignSimulator
 from radtree.diagnose.effects import EFFECTS, Effect, EffectContext, candidates
 from radtree.diagnose.identify import Identifiability, identifiability, noise_sigma
-from radtree.diagnose.outcome import Echo, pick_scenario, resolve_project
+from radtree.diagnose.options import DEFAULT_OPTIONS, DiagnoseOptions
+from radtree.diagnose.outcome import pick_scenario, resolve_project
+from radtree.diagnose.simulate import Run
 from radtree.errors import ConfigError
 from radtree.fileio import atomic_path, write_text
+
+log = logging.getLogger(__name__)
 
 DESIGN_COLUMNS = ["candidate", "description", "separated_effects", "min_correlation_after",
                   "rank", "confounded_pairs_after", "log_det"]
@@ -245,85 +250,106 @@ def rank_candidates(names: list[str], signatures: np.ndarray, sigma: np.ndarray,
     return recs, before, after_top
 
 
-def next_measurement(project: str | os.PathLike | Project, scenario: str | None = None,
-                     campaign: Campaign | None = None,
+def next_measurement(project: str | os.PathLike | Project, *,
                      candidates_file: str | os.PathLike | None = None,
-                     engine: str | None = None, rays: int | None = None,
-                     seed: int | None = None, effects: tuple[Effect, ...] | None = None,
-                     out_dir: str | os.PathLike | None = None, write: bool = True,
-                     echo: Echo | None = print) -> Design:
-    """Rank candidate additions to ``campaign`` (default: the project's own measurement)."""
+                     options: DiagnoseOptions = DEFAULT_OPTIONS) -> Design:
+    """Rank candidate additions to ``options.campaign`` (default: the project's own
+    measurement); ``candidates_file``: a campaign TOML whose groups, hours and days are the
+    candidates (default: :func:`default_candidates`). Writes ``next_measurement.csv``,
+    ``campaign-next.toml`` and ``next_measurement.html`` unless ``options.write`` is off."""
     t0 = time.perf_counter()
-    say = echo or (lambda s: None)
     proj = resolve_project(project)
-    start = pick_scenario(proj, scenario)
-    base = campaign or project_campaign(proj)
+    start = pick_scenario(proj, options.scenario)
+    base = options.campaign or project_campaign(proj)
     cands = (file_candidates(candidates_file, proj, base) if candidates_file is not None
              else default_candidates(proj, base))
     union = merge(base, *[c.addition for c in cands], name="superset")
-    sim = CampaignSimulator(proj, (), engine, rays or base.rays or DESIGN_RAYS, seed,
-                            campaign=union)
+    sim = CampaignSimulator(proj, (), options.engine, options.rays or base.rays or DESIGN_RAYS,
+                            options.seed, campaign=union)
     assert sim.layout is not None
-    say(f"next measurement {proj.name}: scenario {start.name}, {len(cands)} candidates, "
-        f"superset {len(union.days)} day(s) × {len(union.hours)} hour(s) × "
-        f"{len(union.groups)} group(s) = {len(sim.labels)} observations, engine "
-        f"{sim.engine_name}")
+    log.info("next measurement %s: scenario %s, %d candidates, superset %d day(s) × %d "
+             "hour(s) × %d group(s) = %d observations, engine %s", proj.name, start.name,
+             len(cands), len(union.days), len(union.hours), len(union.groups),
+             len(sim.labels), sim.engine_name)
     for note in sim.notes:
-        say(f"  note: {note}")
-    ctx = EffectContext(proj)
-    effs, _ = candidates(ctx, start, effects or EFFECTS)
-    base_run = sim.run(start)
-    cols = []
-    for e in effs:
-        run = sim.run(e.switch_on(ctx, start, e.reference(ctx, start)))
-        cols.append(run.lux - base_run.lux)
-        say(f"  signature {e.name}: {run.seconds:.1f} s")
-    names = [e.name for e in effs]
-    S = np.column_stack(cols)
+        log.info("  note: %s", note)
+    names, S, base_run = _signatures(sim, EffectContext(proj), start, options.effects or EFFECTS)
     sigma = noise_sigma(base_run.lux, base_run.stderr, base.noise, base.noise_lux)
     sigma = np.maximum(sigma, 1e-6)
-    layout = sim.layout
-
-    base_mask = _mask(layout, base)
-    moves = {}
-    for c in cands:
-        drop = (_mask(layout, Campaign("x", c.addition.days, c.addition.hours, base.groups),
-                      c.replaces_means) if c.replaces_means else np.zeros(len(base_mask), bool))
-        moves[c.name] = (_mask(layout, c.addition), drop)
-    recs, before, top_idn = rank_candidates(names, S, sigma, base_mask, moves, sim.labels)
+    base_mask = _mask(sim.layout, base)
+    recs, before, top_idn = rank_candidates(names, S, sigma, base_mask,
+                                            _moves(sim.layout, base, cands, base_mask),
+                                            sim.labels)
     text = {c.name: c.description for c in cands}
     for r in recs:
         r["description"] = text[r["candidate"]]
     chosen = [next(c for c in cands if c.name == r["candidate"]) for r in recs[:TOP]]
     table = pd.DataFrame(recs, columns=DESIGN_COLUMNS)
-    nxt = merge(base, *[c.addition for c in chosen], name=f"{base.name} + next {len(chosen)}")
-    repl = {g for c in chosen for g in c.replaces_means}
-    if repl:
-        nxt = Campaign(nxt.name, nxt.days, nxt.hours, tuple(
-            g if g.name not in repl else SensorGroup(g.name, "sensor", g.grid, g.height_m,
-                                                     g.orientation, g.points)
-            for g in nxt.groups if g.name.removesuffix(PER_SENSOR) not in repl
-            or not g.name.endswith(PER_SENSOR)), nxt.noise, nxt.noise_lux, nxt.rays, False,
-            "the present campaign plus the top three next measurements (no readings yet)",
-            nxt.direct_normal)
-    design = Design(base, start, names, before, table, top_idn, nxt, 0.0)
-    if write:
-        from radtree.diagnose.report_identify import write_design_report
-        from radtree.tomlout import dumps
-
-        out = Path(out_dir) if out_dir is not None else proj.root / "diagnose"
-        out.mkdir(parents=True, exist_ok=True)
-        design.out_dir = out
-        path = out / "next_measurement.csv"
-        with atomic_path(path) as tmp:
-            table.to_csv(tmp, index=False, float_format="%.6g")
-        camp = out / "campaign-next.toml"
-        write_text(camp, dumps(campaign_table(nxt, out), header=(
-            f"Written by radtree diagnose --next-measurement: {base.name} plus the top "
-            f"{len(chosen)} candidates\n({', '.join(c.name for c in chosen)}). Run: radtree "
-            f"diagnose {proj.root} --selftest --campaign {camp}")))
-        design.files = [path, camp]
-        design.seconds = time.perf_counter() - t0
-        design.files += write_design_report(design, out)
+    design = Design(base, start, names, before, table, top_idn, _next_campaign(base, chosen),
+                    0.0)
+    if options.write:
+        _publish(design, proj, chosen, options.folder(proj.root), t0)
     design.seconds = time.perf_counter() - t0
     return design
+
+
+def _signatures(sim: CampaignSimulator, ctx: EffectContext, start: Scenario,
+                effects: tuple[Effect, ...]) -> tuple[list[str], np.ndarray, Run]:
+    """Each candidate effect's change (lux, observations × effects) at its reference
+    strength, and the base run."""
+    effs, _ = candidates(ctx, start, effects)
+    base_run = sim.run(start)
+    cols = []
+    for e in effs:
+        run = sim.run(e.switch_on(ctx, start, e.reference(ctx, start)))
+        cols.append(run.lux - base_run.lux)
+        log.info("  signature %s: %.1f s", e.name, run.seconds)
+    return [e.name for e in effs], np.column_stack(cols), base_run
+
+
+def _moves(layout: Layout, base: Campaign, cands: list[Candidate], base_mask: np.ndarray
+           ) -> dict[str, tuple[np.ndarray, np.ndarray]]:
+    """Each candidate's (added, removed) observations of the superset."""
+    moves = {}
+    for c in cands:
+        drop = (_mask(layout, Campaign("x", c.addition.days, c.addition.hours, base.groups),
+                      c.replaces_means) if c.replaces_means else np.zeros(len(base_mask), bool))
+        moves[c.name] = (_mask(layout, c.addition), drop)
+    return moves
+
+
+def _next_campaign(base: Campaign, chosen: list[Candidate]) -> Campaign:
+    """The present campaign plus the chosen candidates (per-sensor readings replacing the
+    means they replace)."""
+    nxt = merge(base, *[c.addition for c in chosen], name=f"{base.name} + next {len(chosen)}")
+    repl = {g for c in chosen for g in c.replaces_means}
+    if not repl:
+        return nxt
+    return Campaign(nxt.name, nxt.days, nxt.hours, tuple(
+        g if g.name not in repl else SensorGroup(g.name, "sensor", g.grid, g.height_m,
+                                                 g.orientation, g.points)
+        for g in nxt.groups if g.name.removesuffix(PER_SENSOR) not in repl
+        or not g.name.endswith(PER_SENSOR)), nxt.noise, nxt.noise_lux, nxt.rays, False,
+        "the present campaign plus the top three next measurements (no readings yet)",
+        nxt.direct_normal)
+
+
+def _publish(design: Design, proj: Project, chosen: list[Candidate], out: Path,
+             t0: float) -> None:
+    """``next_measurement.csv``, ``campaign-next.toml`` and the report in ``out``."""
+    from radtree.diagnose.report_identify import write_design_report
+    from radtree.tomlout import dumps
+
+    out.mkdir(parents=True, exist_ok=True)
+    design.out_dir = out
+    path = out / "next_measurement.csv"
+    with atomic_path(path) as tmp:
+        design.table.to_csv(tmp, index=False, float_format="%.6g")
+    camp = out / "campaign-next.toml"
+    write_text(camp, dumps(campaign_table(design.next_campaign, out), header=(
+        f"Written by radtree diagnose next: {design.base.name} plus the top "
+        f"{len(chosen)} candidates\n({', '.join(c.name for c in chosen)}). Run: radtree "
+        f"diagnose selftest {proj.root} --campaign {camp}")))
+    design.files = [path, camp]
+    design.seconds = time.perf_counter() - t0
+    design.files += write_design_report(design, out)

@@ -110,13 +110,20 @@ class Effect:
     """One physical effect that can be switched on or off in a scenario.
 
     Subclasses set ``name`` (identifier), ``title``, ``physics`` (one line), ``switch`` (what
-    it changes in the project's words) and implement the methods.
+    it changes in the project's words) and implement the methods, and declare their
+    capabilities (the registry's rows, :func:`radtree.diagnose.registry.effect_rows`):
+    ``strength_mode`` (``linear``: the change scales with the strength; ``search``: re-simulated
+    at a few strengths; ``on/off``: no strength), ``crowns`` (the crown models it applies to;
+    empty: any) and ``needs`` (project data it needs, in words; empty: none).
     """
 
     name: str = ""
     title: str = ""
     physics: str = ""
     switch: str = ""
+    strength_mode: str = "on/off"
+    crowns: tuple[str, ...] = ()
+    needs: str = ""
 
     def strength(self, ctx: EffectContext, sc: Scenario) -> Strength | None:
         """The strength parameter (bounds may depend on the scenario), None if on/off only."""

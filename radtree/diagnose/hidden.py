@@ -39,10 +39,12 @@ the effects named for the others, whether the gap shrank at each step, and the f
 
 from __future__ import annotations
 
+import logging
 import math
 import os
 import time
 from collections.abc import Iterable
+from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
@@ -56,18 +58,13 @@ from radtree.diagnose.attribution import (
     cosine,
     signature_scenarios,
 )
-from radtree.diagnose.campaign import Campaign
 from radtree.diagnose.campaign_sim import CampaignSimulator, campaign_synthetic
 from radtree.diagnose.effects import EFFECTS, Effect, EffectContext, candidates
 from radtree.diagnose.identify import DEFAULT_NOISE, nearest_snr, noise_sigma, unique_snr
-from radtree.diagnose.loop import (
-    DEFAULT_MAX_STEPS,
-    Measured,
-    load_measurements,
-)
+from radtree.diagnose.measured import Measured, load_measurements
+from radtree.diagnose.options import DEFAULT_OPTIONS, DiagnoseOptions
 from radtree.diagnose.outcome import (
     SNR_MIN,
-    Echo,
     HiddenCase,
     SelftestResult,
     pick_scenario,
@@ -77,6 +74,8 @@ from radtree.diagnose.parallel import TracePool
 from radtree.diagnose.simulate import Run, Simulator
 from radtree.errors import RadtreeError
 from radtree.fileio import atomic_path, write_text
+
+log = logging.getLogger(__name__)
 
 TRUTH_SEED_OFFSET = 7919
 
@@ -105,8 +104,8 @@ def _ahead(ctx: EffectContext, start: Scenario, effects: Iterable[Effect]
     return model, truths
 
 
-def _decide(sim: Simulator, ctx: EffectContext, effect: Effect, start: Scenario, noise: float,
-            echo: Echo | None, noise_lux: float | np.ndarray = 0.0,
+def _decide(sim: Simulator, *, ctx: EffectContext, effect: Effect, start: Scenario,
+            noise: float, noise_lux: float | np.ndarray = 0.0,
             margin: float = DEFAULT_MARGIN) -> HiddenCase:
     base = _base(ctx, effect, start)
     ref = effect.reference(ctx, base)
@@ -116,11 +115,12 @@ def _decide(sim: Simulator, ctx: EffectContext, effect: Effect, start: Scenario,
     if effect not in cands:
         raise RadtreeError(f"self-test: {effect.name} is still on after switching it off "
                            "(catalogue bug)")
-    sigs = compute_signatures(sim, ctx, base, base_run, cands, echo)
-    return _verdict(effect, ctx, base, truth, ref, sigs, base_run, noise, noise_lux, margin)
+    sigs = compute_signatures(sim, ctx, base, base_run, cands)
+    return _verdict(effect, ctx=ctx, base=base, truth=truth, ref=ref, sigs=sigs,
+                    base_run=base_run, noise=noise, noise_lux=noise_lux, margin=margin)
 
 
-def _verdict(effect: Effect, ctx: EffectContext, base: Scenario, truth: Scenario,
+def _verdict(effect: Effect, *, ctx: EffectContext, base: Scenario, truth: Scenario,
              ref: float | None, sigs: dict[str, Signature], base_run: Run, noise: float,
              noise_lux: float | np.ndarray, margin: float) -> HiddenCase:
     """The module doc's rule on the signatures of ``base``'s candidates."""
@@ -181,8 +181,10 @@ def margin_snr(margin: float) -> float:
     return math.sqrt((1.0 - margin) ** -2 - 1.0)
 
 
-def _synthetic(truth_sim: Simulator, case: HiddenCase, noise: float, seed: int, index: int,
+def _synthetic(truth_sim: Simulator, case: HiddenCase, *, noise: float, seed: int, index: int,
                folder: Path | None, project: Project, noise_lux: float = 0.0) -> Measured:
+    """The truth's run with seeded relative noise: the synthetic measurement of ``case``
+    (written to ``folder/<effect>.csv`` and read back when ``folder`` is given)."""
     run = truth_sim.run(case.truth)
     rng = np.random.default_rng([int(seed), 4242, index])
     if isinstance(truth_sim, CampaignSimulator):
@@ -212,114 +214,160 @@ def _synthetic(truth_sim: Simulator, case: HiddenCase, noise: float, seed: int, 
     return load_measurements(project, mpath, None, counts, rows_path=rpath)
 
 
-def selftest(project: str | os.PathLike | Project, scenario: str | None = None,
-             effects: Iterable[Effect] | None = None, noise: float | None = None,
-             engine: str | None = None, rays: int | None = None, seed: int | None = None,
-             margin: float = DEFAULT_MARGIN, max_steps: int = DEFAULT_MAX_STEPS,
-             out_dir: str | os.PathLike | None = None, write: bool = True,
-             echo: Echo | None = print, campaign: Campaign | None = None,
+
+@dataclass
+class _Plan:
+    """What a self-test will do: the project and start, the effects to hide, the model's and
+    the truth's simulators (different seeds), the noise and where it writes."""
+
+    project: Project
+    start: Scenario
+    ctx: EffectContext
+    effects: tuple[Effect, ...]
+    sim: Simulator
+    truth_sim: Simulator
+    noise: float
+    noise_lux: float
+    out: Path
+    options: DiagnoseOptions
+    t0: float = field(default_factory=time.perf_counter)
+
+
+def selftest(project: str | os.PathLike | Project, *, noise: float | None = None,
              noise_lux: float = 0.0, resimulate: bool = False,
-             workers: int | None = None) -> SelftestResult:
-    """Hide each effect in synthetic measurements and check the loop names it.
+             options: DiagnoseOptions = DEFAULT_OPTIONS) -> SelftestResult:
+    """Hide each effect of ``options.effects`` (default: the catalogue) in synthetic
+    measurements and check the loop names it.
 
-    ``resimulate``: re-simulate every candidate's signature at every step of each loop
-    (default: after the first step the loop ranks with the first step's signatures,
-    :func:`~radtree.diagnose.loop.run_loop`'s ``first_step_signatures`` — the first step, the
-    one the test judges, is exact either way, and every winner is re-simulated).
-    ``workers``: processes tracing ahead (:class:`~radtree.diagnose.parallel.TracePool`;
-    default the usable cores, at most 4; 1: everything in this process) — same numbers.
+    ``noise``: relative 1-σ noise of each synthetic value (default: the campaign's, else
+    ``DEFAULT_NOISE``); ``noise_lux``: absolute floor (lux). ``resimulate``: re-simulate every
+    candidate's signature at every step of each loop (default: after the first step the loop
+    ranks with the first step's signatures, :class:`~radtree.diagnose.loop.LoopOptions`'s
+    ``first_step_signatures`` — the first step, the one the test judges, is exact either way,
+    and every winner is re-simulated). ``options.workers``: processes tracing ahead
+    (:class:`~radtree.diagnose.parallel.TracePool`) — same numbers. ``options.campaign``:
+    measure what the campaign measures (its days, hours, sensor groups; its noise unless
+    ``noise`` is given); default the project's façade grid mean at its hours."""
+    plan = _plan(project, noise, noise_lux, options)
+    with TracePool(options.workers) as pool:
+        cases, skipped = _decide_all(plan, pool)
+        _diagnose_cases(plan, pool, cases, resimulate)
+    return _publish(plan, cases, skipped)
 
-    ``campaign``: measure what the campaign measures (its days, hours, sensor groups; its
-    noise unless ``noise`` is given); default the project's façade grid mean at its hours."""
+
+def _plan(project: str | os.PathLike | Project, noise: float | None, noise_lux: float,
+          options: DiagnoseOptions) -> _Plan:
+    campaign = options.campaign
     if campaign is not None and noise is None:
         noise, noise_lux = campaign.noise, campaign.noise_lux
     noise = DEFAULT_NOISE if noise is None else noise
     if not 0 <= noise < 1:
         raise RadtreeError(f"noise must be a fraction in [0, 1), got {noise}")
     t0 = time.perf_counter()
-    say = echo or (lambda s: None)
     proj = resolve_project(project)
-    start = pick_scenario(proj, scenario)
-    ctx = EffectContext(proj)
-    out = Path(out_dir) if out_dir is not None else proj.root / "diagnose"
     hours = tuple(proj.site.hours)
-    chosen = tuple(effects) if effects is not None else EFFECTS
     sim: Simulator
     truth_sim: Simulator
     if campaign is None:
-        sim = Simulator(proj, hours, engine, rays, seed)
-        truth_sim = Simulator(proj, hours, engine, sim.rays,
+        sim = Simulator(proj, hours, options.engine, options.rays, options.seed)
+        truth_sim = Simulator(proj, hours, options.engine, sim.rays,
                               int(sim.seed or 0) + TRUTH_SEED_OFFSET)
     else:
-        sim = CampaignSimulator(proj, hours, engine, rays, seed, campaign=campaign)
-        truth_sim = CampaignSimulator(proj, hours, engine, sim.rays,
+        sim = CampaignSimulator(proj, hours, options.engine, options.rays, options.seed,
+                                campaign=campaign)
+        truth_sim = CampaignSimulator(proj, hours, options.engine, sim.rays,
                                       int(sim.seed or 0) + TRUTH_SEED_OFFSET, campaign=campaign)
-    with TracePool(workers) as pool:
-        if pool.workers > 1:
-            say(f"tracing ahead in {pool.workers} processes: the bases, every candidate's "
-                "signature scenarios and the truths")
-            model, truths = _ahead(ctx, start, chosen)
-            pool.prefetch(sim, model)
-            pool.prefetch(truth_sim, truths)
-        if isinstance(sim, CampaignSimulator) and isinstance(truth_sim, CampaignSimulator):
-            assert campaign is not None
-            truth_sim.weights = sim.set_weights(start, noise, noise_lux)
-            say(f"campaign {campaign.summary()} — {len(sim.labels)} observations, compared in "
-                "noise-weighted lux (each value ÷ its noise)")
-            for note in sim.notes:
-                say(f"  note: {note}")
-        skipped: dict[str, str] = {}
-        say(f"self-test {proj.name}: scenario {start.name}, noise {noise:.1%}, engine {sim.engine_name}"
-            + (f", {sim.rays} rays/sensor, seed {sim.seed} (truth seed {truth_sim.seed})"
-               if sim.seeded else ""))
-        say("  deciding which hidden effects are distinguishable (before any diagnosis runs):")
-        cases: list[HiddenCase] = []
-        for e in chosen:
-            why = e.applies(ctx, start)
-            if why:
-                skipped[e.name] = why
-                say(f"  {e.name}: skipped ({why})")
-                continue
-            case = _decide(sim, ctx, e, start, noise, None,
-                           noise_lux * sim.weights if isinstance(sim, CampaignSimulator)
-                           and sim.weights is not None else noise_lux, margin)
-            cases.append(case)
-            say(f"  {e.name:26s} {'distinguishable' if case.distinguishable else 'not distinguishable'}"
-                f": {case.reason}")
-        for i, case in enumerate(cases):
-            case.measured = _synthetic(truth_sim, case, noise, int(sim.seed or 0), i,
-                                       out / "selftest" if write else None, proj, noise_lux)
-        if pool.workers > 1:
-            say(f"  diagnosing the {len(cases)} synthetic measurements in {pool.workers} "
-                "processes")
-        loops = pool.loops(sim, proj, [(c.base, c.measured) for c in cases
-                                       if c.measured is not None],
-                           margin, max_steps, not resimulate)
-        for case, lp in zip(cases, loops):
-            case.loop = lp
-            say(f"  hidden {case.effect} ({case.strength_text}) in {case.base.name}:")
-            verdict = ("correct" if case.correct else
-                       ("MISNAMED" if case.distinguishable else "not distinguishable"))
-            say(f"    named {case.named}"
-                + (f" (tie: {', '.join(lp.steps[0].tie_with)})" if lp.steps and lp.steps[0].tie_with
-                   else "")
-                + f" — {verdict}; nRMSE {lp.start_map.stats['nrmse']:.3f} → "
-                f"{lp.final_map.stats['nrmse']:.3f}"
-                + (f" via {' + '.join(s.effect for s in lp.steps)}" if lp.steps else ""))
-    res = SelftestResult(proj, start, noise, cases, skipped, time.perf_counter() - t0,
-                         sim.traced_runs + truth_sim.traced_runs, out if write else None,
+    return _Plan(proj, pick_scenario(proj, options.scenario), EffectContext(proj),
+                 options.effects if options.effects is not None else EFFECTS, sim, truth_sim,
+                 noise, noise_lux, options.folder(proj.root), options, t0)
+
+
+def _decide_all(plan: _Plan, pool: TracePool) -> tuple[list[HiddenCase], dict[str, str]]:
+    """Before any loop runs: which hidden effects are distinguishable (module doc, 3)."""
+    sim, truth_sim, start = plan.sim, plan.truth_sim, plan.start
+    if pool.workers > 1:
+        log.info("tracing ahead in %d processes: the bases, every candidate's signature "
+                 "scenarios and the truths", pool.workers)
+        model, truths = _ahead(plan.ctx, start, plan.effects)
+        pool.prefetch(sim, model)
+        pool.prefetch(truth_sim, truths)
+    noise_lux: float | np.ndarray = plan.noise_lux
+    if isinstance(sim, CampaignSimulator) and isinstance(truth_sim, CampaignSimulator):
+        assert plan.options.campaign is not None
+        truth_sim.weights = sim.set_weights(start, plan.noise, plan.noise_lux)
+        log.info("campaign %s — %d observations, compared in noise-weighted lux (each value "
+                 "÷ its noise)", plan.options.campaign.summary(), len(sim.labels))
+        for note in sim.notes:
+            log.info("  note: %s", note)
+        if sim.weights is not None:
+            noise_lux = plan.noise_lux * sim.weights
+    log.info("self-test %s: scenario %s, noise %.1f%%, engine %s%s", plan.project.name,
+             start.name, 100 * plan.noise, sim.engine_name,
+             f", {sim.rays} rays/sensor, seed {sim.seed} (truth seed {truth_sim.seed})"
+             if sim.seeded else "")
+    log.info("  deciding which hidden effects are distinguishable (before any diagnosis runs):")
+    skipped: dict[str, str] = {}
+    cases: list[HiddenCase] = []
+    for e in plan.effects:
+        why = e.applies(plan.ctx, start)
+        if why:
+            skipped[e.name] = why
+            log.info("  %s: skipped (%s)", e.name, why)
+            continue
+        case = _decide(sim, ctx=plan.ctx, effect=e, start=start, noise=plan.noise,
+                       noise_lux=noise_lux, margin=plan.options.margin)
+        cases.append(case)
+        log.info("  %-26s %s: %s", e.name, "distinguishable" if case.distinguishable
+                 else "not distinguishable", case.reason)
+    return cases, skipped
+
+
+def _diagnose_cases(plan: _Plan, pool: TracePool, cases: list[HiddenCase],
+                    resimulate: bool) -> None:
+    """Each case's synthetic measurement, then the loop from its base (in the workers)."""
+    seed = int(plan.sim.seed or 0)
+    for i, case in enumerate(cases):
+        case.measured = _synthetic(
+            plan.truth_sim, case, noise=plan.noise, seed=seed, index=i,
+            folder=plan.out / "selftest" if plan.options.write else None,
+            project=plan.project, noise_lux=plan.noise_lux)
+    if pool.workers > 1:
+        log.info("  diagnosing the %d synthetic measurements in %d processes", len(cases),
+                 pool.workers)
+    loops = pool.loops(plan.sim, plan.project,
+                       [(c.base, c.measured) for c in cases if c.measured is not None],
+                       plan.options.loop(catalogue=EFFECTS, first_step_signatures=not resimulate))
+    for case, lp in zip(cases, loops):
+        case.loop = lp
+        log.info("  hidden %s (%s) in %s:", case.effect, case.strength_text, case.base.name)
+        verdict = ("correct" if case.correct else
+                   ("MISNAMED" if case.distinguishable else "not distinguishable"))
+        tie = lp.steps[0].tie_with if lp.steps else []
+        log.info("    named %s%s — %s; nRMSE %.3f → %.3f%s", case.named,
+                 f" (tie: {', '.join(tie)})" if tie else "", verdict,
+                 lp.start_map.stats["nrmse"], lp.final_map.stats["nrmse"],
+                 f" via {' + '.join(s.effect for s in lp.steps)}" if lp.steps else "")
+
+
+def _publish(plan: _Plan, cases: list[HiddenCase], skipped: dict[str, str]) -> SelftestResult:
+    """The result; with ``options.write``: ``selftest.csv`` and the report."""
+    sim, options = plan.sim, plan.options
+    res = SelftestResult(plan.project, plan.start, plan.noise, cases, skipped,
+                         time.perf_counter() - plan.t0,
+                         sim.traced_runs + plan.truth_sim.traced_runs,
+                         plan.out if options.write else None,
                          engine=sim.engine_name, rays=sim.rays if sim.seeded else None,
                          seed=sim.seed if sim.seeded else None,
-                         campaign=campaign.summary() if campaign is not None else "",
-                         margin=margin)
-    if write:
+                         campaign=options.campaign.summary() if options.campaign else "",
+                         margin=options.margin)
+    if options.write:
         from radtree.diagnose.report import write_selftest_report
 
-        out.mkdir(parents=True, exist_ok=True)
-        path = out / "selftest.csv"
+        plan.out.mkdir(parents=True, exist_ok=True)
+        path = plan.out / "selftest.csv"
         with atomic_path(path) as tmp:
             res.table().to_csv(tmp, index=False, float_format="%.6g")
-        res.files = [path] + write_selftest_report(res, out)
-        res.seconds = time.perf_counter() - t0
-        say(f"  wrote {path}")
+        res.files = [path] + write_selftest_report(res, plan.out)
+        res.seconds = time.perf_counter() - plan.t0
+        log.info("  wrote %s", path)
     return res

@@ -313,7 +313,7 @@ def profile_interval(strengths: np.ndarray, predictions: np.ndarray, residual: n
 
 
 def linear_interval(signature: np.ndarray, residual: np.ndarray, reference: float,
-                    lo: float, hi: float, sigma: np.ndarray | float | None = None,
+                    lo: float, hi: float, *, sigma: np.ndarray | float | None = None,
                     known_noise: bool = False, level: float = CONFIDENCE,
                     points: int = 2001) -> Interval:
     """Profile interval of a linear strength (signature at ``reference``) within [lo, hi]."""

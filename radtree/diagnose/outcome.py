@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import math
 import os
-from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -13,16 +12,14 @@ import pandas as pd
 
 from radtree.config import Project, Scenario, load_project
 from radtree.diagnose.attribution import DEFAULT_MARGIN
-from radtree.diagnose.loop import LoopResult, Measured
+from radtree.diagnose.loop import LoopResult
+from radtree.diagnose.measured import Measured
 
 #: a hidden effect is distinguishable when its signature lies at least this many noise units
 #: (over all values) from every other candidate's best fit (radtree.diagnose.hidden)
 SNR_MIN = 3.0
 SELFTEST_COLUMNS = ["hidden_effect", "distinguishable", "named_effect", "rmse_before",
                     "rmse_after"]
-
-Echo = Callable[[str], None]
-
 
 
 def resolve_project(project: str | os.PathLike | Project) -> Project:

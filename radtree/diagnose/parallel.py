@@ -25,12 +25,13 @@ import time
 import uuid
 from collections.abc import Iterable
 from concurrent.futures import Future, ProcessPoolExecutor
-from dataclasses import replace
+from dataclasses import dataclass, replace
 from typing import Any
 
 from radtree.config import Project, Scenario
-from radtree.diagnose.effects import EFFECTS, EffectContext
-from radtree.diagnose.loop import LoopResult, Measured, run_loop
+from radtree.diagnose.effects import EffectContext
+from radtree.diagnose.loop import LoopOptions, LoopResult, run_loop
+from radtree.diagnose.measured import Measured
 from radtree.diagnose.simulate import Simulator
 
 _SIMULATORS: dict[str, Simulator] = {}   # per worker process: token → simulator
@@ -124,21 +125,19 @@ class TracePool:
         return len(futures)
 
     def loops(self, sim: Simulator, project: Project, jobs: list[tuple[Scenario, Measured]],
-              margin: float, max_steps: int, first_step_signatures: bool
-              ) -> list[LoopResult]:
+              options: LoopOptions) -> list[LoopResult]:
         """:func:`~radtree.diagnose.loop.run_loop` from each ``(start, measured)`` of ``jobs``,
         one job per task, with everything ``sim`` has traced so far (what the workers trace
         is added to it); in this process when there is no pool."""
         if self._pool is None:
             ctx = EffectContext(project)
-            return [run_loop(sim, ctx, start, meas, margin, max_steps, EFFECTS, echo=None,
-                             first_step_signatures=first_step_signatures)
+            return [run_loop(sim, ctx=ctx, start=start, measured=meas, options=options)
                     for start, meas in jobs]
         token, spec = self._worker(sim)
         traced = dict(sim.traced_cache())
         weights = getattr(sim, "weights", None)
-        futures = [self._pool.submit(_loop, token, spec, weights, traced, project, start,
-                                     meas, margin, max_steps, first_step_signatures)
+        futures = [self._pool.submit(_loop, token, spec, weights, traced,
+                                     _Job(project, start, meas, options))
                    for start, meas in jobs]
         out = []
         for fut in futures:
@@ -154,9 +153,18 @@ class TracePool:
         return out
 
 
-def _loop(token: str, spec: Spec, weights: Any, traced: dict[str, Any], project: Project,
-          start: Scenario, meas: Measured, margin: float, max_steps: int,
-          first_step_signatures: bool) -> tuple[LoopResult, dict[str, Any], float]:
+@dataclass(frozen=True)
+class _Job:
+    """One diagnosis loop for a worker: from ``start`` against ``measured``."""
+
+    project: Project
+    start: Scenario
+    measured: Measured
+    options: LoopOptions
+
+
+def _loop(token: str, spec: Spec, weights: Any, traced: dict[str, Any], job: _Job
+          ) -> tuple[LoopResult, dict[str, Any], float]:
     sim = _simulator(token, spec)
     if weights is not None:
         sim.weights = weights  # type: ignore[attr-defined]
@@ -164,6 +172,6 @@ def _loop(token: str, spec: Spec, weights: Any, traced: dict[str, Any], project:
     for key, payload in traced.items():
         cache.setdefault(key, payload)
     have, t0 = set(cache), sim.trace_seconds
-    loop = run_loop(sim, EffectContext(project), start, meas, margin, max_steps, EFFECTS,
-                    echo=None, first_step_signatures=first_step_signatures)
+    loop = run_loop(sim, ctx=EffectContext(job.project), start=job.start, measured=job.measured,
+                    options=job.options)
     return loop, {k: v for k, v in cache.items() if k not in have}, sim.trace_seconds - t0

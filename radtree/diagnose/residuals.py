@@ -74,7 +74,7 @@ class DisagreementMap:
         return self.hourly["residual_lux"].to_numpy(float)
 
 
-def disagreement_map(times: tuple[str, ...] | list[str], measured: np.ndarray,
+def disagreement_map(times: tuple[str, ...] | list[str], *, measured: np.ndarray,
                      simulated: np.ndarray, simulated_se: np.ndarray,
                      sun_altitude: np.ndarray, sun_azimuth: np.ndarray,
                      simulated_rows: pd.DataFrame | None = None,
@@ -109,6 +109,17 @@ def disagreement_map(times: tuple[str, ...] | list[str], measured: np.ndarray,
         "mc_se_rms_lux": float(np.sqrt(np.mean(se_ok ** 2))) if se_ok.size else math.nan,
         "mean_measured_lux": mean_m,
     }
+    rows, rows_hourly = _row_tables(simulated_rows, measured_rows, measured_rows_hourly)
+    out = DisagreementMap(hourly, rows, stats, rows_hourly=rows_hourly)
+    out.findings = findings(out)
+    return out
+
+
+def _row_tables(simulated_rows: pd.DataFrame | None, measured_rows: pd.DataFrame | None,
+                measured_rows_hourly: pd.DataFrame | None
+                ) -> tuple[pd.DataFrame | None, pd.DataFrame | None]:
+    """Per-row daily residuals (from the daily means, else from the hourly row values) and
+    the hourly per-row residuals (lx)."""
     rows = None
     rows_hourly = None
     if simulated_rows is not None and measured_rows is not None and len(measured_rows):
@@ -140,9 +151,7 @@ def disagreement_map(times: tuple[str, ...] | list[str], measured: np.ndarray,
                     "simulated_mean_lux": g["simulated_lux"].mean().values})
                 rows["residual_lux"] = rows["measured_mean_lux"] - rows["simulated_mean_lux"]
                 rows["residual_pct"] = 100 * rows["residual_lux"] / rows["measured_mean_lux"]
-    out = DisagreementMap(hourly, rows, stats, rows_hourly=rows_hourly)
-    out.findings = findings(out)
-    return out
+    return rows, rows_hourly
 
 
 def _r(a: np.ndarray, b: np.ndarray) -> float:
@@ -152,21 +161,31 @@ def _r(a: np.ndarray, b: np.ndarray) -> float:
 
 
 def findings(dm: DisagreementMap) -> list[str]:
-    """The residual's structure in words, by the rules of :data:`RULES`."""
-    h = dm.hourly
-    res = h["residual_lux"].to_numpy(float)
-    mean_m = dm.stats["mean_measured_lux"]
+    """The residual's structure in words, by the rules of :data:`RULES` (in their order)."""
+    res = dm.hourly["residual_lux"].to_numpy(float)
+    out = [_bias(dm, res)]
+    out += _altitude_and_level(dm, res)
+    out += _morning_afternoon(dm, res)
+    out += _rows(dm)
+    out += _noise(dm)
+    return out
+
+
+def _bias(dm: DisagreementMap, res: np.ndarray) -> str:
     n = len(res)
-    out: list[str] = []
     word = "under-predicts" if dm.stats["mbe_lux"] > 0 else "over-predicts"
     same = max(int((res > 0).sum()), int((res < 0).sum()))
     if same >= BIAS_SHARE * n and abs(dm.stats["nmbe"]) >= BIAS_NMBE:
-        out.append(f"Bias: the model {word} at {same} of {n} hours "
-                   f"(nMBE {dm.stats['nmbe']:+.3f}, mean residual {dm.stats['mbe_lux']:+.0f} lx).")
-    else:
-        out.append(f"No consistent bias: residuals of both signs (nMBE {dm.stats['nmbe']:+.3f}).")
-    spread = float(np.ptp(res)) if n else 0.0
-    big = spread >= SPREAD * mean_m
+        return (f"Bias: the model {word} at {same} of {n} hours "
+                f"(nMBE {dm.stats['nmbe']:+.3f}, mean residual {dm.stats['mbe_lux']:+.0f} lx).")
+    return f"No consistent bias: residuals of both signs (nMBE {dm.stats['nmbe']:+.3f})."
+
+
+def _altitude_and_level(dm: DisagreementMap, res: np.ndarray) -> list[str]:
+    h = dm.hourly
+    out: list[str] = []
+    spread = float(np.ptp(res)) if len(res) else 0.0
+    big = spread >= SPREAD * dm.stats["mean_measured_lux"]
     r_alt = _r(res, h["sun_altitude_deg"].to_numpy(float))
     if big and math.isfinite(r_alt) and abs(r_alt) >= ALT_R:
         i_lo = int(np.argmin(h["sun_altitude_deg"].to_numpy(float)))
@@ -190,47 +209,57 @@ def findings(dm: DisagreementMap) -> list[str]:
                    + ("a missing factor (too much or too little filtering) rather than an "
                       "additive term." if r_lvl * dm.stats['mbe_lux'] > 0 else
                       "largest where the model is darkest."))
+    return out
+
+
+def _morning_afternoon(dm: DisagreementMap, res: np.ndarray) -> list[str]:
+    h = dm.hourly
     am = (h["period"] == "morning").to_numpy()
     pm = (h["period"] == "afternoon").to_numpy()
-    if am.sum() >= 2 and pm.sum() >= 2:
-        ma = float(res[am].mean())
-        mp = float(res[pm].mean())
-        if abs(ma - mp) >= SPREAD * mean_m:
-            if abs(mp) < 0.5 * abs(ma):
-                what = "morning only"
-            elif abs(ma) < 0.5 * abs(mp):
-                what = "afternoon only"
-            elif ma * mp < 0:
-                what = "of opposite sign in the morning and the afternoon"
-            else:
-                what = "larger in the " + ("morning" if abs(ma) > abs(mp) else "afternoon")
-            out.append(f"Morning/afternoon: asymmetric, {what} (mean residual morning "
-                       f"{ma:+.0f} lx, afternoon {mp:+.0f} lx; noon hours left out).")
-        else:
-            out.append(f"Morning/afternoon: symmetric about solar noon (mean residual morning "
-                       f"{ma:+.0f} lx, afternoon {mp:+.0f} lx).")
-    if dm.rows is not None and len(dm.rows) >= 2:
-        rr = dm.rows.set_index("row")["residual_lux"]
-        rspread = float(rr.max() - rr.min())
-        if rspread >= ROW_SPREAD * mean_m:
-            dev = (rr - rr.median()).abs()
-            worst = str(dev.idxmax())
-            others = rr.drop(worst)
-            only = bool((others.abs() < 0.5 * abs(rr[worst])).all())
-            out.append(f"Rows: the {worst} row departs ({rr[worst]:+.0f} lx against "
-                       + ", ".join(f"{k} {v:+.0f}" for k, v in others.items()) + " lx)"
-                       + (f" — {worst} row only." if only else "."))
-        else:
-            out.append("Rows: the row residuals agree within "
-                       f"{ROW_SPREAD:.0%} of the mean (" + ", ".join(
-                           f"{k} {v:+.0f}" for k, v in rr.items()) + " lx) — no row structure.")
+    if am.sum() < 2 or pm.sum() < 2:
+        return []
+    ma = float(res[am].mean())
+    mp = float(res[pm].mean())
+    if abs(ma - mp) < SPREAD * dm.stats["mean_measured_lux"]:
+        return [f"Morning/afternoon: symmetric about solar noon (mean residual morning "
+                f"{ma:+.0f} lx, afternoon {mp:+.0f} lx)."]
+    if abs(mp) < 0.5 * abs(ma):
+        what = "morning only"
+    elif abs(ma) < 0.5 * abs(mp):
+        what = "afternoon only"
+    elif ma * mp < 0:
+        what = "of opposite sign in the morning and the afternoon"
+    else:
+        what = "larger in the " + ("morning" if abs(ma) > abs(mp) else "afternoon")
+    return [f"Morning/afternoon: asymmetric, {what} (mean residual morning "
+            f"{ma:+.0f} lx, afternoon {mp:+.0f} lx; noon hours left out)."]
+
+
+def _rows(dm: DisagreementMap) -> list[str]:
+    if dm.rows is None or len(dm.rows) < 2:
+        return []
+    rr = dm.rows.set_index("row")["residual_lux"]
+    rspread = float(rr.max() - rr.min())
+    if rspread < ROW_SPREAD * dm.stats["mean_measured_lux"]:
+        return ["Rows: the row residuals agree within "
+                f"{ROW_SPREAD:.0%} of the mean (" + ", ".join(
+                    f"{k} {v:+.0f}" for k, v in rr.items()) + " lx) — no row structure."]
+    dev = (rr - rr.median()).abs()
+    worst = str(dev.idxmax())
+    others = rr.drop(worst)
+    only = bool((others.abs() < 0.5 * abs(rr[worst])).all())
+    return [f"Rows: the {worst} row departs ({rr[worst]:+.0f} lx against "
+            + ", ".join(f"{k} {v:+.0f}" for k, v in others.items()) + " lx)"
+            + (f" — {worst} row only." if only else ".")]
+
+
+def _noise(dm: DisagreementMap) -> list[str]:
     mc = dm.stats["mc_se_rms_lux"]
-    if math.isfinite(mc) and mc > 0:
-        if dm.stats["rmse_lux"] < NOISE_FACTOR * mc:
-            out.append(f"Noise: the residual RMS {dm.stats['rmse_lux']:.0f} lx is within "
-                       f"{NOISE_FACTOR:g}× the Monte Carlo noise ({mc:.1f} lx).")
-        else:
-            out.append(f"Noise: the residual RMS {dm.stats['rmse_lux']:.0f} lx is "
-                       f"{dm.stats['rmse_lux'] / mc:.0f}× the Monte Carlo standard error "
-                       f"({mc:.1f} lx): a model difference, not simulation noise.")
-    return out
+    if not (math.isfinite(mc) and mc > 0):
+        return []
+    rmse = dm.stats["rmse_lux"]
+    if rmse < NOISE_FACTOR * mc:
+        return [f"Noise: the residual RMS {rmse:.0f} lx is within "
+                f"{NOISE_FACTOR:g}× the Monte Carlo noise ({mc:.1f} lx)."]
+    return [f"Noise: the residual RMS {rmse:.0f} lx is {rmse / mc:.0f}× the Monte Carlo "
+            f"standard error ({mc:.1f} lx): a model difference, not simulation noise."]

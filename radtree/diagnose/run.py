@@ -7,110 +7,125 @@ files ``radtree.step<k>.toml`` and ``index.html`` with its PNG figures.
 
 from __future__ import annotations
 
+import logging
 import math
 import os
 import time
-from collections.abc import Iterable
 from pathlib import Path
 
 import pandas as pd
 
 from radtree.config import Project, Scenario
-from radtree.diagnose.attribution import DEFAULT_MARGIN
+from radtree.config.step_project import write_step_project
 from radtree.diagnose.campaign import Campaign
 from radtree.diagnose.campaign_sim import CampaignSimulator, campaign_readings
-from radtree.diagnose.effects import EFFECTS, Effect, EffectContext, candidates
-from radtree.diagnose.loop import (
-    DEFAULT_MAX_STEPS,
-    LoopResult,
-    Measured,
-    load_measurements,
-    run_loop,
-    write_step_project,
-)
-from radtree.diagnose.outcome import DiagnoseResult, Echo, pick_scenario, resolve_project
+from radtree.diagnose.effects import EFFECTS, EffectContext, candidates
+from radtree.diagnose.loop import LoopResult, OnStep, run_loop
+from radtree.diagnose.measured import Measured, load_measurements
+from radtree.diagnose.options import DEFAULT_OPTIONS, DiagnoseOptions
+from radtree.diagnose.outcome import DiagnoseResult, pick_scenario, resolve_project
 from radtree.diagnose.parallel import TracePool
 from radtree.diagnose.simulate import Simulator
 from radtree.errors import ConfigError
 from radtree.fileio import atomic_path
 
+log = logging.getLogger(__name__)
 
-def diagnose(project: str | os.PathLike | Project, measured: str | os.PathLike | None = None,
-             units: str | None = None, scenario: str | None = None, engine: str | None = None,
-             rays: int | None = None, seed: int | None = None, margin: float = DEFAULT_MARGIN,
-             max_steps: int = DEFAULT_MAX_STEPS, effects: Iterable[Effect] = EFFECTS,
-             out_dir: str | os.PathLike | None = None, write: bool = True,
-             echo: Echo | None = print, campaign: Campaign | None = None,
-             workers: int | None = None) -> DiagnoseResult:
-    """Run the discrepancy loop from ``scenario`` (default: the project's first) against the
-    measurements (default: ``[project] measured``) and write ``PROJECT/diagnose/``.
 
-    ``engine``: a registered engine name (default: the seeded engine — ``rays`` per sensor,
-    default 1024, fixed ``seed``, default the project's — so switched runs share random numbers). ``margin``: relative CV improvement a step must bring.
-    ``campaign``: diagnose against the campaign's readings (every day, hour and sensor group;
-    values compared in noise-weighted lux) instead of the project's measured file.
-    ``workers``: processes tracing each step's candidate signatures ahead (default: the usable
-    cores, at most 4; 1 = all in this process) — the same numbers either way.
+def diagnose(project: str | os.PathLike | Project, *, measured: str | os.PathLike | None = None,
+             units: str | None = None, options: DiagnoseOptions = DEFAULT_OPTIONS
+             ) -> DiagnoseResult:
+    """Run the discrepancy loop from ``options.scenario`` (default: the project's first)
+    against the measurements (default: ``[project] measured``; ``units`` when the file does
+    not state them) and write ``PROJECT/diagnose/`` (:class:`DiagnoseOptions`).
+
+    The engine defaults to the seeded engine (``rays`` per sensor, default 1024, fixed
+    ``seed``, default the project's — so switched runs share random numbers).
+    ``options.campaign``: diagnose against the campaign's readings (every day, hour and
+    sensor group; values compared in noise-weighted lux) instead of the measured file.
+    ``options.workers``: processes tracing each step's candidate signatures ahead — the same
+    numbers either way.
     """
     t0 = time.perf_counter()
-    say = echo or (lambda s: None)
     proj = resolve_project(project)
-    sc = pick_scenario(proj, scenario)
-    out = Path(out_dir) if out_dir is not None else proj.root / "diagnose"
-    ctx = EffectContext(proj)
-    sim: Simulator
-    if campaign is not None:
+    sc = pick_scenario(proj, options.scenario)
+    if options.campaign is not None:
         if measured is not None:
             raise ConfigError("--measured does not go with --campaign (the campaign names its "
                               "measured files)")
-        csim = CampaignSimulator(proj, (), engine, rays, seed, campaign=campaign)
-        weights = csim.set_weights(sc, campaign.noise, campaign.noise_lux)
-        sim = csim
-        meas = Measured(tuple(csim.labels), campaign_readings(csim) * weights,
-                        str(campaign.source or campaign.name), "noise-weighted lux",
-                        "campaign", sun=csim.sun_positions(sc), noise=campaign.noise,
-                        noise_lux=campaign.noise_lux)
-        say(f"campaign {campaign.summary()}: {len(csim.labels)} observations")
-        for note in csim.notes:
-            say(f"  note: {note}")
+        sim, meas = _campaign_side(proj, sc, options.campaign, options)
     else:
-        sim = Simulator(proj, tuple(proj.site.hours), engine, rays, seed)
-        meas = load_measurements(proj, measured, units, sim.sensors_per_row())
-        for note in meas.notes():
-            say(f"  note: {note}")
-        sim = Simulator(proj, meas.times, engine, sim.rays, sim.seed)
-    say(f"diagnose {proj.name}: scenario {sc.name} ({sc.model}, {sc.reflection}), engine "
-        f"{sim.engine_name}" + (f", {sim.rays} rays/sensor, seed {sim.seed}" if sim.seeded else "")
-        + f", {len(meas.times)} hours, measured mean {meas.mean:.0f} lx")
-    _, why = candidates(ctx, sc, effects)
+        sim, meas = _file_side(proj, measured, units, options)
+    log.info("diagnose %s: scenario %s (%s, %s), engine %s%s, %d hours, measured mean %.0f lx",
+             proj.name, sc.name, sc.model, sc.reflection, sim.engine_name,
+             f", {sim.rays} rays/sensor, seed {sim.seed}" if sim.seeded else "",
+             len(meas.times), meas.mean)
+    loop = _execute(sim, proj, sc, meas, options)
+    _, why = candidates(EffectContext(proj), sc, options.effects or EFFECTS)
+    out = options.folder(proj.root)
+    res = DiagnoseResult(proj, sc, sim.engine_name, sim.rays if sim.seeded else None,
+                         sim.seed if sim.seeded else None, meas, loop,
+                         out if options.write else None, 0.0, sim.traced_runs, sim.cache_hits,
+                         why, margin=options.margin)
+    log.info("  stop: %s", loop.stop_reason)
+    res.seconds = time.perf_counter() - t0
+    if options.write:
+        res.files = write_outputs(res, out)
+        log.info("  wrote %s and %s", out / "index.html", out / "steps.csv")
+    return res
 
+
+def _campaign_side(proj: Project, sc: Scenario, campaign: Campaign, options: DiagnoseOptions
+                   ) -> tuple[Simulator, Measured]:
+    """The campaign's simulator (noise-weighted) and its readings as the measured side."""
+    csim = CampaignSimulator(proj, (), options.engine, options.rays, options.seed,
+                             campaign=campaign)
+    weights = csim.set_weights(sc, campaign.noise, campaign.noise_lux)
+    meas = Measured(tuple(csim.labels), campaign_readings(csim) * weights,
+                    str(campaign.source or campaign.name), "noise-weighted lux",
+                    "campaign", sun=csim.sun_positions(sc), noise=campaign.noise,
+                    noise_lux=campaign.noise_lux)
+    log.info("campaign %s: %d observations", campaign.summary(), len(csim.labels))
+    for note in csim.notes:
+        log.info("  note: %s", note)
+    return csim, meas
+
+
+def _file_side(proj: Project, measured: str | os.PathLike | None, units: str | None,
+               options: DiagnoseOptions) -> tuple[Simulator, Measured]:
+    """The measured file matched to the project's hours, and a simulator of those hours."""
+    sim = Simulator(proj, tuple(proj.site.hours), options.engine, options.rays, options.seed)
+    meas = load_measurements(proj, measured, units, sim.sensors_per_row())
+    for note in meas.notes():
+        log.info("  note: %s", note)
+    return Simulator(proj, meas.times, options.engine, sim.rays, sim.seed), meas
+
+
+def _execute(sim: Simulator, proj: Project, sc: Scenario, meas: Measured,
+             options: DiagnoseOptions) -> LoopResult:
+    """The loop, with each step's project file written (when writing) and the candidates'
+    signatures traced ahead in ``options.workers`` processes."""
+    on_step = _step_writer(proj, options.folder(proj.root)) if options.write else None
+    with TracePool(options.workers) as pool:
+        if pool.workers > 1:
+            sim.ahead = pool.prefetch
+        try:
+            return run_loop(sim, ctx=EffectContext(proj), start=sc, measured=meas,
+                            options=options.loop(), on_step=on_step)
+        finally:
+            sim.ahead = None
+
+
+def _step_writer(proj: Project, out: Path) -> OnStep:
+    """Writes step ``k``'s scenario to ``out/radtree.step<k>.toml`` and reads it back."""
     def on_step(k: int, new: Scenario) -> tuple[Scenario, Path | None]:
-        if not write:
-            return new, None
         path = out / f"radtree.step{k}.toml"
         header = (f"Written by radtree diagnose, step {k}: the project {proj.source.name} with "
                   f"scenario {new.name}\n({new.description}).\nRun it with: radtree simulate "
                   f"{path} -s {new.name}")
         return write_step_project(proj, new, path, header), path
 
-    with TracePool(workers) as pool:   # the candidates' signatures traced ahead, in parallel
-        if pool.workers > 1:
-            sim.ahead = pool.prefetch
-        try:
-            loop = run_loop(sim, ctx, sc, meas, margin, max_steps, effects, echo=echo,
-                            on_step=on_step)
-        finally:
-            sim.ahead = None
-    res = DiagnoseResult(proj, sc, sim.engine_name, sim.rays if sim.seeded else None,
-                         sim.seed if sim.seeded else None, meas, loop,
-                         out if write else None, 0.0, sim.traced_runs, sim.cache_hits, why,
-                         margin=margin)
-    say(f"  stop: {loop.stop_reason}")
-    res.seconds = time.perf_counter() - t0
-    if write:
-        res.files = write_outputs(res, out)
-        say(f"  wrote {out / 'index.html'} and {out / 'steps.csv'}")
-    return res
+    return on_step
 
 
 def write_outputs(res: DiagnoseResult, out: Path) -> list[Path]:
