@@ -45,20 +45,22 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 from datetime import datetime, timedelta, timezone
+from typing import ClassVar
 
 import numpy as np
 import trimesh
 
 from radtree.config import Project, Scenario
+from radtree.config.spec import Checked, meta
 from radtree.errors import RadtreeError
+from radtree.export.registry import DEFINITIONS
+from radtree.log import progress
 from radtree.optics import Material
 from radtree.scene import Mesh
 from radtree.site.frame import FacadeFrame
 from radtree.trees.raycast import DirectTracer
 
 HOURS = 8760
-DEFINITIONS = ("total", "beam")
-"""Schedule definitions (see the module); the first is the default."""
 CAVEATS = (
     "EnergyPlus passes a shade's scheduled transmittance on undeviated and applies it to beam and "
     "diffuse solar and to daylight alike (EnergyPlus issue #992); 'total' counts the scattered "
@@ -255,46 +257,82 @@ def scattered_forward(crown: Crown, meshes: list[Mesh], materials: dict[str, Mat
     return np.maximum(total - beam, 0.0)
 
 
-def year_schedules(project: Project, scenario: Scenario, frame: FacadeFrame, rays: int = 128,
-                   leaf_on: str | None = None, leaf_off: str | None = None,
-                   seasons: bool = True, progress=None, models=None,
-                   definition: str = DEFINITIONS[0]) -> list[CrownSchedule]:
+@dataclass(frozen=True)
+class ScheduleOptions(Checked):
+    """How the year of transmittances is traced: ``rays`` per hour and crown (about that many
+    bundle rays over the crown's shadow), the leaf season (``leaf_on`` / ``leaf_off`` MM-DD,
+    None: the project's, see :func:`default_leaf_schedule`; ``seasons=False``: leafed all
+    year) and the ``definition`` (``total`` or ``beam``, see the module)."""
+
+    TABLE: ClassVar[str] = "export"
+    rays: int = field(default=128, metadata=meta(1))
+    leaf_on: str | None = None
+    leaf_off: str | None = None
+    seasons: bool = True
+    definition: str = field(default=DEFINITIONS[0], metadata=meta(choices=DEFINITIONS))
+
+    def leaf_states(self, project: Project, hours: list[datetime]) -> np.ndarray:
+        """Per hour of ``hours``: True when the crown is leafed."""
+        if not self.seasons:
+            return np.ones(len(hours), bool)
+        leaf = default_leaf_schedule(project, self.leaf_on, self.leaf_off)
+        return np.asarray(leaf.in_leaf(np.array([h.month for h in hours]),
+                                       np.array([h.day for h in hours])), bool)
+
+
+#: hours traced in one batch (a progress step)
+CHUNK_HOURS = 240
+
+
+def year_schedules(project: Project, scenario: Scenario, frame: FacadeFrame, *,
+                   options: ScheduleOptions = ScheduleOptions(),
+                   models: tuple | None = None) -> list[CrownSchedule]:
     """8760 hourly transmittances per crown (leafed in the leaf season, bare outside it), of
-    ``definition`` ``total`` or ``beam`` (see the module). ``models``: the
-    :func:`crown_models` of the scenario when already built."""
-    if definition not in DEFINITIONS:
-        raise ValueError(f"definition must be one of {DEFINITIONS}, got {definition!r}")
+    ``options.definition`` ``total`` or ``beam`` (see the module), a progress bar per crown
+    and leaf state (:func:`radtree.log.progress`). ``models``: the :func:`crown_models` of
+    the scenario when already built."""
     crowns = crown_envelopes(project, scenario, frame)
     on_meshes, off_meshes, materials, _ = models or crown_models(project, scenario, frame)
     hours = year_hours(project)
     sun, alt = sun_vectors(project, hours)
-    leaf = default_leaf_schedule(project, leaf_on, leaf_off)
-    if seasons:
-        in_leaf = np.asarray(leaf.in_leaf(np.array([h.month for h in hours]),
-                                          np.array([h.day for h in hours])), bool)
-    else:
-        in_leaf = np.ones(HOURS, bool)
+    in_leaf = options.leaf_states(project, hours)
     up = alt >= MIN_ALTITUDE_DEG
-    zenith = np.array([0.0, 0.0, 1.0])
     out = []
     for crown in crowns:
         values = np.zeros(HOURS)
         for state, meshes in ((True, on_meshes), (False, off_meshes)):
-            tracer = own_tracer(crown, meshes, materials)
             sel = in_leaf == state
-            if not sel.any():
-                continue
-            values[sel & ~up] = transmittances(tracer, crown, zenith, rays)[0]
-            if definition == "total":
-                values[sel & ~up] += scattered_forward(crown, meshes, materials, zenith, rays)[0]
-            idx = np.flatnonzero(sel & up)
-            for chunk in (progress(idx, crown.name, state) if progress else [idx]):
-                values[chunk] = transmittances(tracer, crown, sun[chunk], rays)
-                if definition == "total":
-                    values[chunk] += scattered_forward(crown, meshes, materials, sun[chunk],
-                                                       rays, seed=int(chunk[0]) + 1)
+            if sel.any():
+                trace = _Trace(crown, meshes, materials, options)
+                values[sel & ~up] = trace(np.array([[0.0, 0.0, 1.0]]), seed=1)[0]
+                idx = np.flatnonzero(sel & up)
+                chunks = [idx[i:i + CHUNK_HOURS] for i in range(0, len(idx), CHUNK_HOURS)]
+                desc = f"{crown.name} ({'leaf-on' if state else 'leaf-off'})"
+                for chunk in progress(chunks, desc=desc, unit="chunk"):
+                    values[chunk] = trace(sun[chunk], seed=int(chunk[0]) + 1)
         out.append(CrownSchedule(crown, np.clip(values, 0.0, 1.0), in_leaf))
     return out
+
+
+@dataclass
+class _Trace:
+    """One crown in one leaf state: its transmittance of ``options.definition`` along suns."""
+
+    crown: Crown
+    meshes: list[Mesh]
+    materials: dict[str, Material]
+    options: ScheduleOptions
+
+    def __post_init__(self) -> None:
+        self.tracer = own_tracer(self.crown, self.meshes, self.materials)
+
+    def __call__(self, suns: np.ndarray, seed: int) -> np.ndarray:
+        rays = self.options.rays
+        values = transmittances(self.tracer, self.crown, suns, rays)
+        if self.options.definition == "total":
+            values = values + scattered_forward(self.crown, self.meshes, self.materials, suns,
+                                                rays, seed=seed)
+        return values
 
 
 def default_leaf_schedule(project: Project, leaf_on: str | None, leaf_off: str | None):
