@@ -16,10 +16,10 @@ def _help() -> str:
     rows = "\n".join(textwrap.fill(fmt.summary, 92, initial_indent=f"{name:<9} ",
                                    subsequent_indent=" " * 10)
                      for name, fmt in EXPORT_FORMATS.items())
-    return ("Write PROJECT's crowns or scene for other tools into DIR.\n\n\b\n" + rows +
-            f"\n\n{', '.join(formats_needing('schedules'))}: each crown's transmittance along "
-            "the sun for 8760 hours (--definition total: beam + forward-scattered light; beam: "
-            "undeviated only).")
+    traced = textwrap.fill(f"{', '.join(formats_needing('schedules'))}: each crown's "
+                           "transmittance along the sun for 8760 hours (--definition total: "
+                           "beam + forward-scattered light; beam: undeviated only).", 92)
+    return f"Write PROJECT's crowns or scene for other tools into DIR.\n\n\b\n{rows}\n\n\b\n{traced}"
 
 
 @click.command("export", context_settings=CONTEXT, help=_help())

@@ -23,7 +23,7 @@ from typing import ClassVar
 from radtree.config import Project, Scenario
 from radtree.config.spec import Checked, meta
 from radtree.errors import ConfigError
-from radtree.export.registry import FORMATS, ExportFormat, ExportInputs, export_format
+from radtree.export.registry import EXPORT_FORMATS, ExportFormat, ExportInputs, export_format
 from radtree.export.transmittance import CAVEATS, HOURS, ScheduleOptions
 
 log = logging.getLogger(__name__)
@@ -36,10 +36,15 @@ class ExportOptions(Checked):
     when the format needs none), schedules traced as ``schedule`` says."""
 
     TABLE: ClassVar[str] = "export"
-    format: str = field(metadata=meta(choices=FORMATS))
+    format: str
     out: Path
     scenario: str | None = None
     schedule: ScheduleOptions = field(default_factory=ScheduleOptions, metadata=meta(kind="-"))
+
+    def check(self) -> None:
+        if self.format not in EXPORT_FORMATS:     # the registry as it is now
+            raise self.fail("format", f"got {self.format!r}, expected one of "
+                                      f"{', '.join(EXPORT_FORMATS)}")
 
 
 @dataclass(frozen=True)
