@@ -291,7 +291,7 @@ def test_bad_export_options_name_the_field(project, tmp_path, monkeypatch):
     from radtree.errors import ConfigError, RadtreeError
     from radtree.export import registry
     from radtree.export.run import ExportOptions, export_project
-    from radtree.export.transmittance import ScheduleOptions
+    from radtree.export.schedule_options import ScheduleOptions
 
     with pytest.raises(ConfigError, match=r"export\.definition.*'diffuse'.*total, beam"):
         ScheduleOptions(definition="diffuse")

@@ -8,7 +8,8 @@ import textwrap
 import click
 
 from radtree.cli.options import CONTEXT
-from radtree.export.registry import DEFINITIONS, EXPORT_FORMATS, FORMATS, formats_needing
+from radtree.export.registry import EXPORT_FORMATS, FORMATS, formats_needing
+from radtree.export.schedule_options import DEFINITIONS
 
 
 def _help() -> str:
@@ -45,7 +46,7 @@ def export_command(*, project: str, fmt: str, out: str, scenario: str | None, ra
 
     from radtree.config import load_project
     from radtree.export.run import ExportOptions, export_project
-    from radtree.export.transmittance import ScheduleOptions
+    from radtree.export.schedule_options import ScheduleOptions
 
     schedule = ScheduleOptions(rays=rays, leaf_on=leaf_on, leaf_off=leaf_off,
                                seasons=not no_seasons, definition=definition)

@@ -36,9 +36,6 @@ NEEDS: dict[str, str] = {
     "honeybee_model": "the project's Honeybee model ([site] honeybee) when it has one: the "
                       "crown shades are added to it",
 }
-#: the transmittance a ``schedules`` need traces (:mod:`radtree.export.transmittance`); the
-#: first is the default
-DEFINITIONS: tuple[str, ...] = ("total", "beam")
 #: pip extras a format may need → modules that must be importable
 EXTRAS: dict[str, tuple[str, ...]] = {
     "honeybee": ("honeybee", "honeybee_energy", "honeybee_radiance", "ladybug_geometry"),

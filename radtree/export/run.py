@@ -8,9 +8,9 @@ model) and the format's writer writes the files. Messages go to the module's log
 (:mod:`radtree.log`): quiet from a script unless ``radtree.log.enable()``.
 
     from radtree.export.run import ExportOptions, export_project
-    from radtree.export.transmittance import ScheduleOptions
-    export_project(project, options=ExportOptions("idf", "out",
-                                                  schedule=ScheduleOptions(rays=64)))
+    from radtree.export.schedule_options import ScheduleOptions
+    options = ExportOptions("idf", Path("out"), schedule=ScheduleOptions(rays=64))
+    export_project(project, options=options)            # → [Path("out/radtree_crowns.idf")]
 """
 
 from __future__ import annotations
@@ -24,7 +24,8 @@ from radtree.config import Project, Scenario
 from radtree.config.spec import Checked, meta
 from radtree.errors import ConfigError
 from radtree.export.registry import EXPORT_FORMATS, ExportFormat, ExportInputs, export_format
-from radtree.export.transmittance import CAVEATS, HOURS, ScheduleOptions
+from radtree.export.schedule_options import ScheduleOptions
+from radtree.export.transmittance import CAVEATS, HOURS
 
 log = logging.getLogger(__name__)
 
@@ -42,6 +43,7 @@ class ExportOptions(Checked):
     schedule: ScheduleOptions = field(default_factory=ScheduleOptions, metadata=meta(kind="-"))
 
     def check(self) -> None:
+        object.__setattr__(self, "out", Path(self.out))
         if self.format not in EXPORT_FORMATS:     # the registry as it is now
             raise self.fail("format", f"got {self.format!r}, expected one of "
                                       f"{', '.join(EXPORT_FORMATS)}")

@@ -17,7 +17,7 @@
 *Why total by default:* an EnergyPlus shading surface stops what its schedule does not pass,
 and scattered light passes the crown: with ``beam`` every crown without gaps exports as opaque
 (the reference case's homogeneous dome, sun at the zenith, 60° and 40° altitude: beam 0.2–0.6 %, total
-3.9–5.1 %, benchmarks/schedule_total.py) and all scattered light is dropped. Remaining caveats (printed by the export): EnergyPlus applies the
+3.9–5.1 %, benchmarks/schedule_total.py) and all scattered light is dropped. Remaining caveats (logged by the export): EnergyPlus applies the
 value to the beam *and* diffuse solar on the shade and passes it on undeviated, as solar and
 visible alike (its issue #992: "the solar and visible transmittance is the same and … the
 surfaces are non-diffusing"); the schedule takes effect only with the ``PolygonClipping``
@@ -38,22 +38,20 @@ transmittance towards the zenith of the same leaf state.
 
 **Leaf on / off.** :class:`radtree.annual.schedule.LeafSchedule` dates: leafed crown inside
 the season, the bare branches of :func:`radtree.annual.branches.build_leaf_off` outside it
-(``leaf_off=False`` keeps the leafed crown all year).
+(:class:`ScheduleOptions` ``seasons=False`` keeps the leafed crown all year).
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass, field
 from datetime import datetime, timedelta, timezone
-from typing import ClassVar
 
 import numpy as np
 import trimesh
 
 from radtree.config import Project, Scenario
-from radtree.config.spec import Checked, meta
 from radtree.errors import RadtreeError
-from radtree.export.registry import DEFINITIONS
+from radtree.export.schedule_options import ScheduleOptions
 from radtree.log import progress
 from radtree.optics import Material
 from radtree.scene import Mesh
@@ -257,27 +255,14 @@ def scattered_forward(crown: Crown, meshes: list[Mesh], materials: dict[str, Mat
     return np.maximum(total - beam, 0.0)
 
 
-@dataclass(frozen=True)
-class ScheduleOptions(Checked):
-    """How the year of transmittances is traced: ``rays`` per hour and crown (about that many
-    bundle rays over the crown's shadow), the leaf season (``leaf_on`` / ``leaf_off`` MM-DD,
-    None: the project's, see :func:`default_leaf_schedule`; ``seasons=False``: leafed all
-    year) and the ``definition`` (``total`` or ``beam``, see the module)."""
-
-    TABLE: ClassVar[str] = "export"
-    rays: int = field(default=128, metadata=meta(1))
-    leaf_on: str | None = None
-    leaf_off: str | None = None
-    seasons: bool = True
-    definition: str = field(default=DEFINITIONS[0], metadata=meta(choices=DEFINITIONS))
-
-    def leaf_states(self, project: Project, hours: list[datetime]) -> np.ndarray:
-        """Per hour of ``hours``: True when the crown is leafed."""
-        if not self.seasons:
-            return np.ones(len(hours), bool)
-        leaf = default_leaf_schedule(project, self.leaf_on, self.leaf_off)
-        return np.asarray(leaf.in_leaf(np.array([h.month for h in hours]),
-                                       np.array([h.day for h in hours])), bool)
+def leaf_states(project: Project, hours: list[datetime], options: ScheduleOptions
+                ) -> np.ndarray:
+    """Per hour of ``hours``: True when the crown is leafed (always, without ``seasons``)."""
+    if not options.seasons:
+        return np.ones(len(hours), bool)
+    leaf = default_leaf_schedule(project, options.leaf_on, options.leaf_off)
+    return np.asarray(leaf.in_leaf(np.array([h.month for h in hours]),
+                                   np.array([h.day for h in hours])), bool)
 
 
 #: hours traced in one batch (a progress step)
@@ -285,17 +270,18 @@ CHUNK_HOURS = 240
 
 
 def year_schedules(project: Project, scenario: Scenario, frame: FacadeFrame, *,
-                   options: ScheduleOptions = ScheduleOptions(),
+                   options: ScheduleOptions | None = None,
                    models: tuple | None = None) -> list[CrownSchedule]:
     """8760 hourly transmittances per crown (leafed in the leaf season, bare outside it), of
     ``options.definition`` ``total`` or ``beam`` (see the module), a progress bar per crown
     and leaf state (:func:`radtree.log.progress`). ``models``: the :func:`crown_models` of
-    the scenario when already built."""
+    the scenario when already built; ``options`` None: the defaults."""
+    options = options or ScheduleOptions()
     crowns = crown_envelopes(project, scenario, frame)
     on_meshes, off_meshes, materials, _ = models or crown_models(project, scenario, frame)
     hours = year_hours(project)
     sun, alt = sun_vectors(project, hours)
-    in_leaf = options.leaf_states(project, hours)
+    in_leaf = leaf_states(project, hours, options)
     up = alt >= MIN_ALTITUDE_DEG
     out = []
     for crown in crowns:
