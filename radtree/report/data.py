@@ -191,6 +191,38 @@ def is_reference_study(project: Project) -> bool:
             or any(s.form == "dome" for s in project.scenarios))
 
 
+def _build_record(project: Project, name: str, notes: list[str]
+                  ) -> tuple[dict[str, Any] | None, dict[str, Any], Path | None, str]:
+    """Scenario ``name``'s build manifest (None when absent), its ``build`` record, and its
+    crown picture ``model.png`` (None, with the reason when the file is not a PNG)."""
+    folder = project.build_dir / name
+    if not folder.exists() and (project.build_dir / f"{name}@1").exists():
+        folder = project.build_dir / f"{name}@1"   # crown realisations: the first one
+    mf = _read_json(folder / "manifest.json", notes)
+    build = mf.get("build", {}) if mf else {}
+    build = build if isinstance(build, dict) else {}
+    picture, problem = None, ""
+    png = folder / "model.png"
+    if png.is_file():
+        if png.stat().st_size > 0 and _is_png(png):
+            picture = png
+        else:
+            problem = f"{png} is not a valid PNG picture"
+    return mf, build, picture, problem
+
+
+def _hash_notes(name: str, hashes: list[str], current: str | None, notes: list[str]) -> None:
+    """A note when the results mix parameter hashes or differ from the project file's."""
+    if len(hashes) > 1:
+        notes.append(f"scenario {name}: the results mix parameter hashes "
+                     f"{', '.join(hashes)}")
+    elif hashes and current is not None and hashes[0] != current:
+        notes.append(f"scenario {name}: the results were computed with parameters "
+                     f"{hashes[0]}, but the project file (read by this radtree) now gives "
+                     f"{current} — the report shows the stored results; run `radtree "
+                     "simulate` to update them")
+
+
 def scenario_infos(project: Project, results: pd.DataFrame,
                    notes: list[str]) -> list[ScenarioInfo]:
     """One entry per scenario in the results, grouped by crown form, project order inside."""
@@ -207,12 +239,7 @@ def scenario_infos(project: Project, results: pd.DataFrame,
         reflection = refl_col[0] if refl_col else (sc.reflection if sc else "")
         hashes = _unique(rows["params_hash"]) if "params_hash" in rows.columns else []
         engines = _unique(rows["engine"]) if "engine" in rows.columns else []
-        folder = project.build_dir / name
-        if not folder.exists() and (project.build_dir / f"{name}@1").exists():
-            folder = project.build_dir / f"{name}@1"   # crown realisations: the first one
-        mf = _read_json(folder / "manifest.json", notes)
-        build = mf.get("build", {}) if mf else {}
-        build = build if isinstance(build, dict) else {}
+        mf, build, picture, problem = _build_record(project, name, notes)
         if build.get("form"):
             form, source = str(build["form"]), "build manifest"
         elif sc is not None:
@@ -226,22 +253,8 @@ def scenario_infos(project: Project, results: pd.DataFrame,
                     if reflection else "not recorded")
             notes.append(f"scenario {name} is in the results but not in the project file "
                          f"{project.source.name}; it is reported from the results alone")
-        picture, problem = None, ""
-        png = folder / "model.png"
-        if png.is_file():
-            if png.stat().st_size > 0 and _is_png(png):
-                picture = png
-            else:
-                problem = f"{png} is not a valid PNG picture"
         current = project.params_hash(sc) if sc is not None else None
-        if len(hashes) > 1:
-            notes.append(f"scenario {name}: the results mix parameter hashes "
-                         f"{', '.join(hashes)}")
-        elif hashes and current is not None and hashes[0] != current:
-            notes.append(f"scenario {name}: the results were computed with parameters "
-                         f"{hashes[0]}, but the project file (read by this radtree) now gives "
-                         f"{current} — the report shows the stored results; run `radtree "
-                         "simulate` to update them")
+        _hash_notes(name, hashes, current, notes)
         infos.append(ScenarioInfo(
             name=name, model=model, form=form, form_source=source, reflection=reflection,
             reflection_note=note,
