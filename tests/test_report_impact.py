@@ -51,13 +51,14 @@ def _example(tmp: Path, name: str, edits: dict[str, str]) -> Path:
 def _traced(folder: Path) -> tuple[object, Path, list[str]]:
     project = load_project(folder)
     simulate_project(project, engine="numpy", echo=lambda s: None, progress=False)
+    printed: list[str] = []
     stream = io.StringIO()
     log.enable(stream=stream, progress=False)    # the messages the CLI would print
     try:
         index = build_report(project)
     finally:
         log.disable()
-    printed = stream.getvalue().splitlines()
+    printed += stream.getvalue().splitlines()
     assert printed[0] == f"report for {project.name}"
     return project, index, printed
 
