@@ -58,7 +58,7 @@ def main(names: list[str], one_hour: bool = False) -> None:
             project = load_project(dst)
             build_project(project, echo=lambda s: None, progress=False, pictures=False)
             simulate_project(project, engine="numpy", echo=lambda s: None, progress=False)
-            index = build_report(project, echo=lambda s: None)
+            index = build_report(project)
             folder = index.parent
             view = folder / "view3d.html"
             files = sorted((f for f in folder.rglob("*") if f.is_file()),

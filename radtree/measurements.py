@@ -220,6 +220,30 @@ def detect_shape(columns: list[str]) -> tuple[ShapeKind, str]:
         "'time,measured_lux' (grid mean), 'time,row,lux' (per row), 'time,sensor,lux' (per sensor)")
 
 
+def _klux_hint(unit: str) -> str:
+    """What to say after an implausibly low value read as lux."""
+    return (" — if the values are klux, state '# Units: klux' or pass units='klux'"
+            if unit == "lux" else "")
+
+
+def _same_labels_every_hour(frame: pd.DataFrame, label_col: str | None,
+                            lines_by_time: dict[str, list[int]], p: Path
+                            ) -> tuple[str | int, ...]:
+    """The rows' or sensors' labels, sorted; MeasurementError when an hour lacks one that
+    other hours have (``()`` for the mean shape)."""
+    if label_col is None:
+        return ()
+    all_labels = set(frame[label_col])
+    for t, group in frame.groupby("time", sort=True):
+        missing = all_labels - set(group[label_col])
+        if missing:
+            raise MeasurementError(
+                f"time {t} lacks {label_col}(s) {', '.join(sorted(map(str, missing)))} that "
+                "other hours have; every hour needs the same set",
+                source=p, line=lines_by_time[str(t)][0])
+    return tuple(sorted(all_labels, key=lambda v: (str(type(v)), v)))
+
+
 def load_measured(path: str | os.PathLike, units: str | None = None
                   ) -> tuple[pd.DataFrame, MeasuredShape]:
     """Load an hourly measured-illuminance CSV in any accepted shape; values returned in lux.
@@ -265,27 +289,16 @@ def load_measured(path: str | os.PathLike, units: str | None = None
         for r in records:  # mixed numeric and named ids: keep them all as text
             r["sensor"] = str(r["sensor"])
     frame = pd.DataFrame.from_records(records)
-    labels: tuple[str | int, ...] = ()
-    if label_col is not None:
-        all_labels = set(frame[label_col])
-        for t, group in frame.groupby("time", sort=True):
-            missing = all_labels - set(group[label_col])
-            if missing:
-                raise MeasurementError(
-                    f"time {t} lacks {label_col}(s) {', '.join(sorted(map(str, missing)))} that "
-                    "other hours have; every hour needs the same set",
-                    source=p, line=lines_by_time[str(t)][0])
-        labels = tuple(sorted(all_labels, key=lambda v: (str(type(v)), v)))
+    labels = _same_labels_every_hour(frame, label_col, lines_by_time, p)
     hourly = frame.groupby("time", sort=True)["measured_lux"].mean()
     for t, mean in hourly.items():
         if mean < MIN_GRID_MEAN_LUX:
-            hint = (" — if the values are klux, state '# Units: klux' or pass units='klux'"
-                    if unit == "lux" else "")
             at = lines_by_time[str(t)]
             where = "" if len(at) == 1 else f" (lines {', '.join(map(str, at))})"
             raise MeasurementError(
                 f"grid mean {mean:g} lx at {t}{where} is below {MIN_GRID_MEAN_LUX:g} lx, "
-                f"implausible for daylight{hint}", source=p, line=at[0] if len(at) == 1 else None)
+                f"implausible for daylight{_klux_hint(unit)}", source=p,
+                line=at[0] if len(at) == 1 else None)
     sort_cols = ["time"] + ([label_col] if label_col else [])
     frame = frame.sort_values(sort_cols, kind="stable").reset_index(drop=True)
     shape = MeasuredShape(kind=kind, units=unit, source=p,
@@ -322,11 +335,9 @@ def load_measured_rows(path: str | os.PathLike, units: str | None = None) -> pd.
                                    source=p, line=line)
         value = _lux(fields["measured_mean_lux"], "measured_mean_lux", unit, p, line)
         if value < MIN_GRID_MEAN_LUX:
-            hint = (" — if the values are klux, state '# Units: klux' or pass units='klux'"
-                    if unit == "lux" else "")
             raise MeasurementError(
                 f"daily mean {value:g} lx is below {MIN_GRID_MEAN_LUX:g} lx, implausible for "
-                f"daylight{hint}", source=p, line=line)
+                f"daylight{_klux_hint(unit)}", source=p, line=line)
         records.append({"row": row, "sensors": int(sensors), "measured_mean_lux": value})
     return pd.DataFrame.from_records(records)
 

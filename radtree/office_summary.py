@@ -211,6 +211,36 @@ def _map_parts(gt: pd.DataFrame, frame: FacadeFrame) -> list[tuple[int | None, p
     return [(int(k), part) for k, part in gt.groupby("storey", sort=True)]
 
 
+def _map_panel(ax: Any, st: pd.DataFrame, scen: str, frame: Any, norm: Any) -> Any:
+    """One scenario's false-colour panel of a map (its sensors' lux written on the cells,
+    clipped to the norm's range); returns the colour mesh."""
+    lo, hi = norm.vmin, norm.vmax
+    st = st.sort_values("sensor")
+    local = frame.to_local(st[["x", "y", "z"]].to_numpy(float))
+    a, b, xlabel, ylabel, flip = _plane_axes(local)
+    ea, eb, img = _cells(a, b, st["lux"].to_numpy(float))
+    mesh = ax.pcolormesh(ea, eb, np.clip(img, lo, hi), norm=norm, cmap="inferno", shading="flat")
+    ua = 0.5 * (ea[1:] + ea[:-1])
+    ub = 0.5 * (eb[1:] + eb[:-1])
+    for ib, bv in enumerate(ub):
+        for ia, av in enumerate(ua):
+            v = img[ib, ia]
+            if np.isfinite(v):
+                light = norm(max(v, lo)) < 0.6
+                ax.text(av, bv, _fmt_lux(v), ha="center", va="center", fontsize=6,
+                        color="white" if light else "black")
+    ax.set_aspect("equal")
+    if flip:
+        ax.invert_yaxis()
+    model = str(st["model"].iloc[0])
+    ax.set_title(f"{scen} — {tree_label(model)} tree ({model})\n"
+                 f"mean {st['lux'].mean():,.0f} lx", fontsize=9)
+    ax.set_xlabel(xlabel, fontsize=8)
+    ax.set_ylabel(ylabel, fontsize=8)
+    ax.tick_params(labelsize=7)
+    return mesh
+
+
 def write_maps(project: Project, table: pd.DataFrame, out_dir: Path | None = None
                ) -> list[Path]:
     """One PNG per grid and hour: a false-colour panel per scenario, log lux scale."""
@@ -241,30 +271,7 @@ def write_maps(project: Project, table: pd.DataFrame, out_dir: Path | None = Non
                                      squeeze=False, constrained_layout=True)
             mesh = None
             for ax, scen in zip(axes[0], scens):
-                st = ht[ht["scenario"].astype(str) == scen].sort_values("sensor")
-                local = frame.to_local(st[["x", "y", "z"]].to_numpy(float))
-                a, b, xlabel, ylabel, flip = _plane_axes(local)
-                ea, eb, img = _cells(a, b, st["lux"].to_numpy(float))
-                mesh = ax.pcolormesh(ea, eb, np.clip(img, lo, hi), norm=norm, cmap="inferno",
-                                     shading="flat")
-                ua = 0.5 * (ea[1:] + ea[:-1])
-                ub = 0.5 * (eb[1:] + eb[:-1])
-                for ib, bv in enumerate(ub):
-                    for ia, av in enumerate(ua):
-                        v = img[ib, ia]
-                        if np.isfinite(v):
-                            light = norm(max(v, lo)) < 0.6
-                            ax.text(av, bv, _fmt_lux(v), ha="center", va="center", fontsize=6,
-                                    color="white" if light else "black")
-                ax.set_aspect("equal")
-                if flip:
-                    ax.invert_yaxis()
-                model = str(st["model"].iloc[0])
-                ax.set_title(f"{scen} — {tree_label(model)} tree ({model})\n"
-                             f"mean {st['lux'].mean():,.0f} lx", fontsize=9)
-                ax.set_xlabel(xlabel, fontsize=8)
-                ax.set_ylabel(ylabel, fontsize=8)
-                ax.tick_params(labelsize=7)
+                mesh = _map_panel(ax, ht[ht["scenario"].astype(str) == scen], scen, frame, norm)
             assert mesh is not None
             cb = fig.colorbar(mesh, ax=list(axes[0]), shrink=0.9)
             cb.set_label("illuminance (lx), log scale", fontsize=8)

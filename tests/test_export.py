@@ -7,6 +7,7 @@ per hour and crown so that the year takes a few seconds.
 
 from __future__ import annotations
 
+import re
 import shutil
 
 import numpy as np
@@ -239,3 +240,94 @@ def test_cli_gltf_and_obj(project, tmp_path):
         glb.geometry)
     obj = (tmp_path / "out" / "crown_scene.obj").read_text()
     assert obj.count("\nf ") == sum(len(g.faces) for g in glb.geometry.values())
+
+
+# --------------------------------------------------------------------------- the registry
+
+
+def written_inputs(inputs, out):
+    """A writer of a format registered by a test: what it got, as text."""
+    path = out / "inputs.txt"
+    path.write_text(f"{inputs.scenario.name} {inputs.schedules} {inputs.scene} "
+                    f"{inputs.honeybee_model}\n")
+    return [path]
+
+
+def test_cli_choices_and_reference_rows_come_from_the_registry():
+    from radtree.cli.export import export_command
+    from radtree.export import FORMATS
+    from radtree.export.registry import EXPORT_FORMATS, NEEDS, reference_rows
+
+    choices = next(p for p in export_command.params if p.name == "fmt").type.choices
+    assert list(choices) == list(EXPORT_FORMATS) == list(FORMATS) == [
+        "honeybee", "idf", "schedule", "gltf", "obj"]
+    rows = reference_rows()
+    assert [r[0] for r in rows] == list(EXPORT_FORMATS)
+    assert rows[2] == ("schedule", EXPORT_FORMATS["schedule"].summary,
+                       "crown, schedules, extra:honeybee")
+    assert rows[3][2] == "scene"
+    for name, fmt in EXPORT_FORMATS.items():
+        assert callable(fmt.writer()), name
+        assert fmt.needs <= set(NEEDS)
+        assert name in export_command.help
+
+
+def test_a_new_format_is_one_writer_and_one_registry_line(project, tmp_path, monkeypatch):
+    """A format registered at run time is offered to export_project, gets the scenario with a
+    crown and only what it declares (no schedules traced, no scene built)."""
+    from radtree.export.registry import EXPORT_FORMATS, ExportFormat
+    from radtree.export.run import ExportOptions, export_project
+
+    monkeypatch.setitem(EXPORT_FORMATS, "names", ExportFormat(
+        f"{__name__}:written_inputs", "what the writer got", frozenset({"crown"})))
+    paths = export_project(project, options=ExportOptions("names", tmp_path / "o"))
+    assert paths == [tmp_path / "o" / "inputs.txt"]
+    assert paths[0].read_text() == "crown None None None\n"
+    with pytest.raises(ValueError, match="unknown needs"):
+        ExportFormat(f"{__name__}:written_inputs", "x", frozenset({"annual"}))
+
+
+def test_bad_export_options_name_the_field(project, tmp_path, monkeypatch):
+    from radtree.errors import ConfigError, RadtreeError
+    from radtree.export import registry
+    from radtree.export.run import ExportOptions, export_project
+    from radtree.export.schedule_options import ScheduleOptions
+
+    with pytest.raises(ConfigError, match=r"export\.definition.*'diffuse'.*total, beam"):
+        ScheduleOptions(definition="diffuse")
+    with pytest.raises(ConfigError, match=r"export\.rays.*got 0"):
+        ScheduleOptions(rays=0)
+    with pytest.raises(ConfigError, match=r"export\.format.*'png'.*honeybee, idf"):
+        ExportOptions("png", tmp_path)
+    # a format whose extra is missing stops before tracing, with the pip command
+    monkeypatch.setitem(registry.EXTRAS, "honeybee", ("radtree_no_such_module",))
+    with pytest.raises(RadtreeError, match=r"pip install 'radtree\[honeybee\]'"):
+        export_project(project, options=ExportOptions("schedule", tmp_path / "s"))
+    assert not (tmp_path / "s").exists()
+
+
+def test_scenario_without_crown_refused_and_library_quiet(project, tmp_path, capsys):
+    import io
+
+    from radtree import log
+    from radtree.errors import ConfigError
+    from radtree.export.run import ExportOptions, export_project
+
+    folder = tmp_path / "p"
+    shutil.copytree(project.root, folder, ignore=shutil.ignore_patterns("build", "results"))
+    toml = folder / "radtree.toml"
+    toml.write_text(toml.read_text() + '[[scenario]]\nname = "open"\nmodel = "none"\n')
+    p = load_project(folder)
+    with pytest.raises(ConfigError, match="scenario 'open' has no crown") as err:
+        export_project(p, options=ExportOptions("idf", tmp_path / "x", scenario="open"))
+    assert err.value.field == "--scenario"
+    path = export_project(p, options=ExportOptions("obj", tmp_path / "o", scenario="open"))[0]
+    assert path.name == "open_scene.obj" and capsys.readouterr().out == ""
+    stream = io.StringIO()
+    log.enable(stream=stream, progress=False)
+    try:
+        export_project(p, options=ExportOptions("gltf", tmp_path / "o", scenario="open"))
+    finally:
+        log.disable()
+    assert re.fullmatch(rf"open: \d+ meshes, \d+ triangles → {tmp_path}/o/open_scene\.glb\n",
+                        stream.getvalue())

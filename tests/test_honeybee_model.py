@@ -204,7 +204,7 @@ def traced(tmp_path_factory):
     project = load_project(folder)
     build_project(project, echo=lambda s: None, progress=False, pictures=False)
     simulate_project(project, engine="radiance", echo=lambda s: None, progress=False)
-    index = build_report(project, echo=lambda s: None)
+    index = build_report(project)
     return project, pd.read_csv(project.results_dir / "illuminance.csv"), index
 
 

@@ -157,7 +157,7 @@ def built(tmp_path_factory: pytest.TempPathFactory) -> tuple[Project, Path]:
     p = load_project(make_project(tmp_path_factory.mktemp("report") / "proj"))
     write_results(p)
     write_scan_and_diagnosis(p)
-    return p, build_report(p, echo=lambda s: None)
+    return p, build_report(p)
 
 
 def write_scan_and_diagnosis(p: Project) -> None:
@@ -349,7 +349,7 @@ def test_without_measurements(tmp_path: Path):
     p = load_project(make_project(tmp_path / "proj", measured=False))
     assert p.measured is None
     write_results(p)
-    index = build_report(p, echo=lambda s: None)
+    index = build_report(p)
     parser = parse(index)
     text = " ".join(parser.text)
     assert "No measurements" in text
@@ -373,7 +373,7 @@ def test_minimal_results_layout(project: Project):
     import shutil
 
     shutil.rmtree(project.build_dir)
-    parser = parse(build_report(project, echo=lambda s: None))
+    parser = parse(build_report(project))
     text = " ".join(parser.text)
     assert "No façade map" in text and "no build manifest" in text
     html = (project.report_dir / "index.html").read_text()   # sections without data: absent
@@ -387,7 +387,7 @@ def test_minimal_results_layout(project: Project):
 def test_missing_results_is_a_clear_error(tmp_path: Path):
     p = load_project(make_project(tmp_path / "proj"))
     with pytest.raises(RadtreeError, match=r"no results: run `radtree simulate .*` first"):
-        build_report(p, echo=lambda s: None)
+        build_report(p)
     assert not p.report_dir.exists()
 
 
@@ -395,7 +395,7 @@ def test_measured_hour_without_simulation_is_not_dropped(tmp_path: Path):
     p = load_project(make_project(tmp_path / "proj"))
     write_results(p, hours=HOURS[:-1])
     with pytest.raises(RadtreeError, match="measured hour.*without a simulated value.*16:30"):
-        build_report(p, echo=lambda s: None)
+        build_report(p)
     assert not p.report_dir.exists()
 
 
@@ -444,7 +444,7 @@ def test_report_on_a_real_open_street_simulation(open_street: Path):
                            toml.read_text(), flags=re.M))
     p = load_project(open_street)
     simulate_project(p, "radiance", scenarios=["A", "B"], echo=lambda s: None, progress=False)
-    index = build_report(p, echo=lambda s: None)
+    index = build_report(p)
     parser = parse(index)
     assert "figures/facade_map.png" in parser.images
     for src in parser.images:

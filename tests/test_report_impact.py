@@ -8,6 +8,7 @@ fold."""
 
 from __future__ import annotations
 
+import io
 import json
 import re
 import shutil
@@ -18,6 +19,7 @@ import numpy as np
 import pandas as pd
 import pytest
 
+from radtree import log
 from radtree.config import load_project
 from radtree.pipeline.simulate import simulate_project
 from radtree.report import build_report
@@ -50,7 +52,14 @@ def _traced(folder: Path) -> tuple[object, Path, list[str]]:
     project = load_project(folder)
     simulate_project(project, engine="numpy", echo=lambda s: None, progress=False)
     printed: list[str] = []
-    index = build_report(project, echo=printed.append)
+    stream = io.StringIO()
+    log.enable(stream=stream, progress=False)    # the messages the CLI would print
+    try:
+        index = build_report(project)
+    finally:
+        log.disable()
+    printed += stream.getvalue().splitlines()
+    assert printed[0] == f"report for {project.name}"
     return project, index, printed
 
 
@@ -295,7 +304,7 @@ def test_trees_ranked_and_standards_from_the_contract_files(district):
          "unit": "%", "definition": "share of the area with DA300 ≥ 50 %"},
     ]).to_csv(project.results_dir / "annual" / "standards.csv", index=False)
     try:
-        parser = parse(build_report(project, echo=lambda s: None))
+        parser = parse(build_report(project))
     finally:
         (project.results_dir / "tree_impact.csv").unlink()
         shutil.rmtree(project.results_dir / "annual")
@@ -359,7 +368,7 @@ def test_stand_in_scenario_is_marked_and_off_the_scale(tmp_path, monkeypatch):
         scenario="F-photo", params_hash=p.params_hash(p.scenario("F-photo")))
     fphoto["lux"] *= 6.0
     pd.concat([table_, fphoto]).to_csv(p.results_dir / "illuminance.csv", index=False)
-    data = collect(p, echo=lambda s: None)
+    data = collect(p)
     assert [s.name for s in data.scenarios if s.stand_in] == ["F-photo"]
     from matplotlib.figure import Figure
 

@@ -28,7 +28,7 @@ def report_command(project: str, open_: bool) -> None:
     from radtree.report.tables import headline_table
 
     p = load_project(project)
-    index = build_report(p, echo=click.echo)
+    index = build_report(p)
     click.echo("")
     click.echo(headline_table(index.parent / "statistics.csv"))
     click.echo("")

@@ -3,9 +3,10 @@ results table): Honeybee (HBJSON: crowns as ``ShadeMesh`` with the leaf Radiance
 an hourly transmittance schedule), EnergyPlus (IDF via honeybee-energy, ``Schedule:File`` CSV),
 glTF / OBJ (the whole scene via trimesh), and results in honeybee-radiance's layout.
 
-Entry point: :func:`radtree.export.run.export_project`.
+Entry point: :func:`radtree.export.run.export_project`; the formats are registered by name in
+:mod:`radtree.export.registry` (one writer module and one registry line each).
 """
 
-FORMATS = ("honeybee", "idf", "schedule", "gltf", "obj")
+from radtree.export.registry import EXPORT_FORMATS, FORMATS
 
-__all__ = ["FORMATS"]
+__all__ = ["EXPORT_FORMATS", "FORMATS"]

@@ -23,8 +23,9 @@ results in honeybee-radiance's point-in-time layout.
 from __future__ import annotations
 
 import json
+import logging
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 import pandas as pd
@@ -34,6 +35,10 @@ from radtree.export.transmittance import HOURS, CrownSchedule
 from radtree.fileio import atomic_path, write_text
 from radtree.optics import Glass, Material, Plastic, Trans
 
+if TYPE_CHECKING:
+    from radtree.export.registry import ExportInputs
+
+log = logging.getLogger(__name__)
 CSV_NAME = "crown_transmittance"
 #: EnergyPlus ShadowCalculation for scheduled shade transmittance: PolygonClipping (the
 #: PixelCounting method treats transmitting shades as opaque, EnergyPlus issue #9059 and its
@@ -146,6 +151,32 @@ def write_schedule_csv(schedules: list[CrownSchedule], out: Path) -> tuple[Path,
     objs.append(shadow_calculation_idf())
     idf = write_text(out / f"{CSV_NAME}.idf", "\n\n".join(objs) + "\n")
     return csv, idf
+
+
+def crowns_model(inputs: ExportInputs) -> Any:
+    """The crown shades of ``inputs`` (:func:`crown_shades`) in the project's Honeybee model
+    when it has one, else alone (:func:`shade_model`)."""
+    schedules, leaf = inputs.crown_schedules()
+    return shade_model(inputs.project.name, crown_shades(schedules, leaf), inputs.honeybee_model)
+
+
+def export_hbjson(inputs: ExportInputs, out: Path) -> list[Path]:
+    """Format ``honeybee`` (:mod:`radtree.export.registry`): ``radtree_crowns.hbjson``."""
+    path = write_hbjson(crowns_model(inputs), out)
+    log.info("%d crown shades → %s", len(inputs.crown_schedules()[0]), path)
+    return [path]
+
+
+def export_idf(inputs: ExportInputs, out: Path) -> list[Path]:
+    """Format ``idf``: ``radtree_crowns.idf`` (and the file schedules beside it)."""
+    path = write_idf(crowns_model(inputs), out)
+    log.info("%d crown shades → %s", len(inputs.crown_schedules()[0]), path)
+    return [path]
+
+
+def export_schedule(inputs: ExportInputs, out: Path) -> list[Path]:
+    """Format ``schedule``: ``crown_transmittance.csv`` and ``crown_transmittance.idf``."""
+    return list(write_schedule_csv(inputs.crown_schedules()[0], out))
 
 
 def write_results(table: pd.DataFrame, model: Any, out: Path) -> list[Path]:

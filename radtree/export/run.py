@@ -1,24 +1,71 @@
 """``export_project``: one project out in one format (see :mod:`radtree.export`).
 
-``honeybee`` / ``idf`` / ``schedule`` need the scenario's crowns and their year of hourly
-transmittances (:mod:`radtree.export.transmittance`); ``gltf`` / ``obj`` the scenario's whole
-scene. The scenario is the one named, else the first with a crown model.
+Plan → execute → publish: :func:`plan_export` checks the options and picks the scenario (the
+one named, else the first with a crown model when the format needs one), :func:`prepare`
+builds what the format declares it needs (:mod:`radtree.export.registry`: the year of crown
+transmittances of :mod:`radtree.export.transmittance`, the whole scene, the project's Honeybee
+model) and the format's writer writes the files. Messages go to the module's logger
+(:mod:`radtree.log`): quiet from a script unless ``radtree.log.enable()``.
+
+    from radtree.export.run import ExportOptions, export_project
+    from radtree.export.schedule_options import ScheduleOptions
+    options = ExportOptions("idf", Path("out"), schedule=ScheduleOptions(rays=64))
+    export_project(project, options=options)            # → [Path("out/radtree_crowns.idf")]
 """
 
 from __future__ import annotations
 
-from collections.abc import Callable
+import logging
+from dataclasses import dataclass, field, replace
 from pathlib import Path
+from typing import ClassVar
 
 from radtree.config import Project, Scenario
+from radtree.config.spec import Checked, meta
 from radtree.errors import ConfigError
-from radtree.export import FORMATS
+from radtree.export.registry import EXPORT_FORMATS, ExportFormat, ExportInputs, export_format
+from radtree.export.schedule_options import ScheduleOptions
+from radtree.export.transmittance import CAVEATS, HOURS
+
+log = logging.getLogger(__name__)
+
+
+@dataclass(frozen=True)
+class ExportOptions(Checked):
+    """What to export: ``format`` (a name of :data:`radtree.export.registry.EXPORT_FORMATS`)
+    into folder ``out``, of ``scenario`` (None: the first with a crown model, or the first
+    when the format needs none), schedules traced as ``schedule`` says."""
+
+    TABLE: ClassVar[str] = "export"
+    format: str
+    out: Path
+    scenario: str | None = None
+    schedule: ScheduleOptions = field(default_factory=ScheduleOptions, metadata=meta(kind="-"))
+
+    def check(self) -> None:
+        object.__setattr__(self, "out", Path(self.out))
+        if self.format not in EXPORT_FORMATS:     # the registry as it is now
+            raise self.fail("format", f"got {self.format!r}, expected one of "
+                                      f"{', '.join(EXPORT_FORMATS)}")
+
+
+@dataclass(frozen=True)
+class ExportPlan:
+    """The format, the scenario exported and the folder written."""
+
+    format: ExportFormat
+    scenario: Scenario
+    out: Path
 
 
 def export_scenario(project: Project, name: str | None, needs_crown: bool) -> Scenario:
     """The named scenario, else the first with a crown (any when no crown is needed)."""
     if name is not None:
-        return project.scenario(name)
+        sc = project.scenario(name)
+        if needs_crown and sc.model == "none":
+            raise ConfigError(f"scenario {sc.name!r} has no crown (model 'none'): choose one "
+                              "with a crown model", source=str(project.source), field="--scenario")
+        return sc
     for sc in project.scenarios:
         if sc.model != "none" or not needs_crown:
             return sc
@@ -34,76 +81,56 @@ def leaf_material(meshes, materials):
     return materials[max(crown, key=lambda m: m.n_triangles).material]
 
 
-def export_project(project: Project, fmt: str, out: Path, scenario: str | None = None,
-                   rays: int = 128, leaf_on: str | None = None, leaf_off: str | None = None,
-                   seasons: bool = True, echo: Callable[[str], None] = print,
-                   progress: bool = True, definition: str = "total") -> list[Path]:
-    """Write ``project`` in format ``fmt`` into folder ``out``; return the files written.
-    ``definition``: the schedules' transmittance, ``total`` or ``beam``
-    (:mod:`radtree.export.transmittance`); the caveats that remain are echoed."""
-    from radtree.pipeline.assemble import facade_frame, make_scene
-
-    if fmt not in FORMATS:
-        raise ConfigError(f"got {fmt!r}, expected one of {', '.join(FORMATS)}", field="--format")
-    out = Path(out)
+def plan_export(project: Project, options: ExportOptions) -> ExportPlan:
+    """The format (its extra installed), the scenario and the output folder (created)."""
+    fmt = export_format(options.format)
+    sc = export_scenario(project, options.scenario, "crown" in fmt.needs)
+    out = Path(options.out)
     out.mkdir(parents=True, exist_ok=True)
+    return ExportPlan(fmt, sc, out)
+
+
+def crown_schedules(project: Project, sc: Scenario, options: ScheduleOptions) -> ExportInputs:
+    """The year of hourly transmittances of the scenario's crowns and their leaf material,
+    with a summary per crown and the caveats logged."""
+    from radtree.export.transmittance import crown_models, default_leaf_schedule, year_schedules
+    from radtree.pipeline.assemble import facade_frame
+
+    leaf = default_leaf_schedule(project, options.leaf_on, options.leaf_off)
+    season = (f"on {leaf.leaf_on} → off {leaf.leaf_off} (MM-DD)" if options.seasons
+              else "on all year")
+    log.info("%s: hourly crown transmittance (%s) along the sun for %d hours, %d rays per hour "
+             "and crown; leaf %s", sc.name, options.definition, HOURS, options.rays, season)
     frame = facade_frame(project)
-    sc = export_scenario(project, scenario, fmt not in ("gltf", "obj"))
-    if fmt in ("gltf", "obj"):
-        from radtree.export.scene_files import write_scene
-
-        built = make_scene(project, sc)
-        path = write_scene(built.scene, out, fmt, f"{sc.name}_scene")
-        echo(f"{sc.name}: {len(built.scene.solid_meshes())} meshes, {built.triangles} "
-             f"triangles → {path}")
-        return [path]
-    from radtree.export.transmittance import (
-        CAVEATS,
-        DEFINITIONS,
-        crown_models,
-        default_leaf_schedule,
-        year_schedules,
-    )
-    from radtree.pipeline.build import progress_bar
-
-    if sc.model == "none":
-        raise ConfigError(f"scenario {sc.name!r} has no crown (model 'none'): choose one with "
-                          "a crown model", source=str(project.source), field="--scenario")
-    if definition not in DEFINITIONS:
-        raise ConfigError(f"got {definition!r}, expected one of {', '.join(DEFINITIONS)}",
-                          field="--definition")
-    leaf = default_leaf_schedule(project, leaf_on, leaf_off)
-    echo(f"{sc.name}: hourly crown transmittance ({definition}) along the sun for {8760} hours, "
-         f"{rays} rays per hour and crown; leaf " + (
-             f"on {leaf.leaf_on} → off {leaf.leaf_off} (MM-DD)" if seasons else "on all year"))
-
-    def bar(idx, crown, state):
-        chunks = [idx[i:i + 240] for i in range(0, len(idx), 240)]
-        return progress_bar(chunks, f"{crown} ({'leaf-on' if state else 'leaf-off'})",
-                            progress, unit="chunk")
-
     models = crown_models(project, sc, frame)
-    schedules = year_schedules(project, sc, frame, rays, leaf_on, leaf_off, seasons, bar, models,
-                               definition)
+    schedules = year_schedules(project, sc, frame, options=options, models=models)
     for cs in schedules:
-        echo(f"  {cs.crown.name}: transmittance {cs.values.min():.4f}–{cs.values.max():.4f}, "
-             f"mean {cs.values.mean():.4f} ({int(cs.leaf_on.sum())} leaf-on hours)")
+        log.info("  %s: transmittance %.4f–%.4f, mean %.4f (%d leaf-on hours)", cs.crown.name,
+                 cs.values.min(), cs.values.max(), cs.values.mean(), int(cs.leaf_on.sum()))
     for caveat in CAVEATS:
-        echo(f"  caveat: {caveat}")
-    if fmt == "schedule":
-        from radtree.export.honeybee import write_schedule_csv
+        log.info("  caveat: %s", caveat)
+    return ExportInputs(project, sc, schedules=schedules, leaf=leaf_material(models[0], models[2]))
 
-        return list(write_schedule_csv(schedules, out))
-    from radtree.export.honeybee import crown_shades, shade_model, write_hbjson, write_idf
 
-    meshes, _, materials, _ = models
-    base = None
-    if project.honeybee is not None:
+def prepare(project: Project, plan: ExportPlan, options: ExportOptions) -> ExportInputs:
+    """What the plan's format needs, and nothing more."""
+    needs = plan.format.needs
+    inputs = ExportInputs(project, plan.scenario)
+    if "schedules" in needs:
+        inputs = crown_schedules(project, plan.scenario, options.schedule)
+    if "scene" in needs:
+        from radtree.pipeline.assemble import make_scene
+
+        inputs = replace(inputs, scene=make_scene(project, plan.scenario))
+    if "honeybee_model" in needs and project.honeybee is not None:
         from radtree.site.honeybee_model import load_model
 
-        base = load_model(project.honeybee.model)
-    model = shade_model(project.name, crown_shades(schedules, leaf_material(meshes, materials)),
-                        base)
-    path = write_hbjson(model, out) if fmt == "honeybee" else write_idf(model, out)
-    echo(f"{len(schedules)} crown shades → {path}")
-    return [path]
+        inputs = replace(inputs, honeybee_model=load_model(project.honeybee.model))
+    return inputs
+
+
+def export_project(project: Project, *, options: ExportOptions) -> list[Path]:
+    """Write ``project`` in ``options.format`` into folder ``options.out``; return the files
+    written (see the module)."""
+    plan = plan_export(project, options)
+    return plan.format.writer()(prepare(project, plan, options), plan.out)

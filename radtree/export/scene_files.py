@@ -8,7 +8,9 @@ y-up by convention, so the glTF scene gets a root rotation of −90° about x (z
 
 from __future__ import annotations
 
+import logging
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 import trimesh
@@ -16,6 +18,11 @@ import trimesh
 from radtree.fileio import atomic_path
 from radtree.optics import Bsdf, Glass, Material, Trans
 from radtree.scene import Scene
+
+if TYPE_CHECKING:
+    from radtree.export.registry import ExportInputs
+
+log = logging.getLogger(__name__)
 
 
 def material_rgba(material: Material) -> list[int]:
@@ -59,3 +66,22 @@ def write_scene(scene: Scene, out: Path, fmt: str, name: str = "scene") -> Path:
     with atomic_path(path) as tmp:
         Path(tmp).write_bytes(data if isinstance(data, bytes) else data.encode())
     return path
+
+
+def export_scene(inputs: ExportInputs, out: Path, fmt: str) -> list[Path]:
+    """The scenario's scene as ``out/<scenario>_scene.glb`` or ``.obj`` (:func:`write_scene`)."""
+    built = inputs.built_scene()
+    path = write_scene(built.scene, out, fmt, f"{inputs.scenario.name}_scene")
+    log.info("%s: %d meshes, %d triangles → %s", inputs.scenario.name,
+             len(built.scene.solid_meshes()), built.triangles, path)
+    return [path]
+
+
+def export_gltf(inputs: ExportInputs, out: Path) -> list[Path]:
+    """Format ``gltf`` (:mod:`radtree.export.registry`): ``<scenario>_scene.glb``."""
+    return export_scene(inputs, out, "gltf")
+
+
+def export_obj(inputs: ExportInputs, out: Path) -> list[Path]:
+    """Format ``obj``: ``<scenario>_scene.obj``."""
+    return export_scene(inputs, out, "obj")

@@ -17,7 +17,7 @@
 *Why total by default:* an EnergyPlus shading surface stops what its schedule does not pass,
 and scattered light passes the crown: with ``beam`` every crown without gaps exports as opaque
 (the reference case's homogeneous dome, sun at the zenith, 60° and 40° altitude: beam 0.2–0.6 %, total
-3.9–5.1 %, benchmarks/schedule_total.py) and all scattered light is dropped. Remaining caveats (printed by the export): EnergyPlus applies the
+3.9–5.1 %, benchmarks/schedule_total.py) and all scattered light is dropped. Remaining caveats (logged by the export): EnergyPlus applies the
 value to the beam *and* diffuse solar on the shade and passes it on undeviated, as solar and
 visible alike (its issue #992: "the solar and visible transmittance is the same and … the
 surfaces are non-diffusing"); the schedule takes effect only with the ``PolygonClipping``
@@ -38,7 +38,7 @@ transmittance towards the zenith of the same leaf state.
 
 **Leaf on / off.** :class:`radtree.annual.schedule.LeafSchedule` dates: leafed crown inside
 the season, the bare branches of :func:`radtree.annual.branches.build_leaf_off` outside it
-(``leaf_off=False`` keeps the leafed crown all year).
+(:class:`ScheduleOptions` ``seasons=False`` keeps the leafed crown all year).
 """
 
 from __future__ import annotations
@@ -51,14 +51,14 @@ import trimesh
 
 from radtree.config import Project, Scenario
 from radtree.errors import RadtreeError
+from radtree.export.schedule_options import ScheduleOptions
+from radtree.log import progress
 from radtree.optics import Material
 from radtree.scene import Mesh
 from radtree.site.frame import FacadeFrame
 from radtree.trees.raycast import DirectTracer
 
 HOURS = 8760
-DEFINITIONS = ("total", "beam")
-"""Schedule definitions (see the module); the first is the default."""
 CAVEATS = (
     "EnergyPlus passes a shade's scheduled transmittance on undeviated and applies it to beam and "
     "diffuse solar and to daylight alike (EnergyPlus issue #992); 'total' counts the scattered "
@@ -255,46 +255,70 @@ def scattered_forward(crown: Crown, meshes: list[Mesh], materials: dict[str, Mat
     return np.maximum(total - beam, 0.0)
 
 
-def year_schedules(project: Project, scenario: Scenario, frame: FacadeFrame, rays: int = 128,
-                   leaf_on: str | None = None, leaf_off: str | None = None,
-                   seasons: bool = True, progress=None, models=None,
-                   definition: str = DEFINITIONS[0]) -> list[CrownSchedule]:
+def leaf_states(project: Project, hours: list[datetime], options: ScheduleOptions
+                ) -> np.ndarray:
+    """Per hour of ``hours``: True when the crown is leafed (always, without ``seasons``)."""
+    if not options.seasons:
+        return np.ones(len(hours), bool)
+    leaf = default_leaf_schedule(project, options.leaf_on, options.leaf_off)
+    return np.asarray(leaf.in_leaf(np.array([h.month for h in hours]),
+                                   np.array([h.day for h in hours])), bool)
+
+
+#: hours traced in one batch (a progress step)
+CHUNK_HOURS = 240
+
+
+def year_schedules(project: Project, scenario: Scenario, frame: FacadeFrame, *,
+                   options: ScheduleOptions | None = None,
+                   models: tuple | None = None) -> list[CrownSchedule]:
     """8760 hourly transmittances per crown (leafed in the leaf season, bare outside it), of
-    ``definition`` ``total`` or ``beam`` (see the module). ``models``: the
-    :func:`crown_models` of the scenario when already built."""
-    if definition not in DEFINITIONS:
-        raise ValueError(f"definition must be one of {DEFINITIONS}, got {definition!r}")
+    ``options.definition`` ``total`` or ``beam`` (see the module), a progress bar per crown
+    and leaf state (:func:`radtree.log.progress`). ``models``: the :func:`crown_models` of
+    the scenario when already built; ``options`` None: the defaults."""
+    options = options or ScheduleOptions()
     crowns = crown_envelopes(project, scenario, frame)
     on_meshes, off_meshes, materials, _ = models or crown_models(project, scenario, frame)
     hours = year_hours(project)
     sun, alt = sun_vectors(project, hours)
-    leaf = default_leaf_schedule(project, leaf_on, leaf_off)
-    if seasons:
-        in_leaf = np.asarray(leaf.in_leaf(np.array([h.month for h in hours]),
-                                          np.array([h.day for h in hours])), bool)
-    else:
-        in_leaf = np.ones(HOURS, bool)
+    in_leaf = leaf_states(project, hours, options)
     up = alt >= MIN_ALTITUDE_DEG
-    zenith = np.array([0.0, 0.0, 1.0])
     out = []
     for crown in crowns:
         values = np.zeros(HOURS)
         for state, meshes in ((True, on_meshes), (False, off_meshes)):
-            tracer = own_tracer(crown, meshes, materials)
             sel = in_leaf == state
-            if not sel.any():
-                continue
-            values[sel & ~up] = transmittances(tracer, crown, zenith, rays)[0]
-            if definition == "total":
-                values[sel & ~up] += scattered_forward(crown, meshes, materials, zenith, rays)[0]
-            idx = np.flatnonzero(sel & up)
-            for chunk in (progress(idx, crown.name, state) if progress else [idx]):
-                values[chunk] = transmittances(tracer, crown, sun[chunk], rays)
-                if definition == "total":
-                    values[chunk] += scattered_forward(crown, meshes, materials, sun[chunk],
-                                                       rays, seed=int(chunk[0]) + 1)
+            if sel.any():
+                trace = _Trace(crown, meshes, materials, options)
+                values[sel & ~up] = trace(np.array([[0.0, 0.0, 1.0]]), seed=1)[0]
+                idx = np.flatnonzero(sel & up)
+                chunks = [idx[i:i + CHUNK_HOURS] for i in range(0, len(idx), CHUNK_HOURS)]
+                desc = f"{crown.name} ({'leaf-on' if state else 'leaf-off'})"
+                for chunk in progress(chunks, desc=desc, unit="chunk"):
+                    values[chunk] = trace(sun[chunk], seed=int(chunk[0]) + 1)
         out.append(CrownSchedule(crown, np.clip(values, 0.0, 1.0), in_leaf))
     return out
+
+
+@dataclass
+class _Trace:
+    """One crown in one leaf state: its transmittance of ``options.definition`` along suns."""
+
+    crown: Crown
+    meshes: list[Mesh]
+    materials: dict[str, Material]
+    options: ScheduleOptions
+
+    def __post_init__(self) -> None:
+        self.tracer = own_tracer(self.crown, self.meshes, self.materials)
+
+    def __call__(self, suns: np.ndarray, seed: int) -> np.ndarray:
+        rays = self.options.rays
+        values = transmittances(self.tracer, self.crown, suns, rays)
+        if self.options.definition == "total":
+            values = values + scattered_forward(self.crown, self.meshes, self.materials, suns,
+                                                rays, seed=seed)
+        return values
 
 
 def default_leaf_schedule(project: Project, leaf_on: str | None, leaf_off: str | None):

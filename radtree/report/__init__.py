@@ -11,7 +11,6 @@ measurement files. The heavy modules (pandas, matplotlib) load on the first call
 
 from __future__ import annotations
 
-from collections.abc import Callable
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -21,11 +20,12 @@ if TYPE_CHECKING:
 __all__ = ["build_report"]
 
 
-def build_report(project: Project, echo: Callable[[str], None] = print) -> Path:
-    """Write ``PROJECT/report/`` atomically and return the path of ``index.html``.
+def build_report(project: Project) -> Path:
+    """Write ``PROJECT/report/`` atomically and return the path of ``index.html``; quiet
+    unless ``radtree.log.enable()`` (its messages go to :mod:`logging`).
 
     See :func:`radtree.report.build.build_report`.
     """
     from radtree.report.build import build_report as _build
 
-    return _build(project, echo=echo)
+    return _build(project)

@@ -24,6 +24,7 @@ research sections (ground reflection, convergence, timing, provenance).
 from __future__ import annotations
 
 import json
+import logging
 import multiprocessing
 from collections.abc import Callable
 from concurrent.futures import Future, ProcessPoolExecutor
@@ -78,6 +79,7 @@ COMPASS = ("north", "north-east", "east", "south-east", "south", "south-west", "
 STATISTICS_CONTRACT = ["scenario", "model", "reflection", "rmse", "rmse_low", "rmse_high", "mbe",
                        "r", "r2", "n_hours"]
 STATISTICS_EXTRA = ["rmse_lux", "mbe_lux", "rmse_mc_se", "form"]
+log = logging.getLogger(__name__)
 
 
 @dataclass
@@ -177,7 +179,7 @@ class _Figures:
     worker process while everything else of the report is made here (when there is a second
     core), the others drawn at once. :meth:`results` waits for the worker."""
 
-    def __init__(self, data: ReportData, folder: Path, echo: Callable[[str], None]):
+    def __init__(self, data: ReportData, folder: Path):
         plan: list[tuple[str, str, Callable[[ReportData, Path], str], bool]] = [
             ("hourly", "Hourly measured and simulated façade illuminance", figures.hourly_plot,
              True),
@@ -193,7 +195,6 @@ class _Figures:
              data.convergence is not None),
         ]
         self.wanted = [(key, alt, draw) for key, alt, draw, want in plan if want]
-        self.echo = echo
         self.problems: list[str] = []
         apart = [k for k, _, _ in self.wanted if k.startswith("facade_map")]
         self.pool = (ProcessPoolExecutor(1, mp_context=multiprocessing.get_context("spawn"))
@@ -212,7 +213,7 @@ class _Figures:
         except Exception as exc:  # a broken figure must not hide the others
             self.problems.append(f"figure '{key}' could not be drawn: {type(exc).__name__}: "
                                  f"{exc}")
-            self.echo(f"  warning: {self.problems[-1]}")
+            log.warning("%s", self.problems[-1])
             return None
 
     def results(self) -> tuple[dict[str, FigureRef], list[str]]:
@@ -271,15 +272,12 @@ def _subtitle(data: ReportData, light: dict[str, Any]) -> str:
     return f"{p.site.name}, {p.site.date}; {where}; light: {light['first']}"
 
 
-def page_sections(data: ReportData, tables: dict[str, Table], impact: dict[str, Any] | None,
-                  light: dict[str, Any], extras: list[Section], has_maps: bool
-                  ) -> list[Section]:
-    """The page's sections in order, each only when the project has its data."""
+def page_sections(data: ReportData, tables: dict[str, Table], first: list[Section],
+                  extras: list[Section], has_maps: bool) -> list[Section]:
+    """The page's sections in order, each only when the project has its data: ``first`` (what
+    the trees do, the light traced), the results, ``extras``, then the appendix."""
     reference = is_reference_study(data.project)
-    out: list[Section] = []
-    if impact is not None:
-        out.append(Section("impact", impact, "What the trees do"))
-    out.append(Section("light", light, "The light traced"))
+    out: list[Section] = list(first)
     out.append(Section("scenarios", {}, "Scenarios"))
     out.append(Section("hourly", {}, "Hourly façade illuminance"))
     if data.comparison is not None:
@@ -300,76 +298,92 @@ def page_sections(data: ReportData, tables: dict[str, Table], impact: dict[str, 
     return out
 
 
-def build_report(project: Project, echo: Callable[[str], None] = print) -> Path:
+def report_tables(data: ReportData, created: str) -> dict[str, Table]:
+    """Every table the page may show, by key (those without data left out)."""
+    tables: dict[str, Table] = {
+        "scenarios": scenario_table(data), "hourly": hourly_table(data),
+        "statistics": statistics_table(data), "reflection": reflection_table(data),
+    }
+    for key, tb in (("rows", rows_table(data)), ("rows_between", rows_between_table(data)),
+                    ("timing", timing_table(data))):
+        if tb is not None:
+            tables[key] = tb
+    conv, conv_summary = convergence_tables(data)
+    if conv is not None and conv_summary is not None:
+        tables["convergence"], tables["convergence_summary"] = conv, conv_summary
+    tables.update(provenance_tables(data, created))
+    return tables
+
+
+def page_context(data: ReportData, raw: pd.DataFrame, created: str, folder: Path
+                 ) -> PageContext:
+    """The page's context before its figures and sections: tables, what the trees do (its
+    figures written into ``folder``), headline, notes, method and parameters."""
+    p = data.project
+    tables = report_tables(data, created)
+    pairs = tree_pairs(p, data.names)
+    impact = impact_data(p, raw, pairs, folder) if pairs else None
+    if impact is not None:
+        log.info("  what the trees do: %s against %s", ", ".join(x.trees for x in pairs),
+                 pairs[0].baseline)
+    light = light_data(data)
+    ctx = PageContext(
+        title=f"radtree report — {p.name}", subtitle=_subtitle(data, light), created=created,
+        headline=(_warnings(data) + (impact["lines"] if impact else []) + _headline(data)),
+        notes=data.notes, has_measured=data.comparison is not None, tables=tables,
+        models=model_pictures(data), map_reason=data.map_time_reason,
+        method={"measured": (str(p.measured.name) if p.measured is not None else ""),
+                "measured_rows": (str(p.measured_rows.name) if p.measured_rows is not None
+                                  else "")},
+        parameters=parameters_table(data),
+    )
+    ctx.sections = [Section("impact", impact, "What the trees do")] if impact is not None else []
+    ctx.sections.append(Section("light", light, "The light traced"))
+    return ctx
+
+
+def write_pages(ctx: PageContext, data: ReportData, folder: Path) -> None:
+    """The CSVs, index.html and index.md into ``folder``; the charts as palette PNGs."""
+    statistics_frame(data).to_csv(folder / "statistics.csv", index=False)
+    hourly_frame(data).to_csv(folder / "hourly.csv", index=False)
+    rf = rows_frame(data)
+    if rf is not None:
+        rf.to_csv(folder / "rows.csv", index=False)
+    html = environment(html=True).get_template("report.html.j2").render(c=ctx)
+    md = environment(html=False).get_template("report.md.j2").render(c=ctx)
+    (folder / "index.html").write_text(html, encoding="utf-8")
+    (folder / "index.md").write_text(md, encoding="utf-8")
+    for png in sorted((folder / "figures").glob("*.png")) if (folder / "figures").is_dir() else []:
+        compact_png(png, png, max_px=1800, colors=256)   # charts: a palette, same size
+
+
+def build_report(project: Project) -> Path:
     """Write ``PROJECT/report/`` (index.html, index.md, CSVs, figures); return index.html.
+    Progress messages go to this module's logger (:mod:`radtree.log`).
 
     Raises RadtreeError when there are no results, and passes on the RadtreeError of
     :func:`radtree.stats.compare` when a measured hour has no simulated counterpart.
     """
-    echo(f"report for {project.name}")
+    log.info("report for %s", project.name)
     with folder_lock(project.results_dir, "radtree report", wait=True, name=PUBLISH_NAME,
                      shared=True):                 # one simulate's table, timing and manifest
-        data = collect(project, echo=echo)
+        data = collect(project)
         raw = read_results(project)
     created = datetime.now(timezone.utc).isoformat(timespec="seconds")
-    target = project.report_dir
-    with atomic_dir(target) as tmp:
-        drawing = _Figures(data, tmp, echo)
+    with atomic_dir(project.report_dir) as tmp:
+        drawing = _Figures(data, tmp)
         (tmp / "models").mkdir()
         for s in data.scenarios:
             if s.picture is not None:
                 compact_png(s.picture, tmp / "models" / f"{s.name}.png")
-        tables: dict[str, Table] = {
-            "scenarios": scenario_table(data), "hourly": hourly_table(data),
-            "statistics": statistics_table(data), "reflection": reflection_table(data),
-        }
-        for key, tb in (("rows", rows_table(data)), ("rows_between", rows_between_table(data)),
-                        ("timing", timing_table(data))):
-            if tb is not None:
-                tables[key] = tb
-        conv, conv_summary = convergence_tables(data)
-        if conv is not None and conv_summary is not None:
-            tables["convergence"], tables["convergence_summary"] = conv, conv_summary
-        tables.update(provenance_tables(data, created))
-        pairs = tree_pairs(project, data.names)
-        impact = impact_data(project, raw, pairs, tmp) if pairs else None
-        if impact is not None:
-            echo(f"  what the trees do: {', '.join(p.trees for p in pairs)} against "
-                 f"{pairs[0].baseline}")
-        light = light_data(data)
-        p = project
-        ctx = PageContext(
-            title=f"radtree report — {p.name}",
-            subtitle=_subtitle(data, light),
-            created=created, headline=(_warnings(data) + (impact["lines"] if impact else [])
-                                       + _headline(data)),
-            notes=data.notes,
-            has_measured=data.comparison is not None, tables=tables,
-            models=model_pictures(data), map_reason=data.map_time_reason,
-            method={
-                "measured": (str(p.measured.name) if p.measured is not None else ""),
-                "measured_rows": (str(p.measured_rows.name) if p.measured_rows is not None
-                                  else ""),
-            },
-            parameters=parameters_table(data),
-        )
-        extras = extra_sections(project, tmp, echo, raw)
+        ctx = page_context(data, raw, created, tmp)
+        extras = extra_sections(project, tmp, raw)
         ctx.figs, ctx.figure_problems = drawing.results()
         if data.map_time is None and project.district is None:
             ctx.notes.append(f"No façade map: {data.map_time_reason}.")
-        ctx.sections = page_sections(data, tables, impact, light, extras,
+        ctx.sections = page_sections(data, ctx.tables, ctx.sections, extras,
                                      "facade_map" in ctx.figs)
-        statistics_frame(data).to_csv(tmp / "statistics.csv", index=False)
-        hourly_frame(data).to_csv(tmp / "hourly.csv", index=False)
-        rf = rows_frame(data)
-        if rf is not None:
-            rf.to_csv(tmp / "rows.csv", index=False)
-        html = environment(html=True).get_template("report.html.j2").render(c=ctx)
-        md = environment(html=False).get_template("report.md.j2").render(c=ctx)
-        (tmp / "index.html").write_text(html, encoding="utf-8")
-        (tmp / "index.md").write_text(md, encoding="utf-8")
-        for png in sorted((tmp / "figures").glob("*.png")) if (tmp / "figures").is_dir() else []:
-            compact_png(png, png, max_px=1800, colors=256)   # charts: a palette, same size
-    index = target / "index.html"
-    echo(f"report written to {index}")
+        write_pages(ctx, data, tmp)
+    index = project.report_dir / "index.html"
+    log.info("report written to %s", index)
     return index

@@ -8,9 +8,9 @@ files. Nothing here knows which engine produced the numbers.
 from __future__ import annotations
 
 import json
+import logging
 import math
 import re
-from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -22,19 +22,13 @@ from radtree.config import Project
 from radtree.errors import RadtreeError
 from radtree.measurements import (
     MeasuredShape,
-    grid_mean,
-    load_measured,
-    load_measured_rows,
 )
 from radtree.pipeline.results import read_results, results_path
+from radtree.report.measured import compare_measured, row_tables
 from radtree.stats import (
     FACADE_GRID,
     Comparison,
-    compare,
     hourly_means,
-    row_hourly_between_models,
-    row_hourly_means,
-    row_means,
 )
 
 MAP_GRID = "facade_map"
@@ -44,6 +38,7 @@ FORM_LABELS = {"dome": "sensor dome (study form)", "free": "free-standing crown"
 MODEL_LABELS = {"none": "none (open street)"}
 PNG_SIGNATURE = b"\x89PNG\r\n\x1a\n"
 TIMING_PARTS = ("preparation_s", "geometry_s", "tracing_s")
+log = logging.getLogger(__name__)
 
 
 @dataclass
@@ -196,6 +191,38 @@ def is_reference_study(project: Project) -> bool:
             or any(s.form == "dome" for s in project.scenarios))
 
 
+def _build_record(project: Project, name: str, notes: list[str]
+                  ) -> tuple[dict[str, Any] | None, dict[str, Any], Path | None, str]:
+    """Scenario ``name``'s build manifest (None when absent), its ``build`` record, and its
+    crown picture ``model.png`` (None, with the reason when the file is not a PNG)."""
+    folder = project.build_dir / name
+    if not folder.exists() and (project.build_dir / f"{name}@1").exists():
+        folder = project.build_dir / f"{name}@1"   # crown realisations: the first one
+    mf = _read_json(folder / "manifest.json", notes)
+    build = mf.get("build", {}) if mf else {}
+    build = build if isinstance(build, dict) else {}
+    picture, problem = None, ""
+    png = folder / "model.png"
+    if png.is_file():
+        if png.stat().st_size > 0 and _is_png(png):
+            picture = png
+        else:
+            problem = f"{png} is not a valid PNG picture"
+    return mf, build, picture, problem
+
+
+def _hash_notes(name: str, hashes: list[str], current: str | None, notes: list[str]) -> None:
+    """A note when the results mix parameter hashes or differ from the project file's."""
+    if len(hashes) > 1:
+        notes.append(f"scenario {name}: the results mix parameter hashes "
+                     f"{', '.join(hashes)}")
+    elif hashes and current is not None and hashes[0] != current:
+        notes.append(f"scenario {name}: the results were computed with parameters "
+                     f"{hashes[0]}, but the project file (read by this radtree) now gives "
+                     f"{current} — the report shows the stored results; run `radtree "
+                     "simulate` to update them")
+
+
 def scenario_infos(project: Project, results: pd.DataFrame,
                    notes: list[str]) -> list[ScenarioInfo]:
     """One entry per scenario in the results, grouped by crown form, project order inside."""
@@ -212,12 +239,7 @@ def scenario_infos(project: Project, results: pd.DataFrame,
         reflection = refl_col[0] if refl_col else (sc.reflection if sc else "")
         hashes = _unique(rows["params_hash"]) if "params_hash" in rows.columns else []
         engines = _unique(rows["engine"]) if "engine" in rows.columns else []
-        folder = project.build_dir / name
-        if not folder.exists() and (project.build_dir / f"{name}@1").exists():
-            folder = project.build_dir / f"{name}@1"   # crown realisations: the first one
-        mf = _read_json(folder / "manifest.json", notes)
-        build = mf.get("build", {}) if mf else {}
-        build = build if isinstance(build, dict) else {}
+        mf, build, picture, problem = _build_record(project, name, notes)
         if build.get("form"):
             form, source = str(build["form"]), "build manifest"
         elif sc is not None:
@@ -231,22 +253,8 @@ def scenario_infos(project: Project, results: pd.DataFrame,
                     if reflection else "not recorded")
             notes.append(f"scenario {name} is in the results but not in the project file "
                          f"{project.source.name}; it is reported from the results alone")
-        picture, problem = None, ""
-        png = folder / "model.png"
-        if png.is_file():
-            if png.stat().st_size > 0 and _is_png(png):
-                picture = png
-            else:
-                problem = f"{png} is not a valid PNG picture"
         current = project.params_hash(sc) if sc is not None else None
-        if len(hashes) > 1:
-            notes.append(f"scenario {name}: the results mix parameter hashes "
-                         f"{', '.join(hashes)}")
-        elif hashes and current is not None and hashes[0] != current:
-            notes.append(f"scenario {name}: the results were computed with parameters "
-                         f"{hashes[0]}, but the project file (read by this radtree) now gives "
-                         f"{current} — the report shows the stored results; run `radtree "
-                         "simulate` to update them")
+        _hash_notes(name, hashes, current, notes)
         infos.append(ScenarioInfo(
             name=name, model=model, form=form, form_source=source, reflection=reflection,
             reflection_note=note,
@@ -263,64 +271,6 @@ def scenario_infos(project: Project, results: pd.DataFrame,
         return (f, info.form, order.get(info.name, len(order)), info.name)
 
     return sorted(infos, key=key)
-
-
-# --------------------------------------------------------------------------- measurements
-
-
-def _measured_rows_frame(project: Project, measured: pd.DataFrame | None,
-                         notes: list[str]) -> pd.DataFrame | None:
-    if project.measured_rows is not None:
-        return load_measured_rows(project.measured_rows)
-    if measured is not None and "row" in measured.columns:
-        rows = measured.assign(row=measured["row"].astype(str).str.lower())
-        notes.append("per-row measured daily means derived from the hourly measured file "
-                     "(mean over its hours)")
-        return (rows.groupby("row", sort=False)["measured_lux"].mean()
-                .rename("measured_mean_lux").reset_index())
-    return None
-
-
-def _row_tables(project: Project, results: pd.DataFrame, measured: pd.DataFrame | None,
-                measured_times: list[str] | None, order: list[str],
-                notes: list[str]) -> tuple[pd.DataFrame | None, bool, pd.DataFrame | None]:
-    facade = results[results["grid"].astype(str) == FACADE_GRID]
-    if facade.empty or facade["row"].dropna().empty:
-        notes.append("the façade grid has no row labels: no per-row comparison")
-        return None, False, None
-    measured_rows = _measured_rows_frame(project, measured, notes)
-    rows = None
-    if measured_rows is not None:
-        try:
-            rows = row_means(results, measured_rows, times=measured_times)
-        except RadtreeError as exc:
-            notes.append(f"per-row comparison with the measured daily means not possible: {exc}")
-    with_measured = rows is not None
-    if rows is None:
-        per = row_hourly_means(results)
-        rows = (per.groupby(["scenario", "row"], sort=True)
-                .agg(model=("model", "first"), simulated_mean_lux=("lux", "mean"))
-                .reset_index())
-        se = per.groupby(["scenario", "row"], sort=True)["lux_stderr"].apply(
-            lambda v: float(np.sqrt(np.sum(np.asarray(v, float) ** 2)) / len(v)))
-        rows["simulated_stderr"] = se.to_numpy()
-        rows["measured_mean_lux"] = math.nan
-        rows["ratio"] = math.nan
-        rows["difference_lux"] = math.nan
-    rank = {n: i for i, n in enumerate(order)}
-    row_rank = {"higher": 0, "intermediate": 1, "lower": 2}
-    rows = rows.assign(_s=rows["scenario"].map(rank), _r=rows["row"].map(row_rank).fillna(9))
-    rows = rows.sort_values(["_s", "_r", "row"]).drop(columns=["_s", "_r"])
-    between = None
-    if len(order) > 1:
-        try:
-            between = row_hourly_between_models(results, reference=order[0])
-            between = between.assign(_s=between["scenario"].map(rank),
-                                     _r=between["row"].map(row_rank).fillna(9))
-            between = between.sort_values(["_s", "_r"]).drop(columns=["_s", "_r"])
-        except RadtreeError as exc:
-            notes.append(f"per-row hourly comparison between models not possible: {exc}")
-    return rows.reset_index(drop=True), with_measured, between
 
 
 # --------------------------------------------------------------------------- assembly
@@ -386,7 +336,43 @@ def one_level_as_facade(project: Project, results: pd.DataFrame, notes: list[str
     return out
 
 
-def collect(project: Project, echo: Callable[[str], None] = print) -> ReportData:
+def _hourly_table(hourly_sim: pd.DataFrame, measured: pd.DataFrame | None,
+                  order: list[str]) -> pd.DataFrame:
+    """Every simulated or measured hour: time, measured_lux (blank where not measured), one
+    column per scenario (lux)."""
+    wide = hourly_sim.pivot(index="time", columns="scenario", values="lux")
+    wide = wide.reindex(columns=order)
+    if measured is not None:
+        hourly = measured[["time", "measured_lux"]].merge(
+            wide.reset_index(), on="time", how="outer")
+    else:
+        hourly = wide.reset_index()
+        hourly.insert(1, "measured_lux", math.nan)
+    hourly = hourly.sort_values("time").reset_index(drop=True)
+    hourly.columns = [str(c) for c in hourly.columns]
+    return hourly
+
+
+def _run_files(project: Project, order: list[str], notes: list[str]
+               ) -> tuple[pd.DataFrame | None, pd.DataFrame | None, dict[str, Any] | None]:
+    """``results/timing.csv``, ``convergence.csv`` and ``manifest.json`` (None when absent,
+    with a note)."""
+    timing = _read_csv(project.results_dir / "timing.csv", ("scenario", *TIMING_PARTS), notes)
+    if timing is None:
+        notes.append("no results/timing.csv: wall-clock times unavailable")
+    else:
+        timing = timing.assign(scenario=timing["scenario"].astype(str))
+        absent = [n for n in order if n not in set(timing["scenario"])]
+        if absent:
+            notes.append(f"timing.csv has no entry for scenario(s) {', '.join(absent)}")
+    convergence = _read_csv(project.results_dir / "convergence.csv",
+                            ("scenario", "ab", "facade_mean_lux"), notes)
+    if convergence is not None:
+        convergence = convergence.assign(scenario=convergence["scenario"].astype(str))
+    return timing, convergence, _read_json(project.results_dir / "manifest.json", notes)
+
+
+def collect(project: Project) -> ReportData:
     """Read the results layout and compute every table the report shows."""
     notes: list[str] = []
     results = read_results(project)
@@ -404,60 +390,16 @@ def collect(project: Project, echo: Callable[[str], None] = print) -> ReportData
     hourly_sim = hourly_means(results)
     hourly_sim = (hourly_sim.assign(_s=hourly_sim["scenario"].map(rank))
                   .sort_values(["_s", "time"]).drop(columns="_s").reset_index(drop=True))
-
-    measured = measured_shape = comparison = stats = None
-    measured_times: list[str] | None = None
-    measured_tidy = None
-    if project.measured is not None:
-        measured_tidy, measured_shape = load_measured(project.measured)
-        facade = results[results["grid"].astype(str) == FACADE_GRID].dropna(subset=["row"])
-        per_row = facade.groupby(facade["row"].astype(str).str.lower())["sensor"].nunique()
-        measured = grid_mean(measured_tidy,
-                             per_row.to_dict() if "row" in measured_tidy.columns else None)
-        reflection = {s.name: s.reflection for s in scenarios}
-        echo(f"  comparing {len(order)} scenario(s) with {len(measured)} measured hour(s)")
-        comparison = compare(results, measured_tidy, reflection=reflection)
-        notes.extend(comparison.notes)
-        stats = comparison.stats.assign(_s=comparison.stats["scenario"].map(rank))
-        stats = stats.sort_values("_s").drop(columns="_s").reset_index(drop=True)
-        measured_times = list(measured["time"])
-    else:
-        notes.append("the project names no measurements ([project] measured): simulated values "
-                     "only, no statistics")
-
-    # hourly table: every simulated or measured hour, measured blank where not measured
-    wide = hourly_sim.pivot(index="time", columns="scenario", values="lux")
-    wide = wide.reindex(columns=order)
-    if measured is not None:
-        hourly = measured[["time", "measured_lux"]].merge(
-            wide.reset_index(), on="time", how="outer")
-    else:
-        hourly = wide.reset_index()
-        hourly.insert(1, "measured_lux", math.nan)
-    hourly = hourly.sort_values("time").reset_index(drop=True)
-    hourly.columns = [str(c) for c in hourly.columns]
-
-    rows, rows_measured, between = _row_tables(project, results, measured_tidy, measured_times,
-                                               order, notes)
-
-    timing = _read_csv(project.results_dir / "timing.csv", ("scenario", *TIMING_PARTS), notes)
-    if timing is None:
-        notes.append("no results/timing.csv: wall-clock times unavailable")
-    else:
-        timing = timing.assign(scenario=timing["scenario"].astype(str))
-        absent = [n for n in order if n not in set(timing["scenario"])]
-        if absent:
-            notes.append(f"timing.csv has no entry for scenario(s) {', '.join(absent)}")
-    convergence = _read_csv(project.results_dir / "convergence.csv",
-                            ("scenario", "ab", "facade_mean_lux"), notes)
-    if convergence is not None:
-        convergence = convergence.assign(scenario=convergence["scenario"].astype(str))
-    manifest = _read_json(project.results_dir / "manifest.json", notes)
-    map_time, reason = _map_time(results, measured, hourly_sim, project)
+    m = compare_measured(project, results, {s.name: s.reflection for s in scenarios}, order,
+                         notes)
+    hourly = _hourly_table(hourly_sim, m.hourly, order)
+    rows, rows_measured, between = row_tables(project, results, m.tidy, m.times, order, notes)
+    timing, convergence, manifest = _run_files(project, order, notes)
+    map_time, reason = _map_time(results, m.hourly, hourly_sim, project)
     return ReportData(
         project=project, results=results, scenarios=scenarios, hourly_sim=hourly_sim,
-        hourly=hourly, measured=measured, measured_shape=measured_shape, comparison=comparison,
-        stats=stats, rows=rows, rows_measured=rows_measured, rows_between=between,
+        hourly=hourly, measured=m.hourly, measured_shape=m.shape, comparison=m.comparison,
+        stats=m.stats, rows=rows, rows_measured=rows_measured, rows_between=between,
         timing=timing, convergence=convergence, results_manifest=manifest, map_time=map_time,
         map_time_reason=reason, notes=notes)
 

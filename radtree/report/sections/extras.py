@@ -8,7 +8,7 @@ to show.
 
 from __future__ import annotations
 
-from collections.abc import Callable
+import logging
 from pathlib import Path
 from typing import Any
 
@@ -16,6 +16,8 @@ import pandas as pd
 
 from radtree.config import Project
 from radtree.report.sections import Section
+
+log = logging.getLogger(__name__)
 
 
 def realisation_frame(project: Project) -> pd.DataFrame | None:
@@ -80,77 +82,85 @@ def diagnose_data(folder: Path) -> dict[str, Any]:
     } for _, r in steps.iterrows()]}
 
 
-def extra_sections(project: Project, out: Path, echo: Callable[[str], None],
-                   table: pd.DataFrame | None = None) -> list[Section]:
-    """The sections of the studies that exist for this project, in page order (the HTML and
-    the Markdown report show the same). Their figures are written into ``out`` (the report
-    folder). ``table``: the results table, when already read."""
-    secs: list[Section] = []
-    if project.office is not None:
-        from radtree.office_summary import (
-            office_section_data,
-            read_results,
-            summarise,
-            write_hourly_charts,
-            write_maps,
-            write_summary,
-        )
+def _section(key: str, data: dict[str, Any] | None, title: str, message: str = ""
+             ) -> list[Section]:
+    """``[Section]`` when there is ``data`` (``message`` logged), else ``[]``."""
+    if data is None:
+        return []
+    if message:
+        log.info("  %s", message)
+    return [Section(key, data, title)]
 
-        write_summary(project, maps=False)
-        office_table = read_results(project)
-        write_maps(project, office_table, out / "office")
-        write_hourly_charts(project, summarise(office_table), out / "office")
-        secs.append(Section("office", office_section_data(project), "Office block"))
-        echo("  office block: summary table and false-colour maps")
+
+def _office(project: Project, out: Path) -> list[Section]:
+    """The office block's summary, false-colour maps and hourly charts (in ``out/office``)."""
+    if project.office is None:
+        return []
+    from radtree.office_summary import (
+        office_section_data,
+        read_results,
+        summarise,
+        write_hourly_charts,
+        write_maps,
+        write_summary,
+    )
+
+    write_summary(project, maps=False)
+    office_table = read_results(project)
+    write_maps(project, office_table, out / "office")
+    write_hourly_charts(project, summarise(office_table), out / "office")
+    return _section("office", office_section_data(project), "Office block",
+                    "office block: summary table and false-colour maps")
+
+
+def _inventory_and_annual(project: Project, out: Path) -> list[Section]:
+    """Every façade of an inventory (a site plan), and the annual daylight section."""
+    secs: list[Section] = []
     if project.district is not None:
         from radtree.report.sections.facades import facades_data
 
         facades = facades_data(project, out)
-        if facades is not None:
-            secs.append(Section("facades", facades, "Every façade"))
-            echo(f"  every façade: site plan of {facades['features']} façades")
+        msg = (f"every façade: site plan of {facades['features']} façades"
+               if facades is not None else "")
+        secs += _section("facades", facades, "Every façade", msg)
     if (project.results_dir / "annual_summary.csv").exists():
         from radtree.annual.report import annual_section_data
 
-        secs.append(Section("annual", annual_section_data(project), "Annual daylight"))
-        echo("  annual: metric maps and month × hour heat maps")
-    from radtree.pipeline.results import read_results
-    from radtree.report.sections.models3d import honeybee_data, view3d_data
+        secs += _section("annual", annual_section_data(project), "Annual daylight",
+                         "annual: metric maps and month × hour heat maps")
+    return secs
 
-    table = read_results(project) if table is None else table
-    for name, title, make in (("honeybee", "Honeybee model", honeybee_data),
-                              ("view3d", "3-D view", view3d_data)):
-        data = make(project, table, out, echo)
-        if data is not None:
-            secs.append(Section(name, data, title))
+
+def _studies(project: Project, out: Path) -> list[Section]:
+    """The sensitivity sweep, crown realisations, permeability scan and diagnosis."""
+    from radtree.calibrate.scan import scan_section_data
     from radtree.sweep.sensitivity import sweep_section_data
 
-    sweep = sweep_section_data(project.root)
-    if sweep is not None:
-        secs.append(Section("sweep", sweep, "Sensitivity sweep"))
-        echo("  sweep: sensitivity section")
-    crowns = realisations_data(project)
-    if crowns is not None:
-        secs.append(Section("realisations", crowns, "Crown realisations"))
-        echo("  crown realisations section")
-    from radtree.calibrate.scan import scan_section_data
-
-    scan = scan_section_data(project, out)
-    if scan is not None:
-        secs.append(Section("permeability_scan", scan, "Permeability scan"))
-        echo("  permeability scan section")
     diagnosis = diagnose_data(project.root / "diagnose")
-    if diagnosis["steps"] is not None:
-        secs.append(Section("diagnose", diagnosis, "Diagnosis"))
+    return (_section("sweep", sweep_section_data(project.root), "Sensitivity sweep",
+                     "sweep: sensitivity section")
+            + _section("realisations", realisations_data(project), "Crown realisations",
+                       "crown realisations section")
+            + _section("permeability_scan", scan_section_data(project, out),
+                       "Permeability scan", "permeability scan section")
+            + _section("diagnose", diagnosis if diagnosis["steps"] is not None else None,
+                       "Diagnosis"))
 
+
+def extra_sections(project: Project, out: Path, table: pd.DataFrame | None = None
+                   ) -> list[Section]:
+    """The sections of the studies that exist for this project, in page order (the HTML and
+    the Markdown report show the same). Their figures are written into ``out`` (the report
+    folder). ``table``: the results table, when already read."""
+    from radtree.pipeline.results import read_results
+    from radtree.report.sections.method import method_section_data
+    from radtree.report.sections.models3d import honeybee_data, view3d_data
     from radtree.report.sections.photo import photo_sections
 
-    secs += photo_sections(project, out)
-
-    from radtree.report.sections.method import method_section_data
-
-    method = method_section_data(project, out)
-    if method is not None:
-        secs.append(Section("method", method, "The study's method"))
-        echo("  the study's method: variants, findings, dome-radius scan")
-    return secs
+    secs = _office(project, out) + _inventory_and_annual(project, out)
+    table = read_results(project) if table is None else table
+    secs += _section("honeybee", honeybee_data(project, table, out), "Honeybee model")
+    secs += _section("view3d", view3d_data(project, table, out), "3-D view")
+    secs += _studies(project, out) + photo_sections(project, out)
+    return secs + _section("method", method_section_data(project, out), "The study's method",
+                           "the study's method: variants, findings, dome-radius scan")

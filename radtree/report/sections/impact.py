@@ -321,34 +321,26 @@ def extend_facades_geojson(project: Project, impact: pd.DataFrame, pair: Pair) -
     return True
 
 
-def impact_data(project: Project, results: pd.DataFrame, pairs: list[Pair], out: Path
-                ) -> dict[str, Any] | None:
-    """The section's data (None without a with/without-trees pair); writes the plan PNG into
-    the report folder ``out``, ``impact.csv`` beside it, and ``results/rooms.csv`` /
-    ``results/facades.geojson`` as the module doc says."""
-    impact = impact_frame(results, pairs)
-    if impact.empty:
-        return None
-    pair = pairs[0]
-    impact.to_csv(out / "impact.csv", index=False)
-    n_hours = impact[impact["time"] != DAY]["time"].nunique()
-    over = f"mean over the {n_hours} simulated hour(s)"
+def _level_tables(impact: pd.DataFrame, pairs: list[Pair], over: str) -> dict[str, Table]:
+    """The daily tables per façade, storey, building and room (those with data)."""
     tables: dict[str, Table] = {}
     for level, key in (("façade", "impact_facades"), ("storey", "impact_storeys"),
                        ("building", "impact_buildings"), ("room", "impact_rooms")):
         tb = daily_table(impact, level, key, (
             f"What the trees do per {LEVEL_TITLES[level]}: mean illuminance of its sensors with "
-            f"trees ({', '.join(p.trees for p in pairs)}) and without ({pair.baseline}), "
+            f"trees ({', '.join(p.trees for p in pairs)}) and without ({pairs[0].baseline}), "
             f"{over}; change = with − without (lx, ± Monte Carlo standard error; negative = "
             "the trees take light) and in % of the value without; the hour of the largest "
             "relative change."))
         if tb is not None:
             tables[key] = tb
-    hourly = {lv: hourly_table(impact, lv, f"impact_hourly_{i}")
-              for i, lv in enumerate(("façade", "storey", "building", "room"))}
-    annual = annual_rows(project)
-    standards = standards_rows(project, pair)
-    ranking = tree_ranking(project, pair)
+    return tables
+
+
+def _metric_tables(annual: pd.DataFrame | None, standards: pd.DataFrame | None
+                   ) -> dict[str, Table]:
+    """The annual metrics and the standards with and without trees (those that exist)."""
+    tables: dict[str, Table] = {}
     if annual is not None:
         tables["impact_annual"] = metric_table(
             annual, "impact_annual", "Annual metrics per grid with and without trees (results/"
@@ -360,17 +352,11 @@ def impact_data(project: Project, results: pd.DataFrame, pairs: list[Pair], out:
             standards, "impact_standards", "Standards with and without trees (results/annual/"
             "standards.csv): each metric as its definition states; difference = with − "
             "without.", definition=True)
-    if ranking is not None:
-        tables["tree_ranking"] = tree_table(ranking, n_hours)
-    (out / Path(PLAN_FILE).parent).mkdir(parents=True, exist_ok=True)
-    caption = site_plan(project, results, impact, pair, ranking, out / PLAN_FILE)
-    written = []
-    if (impact["level"] == "room").any():
-        with atomic_path(project.results_dir / "rooms.csv") as tmp:
-            rooms_frame(impact, annual, standards, pair).to_csv(tmp, index=False)
-        written.append("results/rooms.csv")
-    if extend_facades_geojson(project, impact, pair):
-        written.append("results/facades.geojson")
+    return tables
+
+
+def _headline_lines(impact: pd.DataFrame, pair: Pair) -> list[str]:
+    """The first page's lines: the day's largest relative change per façade and per room."""
     day = impact[(impact["time"] == DAY) & (impact["trees"] == pair.trees)]
     lines = []
     for level in ("façade", "room"):
@@ -389,8 +375,40 @@ def impact_data(project: Project, results: pd.DataFrame, pairs: list[Pair], out:
                              f"{pct(d['change_pct'].min())} % to {pct(d['change_pct'].max())} % "
                              f"across {len(d)} {LEVEL_TITLES[level]}s; most on "
                              f"{worst['target']} ({vals}).")
+    return lines
+
+
+def impact_data(project: Project, results: pd.DataFrame, pairs: list[Pair], out: Path
+                ) -> dict[str, Any] | None:
+    """The section's data (None without a with/without-trees pair); writes the plan PNG into
+    the report folder ``out``, ``impact.csv`` beside it, and ``results/rooms.csv`` /
+    ``results/facades.geojson`` as the module doc says."""
+    impact = impact_frame(results, pairs)
+    if impact.empty:
+        return None
+    pair = pairs[0]
+    impact.to_csv(out / "impact.csv", index=False)
+    n_hours = impact[impact["time"] != DAY]["time"].nunique()
+    tables = _level_tables(impact, pairs, f"mean over the {n_hours} simulated hour(s)")
+    hourly = {lv: hourly_table(impact, lv, f"impact_hourly_{i}")
+              for i, lv in enumerate(("façade", "storey", "building", "room"))}
+    annual = annual_rows(project)
+    standards = standards_rows(project, pair)
+    ranking = tree_ranking(project, pair)
+    tables.update(_metric_tables(annual, standards))
+    if ranking is not None:
+        tables["tree_ranking"] = tree_table(ranking, n_hours)
+    (out / Path(PLAN_FILE).parent).mkdir(parents=True, exist_ok=True)
+    caption = site_plan(project, results, impact, pair, ranking, out / PLAN_FILE)
+    written = []
+    if (impact["level"] == "room").any():
+        with atomic_path(project.results_dir / "rooms.csv") as tmp:
+            rooms_frame(impact, annual, standards, pair).to_csv(tmp, index=False)
+        written.append("results/rooms.csv")
+    if extend_facades_geojson(project, impact, pair):
+        written.append("results/facades.geojson")
     return {"pairs": [{"trees": p.trees, "baseline": p.baseline} for p in pairs],
-            "baseline": pair.baseline, "lines": lines, "tables": tables,
+            "baseline": pair.baseline, "lines": _headline_lines(impact, pair), "tables": tables,
             "hourly": [t for t in hourly.values() if t is not None],
             "plan": {"file": PLAN_FILE, "caption": caption}, "written": written,
             "tree_impact": ranking is not None}

@@ -11,7 +11,7 @@ the mean / min / max lux per scenario, grid and hour (whole numbers).
 
 from __future__ import annotations
 
-from collections.abc import Callable
+import logging
 from pathlib import Path
 from typing import Any
 
@@ -19,17 +19,18 @@ import pandas as pd
 
 from radtree.config import Project
 
+log = logging.getLogger(__name__)
 
-def view3d_data(project: Project, table: pd.DataFrame, out: Path,
-                echo: Callable[[str], None]) -> dict[str, Any] | None:
+
+def view3d_data(project: Project, table: pd.DataFrame, out: Path) -> dict[str, Any] | None:
     from radtree.report.view3d import write_view
 
     data = write_view(project, table, out)
     if data is None:
-        echo("  3-D view skipped: no simulated scenario has a build folder (`radtree build`)")
-    else:
-        echo(f"  3-D view: {data['triangles']} triangles, {data['sensors']} sensors → "
-             f"{project.report_dir / data['file']}")   # out is the folder renamed into place
+        log.info("  3-D view skipped: no simulated scenario has a build folder (`radtree build`)")
+    else:   # out is the folder renamed into place
+        log.info("  3-D view: %s triangles, %s sensors → %s", data["triangles"], data["sensors"],
+                 project.report_dir / data["file"])
     return data
 
 
@@ -41,8 +42,7 @@ def grid_rows(table: pd.DataFrame) -> list[dict[str, str]]:
              "max": f"{r['max']:.0f}"} for _, r in stats.iterrows()]
 
 
-def honeybee_data(project: Project, table: pd.DataFrame, out: Path,
-                  echo: Callable[[str], None]) -> dict[str, Any] | None:
+def honeybee_data(project: Project, table: pd.DataFrame, out: Path) -> dict[str, Any] | None:
     if project.honeybee is None:
         return None
     from radtree.export.honeybee import write_annual_results, write_results
@@ -53,8 +53,8 @@ def honeybee_data(project: Project, table: pd.DataFrame, out: Path,
     hourly = project.results_dir / "annual" / "hourly.npz"
     if hourly.exists():
         folders += write_annual_results(hourly, parts.model, out / "honeybee" / "annual")
-    echo(f"  Honeybee results: {len(folders)} folders in honeybee-radiance's layout → "
-         f"{project.report_dir / 'honeybee'}")
+    log.info("  Honeybee results: %d folders in honeybee-radiance's layout → %s", len(folders),
+             project.report_dir / "honeybee")
     grids = [g.identifier for g in parts.model.properties.radiance.sensor_grids]
     return {"model": project.honeybee.model.name, "grids": grids,
             "folders": [str(f.relative_to(out)) for f in folders], "notes": parts.notes,
