@@ -375,9 +375,44 @@ def species_page() -> str:
     return "".join(parts)
 
 
+def _caps(caps: object) -> str:
+    if isinstance(caps, dict):
+        return "; ".join(f"{k}: {', '.join(map(str, v)) if isinstance(v, (tuple, list)) else v}"
+                         for k, v in caps.items())
+    return str(caps)
+
+
+def plugins_page() -> str:
+    """Engines, crown models, effects and export formats, each from its registry."""
+    from radtree.diagnose.registry import effect_rows
+    from radtree.engines.registry import engine_rows
+    from radtree.export.registry import reference_rows
+    from radtree.trees.registry import crown_model_rows
+
+    kinds = [
+        ("Engines", "`[engine] name` / `--engine`", "radtree.engines.registry", engine_rows()),
+        ("Crown models", "`[scenario.X] model`", "radtree.config.crown_models",
+         crown_model_rows()),
+        ("Diagnosis effects", "`radtree diagnose selftest --effects`",
+         "radtree.diagnose.registry", effect_rows()),
+        ("Export formats", "`radtree export --format`", "radtree.export.registry",
+         reference_rows()),
+    ]
+    parts = [HEADER, "# Plug-ins: engines, crown models, effects, export formats\n\n",
+             "Each kind has one registry: a name mapped to a lazily imported class or function "
+             "with its declared capabilities. The command line's choices and this page come "
+             "from the registries; adding one is one new module and one registry line "
+             "(see *Developers: the shape of the code*).\n\n"]
+    for title, where, module, rows in kinds:
+        parts += [f"## {title}\n\n", f"Chosen by {where}; registry `{module}`.\n\n",
+                  table(["name", "what it is", "capabilities"],
+                        [[f"`{n}`", summary.replace("``", "`"), _caps(caps)] for n, summary, caps in rows]), "\n"]
+    return "".join(parts)
+
+
 PAGES: dict[str, Callable[[], str]] = {
     "project-file.md": project_file_page, "cli.md": cli_page, "results.md": results_page,
-    "exit-codes.md": exit_codes_page, "species.md": species_page,
+    "exit-codes.md": exit_codes_page, "species.md": species_page, "plugins.md": plugins_page,
 }
 
 

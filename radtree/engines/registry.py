@@ -90,3 +90,22 @@ def attributing_engine() -> Engine | None:
 def engine_named(name: str | None) -> Engine:
     """``get_engine(name)``, or the seeded engine when ``name`` is None."""
     return seeded_engine() if name is None else get_engine(name)
+
+
+#: capability flags an engine class declares (:class:`radtree.engines.base.Engine`), as the
+#: reference pages name them
+CAPABILITIES = ("uses_build_folder", "seeded", "instancing", "ladder_in_one_trace",
+                "attributes_trees", "photon_budget")
+
+
+def engine_rows() -> list[tuple[str, str, str]]:
+    """``(name, summary, capabilities)`` per registered engine, for the reference pages
+    (summary: the class docstring's first sentence; capabilities: the flags it sets)."""
+    rows = []
+    for name in ENGINES:
+        cls = engine_class(name)
+        doc = " ".join((cls.__doc__ or "").split())
+        summary = doc.split(". ")[0].rstrip(".")
+        caps = [c for c in CAPABILITIES if getattr(cls, c, False)]
+        rows.append((name, summary, ", ".join(caps) or "-"))
+    return rows
