@@ -21,8 +21,10 @@ from click.testing import CliRunner
 
 from radtree.cli.sweep import sweep_command
 from radtree.errors import ConfigError
+from radtree.pipeline.options import RunOptions
 from radtree.report.sections import Section, render_section
 from radtree.sweep import (
+    SweepOptions,
     full_factorial,
     latin_hypercube,
     make_design,
@@ -52,11 +54,10 @@ def project(tmp_path: Path) -> Path:
     return p
 
 
-def sweep(project: Path, **kw):
-    kw.setdefault("scenarios", ["B"])
-    kw.setdefault("progress", False)
-    kw.setdefault("echo", lambda msg: None)
-    return run_sweep(project, kw.pop("params", PARAMS), **kw)
+def sweep(project: Path, *, params=PARAMS, out=None, scenarios=("B",), **run):
+    """:func:`run_sweep` with the sweep's parameters and output folder, the run's options."""
+    return run_sweep(project, sweep=SweepOptions(params=params, out=out),
+                     run=RunOptions(scenarios=scenarios, **run))
 
 
 # ---------------------------------------------------------------- designs

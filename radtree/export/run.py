@@ -64,7 +64,7 @@ def export_project(project: Project, fmt: str, out: Path, scenario: str | None =
         default_leaf_schedule,
         year_schedules,
     )
-    from radtree.pipeline.build import progress_bar
+    from radtree.log import progress as progress_bar
 
     if sc.model == "none":
         raise ConfigError(f"scenario {sc.name!r} has no crown (model 'none'): choose one with "
@@ -79,8 +79,8 @@ def export_project(project: Project, fmt: str, out: Path, scenario: str | None =
 
     def bar(idx, crown, state):
         chunks = [idx[i:i + 240] for i in range(0, len(idx), 240)]
-        return progress_bar(chunks, f"{crown} ({'leaf-on' if state else 'leaf-off'})",
-                            progress, unit="chunk")
+        return progress_bar(chunks, desc=f"{crown} ({'leaf-on' if state else 'leaf-off'})",
+                            unit="chunk") if progress else chunks
 
     models = crown_models(project, sc, frame)
     schedules = year_schedules(project, sc, frame, rays, leaf_on, leaf_off, seasons, bar, models,

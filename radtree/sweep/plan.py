@@ -11,6 +11,7 @@ from typing import Any
 
 from radtree.config import set_dotted
 from radtree.errors import ConfigError
+from radtree.pipeline.executor import scheduler_problem
 from radtree.sweep.cases import CaseSpec, absolutise_paths, case_hash, case_header
 from radtree.sweep.design import Design, Parameter, make_design, parse_param
 from radtree.sweep.settings import check_names, load_base, resolve_parameters
@@ -87,9 +88,8 @@ def plan_sweep(project: str | Path, params: Sequence[str | Parameter] | None = N
         root / settings.out if settings.out else root / "sweep")
     out_dir = out_dir if out_dir.is_absolute() else (Path.cwd() / out_dir)
     sched = scheduler or settings.scheduler or "local"
-    if not (sched in ("local", "sequential") or "://" in sched):
-        raise ConfigError(f"scheduler {sched!r}: expected 'local', 'sequential' or a dask "
-                          "scheduler address such as tcp://127.0.0.1:8786")
+    if scheduler_problem(sched):
+        raise ConfigError(scheduler_problem(sched))
     nworkers = workers or settings.workers
     notes = list(d.notes)
     if nworkers and sched not in ("local", "sequential"):
