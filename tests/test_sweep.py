@@ -275,6 +275,10 @@ def test_invalid_case_fails_alone(project: Path):
     assert list(fails["street.ground_reflectance"]) == [0.1, 0.2]
     assert fails["error"].str.contains(r"field 'sensors.height_m': got -1.0, expected > 0").all()
     assert set(out.table["case_id"]) == {"c003", "c004"}
+    # each case's messages go to its own case.log, in whichever process ran it
+    h = out.cases.set_index("case_id").loc["c003", "case_hash"]
+    log_text = (project / "sweep" / "cases" / h / "case.log").read_text()
+    assert log_text.startswith(f"--- case {h} on ") and f"pid {os.getpid()} at " in log_text
     # failed cases are retried on a rerun (and fail again), finished ones are not
     again = sweep(project, params=["sensors.height_m=-1,5", "street.ground_reflectance=0.1,0.2"],
                   scheduler="sequential")

@@ -64,7 +64,7 @@ def simulate_command(*, project: str, scenarios: tuple[str, ...], engine: str,
         return
     t = time.perf_counter()
     if scheduler is not None:
-        click.echo(f"scheduler: dask {scheduler}")
+        click.echo(f"scheduler: {options.executor(1).describe}")   # dask local, …
     out = simulate_project(p, options=options)
     click.echo(_facade_means(out.table))
     unit = "tasks" if p.district is not None else "hours"   # inventories: hour × façade chunk
