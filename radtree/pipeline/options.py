@@ -4,8 +4,8 @@ One frozen value, checked on creation, instead of a row of keyword arguments::
 
     from radtree.pipeline.options import RunOptions
     from radtree.pipeline.simulate import simulate_project
-    simulate_project(project, options=RunOptions(engine="numpy", scenarios=("E",),
-                                                  hours=("12:30",)))
+    simulate_project(project, options=RunOptions(scenarios=("E",), hours=("12:30",),
+                                                  workers=2))
 
 Times are local ``HH:MM`` strings of the project's hours; lists given are kept as tuples.
 """
