@@ -45,7 +45,7 @@ demo-build: demo-doctor
 demo-simulate: demo-build
 	$(RUN) $(BIN)/radtree simulate $(EXAMPLE) --engine $(DEMO_ENGINE)
 demo-convergence: demo-simulate
-	$(RUN) $(BIN)/radtree simulate $(EXAMPLE) --convergence -s A -s C -s E -s F --engine $(DEMO_ENGINE)
+	$(RUN) $(BIN)/radtree convergence $(EXAMPLE) -s A -s C -s E -s F --engine $(DEMO_ENGINE)
 demo-permeability: demo-build
 	$(RUN) $(BIN)/radtree permeability $(EXAMPLE) -s A --rays 512
 demo-diagnose: demo-permeability

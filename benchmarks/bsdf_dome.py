@@ -121,7 +121,7 @@ def main() -> None:
         **({"bsdf.segments": args.segments} if args.segments else {}),
         **({"bsdf.sectors": args.sectors} if args.sectors else {})})
     t0 = time.perf_counter()
-    bands = scenario_xmls(project, bs, progress=print)
+    bands = scenario_xmls(project, bs)
     t_bsdf = time.perf_counter() - t0
     print(f"crown BSDFs ({t_bsdf:.0f} s): " + "; ".join(
         f"|elevation| {lo:g}–{hi:g}°: {xml}" for lo, hi, xml in bands))

@@ -67,7 +67,7 @@ def main() -> None:
             continue
         if label != "explicit":
             t0 = time.perf_counter()
-            xmls = scenario_xmls(project, s, progress=None)
+            xmls = scenario_xmls(project, s)
             print(f"{label}: BSDFs {time.perf_counter() - t0:.0f} s ({len(xmls)} band(s))")
         t0 = time.perf_counter()
         rows = trace_scenario(project, s, "radiance", grids=GRIDS)

@@ -70,12 +70,13 @@ def killing_radiance(folder: Path, always: bool) -> Path:
 
 
 def run(p: Path, scheduler: str, out: Path):  # type: ignore[no-untyped-def]
-    from radtree.sweep.run import run_sweep
+    from radtree.pipeline.options import RunOptions
+    from radtree.sweep.run import SweepOptions, run_sweep
 
     t = time.perf_counter()
-    res = run_sweep(p, PARAMS, scenarios=["B"], engine="radiance", scheduler=scheduler,
-                    workers=2, out=out, progress=False, echo=lambda m: None,
-                    sensitivity=False)
+    res = run_sweep(p, sweep=SweepOptions(params=PARAMS, out=out, sensitivity=False),
+                    run=RunOptions(scenarios=["B"], engine="radiance", scheduler=scheduler,
+                                   workers=2))
     return res, time.perf_counter() - t
 
 

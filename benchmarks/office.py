@@ -39,6 +39,7 @@ def main(argv: list[str] | None = None) -> int:
     from radtree.office_summary import summarise
     from radtree.pipeline.assemble import make_scene
     from radtree.pipeline.build import build_project
+    from radtree.pipeline.options import RunOptions
     from radtree.pipeline.simulate import simulate_project
 
     if find_radiance() is None:
@@ -64,11 +65,12 @@ def main(argv: list[str] | None = None) -> int:
         print(f"  rtrace -ad {e.ad} -as {e.as_} -aa {e.aa:g} -lw {e.lw:g}")
 
         t0 = time.perf_counter()
-        build_project(project, scenarios, echo=lambda s: None, progress=False, pictures=False)
+        build_project(project, scenarios, pictures=False)
         t_build = time.perf_counter() - t0
         t1 = time.perf_counter()
-        out = simulate_project(project, "radiance", scenarios, [args.hour], args.workers,
-                               echo=lambda s: None, progress=False, resume=False)
+        out = simulate_project(project, options=RunOptions(
+            engine="radiance", scenarios=scenarios, hours=[args.hour], workers=args.workers,
+            fresh=True))
         t_sim = time.perf_counter() - t1
         wall = time.perf_counter() - t0
         assert out is not None

@@ -42,6 +42,7 @@ def _size(path: Path) -> int:
 def main(names: list[str], one_hour: bool = False) -> None:
     from radtree.config import load_project
     from radtree.pipeline.build import build_project
+    from radtree.pipeline.options import RunOptions
     from radtree.pipeline.simulate import simulate_project
     from radtree.report import build_report
 
@@ -56,8 +57,8 @@ def main(names: list[str], one_hour: bool = False) -> None:
                                 Path(tmp) / "office-block" / "data")
             _small(dst, one_hour)
             project = load_project(dst)
-            build_project(project, echo=lambda s: None, progress=False, pictures=False)
-            simulate_project(project, engine="numpy", echo=lambda s: None, progress=False)
+            build_project(project, pictures=False)
+            simulate_project(project, options=RunOptions(engine="numpy"))
             index = build_report(project)
             folder = index.parent
             view = folder / "view3d.html"

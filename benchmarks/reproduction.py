@@ -20,6 +20,7 @@ import pandas as pd
 from radtree.config import load_project
 from radtree.measurements import load_measured
 from radtree.pipeline.build import build_project
+from radtree.pipeline.options import RunOptions
 from radtree.pipeline.simulate import simulate_project
 from radtree.stats import compare
 
@@ -36,10 +37,10 @@ def main() -> None:
         load = os.getloadavg()[0]
         c0 = _cpu()
         t0 = time.perf_counter()
-        build_project(project, scenarios, echo=lambda s: None, progress=False, pictures=False)
+        build_project(project, scenarios, pictures=False)
         t1 = time.perf_counter()
-        out = simulate_project(project, "radiance", scenarios, echo=lambda s: None,
-                               progress=False, workers=2)
+        out = simulate_project(project, options=RunOptions(engine="radiance", scenarios=scenarios,
+                                                           workers=2))
         t2 = time.perf_counter()
         assert out is not None
         measured, _ = load_measured(project.measured)

@@ -87,7 +87,8 @@ def main() -> int:
     args = ap.parse_args()
 
     sys.path.insert(0, str(ROOT))
-    from radtree.sweep import run_sweep
+    from radtree.pipeline.options import RunOptions
+    from radtree.sweep import SweepOptions, run_sweep
 
     tmp = Path(tempfile.mkdtemp(prefix="radtree-bench-sweep-"))
     try:
@@ -112,9 +113,10 @@ def main() -> int:
         times: dict[int, float] = {}
         for w in [int(x) for x in args.workers.split(",")]:
             t = time.perf_counter()
-            out = run_sweep(project, PARAMS, scenarios=["A"], hours=hours, engine=args.engine,
-                            scheduler="local", workers=w, out=tmp / f"sweep-{w}", fixed=fixed,
-                            progress=False, echo=lambda _msg: None)
+            out = run_sweep(project, sweep=SweepOptions(params=PARAMS, out=tmp / f"sweep-{w}",
+                                                        fixed=fixed),
+                            run=RunOptions(scenarios=["A"], hours=hours, engine=args.engine,
+                                           scheduler="local", workers=w))
             times[w] = time.perf_counter() - t
             busy = float(out.cases["seconds"].fillna(0).sum())
             print(f"  {w} worker(s): {times[w]:7.1f} s wall ({len(out.computed)} cases run, "

@@ -85,7 +85,7 @@ def main() -> None:
     else:     # leaf-on only: the bare crown's XML is not computed (its model is not traced)
         from radtree.pipeline.crown_bsdf import scenario_xmls
 
-        on = scenario_xmls(project, sc, lambda s: print(s, flush=True))
+        on = scenario_xmls(project, sc)
         if args.xml is not None:   # a free crown reaching the wall: its cap too
             from radtree.pipeline.crown_bsdf import scenario_tree, wall_half_chord
             from radtree.trees.bsdf_shell import WALL_BAND

@@ -8,33 +8,60 @@ change per step.
 
 from __future__ import annotations
 
-from collections.abc import Callable
-from concurrent.futures import ThreadPoolExecutor
+import logging
+from dataclasses import dataclass
 from pathlib import Path
 
 import pandas as pd
 
-from radtree.config import Project, effective_project
+from radtree.config import Project, Scenario, effective_project
 from radtree.engines.base import Engine
 from radtree.fileio import atomic_path
-from radtree.pipeline.assemble import make_scene
+from radtree.pipeline.assemble import BuiltScene, make_scene
 from radtree.pipeline.build import ensure_built
+from radtree.pipeline.executor import ThreadExecutor
+from radtree.pipeline.jobs import resolve_engine
+from radtree.pipeline.options import RunOptions
 from radtree.pipeline.realisations import is_later_realisation, parent_name, selected
-from radtree.pipeline.simulate import resolve_engine
 from radtree.pipeline.trace import trace_ab_ladder
+
+log = logging.getLogger(__name__)
 
 AB_LADDER = (1, 2, 3, 4, 6, 8)
 
 
-def convergence_table(project: Project, scenarios: list[str] | None = None,
-                      hours: list[str] | None = None, ab_values: tuple[int, ...] = AB_LADDER,
-                      echo: Callable[[str], None] = print, engine: str | Engine = "auto",
-                      previous: pd.DataFrame | None = None, workers: int | None = None
-                      ) -> pd.DataFrame:
+@dataclass(frozen=True)
+class _Step:
+    """One row of the table: a scenario-hour at one ``-ab`` (``name``: the parent scenario)."""
+
+    sc: Scenario
+    name: str
+    built: BuiltScene
+    hour: str
+    ab: int
+    ad: int
+    phash: str
+
+
+@dataclass(frozen=True)
+class _Trace:
+    """One engine run: a scenario-hour at some ``-ab`` values (``folder``: its build folder)."""
+
+    built: BuiltScene
+    sc: Scenario
+    hour: str
+    abs_: tuple[int, ...]
+    folder: Path | None
+
+
+def convergence_table(project: Project, *, options: RunOptions | None = None,
+                      ab_values: tuple[int, ...] = AB_LADDER,
+                      previous: pd.DataFrame | None = None) -> pd.DataFrame:
     """One row per scenario × hour × -ab: façade mean lux and relative change from the step before.
-    A scenario with several crown realisations is checked on its first one. ``engine``: as
-    ``simulate`` (``auto`` → the project's ``engine.name``); the scenario's ``engine.*`` switches
-    apply.
+    A scenario with several crown realisations is checked on its first one. ``options``:
+    ``engine`` as ``simulate`` (None or ``auto`` → the project's ``engine.name``; the
+    scenario's ``engine.*`` switches apply), ``scenarios``, ``hours`` (default the first
+    project hour), ``workers``.
 
     ``previous`` (an earlier table, e.g. ``results/convergence.csv``): its rows with the same
     scenario, hour, ``-ab``, ``-ad``, engine and parameter hash are reused, not traced again.
@@ -43,55 +70,66 @@ def convergence_table(project: Project, scenarios: list[str] | None = None,
     in-process engine; an engine with ``ladder_in_one_trace`` (NumPy) traces each scenario-hour
     once to the largest ``-ab`` and reads every step from the bounce orders of the same paths
     (so the steps' changes carry correlated noise, not the noise of independent runs)."""
-    eng = resolve_engine(project, engine)
+    options = options or RunOptions()
+    eng = resolve_engine(project, options.engine)
     done = _known(previous)
-    jobs: list[tuple] = []       # (scenario, name, built, hour, ab, ad, phash)
-    tasks: list[tuple] = []      # (built, scenario, hour, ab values to trace, folder)
-    for sc in selected(project, scenarios):
+    steps, traces = _ladder(project, eng, options, ab_values, done)
+    n = max(1, options.workers or project.engine.workers) if eng.uses_build_folder else 1
+    traced: dict[tuple[str, str, int], float] = {}
+
+    def run(t: _Trace) -> dict[tuple[str, str, int], float]:
+        by_ab = trace_ab_ladder(project, t.sc, eng, t.hour, list(t.abs_), ["facade"], t.built,
+                                t.folder)
+        return {(t.sc.name, t.hour, ab): float(r["facade"].lux.mean()) for ab, r in by_ab.items()}
+
+    for finished in ThreadExecutor(n).run(run, traces, label="ladder"):
+        traced.update(finished.value())
+    means = [done[key][1] if (key := (s.name, s.hour, s.ab, s.ad, eng.name, s.phash)) in done
+             else traced[(s.sc.name, s.hour, s.ab)] for s in steps]
+    return _rows(steps, means, eng)
+
+
+def _ladder(project: Project, eng: Engine, options: RunOptions, ab_values: tuple[int, ...],
+            done: dict[tuple, tuple[str, float]]) -> tuple[list[_Step], list[_Trace]]:
+    """Every row of the table, and the engine runs for the rows not in ``done``."""
+    steps: list[_Step] = []
+    traces: list[_Trace] = []
+    for sc in selected(project, list(options.scenarios) if options.scenarios else None):
         if is_later_realisation(sc.name):
             continue
         built = make_scene(project, sc, dense_grid=False)
         # a build-folder engine (Radiance) traces the ladder in the scenario's build folder:
         # one octree for every -ab (an option of rtrace, not of the scene), not one each
-        folder = ensure_built(project, sc, echo) if eng.uses_build_folder else None
+        folder = ensure_built(project, sc) if eng.uses_build_folder else None
         ad = effective_project(project, sc).engine.ad
         phash = project.params_hash(sc)
-        for hour in hours or [project.site.hours[0]]:
+        for hour in options.hours or [project.site.hours[0]]:
             todo = []
             for ab in sorted(set(ab_values) | {built.ab}):   # always the -ab simulate uses
-                jobs.append((sc, parent_name(sc.name), built, hour, ab, ad, phash))
+                steps.append(_Step(sc, parent_name(sc.name), built, hour, ab, ad, phash))
                 if (parent_name(sc.name), hour, ab, ad, eng.name, phash) not in done:
                     todo.append(ab)
             # an engine that tallies bounce orders traces the ladder once, else one run per -ab
             groups = [todo] if eng.ladder_in_one_trace else [[ab] for ab in todo]
-            tasks += [(built, sc, hour, g, folder) for g in groups if g]
+            traces += [_Trace(built, sc, hour, tuple(g), folder) for g in groups if g]
+    return steps, traces
 
-    def run(task: tuple) -> dict[tuple[str, str, int], float]:
-        built, sc, hour, abs_, folder = task
-        by_ab = trace_ab_ladder(project, sc, eng, hour, abs_, ["facade"], built, folder)
-        return {(sc.name, hour, ab): float(r["facade"].lux.mean()) for ab, r in by_ab.items()}
 
-    n = max(1, workers or project.engine.workers) if eng.uses_build_folder else 1
-    traced: dict[tuple[str, str, int], float] = {}
-    with ThreadPoolExecutor(max_workers=n) as pool:
-        for got in pool.map(run, tasks):
-            traced.update(got)
-    means = [done[(name, hour, ab, ad, eng.name, phash)][1]
-             if (name, hour, ab, ad, eng.name, phash) in done else traced[(sc.name, hour, ab)]
-             for sc, name, _, hour, ab, ad, phash in jobs]
+def _rows(steps: list[_Step], means: list[float], eng: Engine) -> pd.DataFrame:
+    """The table; each row logged as it is made."""
     rows = []
     prev: dict[tuple[str, str], float] = {}
-    for (sc, name, built, hour, ab, ad, phash), mean in zip(jobs, means, strict=True):
-        before = prev.get((name, hour))
+    for s, mean in zip(steps, means, strict=True):
+        before = prev.get((s.name, s.hour))
         change = (mean - before) / before if before else float("nan")
-        rows.append({"scenario": name, "model": sc.model, "time": hour, "ab": ab,
-                     "ad": ad, "facade_mean_lux": round(mean, 1),
+        rows.append({"scenario": s.name, "model": s.sc.model, "time": s.hour, "ab": s.ab,
+                     "ad": s.ad, "facade_mean_lux": round(mean, 1),
                      "change": round(change, 4) if before else None,
-                     "model_recommended_ab": built.ab, "engine": eng.name,
-                     "params_hash": phash})
-        echo(f"  {name} {hour} -ab {ab}: {mean:.0f} lx"
-             + (f" ({change:+.1%})" if before else ""))
-        prev[(name, hour)] = mean
+                     "model_recommended_ab": s.built.ab, "engine": eng.name,
+                     "params_hash": s.phash})
+        log.info("  %s %s -ab %d: %.0f lx%s", s.name, s.hour, s.ab, mean,
+                 f" ({change:+.1%})" if before else "")
+        prev[(s.name, s.hour)] = mean
     return pd.DataFrame(rows)
 
 

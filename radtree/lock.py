@@ -16,14 +16,17 @@ from __future__ import annotations
 import contextlib
 import fcntl
 import json
+import logging
 import os
 import socket
 import threading
-from collections.abc import Callable, Iterator
+from collections.abc import Iterator
 from datetime import datetime, timezone
 from pathlib import Path
 
 from radtree.errors import RadtreeError
+
+log = logging.getLogger(__name__)
 
 LOCK_NAME = ".lock"    # the suffix: PROJECT/results → PROJECT/.radtree.results.lock
 #: held briefly by a writer while it replaces a folder's finished files (exclusive) and by a
@@ -108,15 +111,14 @@ def _holding(key: str, fd: int) -> Iterator[None]:
 
 
 @contextlib.contextmanager
-def folder_lock(folder: str | os.PathLike, command: str, wait: bool = False,
-                echo: Callable[[str], None] | None = None, name: str = LOCK_NAME,
-                shared: bool = False) -> Iterator[Path]:
+def folder_lock(folder: str | os.PathLike, command: str, wait: bool = False, *,
+                name: str = LOCK_NAME, shared: bool = False) -> Iterator[Path]:
     """Hold the lock file ``.radtree.FOLDER<name>`` beside ``folder`` (:func:`lock_path`; neither
     the folder nor its parent is created) while inside.
 
     Another process holding it → :class:`LockHeld` naming its pid and command, or with
-    ``wait`` a message to ``echo`` and a blocking wait. A lock file left by a process that
-    is gone is taken over (said to ``echo``). ``shared``: several readers may hold it at once
+    ``wait`` a message (logged) and a blocking wait. A lock file left by a process that
+    is gone is taken over (logged). ``shared``: several readers may hold it at once
     (they do not sign the file)."""
     path = lock_path(folder, name)
     key = str(path.resolve())
@@ -148,17 +150,16 @@ def folder_lock(folder: str | os.PathLike, command: str, wait: bool = False,
             holder = read_holder(path)
             if not wait:
                 raise LockHeld(Path(folder), holder) from None
-            if echo:
-                echo(f"waiting for {describe(holder)} to release {folder}")
+            log.info("waiting for %s to release %s", describe(holder), folder)
             fcntl.flock(fd, mode)
         if shared:
             with _holding(key, fd):
                 yield path
             return
         previous = read_holder(path)
-        if echo and _left_by_dead_process(previous):
-            echo(f"note: {folder} was locked by pid {previous['pid']} "
-                 f"({previous.get('command', '?')}), which is no longer running; lock taken over")
+        if _left_by_dead_process(previous):
+            log.info("note: %s was locked by pid %s (%s), which is no longer running; lock "
+                     "taken over", folder, previous["pid"], previous.get("command", "?"))
         record = json.dumps({"pid": os.getpid(), "host": socket.gethostname(),
                              "command": command,
                              "since": datetime.now(timezone.utc).isoformat(timespec="seconds")})

@@ -75,6 +75,7 @@ def _tidy(table: pd.DataFrame) -> pd.DataFrame:
 def mendoza_table(engine: str, workdir: Path) -> pd.DataFrame:
     """The reduced Mendoza results table (every scenario) with one engine."""
     from radtree.config import load_project
+    from radtree.pipeline.options import RunOptions
     from radtree.pipeline.simulate import simulate_project
 
     overrides = dict(MENDOZA_OVERRIDES)
@@ -82,8 +83,7 @@ def mendoza_table(engine: str, workdir: Path) -> pd.DataFrame:
         overrides.update(MENDOZA_RADIANCE_OVERRIDES)
     proj = load_project(_copy("mendoza-street", workdir / f"mendoza-{engine}"),
                         overrides=overrides)
-    out = simulate_project(proj, engine=engine, echo=lambda _m: None, progress=False,
-                           resume=False)
+    out = simulate_project(proj, options=RunOptions(engine=engine, fresh=True))
     assert out is not None
     return _tidy(out.table)
 
@@ -92,11 +92,12 @@ def office_summary(engine: str, workdir: Path) -> pd.DataFrame:
     """The reduced office block's hourly summary (results/summary.csv) with one engine."""
     from radtree.config import load_project
     from radtree.office_summary import write_summary
+    from radtree.pipeline.options import RunOptions
     from radtree.pipeline.simulate import simulate_project
 
     proj = load_project(_copy("office-block", workdir / f"office-{engine}"),
                         overrides=OFFICE_OVERRIDES)
-    simulate_project(proj, engine=engine, echo=lambda _m: None, progress=False, resume=False)
+    simulate_project(proj, options=RunOptions(engine=engine, fresh=True))
     path = write_summary(proj, maps=False)
     return pd.read_csv(path, dtype={"time": str})
 

@@ -53,6 +53,7 @@ def run_table(name: str, workdir: Path, seed_flag: str = "-u-") -> pd.DataFrame:
     """The example's per-sensor Radiance table (KEYS + lux) traced with rtrace ``seed_flag``."""
     from radtree.config import load_project
     from radtree.engines.radiance import writer
+    from radtree.pipeline.options import RunOptions
     from radtree.pipeline.simulate import simulate_project
 
     proj = load_project(_copy(EXAMPLES[name], workdir / f"{name}{seed_flag}"),
@@ -60,8 +61,7 @@ def run_table(name: str, workdir: Path, seed_flag: str = "-u-") -> pd.DataFrame:
     saved = writer.FIXED_SEED
     writer.FIXED_SEED = seed_flag          # the golden runs: -u-; the SE run: -u+
     try:
-        out = simulate_project(proj, engine="radiance", echo=lambda _m: None, progress=False,
-                               resume=False)
+        out = simulate_project(proj, options=RunOptions(engine="radiance", fresh=True))
     finally:
         writer.FIXED_SEED = saved
     assert out is not None

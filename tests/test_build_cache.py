@@ -3,6 +3,7 @@ shapes them; a cached build writes the very same scene files; limits, bad entrie
 
 from __future__ import annotations
 
+import logging
 import os
 import pickle
 
@@ -31,7 +32,8 @@ def _scene_files(folder):
     return {k: v for k, v in folder_files(folder).items() if k != SCENE_FILE}
 
 
-def test_a_fresh_build_takes_its_crowns_from_the_cache(tmp_path, cache_dir, monkeypatch):
+def test_a_fresh_build_takes_its_crowns_from_the_cache(tmp_path, cache_dir, monkeypatch,
+                                                       caplog):
     """The second build (``--fresh``) loads B's louvers crown and copies its OBJ text: every
     scene file is byte-identical, though the louvers builder now fails; with all crowns
     cached the queue weights are 0 (no worker is spawned for them)."""
@@ -39,9 +41,7 @@ def test_a_fresh_build_takes_its_crowns_from_the_cache(tmp_path, cache_dir, monk
     b, e = p.scenario("B"), p.scenario("E")
     assert build_mod._weight(p, b) == build_mod._weight(p, e) == 1
     assert not crown_in_cache(p, b, facade_frame(p))
-    lines: list[str] = []
-    first = build_project(p, ["B", "E"], echo=lines.append, progress=False, pictures=False,
-                          workers=1)
+    first = build_project(p, ["B", "E"], pictures=False, workers=1)
     assert not first["B"]["crown_from_cache"] and not first["E"]["crown_from_cache"]
     files = {n: _scene_files(p.build_dir / n) for n in ("B", "E")}
     assert any(k.endswith(".obj") for k in files["B"])
@@ -53,9 +53,9 @@ def test_a_fresh_build_takes_its_crowns_from_the_cache(tmp_path, cache_dir, monk
 
     monkeypatch.setattr("radtree.trees.louvers.build_louvers", broken)  # the registry's
     assert crown_in_cache(p, b, facade_frame(p)) and build_mod._weight(p, b) == 0
-    lines.clear()
-    again = build_project(p, ["B", "E"], echo=lines.append, progress=False, pictures=False,
-                          fresh=True)
+    with caplog.at_level(logging.INFO, logger="radtree"):
+        again = build_project(p, ["B", "E"], pictures=False, fresh=True)
+    lines = [r.getMessage() for r in caplog.records if r.name == "radtree.pipeline.build"]
     assert again["B"]["crown_from_cache"] and again["E"]["crown_from_cache"]
     assert sum("(crown from the cache)" in line for line in lines) == 2
     assert {n: _scene_files(p.build_dir / n) for n in ("B", "E")} == files
@@ -68,7 +68,7 @@ def test_a_switch_or_an_edited_input_file_is_another_crown(tmp_path, cache_dir):
     p = load_project(copy_project(tmp_path / "proj", hours=["13:30"],
                                   replace={r'^name = "B"$': 'name = "B"\nswitches = '
                                            '{ "louvers.layers" = 6 }'}))
-    build_project(p, ["A"], echo=lambda s: None, progress=False, pictures=False, workers=1)
+    build_project(p, ["A"], pictures=False, workers=1)
     frame = facade_frame(p)
     assert crown_in_cache(p, p.scenario("A"), frame)
     assert not crown_in_cache(p, p.scenario("B"), frame)    # 6 layers: not A's crown
@@ -154,7 +154,7 @@ def test_the_crown_picture_is_copied_for_the_same_crown_and_scene(tmp_path, cach
     from radtree.trees import picture
 
     p = load_project(copy_project(tmp_path / "proj", hours=["13:30"]))
-    build_project(p, ["E"], echo=lambda s: None, progress=False, workers=1)
+    build_project(p, ["E"], workers=1)
     png = (p.build_dir / "E" / "model.png").read_bytes()
     assert png[:4] == b"\x89PNG" and len(list(cache_dir.glob("*.png"))) == 1
 
@@ -162,5 +162,5 @@ def test_the_crown_picture_is_copied_for_the_same_crown_and_scene(tmp_path, cach
         raise AssertionError("the picture was drawn again")
 
     monkeypatch.setattr(picture, "render_model_png", no_drawing)
-    build_project(p, ["E"], echo=lambda s: None, progress=False, fresh=True, workers=1)
+    build_project(p, ["E"], fresh=True, workers=1)
     assert (p.build_dir / "E" / "model.png").read_bytes() == png

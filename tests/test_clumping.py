@@ -87,6 +87,7 @@ def test_round_trip_clumped_crown(tmp_path):
     from radtree.hemi.synthetic import save_png
     from radtree.photo.render import render_scenario
     from radtree.pipeline.assemble import make_scene
+    from radtree.pipeline.options import RunOptions
     from radtree.pipeline.simulate import simulate_project
     from radtree.trees.leaf_angles import mean_tilt
     from radtree.trees.photo import PhotoSource
@@ -127,7 +128,7 @@ def test_round_trip_clumped_crown(tmp_path):
     curve = dict((o, v) for o, v in fit["clumping_curve"])
     assert fit["clumping_lx_model"] < curve[1.0]
     run = replace(proj, scenarios=(original, refit))
-    out = simulate_project(run, engine="numpy", echo=lambda _m: None, progress=False)
+    out = simulate_project(run, options=RunOptions(engine="numpy"))
     assert out is not None
     mean = out.table[out.table["grid"] == "facade"].groupby("scenario")["lux"].mean()
     assert mean["R"] == pytest.approx(mean["T"], rel=0.03)

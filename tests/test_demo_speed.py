@@ -3,6 +3,7 @@ path count, traces in spawned worker processes, the build's pickled scene."""
 
 from __future__ import annotations
 
+import logging
 from dataclasses import replace
 
 import numpy as np
@@ -69,7 +70,7 @@ def test_simulate_and_report_load_the_built_scene(proj, monkeypatch):
     """A current build folder's scene.pickle is the scene ``make_scene`` builds, and is what
     :func:`built_scene` returns (no crown built); a changed pickle makes the folder stale and
     the scene is built anew."""
-    build_project(proj, ["C"], echo=lambda _m: None, progress=False, pictures=False)
+    build_project(proj, ["C"], pictures=False)
     sc = proj.scenario("C")
     fresh = make_scene(proj, sc)
     assert build_staleness(proj, sc) == ""
@@ -100,16 +101,15 @@ def _scene_files(folder):
     return {k: v for k, v in files.items() if k != SCENE_FILE}
 
 
-def test_build_in_two_processes_writes_the_same_folders(proj, tmp_path):
+def test_build_in_two_processes_writes_the_same_folders(proj, tmp_path, caplog):
     """Four folders built by this process and a spawned worker are byte for byte the folders
     one process writes (the pickle aside); the facts come back for every scenario, in order."""
     names = ["A", "B", "C", "E"]
-    one = build_project(proj, names, echo=lambda _m: None, progress=False, pictures=False,
-                        workers=1)
+    one = build_project(proj, names, pictures=False, workers=1)
     first = {n: _scene_files(proj.build_dir / n) for n in names}
-    lines: list[str] = []
-    two = build_project(proj, names, echo=lines.append, progress=False, pictures=False,
-                        workers=2)
+    with caplog.at_level(logging.INFO, logger="radtree"):
+        two = build_project(proj, names, pictures=False, workers=2)
+    lines = [r.getMessage() for r in caplog.records if r.name == "radtree.pipeline.build"]
     assert list(two) == names and [two[n]["triangles"] for n in names] == [
         one[n]["triangles"] for n in names]
     assert {n: _scene_files(proj.build_dir / n) for n in names} == first
@@ -117,22 +117,22 @@ def test_build_in_two_processes_writes_the_same_folders(proj, tmp_path):
     assert not list(proj.build_dir.glob(".*"))   # no temporary folder left behind
 
 
-def test_build_keeps_current_folders_unless_fresh(proj):
+def test_build_keeps_current_folders_unless_fresh(proj, caplog):
     """``fresh=False`` keeps a current folder (not rewritten, facts from its manifest) and
     rebuilds a stale one; ``fresh=True`` rebuilds both."""
-    build_project(proj, ["C", "E"], echo=lambda _m: None, progress=False, pictures=False)
+    build_project(proj, ["C", "E"], pictures=False)
     manifest_c = proj.build_dir / "C" / "manifest.json"
     stamp = manifest_c.stat().st_mtime_ns
     (proj.build_dir / "E" / "grids" / "facade.pts").write_text("0 0 0 0 1 0\n")  # stale
-    lines: list[str] = []
-    facts = build_project(proj, ["C", "E"], echo=lines.append, progress=False, pictures=False,
-                          fresh=False)
+    with caplog.at_level(logging.INFO, logger="radtree"):
+        facts = build_project(proj, ["C", "E"], pictures=False, fresh=False)
+    lines = [r.getMessage() for r in caplog.records if r.name == "radtree.pipeline.build"]
     assert manifest_c.stat().st_mtime_ns == stamp
     assert facts["C"]["triangles"] == 19610 and facts["C"]["model"] == "perforated"
     assert any(m.startswith("  C: current, kept") for m in lines)
     assert any(m.startswith("  E: homogeneous") for m in lines)
     assert build_staleness(proj, proj.scenario("E")) == ""
-    build_project(proj, ["C"], echo=lambda _m: None, progress=False, pictures=False,
+    build_project(proj, ["C"], pictures=False,
                   fresh=True)
     assert manifest_c.stat().st_mtime_ns != stamp
 
@@ -150,8 +150,7 @@ def test_a_worker_error_reads_as_it_was_raised(tmp_path):
     toml.write_text(head + 'name = "E"\nswitches = { "dome.radius_m" = 6.0 }\n' + tail)
     proj = load_project(p)
     with pytest.raises(ConfigError) as err:
-        build_project(proj, ["A", "E", "A-photo"], echo=lambda _m: None, progress=False,
-                      pictures=False, workers=2)
+        build_project(proj, ["A", "E", "A-photo"], pictures=False, workers=2)
     assert err.value.field == "tree.dome.radius_m" and "radius 6 m" in str(err.value)
     assert not (proj.build_dir / "E").exists()
     assert (proj.build_dir / "A-photo" / "manifest.json").is_file()   # built here, first
@@ -176,6 +175,5 @@ def test_a_dead_worker_is_a_clear_error(proj, monkeypatch):
     monkeypatch.setattr(build_mod, "_build_in_worker", _worker_dies)
     with pytest.raises(RadtreeError, match=r"worker process building (A|E) ended abruptly.*"
                                            r"--workers 1"):
-        build_project(proj, ["C", "A", "E"], echo=lambda _m: None, progress=False,
-                      pictures=False, workers=2)
+        build_project(proj, ["C", "A", "E"], pictures=False, workers=2)
     assert not list(proj.build_dir.glob(".*"))   # the temporary folders begun are gone

@@ -400,6 +400,7 @@ def test_selftest_cli_exit_code(reduced, monkeypatch):
 def test_simulator_matches_simulate_project(tmp_path):
     """The diagnosis runs give the numbers `radtree simulate` writes (same seed and rays)."""
     from radtree.diagnose.simulate import Simulator
+    from radtree.pipeline.options import RunOptions
     from radtree.pipeline.simulate import simulate_project
 
     p = copy_project(tmp_path / "p", {r"^rays = \d+": "rays = 64",
@@ -408,7 +409,7 @@ def test_simulator_matches_simulate_project(tmp_path):
     proj = load_project(p)
     sc = replace(proj.scenario("A"), switches={"reflection.unfiltered": 0.05})
     proj = replace(proj, scenarios=(sc,))
-    out = simulate_project(proj, engine="numpy", progress=False, echo=lambda s: None)
+    out = simulate_project(proj, options=RunOptions(engine="numpy"))
     assert out is not None
     table = out.table[out.table["grid"] == "facade"]
     sim = Simulator(proj, ("10:30", "13:30"), "numpy", rays=64, seed=proj.engine.seed)

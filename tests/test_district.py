@@ -97,7 +97,7 @@ def _fails(tmp: Path, **kw) -> str:
 
     p = load_project(district(tmp, **kw))
     with pytest.raises(ConfigError) as exc:
-        build_project(p, echo=lambda _m: None, progress=False, pictures=False)
+        build_project(p, pictures=False)
     assert not (tmp / "build" / "T").exists()       # nothing half-written
     return str(exc.value)
 
@@ -122,7 +122,7 @@ def test_crown_through_wall(tmp_path):
     toml.write_text(toml.read_text().replace('form = "free"', 'form = "free"\n'
                                              'wall_policy = "refuse"'))
     with pytest.raises(ConfigError) as exc:
-        build_project(load_project(p), echo=lambda _m: None, progress=False, pictures=False)
+        build_project(load_project(p), pictures=False)
     assert not (tmp_path / "build" / "T").exists()       # nothing half-written
     msg = str(exc.value)
     assert "feature 'T4'" in msg and "reaches a wall of building 'N1'" in msg
@@ -317,10 +317,8 @@ def test_facades_geojson_and_dask_resume(tmp_path):
     """A UTM-projected district on the NumPy engine, on Dask (one local worker): one feature
     per façade with its coordinates back in UTM, the results labelled building/facade/storey,
     the same numbers as the in-process run, and a rerun reuses every part."""
-    from functools import partial
-
+    from radtree.pipeline.options import RunOptions
     from radtree.pipeline.simulate import simulate_project
-    from radtree.sweep.scheduler import map_jobs
 
     root = tmp_path / "d"
     root.mkdir()
@@ -331,8 +329,7 @@ def test_facades_geojson_and_dask_resume(tmp_path):
         SITE + 'trees = "trees.geojson"\nbuildings = "buildings.geojson"\n'
         'facade_spacing_m = 15.0\nfacade_chunk = 4\n' + REST.replace("rays = 48", "rays = 8"))
     p = load_project(root)
-    quiet = {"echo": lambda _m: None, "progress": False}
-    out = simulate_project(p, "numpy", executor=partial(_dask, map_jobs), **quiet)
+    out = simulate_project(p, options=RunOptions(engine="numpy", scheduler="local", workers=1))
     assert out is not None and out.computed == 3    # 10 façades in chunks of 4
     t = out.table
     assert set(t["building"]) == {"N1", "N2", "S1"} and t["storey"].max() == 2
@@ -345,18 +342,14 @@ def test_facades_geojson_and_dask_resume(tmp_path):
                                atol=1e-6)
     mean = t[t["facade"] == "N1:0"]["lux"].mean()
     assert n1["properties"]["lux_T_12:30"] == pytest.approx(mean, abs=0.05)
-    again = simulate_project(p, "numpy", **quiet)
+    again = simulate_project(p, options=RunOptions(engine="numpy"))
     assert again is not None and again.computed == 0 and again.reused == 3
-    fresh = simulate_project(p, "numpy", resume=False, **quiet)
+    fresh = simulate_project(p, options=RunOptions(engine="numpy", fresh=True))
     assert fresh is not None
     key = ["grid", "sensor"]
     a = t.sort_values(key)["lux"].to_numpy()
     b = fresh.table.sort_values(key)["lux"].to_numpy()
     np.testing.assert_array_equal(a, b)
-
-
-def _dask(map_jobs, fn, jobs):
-    return map_jobs(fn, jobs, "local", 1)
 
 
 def test_csv_inventory_in_lonlat_matches_geojson(tmp_path):

@@ -61,13 +61,13 @@ def _wait_for_parts(parts: Path, k: int, proc: subprocess.Popen) -> None:
 
 def held(k: int | None, *args: str, wait_for: str = "engine:") -> subprocess.Popen:
     """``radtree ARGS`` in a child process held at hour k + 1 (k None: not held), returned once
-    its stdout (stderr, for a ``waiting`` line) has printed a line starting with ``wait_for``
+    its stdout has printed a line starting with ``wait_for``
     and, when held, its first k hours' parts are written (no race with a signal sent next)."""
     env = dict(os.environ, PYTHONUNBUFFERED="1")
     head = [HELD, str(k)] if k is not None else ["-m", "radtree.cli"]
     proc = subprocess.Popen([sys.executable, *head, *args], stdout=subprocess.PIPE,
                             stderr=subprocess.PIPE, text=True, env=env)
-    stream = proc.stderr if wait_for.startswith("waiting") else proc.stdout
+    stream = proc.stdout
     assert stream is not None
     for line in stream:
         if line.startswith(wait_for):
@@ -132,7 +132,7 @@ def test_second_writer_is_refused_or_waits_and_readers_see_one_table(tiny: Path)
     res = cli(*sim)
     assert res.exit_code == 0, res.output
     assert (f"note: {tiny / 'results'} was locked by pid {dead.pid} (radtree simulate "
-            "elsewhere), which is no longer running; lock taken over") in res.stderr
+            "elsewhere), which is no longer running; lock taken over") in res.stdout
 
 
 def _holder(pid: int, tiny: Path) -> str:

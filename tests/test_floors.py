@@ -3,6 +3,7 @@ the ground floor included; street sensors at several heights."""
 
 from __future__ import annotations
 
+import logging
 import math
 import re
 import shutil
@@ -41,6 +42,7 @@ EVEN = {r"^bays = 3": "bays = 2", r"^storeys = 3": "storeys = 2", r"^rooms = .*$
 
 def test_even_block_senses_every_room_ground_floor_included(tmp_path):
     from radtree.office_summary import office_section_data, write_maps, write_summary
+    from radtree.pipeline.options import RunOptions
     from radtree.pipeline.simulate import simulate_project
     from radtree.site.office import office_layout
 
@@ -49,8 +51,7 @@ def test_even_block_senses_every_room_ground_floor_included(tmp_path):
     lay = office_layout(proj)
     assert [n for n, _, _ in lay.sensed] == ["0-0", "0-1", "1-0", "1-1"]
     assert lay.bay_u(0) == (-3.0, 0.0) and lay.bay_u(1) == (0.0, 3.0)   # centred on x_m = 0
-    out = simulate_project(proj, engine="numpy", echo=lambda _m: None, progress=False,
-                           resume=False)
+    out = simulate_project(proj, options=RunOptions(engine="numpy", fresh=True))
     assert out is not None
     table = pd.read_csv(proj.results_dir / "illuminance.csv", dtype={"room": str})
     cols = list(table.columns)
@@ -128,6 +129,7 @@ def street_copy(dst: Path, sensors: str) -> Path:
 
 def test_street_with_three_sensor_heights(tmp_path):
     from radtree.pipeline.assemble import make_scene
+    from radtree.pipeline.options import RunOptions
     from radtree.pipeline.simulate import simulate_project
 
     proj = load_project(street_copy(tmp_path / "levels", "heights_m = [1.5, 4.5, 7.5]"))
@@ -140,8 +142,8 @@ def test_street_with_three_sensor_heights(tmp_path):
         circle = grids[f"facade@{h:g}m"]
         assert len(circle) == 8 and circle.labels == {"storey": [k] * 8}
         assert frame.to_local(circle.points)[:, 2].mean() == pytest.approx(h)
-    out = simulate_project(proj, engine="numpy", scenarios=["B"], echo=lambda _m: None,
-                           progress=False, resume=False)
+    out = simulate_project(proj, options=RunOptions(engine="numpy", scenarios=["B"],
+                                                    fresh=True))
     assert out is not None
     t = out.table
     circles = t[~t["grid"].str.startswith("facade_map")]
@@ -150,8 +152,8 @@ def test_street_with_three_sensor_heights(tmp_path):
     # the 4.5 m circle agrees with a one-height project at 4.5 m (independent paths: within
     # four standard errors of the difference of the means)
     one = load_project(street_copy(tmp_path / "one", "height_m = 4.5"))
-    single = simulate_project(one, engine="numpy", scenarios=["B"], grids=["facade"],
-                              echo=lambda _m: None, progress=False, resume=False)
+    single = simulate_project(one, options=RunOptions(engine="numpy", scenarios=["B"],
+                                                      grids=["facade"], fresh=True))
     assert single is not None and "storey" not in single.table.columns
     a = circles[circles["grid"] == "facade@4.5m"]
     b = single.table[single.table["grid"] == "facade"]
@@ -202,15 +204,16 @@ def _lonlat_row():
     return [point("A", LON - dlon, LAT), point("B", LON + dlon, LAT)]
 
 
-def test_inventory_street_without_buildings_builds_behind_the_trees(tmp_path):
+def test_inventory_street_without_buildings_builds_behind_the_trees(tmp_path, caplog):
     """The site origin is the trees' centroid: the façade used to pass through it ("tree
     stands inside a building"); now it stands [tree.crown] trunk_distance_m (3 m) behind them."""
     from radtree.pipeline.assemble import make_scene
     from radtree.pipeline.build import build_project
 
     proj = load_project(inventory_street(tmp_path / "auto", _lonlat_row(), crs=None))
-    said: list[str] = []
-    build_project(proj, echo=said.append, progress=False, pictures=False)
+    with caplog.at_level(logging.INFO, logger="radtree"):
+        build_project(proj, pictures=False)
+    said = [r.getMessage() for r in caplog.records if r.name == "radtree.pipeline.build"]
     placed = [m for m in said if "Façade placed" in m]
     assert len(placed) == 1 and "T: Façade placed 3 m ([tree.crown] trunk_distance_m) behind " \
         "the trunk nearest to it, looking 0° (street.facade_azimuth_deg): to place it " \
@@ -260,7 +263,7 @@ def test_tree_behind_the_facade_names_the_fix(tmp_path):
     with pytest.raises(ConfigError, match=re.escape(
             "field 'feature 'A'': tree stands behind the studied façade (n = -2.00 m across a "
             "20 m street): set [street] facade_line")):
-        build_project(p, echo=lambda _m: None, progress=False, pictures=False)
+        build_project(p, pictures=False)
 
 
 # ---------------------------------------------------------------- one crown–wall policy
@@ -303,13 +306,13 @@ def _row_project(tmp: Path, policy: str) -> Path:
     return tmp
 
 
-def test_row_crown_clip_note_and_refusal(tmp_path):
+def test_row_crown_clip_note_and_refusal(tmp_path, caplog):
     from radtree.pipeline.build import build_project
     from radtree.trees.wall_policy import removed_fraction
 
-    said: list[str] = []
-    build_project(load_project(_row_project(tmp_path / "clip", "clip")), echo=said.append,
-                  progress=False, pictures=False)
+    with caplog.at_level(logging.INFO, logger="radtree"):
+        build_project(load_project(_row_project(tmp_path / "clip", "clip")), pictures=False)
+    said = [r.getMessage() for r in caplog.records if r.name == "radtree.pipeline.build"]
     pct = 100 * removed_fraction(4.0, 3.5 - 0.015)
     assert f"{pct:.1f}" == "1.2"
     assert '  T: Crown–wall policy "clip": crowns cut at the wall; crown volume removed: the ' \
@@ -317,7 +320,7 @@ def test_row_crown_clip_note_and_refusal(tmp_path):
         'fix)' in said
     p = load_project(_row_project(tmp_path / "refuse", "refuse"))
     with pytest.raises(ConfigError) as exc:
-        build_project(p, echo=lambda _m: None, progress=False, pictures=False)
+        build_project(p, pictures=False)
     assert str(exc.value).endswith(
         "field 'tree.crown.radius_m': the row's crown (radius 4 m) reaches the façade: its trunk "
         "stands 3.48 m from the wall's clip plane; [tree] wall_policy = \"refuse\": move the "
@@ -326,7 +329,7 @@ def test_row_crown_clip_note_and_refusal(tmp_path):
     assert not (p.build_dir / "T").exists()
 
 
-def test_inventory_crown_clip_note_and_refusal(tmp_path):
+def test_inventory_crown_clip_note_and_refusal(tmp_path, caplog):
     """The same policy for an inventory tree in the canyon (crs local: façade through the
     origin) and against a building: cut at the wall's clip plane, or refused with the fix."""
     from radtree.pipeline.assemble import make_scene
@@ -336,8 +339,9 @@ def test_inventory_crown_clip_note_and_refusal(tmp_path):
 
     near = [point("N", 0.0, 2.0, crown_diameter_m=6.0)]   # radius 3 m, trunk 2 m out
     p = load_project(inventory_street(tmp_path / "clip", near, crs="local"))
-    said: list[str] = []
-    build_project(p, echo=said.append, progress=False, pictures=False)
+    with caplog.at_level(logging.INFO, logger="radtree"):
+        build_project(p, pictures=False)
+    said = [r.getMessage() for r in caplog.records if r.name == "radtree.pipeline.build"]
     pct = 100 * removed_fraction(3.0, 2.0 - 0.015)
     assert f"{pct:.1f}" == "7.6"
     assert any("Crown–wall policy \"clip\": crowns cut at the wall; crown volume removed: "
@@ -354,8 +358,7 @@ def test_inventory_crown_clip_note_and_refusal(tmp_path):
             "trunk stands 1.99 m from the wall's clip plane; [tree] wall_policy = \"refuse\": "
             "move the trunk 1.02 m further from the wall, or reduce the crown radius "
             "(crown_diameter_m / 2) to 1.98 m")):
-        build_project(load_project(refuse), echo=lambda _m: None, progress=False,
-                      pictures=False)
+        build_project(load_project(refuse), pictures=False)
 
     # against building N1 (south wall at y = 10): the crown keeps y ≤ 10 − 0.015
     q = load_project(district(tmp_path / "bldg", trees=[point("T4", -8, 8.0,
@@ -399,6 +402,5 @@ def test_crown_reaching_both_facades_is_refused_under_either_policy(tmp_path):
             "field 'feature 'W'': the crown of tree 'W' (radius 3 m) reaches two walls (the "
             "façade and the opposite façade); a crown is clipped at one wall only: reduce its "
             "radius to 2.48 m or move its trunk")):
-        build_project(load_project(folder), echo=lambda _m: None, progress=False,
-                      pictures=False)
+        build_project(load_project(folder), pictures=False)
     assert not (folder / "build" / "T").exists()

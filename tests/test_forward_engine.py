@@ -223,6 +223,7 @@ def test_black_floor_reflected_transmitted_absorbed_add_up():
 
 def test_simulate_with_the_forward_engine(tmp_path):
     """``radtree simulate --engine forward``: the same results table, engine column 'forward'."""
+    from radtree.pipeline.options import RunOptions
     from radtree.pipeline.simulate import simulate_project
     from tests.conftest import copy_project
 
@@ -230,8 +231,8 @@ def test_simulate_with_the_forward_engine(tmp_path):
     proj = load_project(root, overrides={"engine.photons": 20_000, "sensors.dense_grid": False,
                                          "street.length_m": 10.0, "engine.max_photons": 40_000})
     with pytest.warns(PrecisionWarning, match="photon cap 40,000 reached"):
-        out = simulate_project(proj, engine="forward", scenarios=["A", "E"],
-                               echo=lambda _m: None, progress=False, resume=False)
+        out = simulate_project(proj, options=RunOptions(engine="forward", scenarios=["A", "E"],
+                                                        fresh=True))
     assert out is not None
     t = out.table
     assert set(t["engine"]) == {"forward"} and set(t["scenario"]) == {"A", "E"}

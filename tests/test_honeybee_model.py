@@ -196,14 +196,15 @@ def traced(tmp_path_factory):
     """The one-room model traced by radtree (Radiance): scenario ``open`` (the model alone) and
     ``crown`` (a radtree crown added in front of the window); built, simulated, reported."""
     from radtree.pipeline.build import build_project
+    from radtree.pipeline.options import RunOptions
     from radtree.pipeline.simulate import simulate_project
     from radtree.report import build_report
 
     folder = write_project(tmp_path_factory.mktemp("hb") / "p", dni=0.0,
                            toml=TOML.replace("[sensors]", "[sensors]\nheight_m = 1.5") + CROWN)
     project = load_project(folder)
-    build_project(project, echo=lambda s: None, progress=False, pictures=False)
-    simulate_project(project, engine="radiance", echo=lambda s: None, progress=False)
+    build_project(project, pictures=False)
+    simulate_project(project, options=RunOptions(engine="radiance"))
     index = build_report(project)
     return project, pd.read_csv(project.results_dir / "illuminance.csv"), index
 
@@ -373,7 +374,7 @@ def sun_build(tmp_path_factory):
     folder = write_project(tmp_path_factory.mktemp("hbsun") / "p", toml=toml)
     (folder / "dni.csv").write_text("time,direct_normal_lux\n12:30,80000\n")
     project = load_project(folder)
-    build_project(project, echo=lambda s: None, progress=False, pictures=False)
+    build_project(project, pictures=False)
     build = project.build_dir / "open"
     subprocess.run(["make", "octrees/1230.oct"], cwd=build, env=require_radiance().env(),
                    check=True, capture_output=True)

@@ -146,8 +146,7 @@ def test_provenance_in_the_manifest(mendoza):
     from radtree.pipeline.build import build_project
 
     proj = load_project(mendoza.source, overrides=FAST)
-    facts = build_project(proj, ["C-photo"], echo=lambda _m: None, progress=False,
-                          pictures=False)
+    facts = build_project(proj, ["C-photo"], pictures=False)
     mf = json.loads((proj.build_dir / "C-photo" / "manifest.json").read_text())
     photo = mf["build"]["photo"]
     assert photo == json.loads(json.dumps(facts["C-photo"]["photo"], default=str))
@@ -167,6 +166,7 @@ def test_round_trip_known_crown_render_fit(tmp_path):
     from radtree.hemi.synthetic import save_png
     from radtree.photo.render import render_scenario
     from radtree.pipeline.assemble import make_scene
+    from radtree.pipeline.options import RunOptions
     from radtree.pipeline.simulate import simulate_project
     from radtree.trees.leaf_angles import mean_tilt
     from radtree.trees.photo import PhotoSource
@@ -201,7 +201,7 @@ def test_round_trip_known_crown_render_fit(tmp_path):
     assert fit["photos"] == 3 and fit["lad_sd"] > 0     # several photos → one fit + spread
     assert len(fitted.photo["photos"]) == 3
     run = replace(proj, scenarios=(original, refit))
-    out = simulate_project(run, engine="numpy", echo=lambda _m: None, progress=False)
+    out = simulate_project(run, options=RunOptions(engine="numpy"))
     assert out is not None
     mean = out.table[out.table["grid"] == "facade"].groupby("scenario")["lux"].mean()
     assert mean["R"] == pytest.approx(mean["T"], rel=0.03)

@@ -10,6 +10,7 @@ import pytest
 from radtree.config import load_project
 from radtree.errors import ConfigError
 from radtree.pipeline.build import build_project
+from radtree.pipeline.options import RunOptions
 from radtree.pipeline.realisations import merge_realisations, selected
 from radtree.pipeline.simulate import simulate_project
 
@@ -65,7 +66,7 @@ def test_merge_realisations_by_hand():
 
 def test_simulate_averages_realisations(reduced):
     proj = load_project(reduced)
-    out = simulate_project(proj, "numpy", ["F"], workers=2, progress=False, echo=lambda s: None)
+    out = simulate_project(proj, options=RunOptions(engine="numpy", scenarios=["F"], workers=2))
     df = out.table
     assert set(df["scenario"]) == {"F"}
     fac = df[df.grid == "facade"].sort_values("sensor")
@@ -100,7 +101,7 @@ def test_simulate_averages_realisations(reduced):
 @needs_radiance
 def test_build_writes_one_folder_per_realisation(reduced):
     proj = load_project(reduced)
-    facts = build_project(proj, ["F"], echo=lambda s: None, progress=False, pictures=False)
+    facts = build_project(proj, ["F"], pictures=False)
     assert sorted(facts) == ["F@1", "F@2", "F@3"]
     for k in (1, 2, 3):
         assert (proj.build_dir / f"F@{k}" / "Makefile").exists()
@@ -116,13 +117,13 @@ def test_build_writes_one_folder_per_realisation(reduced):
 @needs_radiance
 def test_build_removes_the_other_kind_of_folder(reduced):
     proj = load_project(reduced)
-    build_project(proj, ["F"], echo=lambda s: None, progress=False, pictures=False)
+    build_project(proj, ["F"], pictures=False)
     assert (proj.build_dir / "F@3").is_dir() and not (proj.build_dir / "F").exists()
     toml = reduced / "radtree.toml"
     toml.write_text(toml.read_text().replace('"louvers.realisations" = 3',
                                              '"louvers.realisations" = 1'))
     proj = load_project(reduced)
-    build_project(proj, ["F"], echo=lambda s: None, progress=False, pictures=False)
+    build_project(proj, ["F"], pictures=False)
     assert (proj.build_dir / "F").is_dir()
     assert not list(proj.build_dir.glob("F@*"))
 
@@ -141,7 +142,8 @@ def test_convergence_checks_the_first_crown_only(reduced):
     from radtree.convergence import convergence_table
 
     proj = load_project(reduced)
-    t = convergence_table(proj, ["F"], ["13:30"], ab_values=(1, 2), echo=lambda s: None)
+    t = convergence_table(proj, options=RunOptions(scenarios=["F"], hours=["13:30"]),
+                          ab_values=(1, 2))
     # the ladder asked for, plus the -ab simulate uses for this crown (6)
     assert t["scenario"].tolist() == ["F"] * 3 and t["ab"].tolist() == [1, 2, 6]
     assert t["facade_mean_lux"].iloc[2] > t["facade_mean_lux"].iloc[1] > t["facade_mean_lux"].iloc[0]

@@ -433,6 +433,7 @@ def test_facade_coordinates_follow_a_rotated_facade():
 @needs_radiance
 @pytest.mark.radiance
 def test_report_on_a_real_open_street_simulation(open_street: Path):
+    from radtree.pipeline.options import RunOptions
     from radtree.pipeline.simulate import simulate_project
 
     data = open_street / "data" / "measured_vertical_illuminance.csv"
@@ -443,7 +444,7 @@ def test_report_on_a_real_open_street_simulation(open_street: Path):
     toml.write_text(re.sub(r"^dense_size_m = .*$", "dense_size_m = 1.0",
                            toml.read_text(), flags=re.M))
     p = load_project(open_street)
-    simulate_project(p, "radiance", scenarios=["A", "B"], echo=lambda s: None, progress=False)
+    simulate_project(p, options=RunOptions(engine="radiance", scenarios=["A", "B"]))
     index = build_report(p)
     parser = parse(index)
     assert "figures/facade_map.png" in parser.images

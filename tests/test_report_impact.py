@@ -21,6 +21,7 @@ import pytest
 
 from radtree import log
 from radtree.config import load_project
+from radtree.pipeline.options import RunOptions
 from radtree.pipeline.simulate import simulate_project
 from radtree.report import build_report
 from radtree.report.impact import Pair, impact_frame, tree_pairs
@@ -50,7 +51,7 @@ def _example(tmp: Path, name: str, edits: dict[str, str]) -> Path:
 
 def _traced(folder: Path) -> tuple[object, Path, list[str]]:
     project = load_project(folder)
-    simulate_project(project, engine="numpy", echo=lambda s: None, progress=False)
+    simulate_project(project, options=RunOptions(engine="numpy"))
     printed: list[str] = []
     stream = io.StringIO()
     log.enable(stream=stream, progress=False)    # the messages the CLI would print

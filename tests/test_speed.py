@@ -6,6 +6,7 @@ import numpy as np
 
 from radtree.config import load_project
 from radtree.convergence import convergence_table, read_convergence, write_convergence
+from radtree.pipeline.options import RunOptions
 from radtree.trees.geometry import polygons_to_mesh
 
 from .conftest import copy_project
@@ -17,15 +18,16 @@ def test_convergence_reuses_matching_runs_only(tmp_path):
     stored, a row with another parameter hash is traced again (and gives the traced value)."""
     p = load_project(copy_project(tmp_path / "proj", hours=["13:30"]),
                      overrides={"engine.rays": 64})
-    first = convergence_table(p, ["E"], ab_values=(1, 2), echo=lambda _m: None, engine="numpy")
+    first = convergence_table(p, options=RunOptions(engine="numpy", scenarios=["E"]),
+                              ab_values=(1, 2))
     assert first["ab"].tolist() == [1, 2, 5] and set(first["engine"]) == {"numpy"}
     assert (first["params_hash"] == p.params_hash(p.scenario("E"))).all()
     edited = first.copy()
     edited.loc[0, "facade_mean_lux"] = 12345.6              # -ab 1: reused as stored
     edited.loc[1, "params_hash"] = "other"                   # -ab 2: not reused, traced again
     write_convergence(p, edited)
-    again = convergence_table(p, ["E"], ab_values=(1, 2), echo=lambda _m: None, engine="numpy",
-                              previous=read_convergence(p))
+    again = convergence_table(p, options=RunOptions(engine="numpy", scenarios=["E"]),
+                              ab_values=(1, 2), previous=read_convergence(p))
     assert again["facade_mean_lux"].tolist() == [12345.6, *first["facade_mean_lux"][1:]]
     assert again["change"].iloc[1] == round((first["facade_mean_lux"].iloc[1] - 12345.6)
                                             / 12345.6, 4)

@@ -21,8 +21,10 @@ from click.testing import CliRunner
 
 from radtree.cli.sweep import sweep_command
 from radtree.errors import ConfigError
+from radtree.pipeline.options import RunOptions
 from radtree.report.sections import Section, render_section
 from radtree.sweep import (
+    SweepOptions,
     full_factorial,
     latin_hypercube,
     make_design,
@@ -52,11 +54,10 @@ def project(tmp_path: Path) -> Path:
     return p
 
 
-def sweep(project: Path, **kw):
-    kw.setdefault("scenarios", ["B"])
-    kw.setdefault("progress", False)
-    kw.setdefault("echo", lambda msg: None)
-    return run_sweep(project, kw.pop("params", PARAMS), **kw)
+def sweep(project: Path, *, params=PARAMS, out=None, scenarios=("B",), **run):
+    """:func:`run_sweep` with the sweep's parameters and output folder, the run's options."""
+    return run_sweep(project, sweep=SweepOptions(params=params, out=out),
+                     run=RunOptions(scenarios=scenarios, **run))
 
 
 # ---------------------------------------------------------------- designs
@@ -274,6 +275,10 @@ def test_invalid_case_fails_alone(project: Path):
     assert list(fails["street.ground_reflectance"]) == [0.1, 0.2]
     assert fails["error"].str.contains(r"field 'sensors.height_m': got -1.0, expected > 0").all()
     assert set(out.table["case_id"]) == {"c003", "c004"}
+    # each case's messages go to its own case.log, in whichever process ran it
+    h = out.cases.set_index("case_id").loc["c003", "case_hash"]
+    log_text = (project / "sweep" / "cases" / h / "case.log").read_text()
+    assert log_text.startswith(f"--- case {h} on ") and f"pid {os.getpid()} at " in log_text
     # failed cases are retried on a rerun (and fail again), finished ones are not
     again = sweep(project, params=["sensors.height_m=-1,5", "street.ground_reflectance=0.1,0.2"],
                   scheduler="sequential")

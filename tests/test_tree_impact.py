@@ -3,6 +3,7 @@
 
 from __future__ import annotations
 
+import logging
 from pathlib import Path
 
 import numpy as np
@@ -137,7 +138,7 @@ def test_row_crowns_are_numbered():
     assert list(np.unique(trunks.owners, return_counts=True)[1]) == [32, 32, 32]
 
 
-def test_an_engine_that_cannot_attribute_hands_over_and_says_so(district):
+def test_an_engine_that_cannot_attribute_hands_over_and_says_so(district, caplog):
     from radtree.engines.registry import engine_class
     from radtree.light.hours import hour_states
     from radtree.pipeline.tree_impact import tree_impact
@@ -145,17 +146,17 @@ def test_an_engine_that_cannot_attribute_hands_over_and_says_so(district):
     project, built = district
     sc = project.scenario("trees")
     grid = next(iter(built.scene.grids))
-    said: list[str] = []
     radiance = engine_class("radiance")()
     assert not radiance.attributes_trees
-    table = tree_impact(project, radiance, [sc, project.scenario("bare")],
-                        {"trees": (built, hour_states(project, sc, ["12:30"]))},
-                        said.append, grids=[grid])
+    with caplog.at_level(logging.INFO, logger="radtree"):
+        table = tree_impact(project, radiance, [sc, project.scenario("bare")],
+                            {"trees": (built, hour_states(project, sc, ["12:30"]))},
+                            grids=[grid])
     assert table is not None and list(table.columns) == COLUMNS
-    assert "does not attribute light to trees; attributed by the numpy engine" in said[0]
+    assert ("does not attribute light to trees; attributed by the numpy engine"
+            in caplog.messages[0])
     assert set(table["grid"]) == {grid} and set(table["scenario"]) == {"trees"}
     assert set(table["target"]) <= set(built.scene.grids[grid].labels["facade"])
     # no pair, no table: the reference street has no scenario without trees
     street = load_project(EXAMPLES / "mendoza-street")
-    assert tree_impact(street, radiance, [street.scenario("F")], {"F": (built, [])},
-                       said.append) is None
+    assert tree_impact(street, radiance, [street.scenario("F")], {"F": (built, [])}) is None

@@ -9,7 +9,6 @@ from __future__ import annotations
 import importlib.util
 import math
 from dataclasses import replace
-from functools import partial
 from pathlib import Path
 
 import numpy as np
@@ -196,8 +195,8 @@ def test_city_generator_is_seeded(tmp_path):
 def test_small_city_same_table_on_dask(tmp_path):
     """A 2 × 2-block city (16 buildings, 40 turbid trees), two hours: one process and a Dask
     LocalCluster (1 worker) give the same table, number for number."""
+    from radtree.pipeline.options import RunOptions
     from radtree.pipeline.simulate import simulate_project
-    from radtree.sweep.scheduler import map_jobs
 
     root = tmp_path / "city"
     root.mkdir()
@@ -211,11 +210,9 @@ def test_small_city_same_table_on_dask(tmp_path):
         (ROOT / "examples" / "city" / "data" / "direct_normal_illuminance.csv").read_bytes())
     assert _make_city().write(root / "data", 40, blocks=2) == (16, 40)
     p = load_project(root)
-    quiet = {"echo": lambda _m: None, "progress": False}
-    one = simulate_project(p, "numpy", scenarios=["trees"], **quiet)
-    dask = simulate_project(p, "numpy", scenarios=["trees"], resume=False,
-                            executor=partial(lambda m, fn, jobs: m(fn, jobs, "local", 1),
-                                             map_jobs), **quiet)
+    one = simulate_project(p, options=RunOptions(engine="numpy", scenarios=["trees"]))
+    dask = simulate_project(p, options=RunOptions(engine="numpy", scenarios=["trees"],
+                                                  fresh=True, scheduler="local", workers=1))
     assert one is not None and dask is not None
     key = ["time", "grid", "sensor"]
     a, b = one.table.sort_values(key), dask.table.sort_values(key)

@@ -165,11 +165,11 @@ def state_xmls(project: Project, scenario: Scenario,
         scenario_xmls,
     )
 
-    on = scenario_xmls(project, scenario, echo)
+    on = scenario_xmls(project, scenario)
     tree, form = scenario_tree(project, scenario)
     off = ensure_bsdf(leaf_off_sample(project, scenario, leaf_on_sample(project, scenario)),
                       flux_settings(tree, form, os.cpu_count() or 1),
-                      project.build_dir / "bsdf" / scenario.name / "leaf_off", "leaf_off", echo)
+                      project.build_dir / "bsdf" / scenario.name / "leaf_off", "leaf_off")
     return {"leaf_on": on, "leaf_off": [(lo, hi, off.xml) for lo, hi, _ in on]}
 
 

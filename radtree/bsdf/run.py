@@ -115,7 +115,7 @@ def compute_crown_bsdfs(project: Project, scenario: Scenario, out: Path,
     runs, mats, rows = {}, {}, []
     out.mkdir(parents=True, exist_ok=True)
     for state in states:
-        run = ensure_bsdf(samples[state], settings, out / "work" / state, state, progress)
+        run = ensure_bsdf(samples[state], settings, out / "work" / state, state)
         final = out / f"{state}.xml"
         with atomic_path(final) as tmp:
             shutil.copyfile(run.xml, tmp)

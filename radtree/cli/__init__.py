@@ -27,6 +27,7 @@ COMMANDS = {
     "doctor": "radtree.cli.doctor:doctor_command",
     "build": "radtree.cli.build:build_command",
     "simulate": "radtree.cli.simulate:simulate_command",
+    "convergence": "radtree.cli.convergence:convergence_command",
     "hemi": "radtree.cli.hemi:hemi_command",
     "report": "radtree.cli.report:report_command",
     "calibrate": "radtree.cli.calibrate:calibrate_command",

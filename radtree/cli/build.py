@@ -20,8 +20,8 @@ from radtree.cli.options import CONTEXT, scenarios_option, writes
 @click.option("--workers", type=click.IntRange(min=1), default=None,
               help="Processes building folders side by side (default: the usable cores, "
                    "when there are 4 crowns or more to build that the build cache lacks).")
-def build_command(project: str, scenarios: tuple[str, ...], no_pictures: bool, fresh: bool,
-                  workers: int | None) -> None:
+def build_command(*, project: str, scenarios: tuple[str, ...], no_pictures: bool,
+                  fresh: bool, workers: int | None) -> None:
     """Write the Radiance build folder of PROJECT.
 
     \b
@@ -43,6 +43,6 @@ def build_command(project: str, scenarios: tuple[str, ...], no_pictures: bool, f
     p = load_project(project)
     check_inputs(p)
     click.echo(f"building {p.name} ({len(p.scenarios)} scenarios, {len(p.site.hours)} hours)")
-    build_project(p, list(scenarios) or None, echo=click.echo, pictures=not no_pictures,
-                  fresh=fresh, workers=workers)
+    build_project(p, list(scenarios) or None, pictures=not no_pictures, fresh=fresh,
+                  workers=workers)
     click.echo(f"build written to {p.build_dir} in {time.perf_counter() - t:.1f} s")

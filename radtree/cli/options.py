@@ -36,8 +36,7 @@ def writing(folders: list[Path], project: str, wait: bool) -> Iterator[None]:
     command = f"radtree {ctx.info_name} {project}"
     with ExitStack() as stack:
         for folder in folders:
-            stack.enter_context(folder_lock(folder, command, wait=wait,
-                                            echo=lambda m: click.echo(m, err=True)))
+            stack.enter_context(folder_lock(folder, command, wait=wait))
         yield
 
 

@@ -2,12 +2,19 @@
 
 from __future__ import annotations
 
+import logging
 import time
+from typing import TYPE_CHECKING
 
 import click
 
 from radtree.cli.options import CONTEXT, scenarios_option, writes
 from radtree.engines.registry import ENGINE_CHOICES
+
+if TYPE_CHECKING:
+    import pandas as pd
+
+log = logging.getLogger(__name__)
 
 
 @click.command("simulate", context_settings=CONTEXT)
@@ -24,8 +31,8 @@ from radtree.engines.registry import ENGINE_CHOICES
               help="Distribute scenario × hour × realisation × façade-chunk tasks on Dask "
                    "(local: one worker process per core, or --workers); same resume.")
 @click.option("--convergence", is_flag=True,
-              help="Run the façade sensors over increasing -ab/-ad and print the change per step.")
-def simulate_command(project: str, scenarios: tuple[str, ...], engine: str,
+              help="Deprecated: use `radtree convergence PROJECT` (same options).")
+def simulate_command(*, project: str, scenarios: tuple[str, ...], engine: str,
                      hours: tuple[str, ...], workers: int | None, dry_run: bool, fresh: bool,
                      convergence: bool, scheduler: str | None) -> None:
     """Trace every scenario × hour of PROJECT → PROJECT/results/illuminance.csv.
@@ -35,52 +42,46 @@ def simulate_command(project: str, scenarios: tuple[str, ...], engine: str,
     (results/parts/) so an interrupted run resumes; --fresh recomputes all.
     """
     from radtree.config import load_project
-    from radtree.pipeline.simulate import resolve_engine, simulate_project
+    from radtree.pipeline.options import RunOptions
+    from radtree.pipeline.simulate import dry_run_commands, resolve_engine, simulate_project
 
-    p = load_project(project)
+    options = RunOptions(engine=engine, scenarios=scenarios, hours=hours, workers=workers,
+                         scheduler=scheduler, fresh=fresh)
     if convergence:
-        from radtree.convergence import convergence_table, read_convergence, write_convergence
+        from radtree.cli.convergence import DEPRECATED, run_convergence
 
-        table = convergence_table(p, list(scenarios) or None, list(hours) or None,
-                                  echo=click.echo, engine=engine, workers=workers,
-                                  previous=None if fresh else read_convergence(p))
-        click.echo(table.to_string(index=False))
-        click.echo(f"convergence table → {write_convergence(p, table)}")
+        log.warning(DEPRECATED)
+        run_convergence(project, options)
         return
+    p = load_project(project)
     eng = resolve_engine(p, engine)
     click.echo(f"engine: {eng.name}" + (" (auto)" if engine == "auto" else ""))
-    t = time.perf_counter()
-    executor = None
-    if scheduler is not None:
-        from functools import partial
-
-        from radtree.sweep.scheduler import map_jobs
-
-        executor = partial(_on_dask, map_jobs, scheduler, workers)
-        click.echo(f"scheduler: dask {scheduler}")
-    out = simulate_project(p, eng, list(scenarios) or None, list(hours) or None, workers,
-                           dry_run=dry_run, echo=click.echo, resume=not fresh,
-                           executor=executor)
-    if out is None:
+    options = RunOptions(engine=eng, scenarios=scenarios, hours=hours, workers=workers,
+                         scheduler=scheduler, fresh=fresh)
+    if dry_run:
+        for line in dry_run_commands(p, options=options):
+            click.echo(line)
         return
-    from radtree.pipeline.results import facade_means
-
-    if "facade" in out.table.columns and out.table["facade"].notna().any():
-        click.echo("building façade means (lux):")
-        click.echo(out.table.groupby(["scenario", "time"])["lux"].mean().unstack("time")
-                   .round(0).to_string())
-    elif out.table["grid"].astype(str).str.startswith("facade@").any():   # [sensors] heights_m
-        click.echo("façade sensor means per height (lux):")
-        levels = out.table[out.table["grid"].astype(str).str.startswith("facade@")]
-        click.echo(levels.groupby(["scenario", "grid"], sort=False)["lux"].mean()
-                   .unstack("grid").round(0).to_string())
-    else:
-        click.echo("façade sensor means (lux):")
-        click.echo(facade_means(out.table).round(0).to_string())
+    t = time.perf_counter()
+    if scheduler is not None:
+        click.echo(f"scheduler: {options.executor(1).describe}")   # dask local, …
+    out = simulate_project(p, options=options)
+    click.echo(_facade_means(out.table))
     unit = "tasks" if p.district is not None else "hours"   # inventories: hour × façade chunk
     click.echo(f"{out.computed} {unit} traced, {out.reused} reused, "
                f"{time.perf_counter() - t:.1f} s → {out.path}")
 
 
-def _on_dask(map_jobs, scheduler, workers, fn, jobs):   # type: ignore[no-untyped-def]
-    return map_jobs(fn, jobs, scheduler, workers)
+def _facade_means(table: pd.DataFrame) -> str:
+    """The façade means (lux) a run prints: per building, per sensor height or per scenario."""
+    from radtree.pipeline.results import facade_means
+
+    if "facade" in table.columns and table["facade"].notna().any():
+        return ("building façade means (lux):\n" + table.groupby(["scenario", "time"])["lux"]
+                .mean().unstack("time").round(0).to_string())
+    if table["grid"].astype(str).str.startswith("facade@").any():   # [sensors] heights_m
+        levels = table[table["grid"].astype(str).str.startswith("facade@")]
+        return ("façade sensor means per height (lux):\n"
+                + levels.groupby(["scenario", "grid"], sort=False)["lux"].mean()
+                .unstack("grid").round(0).to_string())
+    return "façade sensor means (lux):\n" + facade_means(table).round(0).to_string()

@@ -3,11 +3,15 @@
 from __future__ import annotations
 
 import time
+from typing import TYPE_CHECKING
 
 import click
 
 from radtree.cli.options import CONTEXT, writes
 from radtree.engines.registry import ENGINE_CHOICES
+
+if TYPE_CHECKING:
+    from radtree.sweep.run import SweepOutcome
 
 
 @click.command("sweep", context_settings=CONTEXT)
@@ -38,7 +42,7 @@ from radtree.engines.registry import ENGINE_CHOICES
               help="Set a field in every case, e.g. --set sensors.dense_grid=false "
                    "(repeatable).")
 @click.option("--no-progress", is_flag=True, help="No progress bar.")
-def sweep_command(project: str, params: tuple[str, ...], design: str | None,
+def sweep_command(*, project: str, params: tuple[str, ...], design: str | None,
                   samples: int | None, seed: int | None, scenarios: tuple[str, ...],
                   hours: tuple[str, ...], engine: str | None, scheduler: str | None,
                   workers: int | None, out: str | None, fixed: tuple[str, ...],
@@ -55,18 +59,35 @@ def sweep_command(project: str, params: tuple[str, ...], design: str | None,
     case), sensitivity.csv and tornado.png. Settings may also live in a [sweep] table of the
     project file (command-line options win).
     """
+    from radtree.pipeline.options import RunOptions
     from radtree.sweep.design import parse_set
-    from radtree.sweep.run import run_sweep
+    from radtree.sweep.run import SweepOptions, run_sweep
 
+    if no_progress:
+        _no_bars()
     t = time.perf_counter()
-    outcome = run_sweep(project, list(params) or None, design=design, samples=samples,
-                        seed=seed, scenarios=list(scenarios) or None,
-                        hours=list(hours) or None, engine=engine, scheduler=scheduler,
-                        workers=workers, out=out, fixed=parse_set(fixed),
-                        progress=not no_progress, echo=click.echo)
+    outcome = run_sweep(project, sweep=SweepOptions(
+        params=params, design=design, samples=samples, seed=seed, out=out,
+        fixed=parse_set(fixed)), run=RunOptions(
+        engine=engine, scenarios=scenarios, hours=hours, scheduler=scheduler, workers=workers))
+    _print_outcome(outcome, time.perf_counter() - t)
+
+
+def _no_bars() -> None:
+    """``--no-progress``: keep the messages of ``radtree`` (when on), without progress bars."""
+    import logging
+
+    from radtree import log
+
+    if log.enabled():
+        log.enable(logging.getLogger(log.ROOT).level, progress=False)
+
+
+def _print_outcome(outcome: SweepOutcome, seconds: float) -> None:
+    """What a sweep prints as its result: counts, the ranking per scenario, the files."""
     o = outcome.out_dir
     click.echo(f"{len(outcome.computed)} cases run, {len(outcome.reused)} reused, "
-               f"{len(outcome.failed)} failed in {time.perf_counter() - t:.1f} s")
+               f"{len(outcome.failed)} failed in {seconds:.1f} s")
     if outcome.failed:
         click.secho(f"failed cases (parameters and errors): {o / 'failures.csv'}",
                     fg="yellow", err=True)

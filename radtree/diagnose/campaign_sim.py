@@ -193,7 +193,7 @@ class CampaignSimulator(Simulator):
         traced = {}
         built = self._scene(sc)
         for day, proj in self._days.items():
-            out = trace_hours(proj, sc, self._engine, list(self.hours), names,
+            out = trace_hours(proj, sc, self._engine, hours=list(self.hours), grids=names,
                               rays=int(self.rays or 1), seed=int(self.seed or 0),
                               built=built)
             for name in names:

@@ -213,7 +213,7 @@ class Simulator:
         t0 = time.perf_counter()
         # as radtree simulate: the scene's -ab rule and engine switches (the scene is cached
         # without them; trace_hours takes -ab afresh from the switched project)
-        out = trace_hours(self.project, sc, self._engine, list(self.hours), [FACADE],
+        out = trace_hours(self.project, sc, self._engine, hours=list(self.hours), grids=[FACADE],
                           rays=int(self.rays or 1), seed=int(self.seed or 0),
                           built=self._scene(sc))
         lux, se = [], []

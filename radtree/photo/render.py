@@ -159,7 +159,7 @@ def radiance_picture(project: Project, sc: Scenario, hour: str, size: int, out: 
         raise ConfigError(f"unknown hour {hour!r} (site.hours: {', '.join(project.site.hours)})",
                           source=str(project.source), field="--hour")
     built = make_scene(project, sc)
-    folder = ensure_built(project, sc, log.info)
+    folder = ensure_built(project, sc)
     params = effective_project(project, sc).engine
     plan = RadianceEngine().prepare(built.scene, states, params, built.ab, folder)
     frame = facade_frame(project)

@@ -11,12 +11,13 @@ file's checksum, by which a stale folder is detected; ``build/Makefile`` runs th
 from __future__ import annotations
 
 import json
+import logging
 import multiprocessing
 import pickle
 import shutil
 import time
 from collections import deque
-from collections.abc import Callable, Iterable
+from collections.abc import Callable
 from concurrent.futures import FIRST_COMPLETED, Future, ProcessPoolExecutor, wait
 from concurrent.futures.process import BrokenProcessPool
 from pathlib import Path
@@ -28,6 +29,7 @@ from radtree.engines.registry import folder_engine
 from radtree.errors import RadtreeError
 from radtree.fileio import atomic_dir, write_text
 from radtree.light.hours import hour_states
+from radtree.log import progress
 from radtree.pipeline.assemble import BuiltScene, facade_frame, make_scene
 from radtree.pipeline.manifest import file_sha256, manifest
 from radtree.pipeline.processes import usable_cores
@@ -38,6 +40,8 @@ from radtree.pipeline.realisations import (
     realisations_of,
     selected,
 )
+
+log = logging.getLogger(__name__)
 
 
 def hour_grids(project: Project, time_: str, available: list[str],
@@ -53,8 +57,8 @@ def hour_grids(project: Project, time_: str, available: list[str],
     return use
 
 
-def echo_notes(name: str, notes: list[str], echo: Callable[[str], None]) -> None:
-    """Print the notes a user must see at build time: the crown–wall policy's clip note
+def log_notes(name: str, notes: list[str]) -> None:
+    """Log the notes a user must see at build time: the crown–wall policy's clip note
     (:mod:`radtree.trees.wall_policy`) and where an inventory's façade was placed
     (:mod:`radtree.site.placement`)."""
     from radtree.site.placement import NOTE_PREFIX as PLACED
@@ -62,11 +66,10 @@ def echo_notes(name: str, notes: list[str], echo: Callable[[str], None]) -> None
 
     for note in notes:
         if note.startswith((WALL, PLACED)):
-            echo(f"  {name}: {note}")
+            log.info("  %s: %s", name, note)
 
 
-def build_project(project: Project, scenarios: list[str] | None = None,
-                  echo: Callable[[str], None] = print, progress: bool = True,
+def build_project(project: Project, scenarios: list[str] | None = None, *,
                   pictures: bool = True, fresh: bool = True,
                   workers: int | None = None) -> dict[str, dict]:
     """Write the build folders of the selected scenarios; return per-scenario build facts.
@@ -90,28 +93,27 @@ def build_project(project: Project, scenarios: list[str] | None = None,
             todo.append(sc)
         else:
             facts[sc.name] = kept
-            echo(f"  {sc.name}: current, kept (--fresh rebuilds it) → {build_root / sc.name}")
+            log.info("  %s: current, kept (--fresh rebuilds it) → %s", sc.name,
+                     build_root / sc.name)
     weight = {sc.name: _weight(project, sc) for sc in todo}
     n = min(len(todo), usable_cores() if workers is None else max(1, int(workers)))
     if workers is None and sum(w > 0 for w in weight.values()) < PARALLEL_MIN:
         n = 1     # crowns from the cache (or none): a folder takes ~0.1 s, a worker ~1 s
-    bar = progress_bar(None, "build", progress, total=len(todo), unit="scenario")
+    bar = progress(None, desc="build", total=len(todo), unit="scenario")
     with _Pictures(len(drawn & {sc.name for sc in todo})) as painter:
         def done(name: str, built_facts: dict) -> None:
             facts[name] = built_facts
             if name in drawn:
                 painter.draw(build_root / name)
-            echo(_built_line(built_facts, build_root / name))
-            echo_notes(name, built_facts["notes"], echo)
-            if bar is not None:
-                bar.update(1)
+            log.info("%s", _built_line(built_facts, build_root / name))
+            log_notes(name, built_facts["notes"])
+            bar.update(1)
 
         try:
             _build_all(project, sorted(todo, key=lambda sc: weight[sc.name], reverse=True),
                        engine, build_root, n, done)
         finally:
-            if bar is not None:
-                bar.close()
+            bar.close()
     _remove_stale_builds(project, chosen)
     engine.write_index(build_root, [s.name for s in selected(project, None)
                                     if (build_root / s.name).exists()])
@@ -367,12 +369,12 @@ def build_is_current(project: Project, sc: Scenario) -> bool:
     return not build_staleness(project, sc)
 
 
-def ensure_built(project: Project, sc: Scenario, echo: Callable[[str], None]) -> Path:
-    """The scenario's build folder, (re)built first when missing or stale (said why)."""
+def ensure_built(project: Project, sc: Scenario) -> Path:
+    """The scenario's build folder, (re)built first when missing or stale (logged why)."""
     why = build_staleness(project, sc)
     if why:
-        echo(f"  build/{sc.name} {why}: building it")
-        build_project(project, [sc.name], echo=echo, progress=False)
+        log.info("  build/%s %s: building it", sc.name, why)
+        build_project(project, [sc.name])
     return project.build_dir / sc.name
 
 
@@ -385,16 +387,3 @@ def _remove_stale_builds(project: Project, built: list[Scenario]) -> None:
                        *project.build_dir.glob(f"{parent}{REALISATION_MARK}*")]:
             if folder.is_dir() and folder.name not in current:
                 shutil.rmtree(folder)
-
-
-def progress_bar(items: Iterable | None, desc: str, enabled: bool, total: int | None = None,
-                 unit: str = "hour") -> Any:
-    """A tqdm progress bar on stderr over ``items`` (or of ``total`` steps), or the plain
-    iterable / None when disabled."""
-    if not enabled:
-        return items
-    from tqdm import tqdm
-
-    if items is None:
-        return tqdm(total=total, desc=desc, unit=unit, leave=False)
-    return tqdm(items, desc=desc, unit=unit, leave=False)

@@ -57,7 +57,7 @@ from radtree.trees.volume import recommended_volume_ab
 
 #: -ab of a scene with a BSDF crown: every pass through the shell's Klems BSDF is an ambient
 #: bounce, and the Mendoza dome's façade mean settles by -ab 6 (-ab 4 reads ≈ 9 % low);
-#: `radtree simulate PROJECT --convergence` prints the ladder, figures in CHANGELOG.md
+#: `radtree convergence PROJECT` prints the ladder, figures in CHANGELOG.md
 BSDF_SCENE_AB = 6
 #: thinnest chord-ring slab, in slat sizes (a thinner slab is no random medium of slats)
 CHORD_MIN_SLATS = 2.0
@@ -167,8 +167,7 @@ def sample_key(sample: SlabSample | RingSamples | PatchDepthSample,
 
 
 def ensure_bsdf(sample: SlabSample | RingSamples | PatchDepthSample, settings: FluxSettings,
-                folder: Path,
-                name: str, progress: Callable[[str], None] | None = None) -> BsdfRun:
+                folder: Path, name: str) -> BsdfRun:
     """The XML of ``sample`` in ``folder`` (``<name>.xml``): reused when its key matches,
     else computed (rfluxmtx, wrapBSDF, checkBSDF; an envelope sample: one system per Klems
     ring in ``folder/ring<k>/``)."""
@@ -179,7 +178,7 @@ def ensure_bsdf(sample: SlabSample | RingSamples | PatchDepthSample, settings: F
         return BsdfRun(xml, check_bsdf(xml), 0.0, tt if tt.exists() else None)
     comment = (f"radtree crown BSDF: {sample.name}; " + " ".join(sample.notes))[:900]
     if isinstance(sample, PatchDepthSample):
-        result = depth_bsdf(folder, sample, settings, name, comment, progress)
+        result = depth_bsdf(folder, sample, settings, name, comment)
         write_text(key_file, key + "\n")
         return result
     if isinstance(sample, RingSamples):
@@ -189,13 +188,13 @@ def ensure_bsdf(sample: SlabSample | RingSamples | PatchDepthSample, settings: F
                               field="tree.bsdf.tensor_tree")
         subs = write_systems(folder, "ring", sample.rings, settings.tiles)
         result = klems_bsdf_rings(folder, subs, settings, name, sample.thickness,
-                                  sample.width, sample.height, comment, progress)
+                                  sample.width, sample.height, comment)
         write_text(key_file, key + "\n")
         return result
     write_system(folder, sample.polygons, sample.materials, sample.width, sample.height,
                  sample.thickness, settings.tiles)
     result = klems_bsdf(folder, settings, name, sample.thickness, sample.width, sample.height,
-                        comment=comment, progress=progress)
+                        comment=comment)
     if settings.tensor_tree:
         result.tensor_xml = tensor_tree_bsdf(folder, settings, name, sample.thickness,
                                              sample.width, sample.height)
@@ -203,9 +202,7 @@ def ensure_bsdf(sample: SlabSample | RingSamples | PatchDepthSample, settings: F
     return result
 
 
-def scenario_xmls(project: Project, scenario: Scenario,
-                  progress: Callable[[str], None] | None = None
-                  ) -> list[tuple[float, float, Path]]:
+def scenario_xmls(project: Project, scenario: Scenario) -> list[tuple[float, float, Path]]:
     """The leaf-on XML of each band of ``scenario``'s BSDF shell, (lowest, highest |elevation|,
     XML) — for a dome with ``tree.bsdf.sectors`` > 1 one entry per band and sector
     (band-major, :func:`radtree.trees.bsdf_shell.sector_bounds`): ``tree.bsdf.xml`` for every
@@ -244,27 +241,28 @@ def scenario_xmls(project: Project, scenario: Scenario,
                                      CHORD_MIN_SLATS * tree.louvers.slat_size_m)
         else:
             sample = leaf_on_sample(project, scenario, el, half)
-        run = ensure_bsdf(sample, settings, folder, name, progress)
+        run = ensure_bsdf(sample, settings, folder, name)
         for sector in sectors:
             xml = run.xml
             if (form == "dome" and tree.bsdf.curvature != "planar"
                     and not isinstance(sample, PatchDepthSample)):
-                xml = ensure_curved(project, tree, curved, sample, settings, folder, name, lo,
-                                    hi, progress, sector if len(sectors) > 1 else None)
+                xml = ensure_curved(project, tree, curved, sample, settings, folder=folder,
+                                    name=name, band=(lo, hi),
+                                    sector=sector if len(sectors) > 1 else None)
             out.append((lo, hi, xml))
     return out
 
 
 def ensure_curved(project: Project, tree: Tree, dome: Callable[[], CurvedDome],
-                  sample: SlabSample | RingSamples, settings: FluxSettings, folder: Path,
-                  name: str, lo: float, hi: float,
-                  progress: Callable[[str], None] | None = None,
+                  sample: SlabSample | RingSamples, settings: FluxSettings, *, folder: Path,
+                  name: str, band: tuple[float, float],
                   sector: tuple[float, float] | None = None) -> Path:
-    """The dome band's XML with the view from the centre traced through the curved slats
+    """The dome band's XML (``band``: its lowest and highest |elevation|, degrees) with the view from the centre traced through the curved slats
     (``dome()``, :mod:`radtree.pipeline.dome_curvature`), in ``folder/curved/``; reused when
     the planar sample's key and the trace's settings match. ``sector``: (lowest, highest)
     horizontal angle from the façade normal of the part of the band traced
     (``tree.bsdf.sectors``; in ``folder/curved_s<lo>_<hi>/``), None: the whole band."""
+    lo, hi = band
     per = "ring" if tree.bsdf.curvature == "rings" else "patch"
     span = (-90.0, 90.0) if sector is None else sector
     key = (f"{sample_key(sample, settings)}|{lo:g}|{hi:g}|{CURVATURE_PATHS}|{per}|v{CURVATURE_VERSION}|"
@@ -283,8 +281,9 @@ def ensure_curved(project: Project, tree: Tree, dome: Callable[[], CurvedDome],
                f"{where}: the normal-outgoing row traced per {per} through the dome's slats "
                f"({row.paths} paths); "
                + " ".join(sample.notes))[:900]
-    out, _ = write_curved_xml(folder, sub, f"{name}_curved{tag}", row, sample.thickness,
-                              sample.width, sample.height, comment, progress, per)
+    out, _ = write_curved_xml(folder, sub, f"{name}_curved{tag}", row,
+                              size=(sample.thickness, sample.width, sample.height),
+                              comment=comment, per=per)
     check_bsdf(out)
     write_text(key_file, key + "\n")
     return out

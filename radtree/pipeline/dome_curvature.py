@@ -43,8 +43,8 @@ with its own XML.
 
 from __future__ import annotations
 
+import logging
 import math
-from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -64,6 +64,8 @@ from radtree.trees.build import build_tree
 from radtree.trees.envelope import dome_spec
 from radtree.trees.louvers_dome import dome_layer_radii
 from radtree.trees.model import TRUNK
+
+log = logging.getLogger(__name__)
 
 #: the sphere inside the innermost shell that ends paths coming back (reflected by the stack)
 SINK = "curvature_sink"
@@ -328,15 +330,14 @@ def curved_flux(flux: dict[str, np.ndarray], row: RingRow, per: str = "patch"
     return out, factor
 
 
-def write_curved_xml(planar_folder: Path, folder: Path, name: str, row: RingRow,
-                     thickness: float, width: float, height: float, comment: str = "",
-                     progress: Callable[[str], None] | None = None, per: str = "patch"
-                     ) -> tuple[Path, np.ndarray]:
+def write_curved_xml(planar_folder: Path, folder: Path, name: str, row: RingRow, *,
+                     size: tuple[float, float, float], comment: str = "",
+                     per: str = "patch") -> tuple[Path, np.ndarray]:
     """The planar sample's four flux matrices (``planar_folder/*.dat``) with the traced row
-    (:func:`curved_flux`, ``per`` patch or ring), wrapped into ``folder/<name>.xml``; returns
-    it and the factors per ring."""
+    (:func:`curved_flux`, ``per`` patch or ring), wrapped into ``folder/<name>.xml`` of the
+    sample's ``size`` (thickness, width, height; m); returns it and the factors per ring
+    (logged)."""
     flux = {k: np.loadtxt(planar_folder / f"{k}.dat", ndmin=2) for k in KEYS}
     curved, factor = curved_flux(flux, row, per)
-    if progress:
-        progress(f"curvature: ring factors {np.array2string(factor, precision=3)}")
-    return wrap_flux(folder, curved, name, thickness, width, height, comment), factor
+    log.info("curvature: ring factors %s", np.array2string(factor, precision=3))
+    return wrap_flux(folder, curved, name, *size, comment), factor

@@ -1,118 +1,155 @@
 """Simulate: every selected scenario × hour on one engine → ``results/illuminance.csv``.
 
+Three steps, each a function of its own:
+
+* **plan** (:func:`plan_simulation`): the engine, the scenarios and their hour states and
+  scenes (a build-folder engine's folders built when stale), the parts already finished
+  (resume), and the trace jobs left, grouped as the engine traces best — decided once in
+  :class:`Layout`;
+* **execute** (:func:`execute_plan`): the jobs on one :class:`~radtree.pipeline.executor.Executor`
+  (a thread pool by default, Dask with ``RunOptions(scheduler=…)``), each hour written to its
+  part file as it finishes;
+* **publish** (:func:`radtree.pipeline.publish.publish`): the results table, direct-sun file,
+  district GeoJSON, tree impact, timing and manifest, together under the publish lock.
+
 Finished (scenario, hour) parts are kept in ``results/parts/`` keyed by the engine and the
 scenario's parameter hash, so an interrupted run resumes where it stopped. Crown realisations
 (``F@k``) are averaged back into their scenario (:mod:`radtree.pipeline.realisations`).
+Messages go to the module loggers (:mod:`radtree.log`), the progress bar through
+:func:`radtree.log.progress`.
 """
 
 from __future__ import annotations
 
-import json
-import threading
-import time
-from collections.abc import Callable
-from concurrent.futures import ThreadPoolExecutor, as_completed
+import logging
 from dataclasses import dataclass, replace
 from pathlib import Path
-from typing import Any
 
 import pandas as pd
 
-from radtree.config import Project, Scenario, effective_project
+from radtree.config import Project, Scenario
 from radtree.engines.base import Engine
-from radtree.engines.registry import get_engine
-from radtree.errors import EngineError, RadtreeError
-from radtree.fileio import atomic_path, make_folder, write_text
-from radtree.light.hours import hour_states
+from radtree.fileio import make_folder
 from radtree.light.sky import SkyState
-from radtree.lock import PUBLISH_NAME, folder_lock
-from radtree.pipeline.assemble import BuiltScene
-from radtree.pipeline.build import (
-    built_scene,
-    echo_notes,
-    ensure_built,
-    hour_grids,
-    progress_bar,
+from radtree.log import progress
+from radtree.pipeline.build import hour_grids
+from radtree.pipeline.executor import Executor
+from radtree.pipeline.jobs import (
+    RESUME,
+    Prepared,
+    TraceJob,
+    engine_trace,
+    prepare_scenario,
+    resolve_engine,
+    trace_job,
 )
 from radtree.pipeline.limits import check_memory
-from radtree.pipeline.manifest import manifest, weather_record
-from radtree.pipeline.parts import check_part, write_part
+from radtree.pipeline.options import RunOptions
+from radtree.pipeline.parts import check_part
 from radtree.pipeline.processes import usable_cores, with_threads
-from radtree.pipeline.realisations import merge_realisations, parent_name, selected
-from radtree.pipeline.results import hour_rows, in_column_order, merge_write, results_path
+from radtree.pipeline.publish import Run, SimulationOutcome, publish
+from radtree.pipeline.realisations import selected
 from radtree.scene import Scene
 
-RESUME = "finished hours are kept in results/parts/; run the same command again to resume"
+__all__ = ["RESUME", "Layout", "RunOptions", "SimulationOutcome", "SimulationPlan",
+           "TraceJob", "dry_run_commands", "engine_trace", "execute_plan", "plan_simulation",
+           "prepare_scenario", "resolve_engine", "simulate_project", "task_chunks", "trace_job"]
+
+log = logging.getLogger(__name__)
 
 
-@dataclass
-class SimulationOutcome:
-    """What ``simulate`` wrote: the results ``table`` (read back from ``path``), per-scenario
-    ``timing`` (s), hours ``computed`` and ``reused`` from earlier parts, the ``engine`` name."""
+@dataclass(frozen=True)
+class Layout:
+    """How the engine's work is laid out, decided once per run from the engine and executor.
 
-    table: pd.DataFrame
-    path: Path
-    timing: pd.DataFrame
-    computed: int
-    reused: int
-    engine: str
+    ``folder``: the engine traces ``build/<scenario>/`` (Radiance: built first, one job per
+    hour — a Makefile target each); else an in-process engine, whose jobs hold a scenario's
+    hours (each grid traced at all its hours in one batch, :meth:`Engine.trace_many`; each
+    grid draws from its own stream, so a grid's numbers are those of
+    :func:`radtree.pipeline.trace.trace_hours` over the same hours and a resumed run's those
+    of a fresh one). ``ship_plans``: jobs carry the engine's plan (not for an in-process
+    engine's jobs pickled to Dask: a worker prepares the scenario itself). ``threads``: the
+    engine threads of each in-process job (None: the project's ``engine.workers``)."""
 
+    folder: bool
+    ship_plans: bool
+    threads: int | None
 
-@dataclass
-class _Prepared:
-    built: BuiltScene
-    states: list[SkyState]
-    phash: str
-    plan: Any
-    seconds: float   # hour states (sun, sky, weather)
-
-
-@dataclass
-class TraceJob:
-    """One unit of work: a scenario's hours on some grids (a façade chunk), each hour written
-    to its part (``parts[i]`` for ``states[i]``). ``plan`` None: the worker prepares the
-    scenario itself (in-memory engines on Dask)."""
-
-    engine: Engine
-    plan: Any
-    project: Project
-    scenario: Scenario
-    states: list[SkyState]
-    grids: list[list[str]]  # per state
-    scene: Scene            # the grids only
-    phash: str
-    parts: list[Path]
+    @classmethod
+    def of(cls, engine: Engine, executor: Executor, jobs_at_once: int) -> Layout:
+        in_process = not engine.uses_build_folder
+        threads = None
+        if in_process and not executor.remote:
+            # the cores shared out over the hours traced at once (an in-process engine's
+            # numbers do not depend on them; 2 hours × 1 thread take ~20 % less CPU and wall
+            # time than 2 × 2 on 2 cores)
+            threads = max(1, usable_cores() // max(1, jobs_at_once))
+        return cls(not in_process, not (in_process and executor.remote), threads)
 
 
-_WORKER_PLANS: dict[tuple[str, str], Any] = {}
+@dataclass(frozen=True)
+class SimulationPlan:
+    """A run decided, nothing traced yet: ``run`` (what publish needs), the ``jobs`` left
+    (most sensors first), the rows of the parts ``reused``, the ``executor``, the ``layout``
+    and the preparation ``timing`` (s) per scenario."""
+
+    run: Run
+    jobs: list[TraceJob]
+    reused: list[pd.DataFrame]
+    executor: Executor
+    layout: Layout
+    timing: dict[str, dict[str, float]]
 
 
-def trace_job(job: TraceJob) -> pd.DataFrame:
-    """Trace one job and write its part file atomically (runs in a thread or a Dask worker)."""
-    plan = job.plan
-    if plan is None:   # a worker process of an in-memory engine: prepare once per scenario
-        key = (job.scenario.name, job.phash)
-        if key not in _WORKER_PLANS:
-            _WORKER_PLANS.clear()
-            _WORKER_PLANS[key] = prepare_scenario(job.project, job.scenario, job.engine,
-                                                  None, lambda _m: None).plan
-        plan = _WORKER_PLANS[key]
-    frames = []
-    if len(job.states) == 1:
-        results = engine_trace(job.engine, plan, job.scenario, job.states, job.grids[0])
-    else:   # each grid at the hours it is traced at, in one batch
-        results = [{} for _ in job.states]
-        for g in dict.fromkeys(g for gs in job.grids for g in gs):
-            at = [i for i, gs in enumerate(job.grids) if g in gs]
-            got = engine_trace(job.engine, plan, job.scenario, [job.states[i] for i in at], [g])
-            for i, res in zip(at, got, strict=True):
-                results[i].update(res)
-    for st, res, part in zip(job.states, results, job.parts, strict=True):
-        df = hour_rows(job.project, job.scenario, st, job.scene, res, job.engine.name,
-                       job.phash)
-        write_part(part, df)
-        frames.append(df)
-    return pd.concat(frames, ignore_index=True)
+def simulate_project(project: Project, *, options: RunOptions | None = None
+                     ) -> SimulationOutcome:
+    """Trace every selected scenario × hour and write ``results/illuminance.csv`` (plan →
+    execute → publish; see the module text). Finished parts are kept and reused on the next
+    run unless ``options.fresh``."""
+    plan = plan_simulation(project, options=options or RunOptions())
+    frames, timing = execute_plan(plan)
+    computed = sum(len(j.parts) for j in plan.jobs)
+    return publish(plan.run, frames, timing, (computed, len(plan.reused)))
+
+
+def _prepare(project: Project, options: RunOptions
+             ) -> tuple[Engine, list[Scenario], dict[str, Prepared], Executor, Layout]:
+    """The engine, the chosen scenarios prepared for it, the executor and the layout."""
+    eng = resolve_engine(project, options.engine)
+    chosen = selected(project, list(options.scenarios) if options.scenarios else None)
+    workers = options.workers or project.engine.workers
+    executor = options.executor(project.engine.workers)
+    hours = list(options.hours) if options.hours else None
+    layout = Layout.of(eng, executor, min(workers, len(chosen) * len(hours or
+                                                                      project.site.hours)))
+    here = project if layout.threads is None else with_threads(project, layout.threads)
+    prepared = {sc.name: prepare_scenario(here, sc, eng, hours) for sc in chosen}
+    check_memory(project, [p.built.triangles for p in prepared.values()], max(1, workers))
+    return eng, chosen, prepared, executor, layout
+
+
+def dry_run_commands(project: Project, *, options: RunOptions | None = None) -> list[str]:
+    """The engine's commands for every selected scenario × hour (nothing traced; a
+    build-folder engine's folders are built when stale)."""
+    eng, chosen, prepared, _, layout = _prepare(project, options or RunOptions())
+    return [line if layout.folder else f"{sc.name}: {line}"
+            for sc in chosen for st in prepared[sc.name].states
+            for line in eng.commands(prepared[sc.name].plan, st.label)]
+
+
+def plan_simulation(project: Project, *, options: RunOptions) -> SimulationPlan:
+    """The plan step: prepare the scenarios, find the finished parts, make the jobs left."""
+    eng, chosen, prepared, executor, layout = _prepare(project, options)
+    groups = _part_groups(project, eng, chosen, prepared, options.grids, layout)
+    jobs, reused = _jobs_left(project, eng, chosen, prepared, groups, options.resume)
+    # most sensors first (the dense map's hour, the crowns' realisations after), so the
+    # workers do not end on one long task; the table's order does not depend on it
+    jobs.sort(key=lambda j: -len(j.states) * sum(len(g.points) for g in j.scene.grids.values()))
+    timing = {n: {"preparation_s": p.seconds, "geometry_s": p.built.geometry_seconds,
+                  "tracing_s": 0.0} for n, p in prepared.items()}
+    run = Run(project, eng, tuple(chosen), prepared, options.grids,
+              frozenset(j.scenario.name for j in jobs))
+    return SimulationPlan(run, jobs, reused, executor, layout, timing)
 
 
 def _district_chunks(project: Project) -> bool:
@@ -127,256 +164,79 @@ def task_chunks(project: Project, grids: list[str]) -> list[list[str]]:
     return [grids]
 
 
-def resolve_engine(project: Project, engine: str | Engine = "auto") -> Engine:
-    """The engine to run: an instance as given, or by name (``auto`` → the project's
-    ``engine.name``, itself ``auto`` → Radiance when found, else NumPy)."""
-    if isinstance(engine, Engine):
-        return engine
-    if engine != "auto":
-        return get_engine(engine)
-    return get_engine(project.engine.name, source=str(project.source))
+_Member = tuple[SkyState, Path, list[str]]   # an hour, its part file, its grids
 
 
-def prepare_scenario(project: Project, sc: Scenario, engine: Engine,
-                     hours: list[str] | None = None, echo: Callable[[str], None] = print
-                     ) -> _Prepared:
-    """A scenario's scene, hour states, parameter hash and the engine's plan."""
-    t0 = time.perf_counter()
-    states = hour_states(project, sc, hours)
-    seconds = time.perf_counter() - t0
-    built = built_scene(project, sc)
-    if not engine.uses_build_folder:   # a build folder's notes are printed when it is built
-        echo_notes(sc.name, built.notes, echo)
-    scene = built.scene
-    if scene.instances and not engine.instancing:
-        extra = scene.instanced_triangles()
-        echo(f"  {sc.name}: the {engine.name} engine has no instancing — {len(scene.instances)} "
-             f"crowns expanded to {extra} triangles (~{extra * 9 * 8 / 2**20:.0f} MiB of "
-             f"vertices, vs {scene.n_triangles} stored for Radiance)")
-    folder = ensure_built(project, sc, echo) if engine.uses_build_folder else None
-    plan = engine.prepare(built.scene, states, effective_project(project, sc).engine, built.ab,
-                          folder)
-    return _Prepared(built, states, project.params_hash(sc), plan, seconds)
-
-
-def simulate_project(project: Project, engine: str | Engine = "auto",
-                     scenarios: list[str] | None = None, hours: list[str] | None = None,
-                     workers: int | None = None, dry_run: bool = False,
-                     echo: Callable[[str], None] = print, progress: bool = True,
-                     resume: bool = True, grids: list[str] | None = None,
-                     executor: Callable[[Callable, list], Any] | None = None
-                     ) -> SimulationOutcome | None:
-    """Trace every selected scenario × hour and write ``results/illuminance.csv``.
-
-    ``executor(fn, jobs)``: yields ``fn(job)`` for every :class:`TraceJob` as they complete
-    (e.g. on Dask, :func:`radtree.sweep.scheduler.map_jobs`); default a thread pool of
-    ``workers``. Either way finished parts are kept and reused on the next run."""
-    eng = resolve_engine(project, engine)
-    chosen = selected(project, scenarios)
-    workers = workers or project.engine.workers
+def _part_groups(project: Project, eng: Engine, chosen: list[Scenario],
+                 prepared: dict[str, Prepared], grids: tuple[str, ...] | None,
+                 layout: Layout) -> dict[tuple, list[_Member]]:
+    """The parts to have, grouped into jobs: per scenario (and façade chunk), per hour too
+    for a build-folder engine. The groups do not depend on what is already done."""
     parts_dir = project.results_dir / "parts"
-    timing: dict[str, dict[str, float]] = {}
-    prepared: dict[str, _Prepared] = {}
-    tasks: list[tuple[Scenario, SkyState]] = []
-    traced_here = project
-    if not eng.uses_build_folder and executor is None:
-        # an in-process engine's threads per hour: the cores shared out over the hours traced
-        # at once (its numbers do not depend on them; 2 hours × 1 thread take ~20 % less CPU
-        # and wall time than 2 × 2 on 2 cores)
-        at_once = max(1, min(workers, len(chosen) * len(hours or project.site.hours)))
-        traced_here = with_threads(project, max(1, usable_cores() // at_once))
+    wanted = list(grids) if grids else None
+    groups: dict[tuple, list[_Member]] = {}
     for sc in chosen:
-        prep = prepare_scenario(traced_here, sc, eng, hours, echo)
-        prepared[sc.name] = prep
-        timing[sc.name] = {"preparation_s": prep.seconds,
-                           "geometry_s": prep.built.geometry_seconds, "tracing_s": 0.0}
-        tasks.extend((sc, st) for st in prep.states)
-    check_memory(project, [p.built.triangles for p in prepared.values()], max(1, workers))
-    if dry_run:
-        for sc, st in tasks:
-            for line in eng.commands(prepared[sc.name].plan, st.label):
-                echo(f"{sc.name}: {line}" if not eng.uses_build_folder else line)
-        return None
-
-    make_folder(parts_dir)
-    lock = threading.Lock()
-    frames: list[pd.DataFrame] = []
-    # an in-process engine traces a scenario's hours in one job, each grid at all the hours
-    # it is traced at in the same batches (:meth:`Engine.trace_many`; each grid draws from its
-    # own stream): a grid's numbers are those of pipeline.trace.trace_hours over the same
-    # hours, and a resumed run's those of a fresh one (the groups do not depend on what is
-    # already done)
-    groups: dict[tuple, list[tuple[SkyState, Path, list[str]]]] = {}
-    for sc, st in tasks:
         prep = prepared[sc.name]
-        use = hour_grids(project, st.time, list(prep.built.scene.grids), grids, sc)
-        for chunk in task_chunks(project, use):
-            tag = f"_{chunk[0]}" if len(chunk) == 1 and project.district is not None else ""
-            part = parts_dir / f"{sc.name}_{st.label}{tag}_{eng.name}_{prep.phash}.csv"
-            key = (sc.name, tuple(chunk) if _district_chunks(project) else (),
-                   "" if not eng.uses_build_folder else st.label)
-            groups.setdefault(key, []).append((st, part, chunk))
-    todo: list[TraceJob] = []
-    reused = 0
+        for st in prep.states:
+            use = hour_grids(project, st.time, list(prep.built.scene.grids), wanted, sc)
+            for chunk in task_chunks(project, use):
+                tag = f"_{chunk[0]}" if len(chunk) == 1 and project.district is not None else ""
+                part = parts_dir / f"{sc.name}_{st.label}{tag}_{eng.name}_{prep.phash}.csv"
+                key = (sc.name, tuple(chunk) if _district_chunks(project) else (),
+                       st.label if layout.folder else "")
+                groups.setdefault(key, []).append((st, part, chunk))
+    return groups
+
+
+def _jobs_left(project: Project, eng: Engine, chosen: list[Scenario],
+               prepared: dict[str, Prepared], groups: dict[tuple, list[_Member]],
+               resume: bool) -> tuple[list[TraceJob], list[pd.DataFrame]]:
+    """A job per group with a part missing (or unsound, or ``resume`` off); the rows of the
+    groups whose parts are all there."""
+    jobs: list[TraceJob] = []
+    reused: list[pd.DataFrame] = []
     by_name = {sc.name: sc for sc in chosen}
     for (name, *_), members in groups.items():
         sc, prep = by_name[name], prepared[name]
-        done = []
-        for st, part, _ in members:
-            rows, why = check_part(part, sc.name, st.time, prep.phash) if resume and \
-                part.exists() else (None, "")
-            if why:
-                echo(f"  results/parts/{part.name} {why}: recomputing it")
-            done.append(rows)
+        done = [_finished_part(part, sc, st, prep.phash, resume) for st, part, _ in members]
         if all(rows is not None for rows in done):
-            frames.extend(done)
-            reused += len(done)
+            reused.extend(d for d in done if d is not None)
             continue
         union = dict.fromkeys(g for _, _, chunk in members for g in chunk)
         sub = Scene([], {}, {g: prep.built.scene.grids[g] for g in union})
-        todo.append(TraceJob(eng, prep.plan, project, sc, [m[0] for m in members],
+        jobs.append(TraceJob(eng, prep.plan, project, sc, [m[0] for m in members],
                              [m[2] for m in members], sub, prep.phash, [m[1] for m in members]))
-
-    def work(job: TraceJob) -> pd.DataFrame:
-        t = time.perf_counter()
-        df = trace_job(job)
-        with lock:
-            timing[job.scenario.name]["tracing_s"] += time.perf_counter() - t
-        return df
-
-    # most sensors first (the dense map's hour, the crowns' realisations after), so the
-    # workers do not end on one long task; the table's order does not depend on it
-    todo.sort(key=lambda j: -len(j.states) * sum(len(g.points) for g in j.scene.grids.values()))
-    if todo:
-        bar = progress_bar(None, f"simulate ({eng.name})", progress,
-                           total=sum(len(j.states) for j in todo), unit="hour")
-        try:
-            if executor is not None:
-                light = [replace(j, plan=None) if not eng.uses_build_folder else j for j in todo]
-                for df in executor(trace_job, light):
-                    frames.append(df)
-                    if bar is not None:
-                        bar.update(df["time"].nunique())
-            else:
-                with ThreadPoolExecutor(max_workers=max(1, workers)) as pool:
-                    futures = {pool.submit(work, item): item for item in todo}
-                    try:
-                        for fut in as_completed(futures):
-                            frames.append(fut.result())
-                            if bar is not None:
-                                bar.update(len(futures[fut].states))
-                    except BaseException:
-                        for f in futures:
-                            f.cancel()
-                        raise
-        finally:
-            if bar is not None:
-                bar.close()
-    table = pd.concat(frames, ignore_index=True)
-    parents = list(dict.fromkeys(parent_name(sc.name) for sc in chosen))
-    table, per_realisation = merge_realisations(
-        table, {p: project.params_hash(project.scenario(p)) for p in parents})
-    if per_realisation is not None:
-        merge_write(project.results_dir / "realisations.csv", per_realisation, parents)
-    table = in_column_order(table, [s.name for s in project.scenarios])
-    impact = _tree_impact(project, eng, chosen, prepared, echo, grids,
-                          {j.scenario.name for j in todo})
-    out = results_path(project)
-    tdf = _timing_table(timing, eng.name)
-    with folder_lock(project.results_dir, "radtree simulate", wait=True, name=PUBLISH_NAME,
-                     echo=echo):
-        merge_write(out, table, parents)   # table, timing and manifest: one reader sees all
-        _write_direct_sun(project, chosen, prepared)
-        if project.district is not None and project.district.buildings is not None:
-            from radtree.pipeline.district import write_facades_geojson
-
-            write_facades_geojson(project, pd.read_csv(out, dtype={"facade": str,
-                                                                   "building": str}))
-        if impact is not None:
-            from radtree.pipeline.tree_impact import write_tree_impact
-
-            echo(f"  tree impact: {write_tree_impact(project, impact)}")
-        _merge_timing(project.results_dir / "timing.csv", tdf)
-        write_text(project.results_dir / "manifest.json", json.dumps(
-            manifest(project, extra={"engine": eng.name, "scenarios": [s.name for s in chosen],
-                                     "weather": _weather(project, prepared)}),
-            indent=2, default=str))
-    return SimulationOutcome(pd.read_csv(out), out, tdf, sum(len(j.parts) for j in todo),
-                             reused, eng.name)
+    return jobs, reused
 
 
-def _weather(project: Project, prepared: dict[str, _Prepared]) -> dict[str, Any]:
-    """The manifest's weather record: this run's scenarios' hour states, and the earlier
-    runs' record of the scenarios the results table still holds."""
-    old: dict[str, Any] = {}
-    path = project.results_dir / "manifest.json"
-    if path.is_file():
-        try:
-            old = json.loads(path.read_text(encoding="utf-8")).get("weather") or {}
-        except (OSError, ValueError):
-            old = {}
-    states: dict[str, list[SkyState]] = {}
-    for name, prep in prepared.items():
-        states.setdefault(parent_name(name), prep.states)
-    return {**old, **weather_record(project, states)}
-
-
-def engine_trace(eng: Engine, plan: Any, sc: Scenario, states: list[SkyState],
-                grids: list[str]) -> list[dict[str, Any]]:
-    """``eng.trace_many`` of some hours; any failure of the engine (a Radiance program failing
-    or killed, the in-process engine raising) → one :class:`EngineError` naming scenario and
-    hour(s). Interrupts pass through."""
-    try:
-        return eng.trace_many(plan, [st.label for st in states], grids)
-    except Exception as exc:  # noqa: BLE001 - every engine failure gets its scenario and hour
-        what = str(exc) if isinstance(exc, RadtreeError) else f"{type(exc).__name__}: {exc}"
-        hours = ("hour " if len(states) == 1 else "hours ") + ", ".join(st.time for st in states)
-        raise EngineError(f"scenario {sc.name}, {hours}: the {eng.name} engine failed: "
-                          f"{what}\n  {RESUME}") from exc
-
-
-def _timing_table(timing: dict[str, dict[str, float]], engine: str) -> pd.DataFrame:
-    """Seconds per scenario (realisations summed into their scenario)."""
-    summed: dict[str, dict[str, float]] = {}
-    for name, v in timing.items():
-        acc = summed.setdefault(parent_name(name), dict.fromkeys(v, 0.0))
-        for k, x in v.items():
-            acc[k] += x
-    return pd.DataFrame([{"scenario": k, "engine": engine, **v} for k, v in summed.items()])
-
-
-def _merge_timing(out: Path, tdf: pd.DataFrame) -> None:
-    if out.exists():
-        old = pd.read_csv(out)
-        old = old[~old["scenario"].astype(str).isin(tdf["scenario"].astype(str))]
-        tdf = pd.concat([old, tdf], ignore_index=True)
-    with atomic_path(out) as tmp:
-        tdf.to_csv(tmp, index=False)
-
-
-def _tree_impact(project: Project, eng: Engine, chosen: list[Scenario],
-                 prepared: dict[str, _Prepared], echo: Callable[[str], None],
-                 grids: list[str] | None, traced: set[str]) -> pd.DataFrame | None:
-    """The tree-impact table (:mod:`radtree.pipeline.tree_impact`) of the chosen scenarios,
-    unless every one of them was reused from earlier parts and the table is there."""
-    from radtree.pipeline.tree_impact import tree_impact, tree_impact_path
-
-    if not traced and tree_impact_path(project).exists():
+def _finished_part(part: Path, sc: Scenario, st: SkyState, phash: str,
+                   resume: bool) -> pd.DataFrame | None:
+    """The rows of a sound earlier part (None: missing, unsound, or not resuming)."""
+    if not resume or not part.exists():
         return None
-    return tree_impact(project, eng, chosen,
-                       {n: (p.built, p.states) for n, p in prepared.items()}, echo, grids)
+    rows, why = check_part(part, sc.name, st.time, phash)
+    if why:
+        log.info("  results/parts/%s %s: recomputing it", part.name, why)
+    return rows
 
 
-def _write_direct_sun(project: Project, chosen: list[Scenario],
-                      prepared: dict[str, _Prepared]) -> None:
-    """``results/direct_sun.csv``: whether the sun beam reaches each sensor at each hour, per
-    crown realisation, for the perforated scenarios (:mod:`radtree.pipeline.sunreach`)."""
-    from radtree.pipeline.sunreach import direct_sun_rows
-
-    rows = [direct_sun_rows(sc.name, prepared[sc.name].built.scene, prepared[sc.name].states)
-            for sc in chosen if sc.model == "perforated"
-            and "facade" in prepared[sc.name].built.scene.grids]
-    if rows:
-        table = pd.concat(rows, ignore_index=True)
-        merge_write(project.results_dir / "direct_sun.csv", table,
-                    list(dict.fromkeys(table["scenario"].astype(str))))
+def execute_plan(plan: SimulationPlan) -> tuple[list[pd.DataFrame], dict[str, dict[str, float]]]:
+    """The execute step: trace the plan's jobs on its executor (each hour's part written as
+    it finishes); return every row (reused parts first) and the timing per scenario (s). A
+    failed job raises (the parts finished so far stay: the next run resumes)."""
+    frames = list(plan.reused)
+    timing = {n: dict(t) for n, t in plan.timing.items()}
+    if not plan.jobs:
+        return frames, timing
+    make_folder(plan.run.project.results_dir / "parts")
+    jobs = plan.jobs if plan.layout.ship_plans else [replace(j, plan=None) for j in plan.jobs]
+    bar = progress(None, desc=f"simulate ({plan.run.engine.name})",
+                   total=sum(len(j.states) for j in jobs), unit="hour")
+    try:
+        for done in plan.executor.run(trace_job, jobs, label="trace"):
+            frames.append(done.value())
+            timing[done.job.scenario.name]["tracing_s"] += done.seconds
+            bar.update(len(done.job.states))
+    finally:
+        bar.close()
+    return frames, timing

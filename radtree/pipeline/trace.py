@@ -39,7 +39,7 @@ def _engine(engine: str | Engine | None) -> Engine:
     return engine if isinstance(engine, Engine) else engine_named(engine)
 
 
-def trace_hours(project: Project, sc: Scenario, engine: str | Engine | None = None,
+def trace_hours(project: Project, sc: Scenario, engine: str | Engine | None = None, *,
                 hours: list[str] | None = None, grids: list[str] | None = None,
                 rays: int | None = None, seed: int | None = None, ab: int | None = None,
                 built: BuiltScene | None = None, folder: Path | None = None) -> TracedHours:
@@ -86,7 +86,7 @@ def trace_scenario(project: Project, sc: Scenario, engine: str | Engine | None =
     """Every hour of one scenario in memory: the rows ``simulate`` would write (calculated
     ground terms included)."""
     eng = _engine(engine)
-    traced = trace_hours(project, sc, eng, hours, grids, rays, seed)
+    traced = trace_hours(project, sc, eng, hours=hours, grids=grids, rays=rays, seed=seed)
     phash = project.params_hash(sc)
     return pd.concat([hour_rows(project, sc, st, traced.built.scene, res, eng.name, phash)
                       for st, res in zip(traced.states, traced.results)], ignore_index=True)

@@ -25,7 +25,7 @@ Columns (one row per scenario × hour × tree × target where the tree changes t
 
 from __future__ import annotations
 
-from collections.abc import Callable
+import logging
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -48,6 +48,8 @@ if TYPE_CHECKING:
 COLUMNS = ["scenario", "time", "tree", "target", "grid", "lux_removed", "lux_removed_stderr",
            "share"]
 FILE = "tree_impact.csv"
+
+log = logging.getLogger(__name__)
 
 
 def tree_impact_path(project: Project) -> Path:
@@ -102,9 +104,8 @@ def scenario_impact(project: Project, sc: Scenario, built: BuiltScene, states: l
 
 
 def tree_impact(project: Project, engine: Engine, scenarios: list[Scenario],
-                built: dict[str, tuple[BuiltScene, list[SkyState]]],
-                echo: Callable[[str], None] = print, grids: list[str] | None = None
-                ) -> pd.DataFrame | None:
+                built: dict[str, tuple[BuiltScene, list[SkyState]]], *,
+                grids: list[str] | None = None) -> pd.DataFrame | None:
     """The table for the ``scenarios`` with trees that have ids (``built``: each one's scene
     and hour states), or None when the project has no pair or no engine can attribute."""
     with_ids = [sc for sc in scenarios if sc.model != "none"
@@ -115,12 +116,13 @@ def tree_impact(project: Project, engine: Engine, scenarios: list[Scenario],
     if not engine.attributes_trees:
         other = attributing_engine()
         if other is None:
-            echo(f"  tree impact: the {engine.name} engine does not attribute light to trees "
-                 f"and no engine here does; {FILE} not written")
+            log.info("  tree impact: the %s engine does not attribute light to trees and no "
+                     "engine here does; %s not written", engine.name, FILE)
             return None
         eng = other
-        echo(f"  tree impact: the {engine.name} engine does not attribute light to trees; "
-             f"attributed by the {eng.name} engine (same scene, hours and sampling settings)")
+        log.info("  tree impact: the %s engine does not attribute light to trees; attributed "
+                 "by the %s engine (same scene, hours and sampling settings)", engine.name,
+                 eng.name)
     frames = [scenario_impact(project, sc, *built[sc.name], eng, grids) for sc in with_ids]
     return pd.concat(frames, ignore_index=True)[COLUMNS]
 

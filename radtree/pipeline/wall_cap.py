@@ -27,7 +27,6 @@ from __future__ import annotations
 
 import math
 import time
-from collections.abc import Callable
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, field, replace
 from pathlib import Path
@@ -221,7 +220,7 @@ def write_systems(folder: Path, prefix: str, slabs: list[SlabSample], tiles: int
 
 
 def depth_bsdf(folder: Path, sample: PatchDepthSample, settings: FluxSettings, name: str,
-               comment: str = "", progress: Callable[[str], None] | None = None) -> BsdfRun:
+               comment: str = "") -> BsdfRun:
     """The XML of ``sample`` in ``folder/<name>.xml``: both rfluxmtx passes per node
     (``folder/node<k>/``, ``settings.nproc`` at a time), columns mixed per patch
     (:func:`mixed`), made reciprocal by ring blocks (:func:`reciprocal_rings`), wrapped."""
@@ -229,7 +228,7 @@ def depth_bsdf(folder: Path, sample: PatchDepthSample, settings: FluxSettings, n
     subs = write_systems(folder, "node", sample.rings, settings.tiles)
     single = replace(settings, nproc=1)
     with ThreadPoolExecutor(max_workers=max(1, min(settings.nproc, len(subs)))) as pool:
-        list(pool.map(lambda sub: flux_passes(sub, single, progress), subs))
+        list(pool.map(lambda sub: flux_passes(sub, single), subs))
     flux = {}
     for key in KEYS:
         mats = [np.loadtxt(sub / f"{key}.dat", ndmin=2) for sub in subs]

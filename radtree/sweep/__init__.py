@@ -1,15 +1,17 @@
 """Parameter sweeps over the unknowns of a project (reference case §1), run on dask.distributed.
 
-    from radtree.sweep import run_sweep
-    out = run_sweep("my-street", ["tree.crown.trunk_distance_m=2:6:5",
-                                               "tree.louvers.layers=3,4,5"], scenarios=["A"])
+    from radtree.pipeline.options import RunOptions
+    from radtree.sweep import SweepOptions, run_sweep
+    out = run_sweep("my-street", sweep=SweepOptions(params=("tree.crown.trunk_distance_m=2:6:5",
+                                                            "tree.louvers.layers=3,4,5")),
+                    run=RunOptions(scenarios=("A",)))
     out.table        # every case's tidy rows + case_id, case_hash and parameter columns
     out.sensitivity  # per scenario × parameter × metric: main-effect range, Spearman ρ
 
 Modules: :mod:`~radtree.sweep.design` (parameters, full factorial, Latin hypercube),
 :mod:`~radtree.sweep.settings` (the ``[sweep]`` table, field checks), :mod:`~radtree.sweep.plan`
 (the case specs), :mod:`~radtree.sweep.cases` (one case: folder, hash, the worker function),
-:mod:`~radtree.sweep.scheduler` (dask or sequential execution), :mod:`~radtree.sweep.run`
+:mod:`~radtree.sweep.scheduler` (the cases on an executor: dask or sequential), :mod:`~radtree.sweep.run`
 (the whole sweep: resume, merged table, case and failure tables), :mod:`~radtree.sweep.sensitivity`
 (metrics, effect ranges, tornado plot, report fragment); the command is :mod:`radtree.cli.sweep`.
 """
@@ -26,7 +28,7 @@ _EXPORTS = {
     "parse_spec": "design",
     "CaseResult": "cases", "CaseSpec": "cases", "run_case": "cases",
     "SweepPlan": "plan", "plan_sweep": "plan", "execute": "scheduler",
-    "SweepOutcome": "run", "merge_results": "run", "run_sweep": "run",
+    "SweepOutcome": "run", "SweepOptions": "run", "merge_results": "run", "run_sweep": "run",
     "case_metrics": "sensitivity", "sensitivity_table": "sensitivity",
     "sweep_section_data": "sensitivity", "tornado_plot": "sensitivity",
     "write_sensitivity": "sensitivity",

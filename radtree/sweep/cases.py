@@ -4,13 +4,15 @@ worker runs (build and simulate the case as an ordinary project in its folder, n
 
 from __future__ import annotations
 
+import contextlib
 import hashlib
 import json
+import logging
 import os
 import socket
 import time
 import traceback
-from collections.abc import Callable, Iterable
+from collections.abc import Iterable, Iterator
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
 from typing import Any
@@ -20,7 +22,10 @@ import pandas as pd
 from radtree.config import PATH_FIELDS
 from radtree.errors import RadtreeError
 from radtree.fileio import atomic_path, write_text
+from radtree.log import ROOT
 from radtree.sweep.design import Value
+
+log = logging.getLogger(__name__)
 
 CASE_COLUMNS = ["case_id", "case_hash"]
 
@@ -122,11 +127,24 @@ def case_header(source: Path, case_id: str, params: dict[str, Value]) -> str:
     return "\n".join(lines)
 
 
-def _log_writer(path: Path) -> Callable[[str], None]:
-    def echo(msg: str) -> None:
-        with path.open("a", encoding="utf-8") as fh:
-            fh.write(str(msg) + "\n")
-    return echo
+@contextlib.contextmanager
+def case_log(path: Path) -> Iterator[None]:
+    """radtree's messages (INFO and above) appended to ``path`` while inside: a case's
+    ``case.log``, written in whichever process runs the case."""
+    root = logging.getLogger(ROOT)
+    handler = logging.FileHandler(path, encoding="utf-8")
+    handler.setLevel(logging.INFO)
+    handler.setFormatter(logging.Formatter("%(message)s"))
+    level = root.level
+    if level == logging.NOTSET or level > logging.INFO:   # a worker process: quiet by default
+        root.setLevel(logging.INFO)
+    root.addHandler(handler)
+    try:
+        yield
+    finally:
+        root.removeHandler(handler)
+        handler.close()
+        root.setLevel(level)
 
 
 def run_case(spec: CaseSpec) -> CaseResult:
@@ -136,11 +154,6 @@ def run_case(spec: CaseSpec) -> CaseResult:
     (after building with pictures off for Radiance), then ``result.csv`` atomically and
     ``case.json``. Any exception becomes a ``failed`` result carrying its message.
     """
-    from radtree.config import load_project
-    from radtree.engines.registry import get_engine
-    from radtree.pipeline.build import build_project
-    from radtree.pipeline.simulate import simulate_project
-
     t0 = time.perf_counter()
     folder = Path(spec.folder)
     result = CaseResult(spec.case_id, spec.case_hash, dict(spec.params), "failed",
@@ -150,19 +163,11 @@ def run_case(spec: CaseSpec) -> CaseResult:
         toml = folder / "radtree.toml"
         if not toml.exists() or toml.read_text(encoding="utf-8") != spec.toml_text:
             write_text(toml, spec.toml_text)
-        log = _log_writer(folder / "case.log")
-        log(f"--- case {spec.case_hash} on {result.host} pid {result.pid} at "
-            f"{time.strftime('%Y-%m-%d %H:%M:%S')}")
-        project = load_project(folder)
-        scenarios = list(spec.scenarios) if spec.scenarios else None
-        hours = list(spec.hours) if spec.hours else None
-        if get_engine(spec.engine).uses_build_folder:   # build without model pictures
-            build_project(project, scenarios, echo=log, progress=False, pictures=False)
-        out = simulate_project(project, spec.engine, scenarios, hours, workers=1, echo=log,
-                               progress=False)
-        if out is None:  # only on dry runs
-            raise RadtreeError("simulation returned no table")
-        table = out.table
+        with case_log(folder / "case.log"):
+            log.info("--- case %s on %s pid %s at %s", spec.case_hash, result.host, result.pid,
+                     time.strftime("%Y-%m-%d %H:%M:%S"))
+            table = _simulate_case(folder, spec)
+        scenarios, hours = spec.scenarios, spec.hours
         if scenarios:
             table = table[table["scenario"].astype(str).isin(scenarios)]
         if hours:
@@ -184,3 +189,19 @@ def run_case(spec: CaseSpec) -> CaseResult:
     except OSError:
         pass
     return result
+
+
+def _simulate_case(folder: Path, spec: CaseSpec) -> pd.DataFrame:
+    """Build (Radiance: without model pictures) and simulate the case's project; its table."""
+    from radtree.config import load_project
+    from radtree.engines.registry import get_engine
+    from radtree.pipeline.build import build_project
+    from radtree.pipeline.options import RunOptions
+    from radtree.pipeline.simulate import simulate_project
+
+    project = load_project(folder)
+    if get_engine(spec.engine).uses_build_folder:
+        build_project(project, list(spec.scenarios) if spec.scenarios else None,
+                      pictures=False)
+    return simulate_project(project, options=RunOptions(
+        engine=spec.engine, scenarios=spec.scenarios, hours=spec.hours, workers=1)).table

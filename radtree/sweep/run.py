@@ -25,8 +25,9 @@ Modules: :mod:`~radtree.sweep.plan` (the design resolved to case specs),
 from __future__ import annotations
 
 import json
+import logging
 import time
-from collections.abc import Callable, Sequence
+from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -35,10 +36,37 @@ import pandas as pd
 
 from radtree.errors import RadtreeError
 from radtree.fileio import atomic_path, write_text
+from radtree.log import progress
+from radtree.pipeline.options import RunOptions
 from radtree.sweep.cases import CASE_COLUMNS, CaseResult, CaseSpec
 from radtree.sweep.design import Design, Parameter
-from radtree.sweep.plan import plan_sweep
-from radtree.sweep.scheduler import default_workers, execute
+from radtree.sweep.plan import SweepPlan, plan_sweep
+from radtree.sweep.scheduler import default_workers, execute, make_executor
+
+log = logging.getLogger(__name__)
+
+
+@dataclass(frozen=True)
+class SweepOptions:
+    """What to sweep (None = the project's ``[sweep]`` table, then the defaults).
+
+    ``params``: ``FIELD=VALUES`` strings (``a:b:n`` or ``v1,v2``) or :class:`Parameter` —
+    they replace the table's parameters; ``design`` ``full`` (default) or ``lhs``;
+    ``samples``/``seed`` of a Latin hypercube (default 10 per parameter, seed 1); ``out`` the
+    output folder (default ``PROJECT/sweep``); ``fixed`` fields set in every case;
+    ``sensitivity``: write the sensitivity summary."""
+
+    params: tuple[str | Parameter, ...] | None = None
+    design: str | None = None
+    samples: int | None = None
+    seed: int | None = None
+    out: str | Path | None = None
+    fixed: Mapping[str, Any] | None = None
+    sensitivity: bool = True
+
+    def __post_init__(self) -> None:
+        if self.params is not None:
+            object.__setattr__(self, "params", tuple(self.params) or None)
 
 
 @dataclass
@@ -79,54 +107,60 @@ def merge_results(specs: list[CaseSpec], names: list[str]) -> pd.DataFrame:
     return pd.concat(frames, ignore_index=True)
 
 
-def run_sweep(project: str | Path, params: Sequence[str | Parameter] | None = None, *,
-              design: str | None = None, samples: int | None = None, seed: int | None = None,
-              scenarios: list[str] | None = None, hours: list[str] | None = None,
-              engine: str | None = None, scheduler: str | None = None,
-              workers: int | None = None, out: str | Path | None = None,
-              fixed: dict[str, Any] | None = None, progress: bool = True,
-              echo: Callable[[str], None] = print, sensitivity: bool = True) -> SweepOutcome:
+def run_sweep(project: str | Path, *, sweep: SweepOptions | None = None,
+              run: RunOptions | None = None) -> SweepOutcome:
     """Plan, run (skipping finished cases), merge and summarise a sweep. See the module text.
 
-    ``params`` are ``FIELD=VALUES`` strings (``a:b:n`` or ``v1,v2``) or :class:`Parameter`;
-    without them the ``[sweep.params]`` table is used. ``fixed`` sets fields in every case.
-    Returns a :class:`SweepOutcome`; failures do not raise (they are in ``failures``).
-    """
+    ``sweep``: what to sweep (:class:`SweepOptions`); ``run``: how each case runs
+    (:class:`~radtree.pipeline.options.RunOptions`: ``engine``, ``scenarios``, ``hours``,
+    ``scheduler`` — default ``local`` —, ``workers``). Returns a :class:`SweepOutcome`;
+    failures do not raise (they are in ``failures``)."""
     t0 = time.perf_counter()
-    plan = plan_sweep(project, params, design=design, samples=samples, seed=seed,
-                      scenarios=scenarios, hours=hours, engine=engine, scheduler=scheduler,
-                      workers=workers, out=out, fixed=fixed)
-    out_dir = plan.out_dir
-    out_dir.mkdir(parents=True, exist_ok=True)
-    names = plan.design.names
+    sweep, run = sweep or SweepOptions(), run or RunOptions()
+    plan = plan_sweep(project, list(sweep.params) if sweep.params else None,
+                      design=sweep.design, samples=sweep.samples, seed=sweep.seed,
+                      scenarios=list(run.scenarios) if run.scenarios else None,
+                      hours=list(run.hours) if run.hours else None,
+                      engine=run.engine if isinstance(run.engine, str) else
+                      getattr(run.engine, "name", None), scheduler=run.scheduler,
+                      workers=run.workers, out=sweep.out,
+                      fixed=dict(sweep.fixed) if sweep.fixed else None)
+    todo, unique, reused = _start(plan)
+    results = _run_cases(plan, todo, unique)
+    return _publish(plan, results, reused, sweep.sensitivity, time.perf_counter() - t0)
+
+
+def _start(plan: SweepPlan) -> tuple[list[CaseSpec], dict[str, CaseSpec], set[str]]:
+    """Write ``design.json``; the cases to run, every distinct case by hash, and the hashes
+    of the cases finished before (their ``result.csv`` is there)."""
+    plan.out_dir.mkdir(parents=True, exist_ok=True)
     for note in plan.notes:
-        echo(f"note: {note}")
-    write_text(out_dir / "design.json", json.dumps({
+        log.info("note: %s", note)
+    write_text(plan.out_dir / "design.json", json.dumps({
         "project": str(plan.project_file), "design": plan.design.kind, "seed": plan.design.seed,
         "cases": len(plan.specs), "engine": plan.engine, "scenarios": plan.scenarios,
         "hours": plan.hours, "fixed": plan.fixed,
         "parameters": [{"name": p.name, "kind": p.kind, "spec": p.text, "integer": p.integer}
                        for p in plan.design.parameters],
     }, indent=2, default=str))
-
     unique: dict[str, CaseSpec] = {}
     for s in plan.specs:
         unique.setdefault(s.case_hash, s)
     todo = [s for s in unique.values() if not (Path(s.folder) / "result.csv").exists()]
-    reused_hashes = {h for h, s in unique.items() if s not in todo}
-    echo(f"sweep: {len(plan.specs)} cases ({plan.design.kind}, {len(names)} parameter(s)), "
-         f"{len(todo)} to run, {len(reused_hashes)} finished before; engine {plan.engine}; "
-         f"scheduler {plan.scheduler}"
-         + (f" ({plan.workers or min(default_workers(), max(1, len(todo)))} workers)"
-            if plan.scheduler == "local" else ""))
+    reused = {h for h, s in unique.items() if s not in todo}
+    log.info("sweep: %d cases (%s, %d parameter(s)), %d to run, %d finished before; engine %s; "
+             "scheduler %s%s", len(plan.specs), plan.design.kind, len(plan.design.names),
+             len(todo), len(reused), plan.engine, plan.scheduler,
+             f" ({plan.workers or min(default_workers(), max(1, len(todo)))} workers)"
+             if plan.scheduler == "local" else "")
+    return todo, unique, reused
 
-    bar = None
-    if progress and todo:
-        from tqdm import tqdm
 
-        bar = tqdm(total=len(todo), desc="sweep", unit="case")
-    write = bar.write if bar is not None else echo
-    failed: list[CaseResult] = []
+def _run_cases(plan: SweepPlan, todo: list[CaseSpec], unique: dict[str, CaseSpec]
+               ) -> dict[str, CaseResult]:
+    """Run the cases left on the plan's executor; each result by case hash. A case's table
+    comes back from a worker without our file system: it is written here."""
+    bar = progress(None, desc="sweep", total=len(todo), unit="case")
 
     def on_result(res: CaseResult) -> None:
         if res.status == "done":
@@ -135,65 +169,75 @@ def run_sweep(project: str | Path, params: Sequence[str | Parameter] | None = No
                 with atomic_path(f) as tmp:
                     res.table.to_csv(tmp, index=False)
         else:
-            failed.append(res)
             shown = ", ".join(f"{k}={v!r}" for k, v in res.params.items())
             first = res.error.strip().splitlines()[0] if res.error.strip() else res.error_type
-            write(f"case {res.case_id} ({shown}) failed: {first}")
-        if bar is not None:
-            bar.update(1)
+            log.warning("case %s (%s) failed: %s", res.case_id, shown, first)
+        bar.update(1)
 
     try:
-        results = execute(todo, plan.scheduler, plan.workers, on_result)
+        results = execute(todo, make_executor(plan.scheduler, plan.workers), on_result)
     finally:
-        if bar is not None:
-            bar.close()
-    by_hash = {r.case_hash: r for r in results}
+        bar.close()
+    return {r.case_hash: r for r in results}
 
+
+def _publish(plan: SweepPlan, by_hash: dict[str, CaseResult], reused: set[str],
+             sensitivity: bool, seconds: float) -> SweepOutcome:
+    """Write ``results.csv``, ``cases.csv``, ``failures.csv`` (and the sensitivity summary);
+    the outcome."""
+    names = plan.design.names
     table = merge_results(plan.specs, names)
-    with atomic_path(out_dir / "results.csv") as tmp:
-        table.to_csv(tmp, index=False)
-
-    rows = []
-    for s in plan.specs:
-        r = by_hash.get(s.case_hash)
-        status = ("reused" if s.case_hash in reused_hashes
-                  else (r.status if r is not None else "missing"))
-        rows.append({"case_id": s.case_id, "case_hash": s.case_hash, "status": status,
-                     "seconds": round(r.seconds, 3) if r is not None else None,
-                     "host": r.host if r is not None else "",
-                     "pid": r.pid if r is not None else None,
-                     **{n: s.params[n] for n in names}})
-    cases = pd.DataFrame(rows, columns=CASE_COLUMNS + ["status", "seconds", "host", "pid"]
-                         + names)
-    with atomic_path(out_dir / "cases.csv") as tmp:
-        cases.to_csv(tmp, index=False)
-
-    fail_rows = []
-    for s in plan.specs:
-        r = by_hash.get(s.case_hash)
-        if r is not None and r.status != "done":
-            fail_rows.append({"case_id": s.case_id, "case_hash": s.case_hash,
-                              **{n: s.params[n] for n in names},
-                              "error_type": r.error_type, "error": r.error.strip()})
-    failures = pd.DataFrame(fail_rows,
-                            columns=CASE_COLUMNS + names + ["error_type", "error"])
-    with atomic_path(out_dir / "failures.csv") as tmp:
-        failures.to_csv(tmp, index=False)
-
+    cases = _case_table(plan, by_hash, reused)
+    failures = _failure_table(plan, by_hash)
+    for name, frame in (("results.csv", table), ("cases.csv", cases),
+                        ("failures.csv", failures)):
+        with atomic_path(plan.out_dir / name) as tmp:
+            frame.to_csv(tmp, index=False)
     notes = list(plan.notes)
     sens = None
     if sensitivity and len(table):
         from radtree.sweep.sensitivity import write_sensitivity
 
         try:
-            sens = write_sensitivity(out_dir, table, plan.design, plan.measured)
+            sens = write_sensitivity(plan.out_dir, table, plan.design, plan.measured)
         except (RadtreeError, ValueError, KeyError, OSError) as exc:  # results are kept
             notes.append(f"sensitivity summary not written: {exc}")
-            echo(f"warning: sensitivity summary not written: {exc}")
-    computed = [s.case_id for s in plan.specs
-                if s.case_hash in by_hash and by_hash[s.case_hash].status == "done"]
-    reused = [s.case_id for s in plan.specs if s.case_hash in reused_hashes]
-    failed_ids = [s.case_id for s in plan.specs
-                  if s.case_hash in by_hash and by_hash[s.case_hash].status != "done"]
-    return SweepOutcome(out_dir, plan.design, table, cases, failures, computed, reused,
-                        failed_ids, plan.engine, time.perf_counter() - t0, sens, notes)
+            log.warning("sensitivity summary not written: %s", exc)
+    ok = {h for h, r in by_hash.items() if r.status == "done"}
+    ids = {k: [s.case_id for s in plan.specs if s.case_hash in hashes]
+           for k, hashes in (("computed", ok), ("reused", reused),
+                             ("failed", set(by_hash) - ok))}
+    return SweepOutcome(plan.out_dir, plan.design, table, cases, failures, ids["computed"],
+                        ids["reused"], ids["failed"], plan.engine, seconds, sens, notes)
+
+
+def _case_table(plan: SweepPlan, by_hash: dict[str, CaseResult], reused: set[str]
+                ) -> pd.DataFrame:
+    """One line per case of the design: status (done, failed, reused, missing), seconds,
+    host, pid and the parameters."""
+    names = plan.design.names
+    rows = []
+    for s in plan.specs:
+        r = by_hash.get(s.case_hash)
+        status = "reused" if s.case_hash in reused else (r.status if r is not None
+                                                          else "missing")
+        rows.append({"case_id": s.case_id, "case_hash": s.case_hash, "status": status,
+                     "seconds": round(r.seconds, 3) if r is not None else None,
+                     "host": r.host if r is not None else "",
+                     "pid": r.pid if r is not None else None,
+                     **{n: s.params[n] for n in names}})
+    return pd.DataFrame(rows, columns=CASE_COLUMNS + ["status", "seconds", "host", "pid"]
+                        + names)
+
+
+def _failure_table(plan: SweepPlan, by_hash: dict[str, CaseResult]) -> pd.DataFrame:
+    """The failed cases: parameters, error type and message."""
+    names = plan.design.names
+    rows = []
+    for s in plan.specs:
+        r = by_hash.get(s.case_hash)
+        if r is not None and r.status != "done":
+            rows.append({"case_id": s.case_id, "case_hash": s.case_hash,
+                         **{n: s.params[n] for n in names},
+                         "error_type": r.error_type, "error": r.error.strip()})
+    return pd.DataFrame(rows, columns=CASE_COLUMNS + names + ["error_type", "error"])
