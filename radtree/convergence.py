@@ -54,7 +54,7 @@ def convergence_table(project: Project, scenarios: list[str] | None = None,
         # a build-folder engine (Radiance) traces the ladder in the scenario's build folder:
         # one octree for every -ab (an option of rtrace, not of the scene), not one each
         folder = ensure_built(project, sc, echo) if eng.uses_build_folder else None
-        ad = effective_project(project, sc).engine.ad
+        ad = effective_project(project, sc).engine.radiance.ad
         phash = project.params_hash(sc)
         for hour in hours or [project.site.hours[0]]:
             todo = []

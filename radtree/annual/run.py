@@ -325,7 +325,7 @@ def compute_annual(project: Project, options: AnnualOptions | None = None,
     notes += crown_notes
     eng = effective_project(project, with_sc).engine
     ab = options.ab if options.ab is not None else (eng.ab if eng.ab is not None else rec_ab)
-    trace = TraceParams(ab=ab, ad=options.ad or eng.ad, lw=options.lw or eng.lw,
+    trace = TraceParams(ab=ab, ad=options.ad or eng.radiance.ad, lw=options.lw or eng.radiance.lw,
                         nproc=options.nproc)
     sun_trace = TraceParams(ab=ab, ad=options.sun_ad or max(128, trace.ad // 4),
                             lw=options.sun_lw or max(trace.lw, SUN_LW_MIN), nproc=options.nproc)

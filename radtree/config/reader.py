@@ -18,7 +18,7 @@ import tomllib
 from radtree.config.district import DISTRICT_KEYS, read_district
 from radtree.config.honeybee import read_honeybee
 from radtree.config.schema import Project, Scenario, Site, Street, parse_time
-from radtree.config.spec import SchemaError, Spec, spec_for, spec_of, toml_name
+from radtree.config.spec import SchemaError, Spec, spec_for, spec_of, table_fields, toml_name
 from radtree.config.species import find_species, tree_defaults, unknown_species_message
 from radtree.config.switches import (
     FIELD,
@@ -106,7 +106,7 @@ def _table(r: _Reader, table: str, base: Path, **given: Any) -> Any:
     holds (paths resolved), then ``given``; the table's unknown fields are rejected."""
     cls = TABLES[table]
     kwargs: dict[str, Any] = {}
-    for f in fields(cls):
+    for f in table_fields(cls):
         spec = spec_of(cls, f.name)
         key = toml_name(cls, f.name)
         if spec is None or f.name in given or not r.has(key):

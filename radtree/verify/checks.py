@@ -17,7 +17,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -306,8 +306,8 @@ def agreement_checks(hours: tuple[str, ...] = ("12:30",), scenarios: tuple[str, 
             got, se = fw.grid_mean("facade")
             for e in active:
                 plan = plan_of[e]
-                params = proj.engine if plan.ad is None else replace(proj.engine,
-                                                                     ad=int(plan.ad))
+                params = (proj.engine if plan.ad is None
+                          else proj.engine.changed(ad=int(plan.ad)))
                 bw = backward_patch_mean(e, built.scene, st, "facade", 0.5, ab=built.ab,
                                          points=plan.points, rays=plan.rays, params=params)
                 comb = math.hypot(se, bw.stderr)

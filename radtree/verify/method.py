@@ -157,7 +157,7 @@ def run_method_study(root: Path, *, photons: int = 1_000_000, radii: Sequence[fl
                 continue
             h["variant"], h["radius_m"], h["engine"] = variant.label, radius, variant.engine
             h["slat_m"] = use.tree.louvers.slat_size_m
-            h["photons"] = photons if variant.engine in photon_engines() else proj.engine.rays
+            h["photons"] = photons if variant.engine in photon_engines() else proj.engine.numpy.rays
             echo(f"  {variant.label}, dome {radius:g} m, {name}: "
                  + " ".join(f"{v:.0f}" for v in h["lux"]))
             table = pd.concat([table, h[COLUMNS]], ignore_index=True)

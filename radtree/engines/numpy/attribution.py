@@ -227,7 +227,7 @@ def attribute_hour(scene: Scene, state: SkyState, params: EngineParams,
                  scene_optics(scene, state, geo.material_names))
     seed = params.seed if seed is None else seed
     return {g: _attribute_grid(hour, scene.grids[g], grid_rays(params, g),
-                               _grid_seed(seed, g), params.sampling, names)
+                               _grid_seed(seed, g), params.numpy.sampling, names)
             for g in grid_names}
 
 

@@ -158,7 +158,7 @@ class _Tracer:
         self.opt = optics
         self.env = Environment(state)
         self.state = state
-        self.max_bounces = int(params.max_bounces)
+        self.max_bounces = int(params.numpy.max_bounces)
         self.opts = opts
         self.workers = max(1, int(getattr(params, "workers", 2) or 1))
         self.eps = opts.epsilon if opts.epsilon is not None else max(1e-5, 2e-6 * geo.size)

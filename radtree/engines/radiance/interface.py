@@ -60,7 +60,7 @@ class RadianceEngine(Engine):
 
     def sampling(self, params: EngineParams) -> str:
         pm = PhotonMap.from_params(params)
-        return f"-ad {params.ad} -lw {params.lw:g}" + (f", {pm.describe()}" if pm else "")
+        return f"-ad {params.radiance.ad} -lw {params.radiance.lw:g}" + (f", {pm.describe()}" if pm else "")
 
     def prepare(self, scene: Scene, states: list[SkyState], params: EngineParams, ab: int,
                 folder: Path | None = None) -> BuildPlan:
