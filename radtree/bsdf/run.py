@@ -15,7 +15,6 @@ from __future__ import annotations
 
 import math
 import shutil
-from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -101,11 +100,11 @@ def summary_row(state: str, run: BsdfRun, k: KlemsBsdf) -> dict:
     return row
 
 
-def compute_crown_bsdfs(project: Project, scenario: Scenario, out: Path,
-                        states: tuple[str, ...] = STATES, nproc: int = 1,
-                        progress: Callable[[str], None] | None = None) -> CrownBsdfs:
+def compute_crown_bsdfs(project: Project, scenario: Scenario, out: Path, *,
+                        states: tuple[str, ...] = STATES, nproc: int = 1) -> CrownBsdfs:
     """Leaf-on/off XMLs of ``scenario`` in ``out`` (``<state>.xml``, work files in
-    ``out/work/<state>/``) and ``out/summary.csv``."""
+    ``out/work/<state>/``) and ``out/summary.csv``; ``nproc`` rfluxmtx processes. The
+    commands run are logged (INFO)."""
     tree, form = scenario_tree(project, scenario)
     settings = flux_settings(tree, form, nproc)
     on = leaf_on_sample(project, scenario)
@@ -115,7 +114,7 @@ def compute_crown_bsdfs(project: Project, scenario: Scenario, out: Path,
     runs, mats, rows = {}, {}, []
     out.mkdir(parents=True, exist_ok=True)
     for state in states:
-        run = ensure_bsdf(samples[state], settings, out / "work" / state, state, progress)
+        run = ensure_bsdf(samples[state], settings, out / "work" / state, state)
         final = out / f"{state}.xml"
         with atomic_path(final) as tmp:
             shutil.copyfile(run.xml, tmp)

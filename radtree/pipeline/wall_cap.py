@@ -229,7 +229,7 @@ def depth_bsdf(folder: Path, sample: PatchDepthSample, settings: FluxSettings, n
     subs = write_systems(folder, "node", sample.rings, settings.tiles)
     single = replace(settings, nproc=1)
     with ThreadPoolExecutor(max_workers=max(1, min(settings.nproc, len(subs)))) as pool:
-        list(pool.map(lambda sub: flux_passes(sub, single, progress), subs))
+        list(pool.map(lambda sub: flux_passes(sub, single), subs))
     flux = {}
     for key in KEYS:
         mats = [np.loadtxt(sub / f"{key}.dat", ndmin=2) for sub in subs]
