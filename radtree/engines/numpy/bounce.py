@@ -25,8 +25,9 @@ from typing import Any
 
 import numpy as np
 
-from radtree.engines.common.geometry import glass_coefficients
+from radtree.engines.common.geometry import Geometry, Optics, glass_coefficients
 from radtree.engines.common.kernel import kernel
+from radtree.engines.common.raycast import RayCaster
 from radtree.engines.common.sampling import cosine_rows, mirror, uniform_cone
 from radtree.engines.common.streams import Draws
 from radtree.engines.numpy.shadow import rows as _rows
@@ -98,13 +99,18 @@ class BounceSteps:
     """The steps of a bounce, mixed into the tracer (:class:`_Tracer
     <radtree.engines.numpy.engine._Tracer>`), which sets these attributes."""
 
-    caster: Any
+    caster: RayCaster
     media: Any
     opts: Any
     env: Any
     envs: list[Any]
-    geo: Any
+    geo: Geometry
+    opt: Optics
     eps: float
+    tri_ts: np.ndarray
+    sun_cos: np.ndarray
+    sun_side: np.ndarray
+    sun_grazing: bool
     n_tri: int
     sun: np.ndarray
     suns: np.ndarray
