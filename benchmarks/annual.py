@@ -108,7 +108,7 @@ def main() -> None:
         project = load_project(dst)
         t0 = time.perf_counter()
         radtree.log.enable(progress=False)   # the run's messages, as it goes
-        out = run_annual(project, AnnualOptions(nproc=args.processes), figures=True)
+        out = run_annual(project, options=AnnualOptions(nproc=args.processes), figures=True)
         wall = time.perf_counter() - t0
         r = out.result
         print(f"\nwall time of the full annual run ({args.processes} rcontrib processes): "

@@ -77,7 +77,7 @@ def timed(project_dir: Path, options: AnnualOptions, overrides: dict | None = No
     project = load_project(project_dir, overrides=overrides)
     t0, c0 = time.perf_counter(), cpu_seconds()
     radtree.log.enable(progress=False)   # the run's messages, as it goes
-    result = compute_annual(project, options)
+    result = compute_annual(project, options=options)
     return result, time.perf_counter() - t0, cpu_seconds() - c0
 
 

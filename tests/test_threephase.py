@@ -41,11 +41,12 @@ def runs(project_dir):
 
     project = load_project(project_dir)
     quick = dict(nproc=1, method="3phase", daylight_samples=24, sun_ad=32)
-    first = compute_annual(project, AnnualOptions(**quick))
+    first = compute_annual(project, options=AnnualOptions(**quick))
     folder = project.results_dir / "annual" / "threephase"
     stamps = {f.name: f.stat().st_mtime_ns for f in folder.iterdir()
               if f.name.startswith(("view_", "daylight_")) and not f.suffix}
-    second = compute_annual(project, AnnualOptions(**quick, leaf=LeafSchedule("01-01", "12-31")))
+    second = compute_annual(project, options=AnnualOptions(**quick, leaf=LeafSchedule(
+        "01-01", "12-31")))
     return project, first, second, folder, stamps
 
 
@@ -238,7 +239,7 @@ def test_default_method_reuses_the_three_phase_sun_runs(runs):
     before = {f: f.stat().st_mtime_ns for s in ("leaf_on", "leaf_off")
               for f in (coeffs / s).glob("sun_*.npy")}
     assert len(before) == 6                  # direct, patch -ab 0, patch -ab N per state
-    dc = compute_annual(project, AnnualOptions(nproc=1, method="dc", sun_ad=32))
+    dc = compute_annual(project, options=AnnualOptions(nproc=1, method="dc", sun_ad=32))
     after = {f: f.stat().st_mtime_ns for s in ("leaf_on", "leaf_off")
              for f in (coeffs / s).glob("sun_*.npy")}
     assert after == before

@@ -11,15 +11,15 @@ from radtree.annual.threephase_run import compute_annual_3phase
 from radtree.config import Project
 
 
-def compute(project: Project, options: AnnualOptions | None = None) -> AnnualResult:
+def compute(project: Project, *, options: AnnualOptions | None = None) -> AnnualResult:
     """8760 hours of illuminance by ``options.method``."""
     options = options or AnnualOptions()
     if options.method == "3phase":
-        return compute_annual_3phase(project, options)
-    return compute_annual(project, options)
+        return compute_annual_3phase(project, options=options)
+    return compute_annual(project, options=options)
 
 
-def run(project: Project, options: AnnualOptions | None = None, *,
+def run(project: Project, *, options: AnnualOptions | None = None,
         figures: bool = True) -> AnnualOutcome:
     """Compute and write the annual results by ``options.method``."""
-    return write_annual(compute(project, options), figures=figures)
+    return write_annual(compute(project, options=options), figures=figures)

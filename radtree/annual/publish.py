@@ -96,8 +96,8 @@ def write_annual(result: AnnualResult, figures: bool = True) -> AnnualOutcome:
     return AnnualOutcome(result, a, s, m, hourly, mp, figs)
 
 
-def run_annual(project: Project, options: AnnualOptions | None = None, *,
+def run_annual(project: Project, *, options: AnnualOptions | None = None,
                figures: bool = True) -> AnnualOutcome:
     """Compute (the default ``dc`` method, :func:`radtree.annual.run.compute_annual`) and
     write the annual results; :func:`radtree.annual.methods.run` picks the method."""
-    return write_annual(compute_annual(project, options), figures=figures)
+    return write_annual(compute_annual(project, options=options), figures=figures)

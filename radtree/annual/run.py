@@ -413,7 +413,8 @@ def finish_annual(project: Project, plan: AnnualPlan, year: YearInputs,
                         sunlight=sun)
 
 
-def compute_annual(project: Project, options: AnnualOptions | None = None) -> AnnualResult:
+def compute_annual(project: Project, *, options: AnnualOptions | None = None
+                   ) -> AnnualResult:
     """Trace the three scenes and assemble 8760 hours of illuminance per sensor (the default
     ``dc`` method): plan, the year, the scenes' coefficients, the result. Messages through
     :mod:`logging` (INFO), a progress bar over the scenes when the CLI turned bars on."""

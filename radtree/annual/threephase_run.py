@@ -108,7 +108,7 @@ def _state_lux(plan: AnnualPlan, year: YearInputs, *, state: str, tp: ThreePhase
     return (sun_tot + sky_tot).astype(np.float32), sun_dir
 
 
-def compute_annual_3phase(project: Project, options: AnnualOptions) -> AnnualResult:
+def compute_annual_3phase(project: Project, *, options: AnnualOptions) -> AnnualResult:
     """The annual run of :func:`radtree.annual.run.compute_annual` by the three-phase method
     (:mod:`radtree.annual.threephase`); the same :class:`AnnualResult`, variants
     ``leaf_on``/``leaf_off`` from the crown BSDFs, ``without`` as the default method."""

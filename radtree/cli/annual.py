@@ -86,7 +86,7 @@ def annual_command(*, project: Path, leaf_on: str | None, leaf_off: str | None, 
         species_phenology=not use_dates, method=method, sun_crown=sun_crown,
         sunlight_date=sunlight_date)
     click.echo(f"annual: {proj.name}; leaf season {options.season.describe()}")
-    out = run_annual(proj, options, figures=not no_figures)
+    out = run_annual(proj, options=options, figures=not no_figures)
     from radtree.annual.report import grid_summary
 
     for row in grid_summary(proj).itertuples(index=False):

@@ -33,7 +33,7 @@ Light sources and physics, chosen to behave like Radiance:
   specular only, with Radiance's angular ``glass`` formulas (Fresnel at n = 1.52 with the
   transmissivity along the refracted path, multiple internal reflections): transmission T(θ)
   and mirror reflection R(θ) (≈ 8 % at normal incidence).
-* **Bounces** — ``params.max_bounces`` counts diffuse segments exactly like ``rtrace -ab``:
+* **Bounces** — ``params.numpy.max_bounces`` counts diffuse segments exactly like ``rtrace -ab``:
   the sensor's sample is bounce 1, the surface at the end of the last allowed segment still
   gets its direct sun but no further diffuse ray. Specular events (T_s, glass, mirror) do not
   count as bounces (capped separately). Path weights are multiplied by the surface's total

@@ -181,7 +181,7 @@ def trace_hour(scene: Scene, state: SkyState, params: EngineParams,
                ) -> dict[str, GridResult]:
     """Illuminance (lux) and its Monte Carlo standard error per sensor of each grid, one hour.
 
-    ``params.rays`` paths per sensor, ``params.max_bounces`` diffuse bounces (like ``-ab``),
+    ``params.numpy.rays`` paths per sensor, ``params.numpy.max_bounces`` diffuse bounces (like ``-ab``),
     ``seed`` (default ``params.seed``): the same seed gives identical numbers; each grid draws
     from its own stream (seed, grid name), so a grid's values do not depend on which other
     grids are traced.
