@@ -153,7 +153,7 @@ def main() -> None:
             runs.append(("radiance", replace(proj.engine, ad=a.ad, pmap_photons=a.pmap,
                                              pmap_caustic_photons=a.pmap)))
         for e, params in runs:
-            label = "pmap" if params.pmap_photons else e
+            label = "pmap" if params.radiance.pmap_photons else e
             t0, c0 = time.perf_counter(), time.process_time()
             bw = backward_patch_mean(e, scene, st, "facade", 0.5, ab=built.ab,
                                      points=a.points, rays=a.rays, params=params)

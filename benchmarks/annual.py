@@ -31,8 +31,10 @@ import numpy as np
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
+import radtree.log  # noqa: E402
+from radtree.annual.publish import run_annual  # noqa: E402
 from radtree.annual.report import grid_summary  # noqa: E402
-from radtree.annual.run import AnnualOptions, AnnualResult, annual_scenes, run_annual  # noqa: E402
+from radtree.annual.run import AnnualOptions, AnnualResult, annual_scenes  # noqa: E402
 from radtree.config import load_project  # noqa: E402
 from radtree.light.units import PHOTOPIC_RGB, WHITE_EFFICACY  # noqa: E402
 
@@ -105,8 +107,8 @@ def main() -> None:
     try:
         project = load_project(dst)
         t0 = time.perf_counter()
-        out = run_annual(project, AnnualOptions(nproc=args.processes), echo=print,
-                         figures=True)
+        radtree.log.enable(progress=False)   # the run's messages, as it goes
+        out = run_annual(project, options=AnnualOptions(nproc=args.processes), figures=True)
         wall = time.perf_counter() - t0
         r = out.result
         print(f"\nwall time of the full annual run ({args.processes} rcontrib processes): "

@@ -133,8 +133,8 @@ def engine_hour(quick: bool) -> Scene:
     dt = time.perf_counter() - t
     rays = geo.caster.rays_cast
     assert r.stderr is not None
-    print(f"slat scene: {sc.n_triangles} triangles (3000 slats), 8 sensors × {p.rays} paths, "
-          f"max_bounces {p.max_bounces}, Perez sky + sun")
+    print(f"slat scene: {sc.n_triangles} triangles (3000 slats), 8 sensors × {p.numpy.rays} paths, "
+          f"max_bounces {p.numpy.max_bounces}, Perez sky + sun")
     print(f"  geometry {prep:.2f} s; tracing {dt:.2f} s per hour; {rays / 1e6:.2f} M rays "
           f"({rays / dt / 1e6:.2f} M rays/s overall); mean {r.lux.mean():.0f} lx, "
           f"stderr {100 * (r.stderr / r.lux).mean():.2f} %")
@@ -148,7 +148,7 @@ def engine_hour(quick: bool) -> Scene:
                         and s.reflection == "traced")
         built = make_scene(project, scenario, dense_grid=False)
         state = hour_states(project, scenario, ["11:30"])[0]
-        pp = EngineParams(rays=p.rays, max_bounces=max(8, built.ab))
+        pp = EngineParams(rays=p.numpy.rays, max_bounces=max(8, built.ab))
         scene_geometry(built.scene, DEFAULT_OPTIONS.backend, pp.workers)
         t = time.perf_counter()
         rr = trace(built.scene, state, pp)["facade"]

@@ -55,9 +55,11 @@ import pandas as pd
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
+import radtree.log  # noqa: E402
 from radtree.annual.methods import compute as compute_annual  # noqa: E402
 from radtree.annual.report import summarise  # noqa: E402
-from radtree.annual.run import AnnualOptions, AnnualResult, annual_tables  # noqa: E402
+from radtree.annual.run import AnnualOptions, AnnualResult  # noqa: E402
+from radtree.annual.tables import annual_tables  # noqa: E402
 from radtree.config import load_project  # noqa: E402
 
 COLUMNS = ["sda_300_50", "udi_below_100", "udi_100_300", "udi_300_3000", "udi_above_3000"]
@@ -74,7 +76,8 @@ def timed(project_dir: Path, options: AnnualOptions, overrides: dict | None = No
           ) -> tuple[AnnualResult, float, float]:
     project = load_project(project_dir, overrides=overrides)
     t0, c0 = time.perf_counter(), cpu_seconds()
-    result = compute_annual(project, options, echo=lambda s: print(s, flush=True))
+    radtree.log.enable(progress=False)   # the run's messages, as it goes
+    result = compute_annual(project, options=options)
     return result, time.perf_counter() - t0, cpu_seconds() - c0
 
 
@@ -133,19 +136,19 @@ def same_crown(project_dir: Path, overrides: dict, r3: AnnualResult) -> AnnualRe
 
     project = load_project(project_dir, overrides=overrides)
     sc = project.scenario(r3.scenarios["with"])
-    models, form = crown_models(project, sc, state_xmls(project, sc, print))
+    models, form = crown_models(project, sc, state_xmls(project, sc))
     bare = make_scene(project, replace(sc, model="none"), dense_grid=False).scene
     grids, rho, mf = list(r3.grids), r3.ground_reflectance, r3.options.mf
     sky = sky_matrix(r3.wea, mf, rho)
     work = project.results_dir / "annual" / "threephase"
-    tp = ThreePhase(work, bare, models, form, grids, rho, mf, r3.trace, print,
-                    r3.options.daylight_samples)
+    tp = ThreePhase(work, bare=bare, models=models, form=form, grids=grids, rho=rho, mf=mf,
+                    trace=r3.trace, samples=r3.options.daylight_samples)
     views, v_sky = tp.view()
     total = {k: dict(v) for k, v in r3.total.items()}
     direct = {k: dict(v) for k, v in r3.direct.items()}
     for state in STATES:
         runner = CoefficientRunner(_scene_with(bare, models[state]), grids,
-                                   work / f"sun_{state}", rho, echo=print)
+                                   work / f"sun_{state}", rho)
         diff = sky_lux(runner.sky(mf, r3.trace), sky) - sky_lux(
             tp.coefficients(state, views, v_sky), sky)
         start = 0

@@ -36,6 +36,7 @@ import pandas as pd
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
+import radtree.log  # noqa: E402
 from radtree.annual.closure import (  # noqa: E402
     ClosureSettings,
     closure_sensors,
@@ -68,6 +69,7 @@ def main() -> None:
                     help="also the ratio per sensor row (height) of each grid, uniform sky")
     ap.add_argument("-j", "--processes", type=int, default=2)
     args = ap.parse_args()
+    radtree.log.enable(progress=False)   # the rfluxmtx runs, as they go
     work = args.work / args.project.name
     if not work.exists():
         shutil.copytree(args.project, work, ignore=shutil.ignore_patterns("build", "results"))
@@ -81,7 +83,7 @@ def main() -> None:
     t0 = time.perf_counter()
     states = args.states.split(",")
     if "leaf_off" in states:
-        xmls = state_xmls(project, sc, lambda s: print(s, flush=True))
+        xmls = state_xmls(project, sc)
     else:     # leaf-on only: the bare crown's XML is not computed (its model is not traced)
         from radtree.pipeline.crown_bsdf import scenario_xmls
 
@@ -106,21 +108,20 @@ def main() -> None:
     for level in [int(x) for x in args.levels.split(",")]:
         for up in args.up.split(","):
             t1 = time.perf_counter()
-            table = closure_table(bare, models, form, grids, rho,
-                                  project.results_dir / "closure",
-                                  ClosureSettings(trace, args.daylight_samples, level,
-                                                  up == "material", args.tile),
-                                  tuple(states),
-                                  lambda s: print(s, flush=True))
+            table = closure_table(bare, models=models, form=form, grids=grids, rho=rho,
+                                  folder=project.results_dir / "closure",
+                                  settings=ClosureSettings(trace, args.daylight_samples, level,
+                                                           up == "material", args.tile),
+                                  states=tuple(states))
             print(f"\nlevel {level}, up {up} ({time.perf_counter() - t1:.0f} s):")
             print(table.round(4).to_string(index=False), flush=True)
             if args.rows:     # per sensor row (height), uniform sky, from the cached matrices
-                ref, parts, _ = closure_sensors(bare, models, form, grids, rho,
-                                                project.results_dir / "closure",
-                                                ClosureSettings(trace, args.daylight_samples,
-                                                                level, up == "material",
-                                                                args.tile),
-                                                states[0])
+                ref, parts, _ = closure_sensors(
+                    bare, models=models, form=form, grids=grids, rho=rho,
+                    folder=project.results_dir / "closure",
+                    settings=ClosureSettings(trace, args.daylight_samples, level,
+                                             up == "material", args.tile),
+                    state=states[0])
                 chain = sum(parts.values())
                 start = 0
                 for g in grids:

@@ -101,7 +101,7 @@ def _ladder(project: Project, eng: Engine, options: RunOptions, ab_values: tuple
         # a build-folder engine (Radiance) traces the ladder in the scenario's build folder:
         # one octree for every -ab (an option of rtrace, not of the scene), not one each
         folder = ensure_built(project, sc) if eng.uses_build_folder else None
-        ad = effective_project(project, sc).engine.ad
+        ad = effective_project(project, sc).engine.radiance.ad
         phash = project.params_hash(sc)
         for hour in options.hours or [project.site.hours[0]]:
             todo = []

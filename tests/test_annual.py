@@ -366,8 +366,7 @@ def test_leaf_dates_switch_between_leafed_and_bare_coefficients(tiny_project):
     from radtree.config import load_project
 
     project = load_project(tiny_project)
-    quiet = dict(echo=lambda s: None)
-    base = compute_annual(project, AnnualOptions(nproc=1), **quiet)
+    base = compute_annual(project, options=AnnualOptions(nproc=1))
     assert base.scenarios == {"with": "with", "without": "without"}
     assert base.weather.generated
     assert base.trace.ab == 1
@@ -382,8 +381,8 @@ def test_leaf_dates_switch_between_leafed_and_bare_coefficients(tiny_project):
     np.testing.assert_array_equal(base.total["with"][g][:, july], off[:, july])
     np.testing.assert_array_equal(base.total["with"][g][:, january], on[:, january])
     # in leaf all year: July now uses the leafed coefficients; coefficients are reused
-    always = compute_annual(project, AnnualOptions(leaf=LeafSchedule("01-01", "12-31"),
-                                                   nproc=1), **quiet)
+    always = compute_annual(project, options=AnnualOptions(
+        leaf=LeafSchedule("01-01", "12-31"), nproc=1))
     np.testing.assert_array_equal(always.total["with"][g][:, july], on[:, july])
     assert not np.allclose(always.total["with"][g][:, july], base.total["with"][g][:, july])
     np.testing.assert_allclose(always.total["leaf_off"][g], off)
@@ -461,7 +460,7 @@ def test_species_phenology_weighs_leafed_and_bare_hour_by_hour(tiny_project):
     from radtree.config import load_project
 
     project = load_project(tiny_project, {"tree.species": "morus_alba"})
-    res = compute_annual(project, AnnualOptions(nproc=1), echo=lambda s: None)
+    res = compute_annual(project, options=AnnualOptions(nproc=1))
     wea, g = res.wea, "facade"
     on, off, with_ = (res.total[k][g].astype(np.float64) for k in ("leaf_on", "leaf_off", "with"))
     assert res.leaf_fraction is not None and res.leaf_weight is not None
@@ -511,12 +510,14 @@ def test_reflected_sun_sampling_from_the_command_line(tiny_project, tmp_path):
 
     from click.testing import CliRunner
 
+    from radtree.cli import main
     from radtree.cli.annual import annual_command
 
     proj = tmp_path / "proj"
     shutil.copytree(tiny_project, proj, ignore=shutil.ignore_patterns("results"))
-    res = CliRunner().invoke(annual_command, [str(proj), "--no-figures", "-j", "1",
-                                              "--sun-ad", "96", "--sun-lw", "0.002"])
+    # through the command group, which shows the run's messages (radtree.log)
+    res = CliRunner().invoke(main, ["annual", str(proj), "--no-figures", "-j", "1",
+                                    "--sun-ad", "96", "--sun-lw", "0.002"])
     assert res.exit_code == 0, res.output
     assert "-ad 96 -lw 0.002 (reflected sun)" in res.output
     meta = json.loads((proj / "results" / "annual" / "annual_meta.json").read_text())

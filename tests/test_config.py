@@ -21,7 +21,7 @@ def test_mendoza_project_loads():
                                                    "calculated", "traced", "calculated", "traced",
                                                    "calculated", "traced", "traced"]
     assert p.tree.louvers.layers == 5 and p.tree.louvers.specular_fraction == 0.9
-    assert p.engine.as_ == 0 and p.engine.aa == 0 and p.engine.ab is None
+    assert p.engine.radiance.as_ == 0 and p.engine.radiance.aa == 0 and p.engine.ab is None
 
 
 def test_params_hash_changes_with_parameters(tmp_path):

@@ -5,7 +5,6 @@ from __future__ import annotations
 import importlib.util
 import json
 import re
-from dataclasses import fields
 from pathlib import Path
 
 import pytest
@@ -14,7 +13,7 @@ from click.testing import CliRunner
 
 from radtree.cli import main
 from radtree.config import Crown, Louvers, Sensors, Street, load_project
-from radtree.config.spec import spec_of, toml_name
+from radtree.config.spec import spec_of, table_fields, toml_name
 from radtree.config.switches import TABLES
 from radtree.errors import ConfigError
 from radtree.site.starter import Location, new_project, read_inputs, site_facts
@@ -45,7 +44,7 @@ def test_new_from_an_epw_then_build(tmp_path: Path) -> None:
         if table == "office":
             continue
         body = _section(text, table)
-        for f in fields(cls):
+        for f in table_fields(cls):
             if spec_of(cls, f.name) is not None:
                 assert re.search(rf"^(# )?{toml_name(cls, f.name)} = ", body, flags=re.M), \
                     (table, f.name)

@@ -15,7 +15,8 @@ import pytest
 from radtree.config import EngineParams
 from radtree.engines.common.sampling import cosine_hemisphere, cosine_rows
 from radtree.engines.numpy import tracing
-from radtree.engines.numpy.engine import DEFAULT_OPTIONS, _cumulative, _event
+from radtree.engines.numpy.bounce import _cumulative, _event
+from radtree.engines.numpy.engine import DEFAULT_OPTIONS
 from radtree.engines.numpy.scenes import dome_slats, sky_state
 from radtree.engines.numpy.shadow import crossed, crossed_sun
 from radtree.optics import Plastic, Trans

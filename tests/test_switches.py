@@ -26,6 +26,7 @@ from radtree.config import (
     load_project,
     lookup_key,
 )
+from radtree.config.spec import table_fields
 from radtree.config.switches import TABLES, table_keys
 from radtree.errors import ConfigError
 
@@ -41,7 +42,7 @@ def _lists_all(message: str, names) -> bool:
 # ---------------------------------------------------------------- the registry itself
 def test_every_dataclass_field_is_a_key():
     for table, cls in TABLES.items():
-        for f in fields(cls):
+        for f in table_fields(cls):
             if f.name == "ground_reflectance_table" or f"{table}.{f.name}" in TABLES:
                 continue  # derived from street.ground_reflectance; a sub-table
             toml = {"as_": "as", "direct_normal_table": "direct_normal"}.get(f.name, f.name)
@@ -60,8 +61,8 @@ def test_toml_names_are_mapped_once():
         lookup_key("engine.as_")
     p = load_project(MENDOZA)
     sw = effective_project(p, Scenario("x", "louvers", switches={"engine.as": 16}))
-    assert sw.engine.as_ == 16
-    assert load_project(MENDOZA, overrides={"engine.as": 8}).engine.as_ == 8
+    assert sw.engine.radiance.as_ == 16
+    assert load_project(MENDOZA, overrides={"engine.as": 8}).engine.radiance.as_ == 8
 
 
 def test_switch_uses():

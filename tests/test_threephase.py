@@ -41,12 +41,12 @@ def runs(project_dir):
 
     project = load_project(project_dir)
     quick = dict(nproc=1, method="3phase", daylight_samples=24, sun_ad=32)
-    first = compute_annual(project, AnnualOptions(**quick), echo=lambda s: None)
+    first = compute_annual(project, options=AnnualOptions(**quick))
     folder = project.results_dir / "annual" / "threephase"
     stamps = {f.name: f.stat().st_mtime_ns for f in folder.iterdir()
               if f.name.startswith(("view_", "daylight_")) and not f.suffix}
-    second = compute_annual(project, AnnualOptions(**quick, leaf=LeafSchedule("01-01", "12-31")),
-                            echo=lambda s: None)
+    second = compute_annual(project, options=AnnualOptions(**quick, leaf=LeafSchedule(
+        "01-01", "12-31")))
     return project, first, second, folder, stamps
 
 
@@ -68,11 +68,12 @@ def test_three_phase_sky_matches_rcontrib_on_the_same_bsdf_crown(runs):
     sc = project.scenario("with")
     from dataclasses import replace
 
-    models, form = crown_models(project, sc, state_xmls(project, sc, lambda s: None))
+    models, form = crown_models(project, sc, state_xmls(project, sc))
     bare = make_scene(project, replace(sc, model="none"), dense_grid=False).scene
     trace = TraceParams(ab=4, ad=192, lw=1e-3)
     rho = first.ground_reflectance
-    tp = ThreePhase(folder, bare, models, form, ["facade"], rho, 1, trace, lambda s: None, 24)
+    tp = ThreePhase(folder, bare=bare, models=models, form=form, grids=["facade"], rho=rho,
+                    mf=1, trace=trace, samples=24)
     views, v_sky = tp.view()
     assert tp.timing == {}                      # cached: nothing traced again
     sky = sky_matrix(first.wea, 1, rho).sum(axis=1)            # (patches, 3): the year
@@ -193,7 +194,7 @@ def test_sun_through_the_explicit_crown(runs, tmp_path):
     opts = first.options
     with_sc, without_sc, _ = choose_scenarios(project, opts)
     scenes, grids, _, _ = annual_scenes(project, with_sc, without_sc, opts.branches, None)
-    year = annual_weather(project, None, 1, 1, first.ground_reflectance, lambda s: None)
+    year = annual_weather(project, epw=None, mf=1, sun_mf=1, rho=first.ground_reflectance)
     suns = year[3]
     trace = TraceParams(ab=4, ad=192, lw=1e-3)
     for state in ("leaf_on", "leaf_off"):
@@ -238,8 +239,7 @@ def test_default_method_reuses_the_three_phase_sun_runs(runs):
     before = {f: f.stat().st_mtime_ns for s in ("leaf_on", "leaf_off")
               for f in (coeffs / s).glob("sun_*.npy")}
     assert len(before) == 6                  # direct, patch -ab 0, patch -ab N per state
-    dc = compute_annual(project, AnnualOptions(nproc=1, method="dc", sun_ad=32),
-                        echo=lambda s: None)
+    dc = compute_annual(project, options=AnnualOptions(nproc=1, method="dc", sun_ad=32))
     after = {f: f.stat().st_mtime_ns for s in ("leaf_on", "leaf_off")
              for f in (coeffs / s).glob("sun_*.npy")}
     assert after == before

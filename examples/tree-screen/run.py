@@ -24,6 +24,7 @@ import numpy as np
 from honeybee_radiance.geometry import Polygon
 from honeybee_radiance.modifier.material import BSDF, Glass, Plastic
 
+import radtree.log
 from radtree.bsdf.run import compute_crown_bsdfs
 from radtree.config import load_project
 from radtree.engines.radiance.binaries import require_radiance
@@ -101,7 +102,8 @@ def main() -> None:
     if not xmls:
         proj = load_project(HERE.parent / "mendoza-street",
                             overrides={"tree.bsdf.samples": args.samples})
-        result = compute_crown_bsdfs(proj, proj.scenario("B"), out / "bsdf", progress=print)
+        radtree.log.enable(progress=False)   # the rfluxmtx commands as they run
+        result = compute_crown_bsdfs(proj, proj.scenario("B"), out / "bsdf")
         xmls = [r.xml for r in result.runs.values()]
     clear = trace(out, "clear", Glass.from_single_transmittance("clear_glass", 0.8))
     print(f"clear glazing (τ 0.8):          work plane mean {clear:8.1f} lx")

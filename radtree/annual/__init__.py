@@ -9,9 +9,12 @@
 * :mod:`~radtree.annual.schedule` — leaf-on/leaf-off dates, occupancy;
 * :mod:`~radtree.annual.branches` — the leaf-off crown (opaque branches at 40°);
 * :mod:`~radtree.annual.metrics` — UDI, DA, sDA, ASE;
-* :mod:`~radtree.annual.run` — the run (:func:`run_annual`) and its tables;
+* :mod:`~radtree.annual.run` — the run's steps (plan, coefficients, result:
+  :func:`compute_annual`); :mod:`~radtree.annual.publish` writes its tables
+  (:func:`run_annual`);
 * :mod:`~radtree.annual.threephase` — the three-phase method (view matrix · crown BSDF ·
-  daylight matrix · sky), ``--method 3phase``; :mod:`~radtree.annual.methods` picks the method;
+  daylight matrix · sky), run by :mod:`~radtree.annual.threephase_run` (``--method
+  3phase``); :mod:`~radtree.annual.methods` picks the method;
 * :mod:`~radtree.annual.report` — figures and :func:`annual_section_data`.
 
 The command is :mod:`radtree.cli.annual`.
@@ -19,7 +22,8 @@ The command is :mod:`radtree.cli.annual`.
 
 from __future__ import annotations
 
-from radtree.annual.run import AnnualOptions, AnnualResult, compute_annual, run_annual
+from radtree.annual.publish import run_annual
+from radtree.annual.run import AnnualOptions, AnnualResult, compute_annual
 from radtree.annual.schedule import LeafSchedule
 
 

@@ -65,17 +65,18 @@ def chain_parts(tp: ThreePhase, state: str) -> tuple[dict[str, np.ndarray], int]
     return {"bypass": vs.mean(axis=2), "transmitted": trans, "reflected": refl}, len(groups)
 
 
-def closure_sensors(bare: Scene, models: dict[str, TreeModel], form: str, grids: list[str],
-                    rho: float, folder: Path, settings: ClosureSettings, state: str,
-                    echo=None) -> tuple[np.ndarray, dict[str, np.ndarray], int]:
+def closure_sensors(bare: Scene, *, models: dict[str, TreeModel], form: str,
+                    grids: list[str], rho: float, folder: Path, settings: ClosureSettings,
+                    state: str) -> tuple[np.ndarray, dict[str, np.ndarray], int]:
     """(sensors, patches) grey coefficients of the reference (rcontrib on the BSDF-crown
     scene, MF 1) and of the chain's parts (:func:`chain_parts`), the number of groups.
     Matrices are cached in ``folder`` by their inputs."""
     tag = (f"l{settings.level}_{'material' if settings.material_up else 'default'}"
            + (f"_t{settings.tile_m:g}" if settings.tile_m else ""))
-    tp = ThreePhase(folder / f"chain_{tag}", bare, models, form, grids, rho, 1,
-                    settings.trace, echo or (lambda _s: None), settings.samples,
-                    settings.level, settings.material_up, settings.tile_m)
+    tp = ThreePhase(folder / f"chain_{tag}", bare=bare, models=models, form=form, grids=grids,
+                    rho=rho, mf=1, trace=settings.trace, samples=settings.samples,
+                    level=settings.level, material_up=settings.material_up,
+                    tile_m=settings.tile_m)
     runner = CoefficientRunner(_scene_with(bare, models[state]), grids,
                                folder / f"reference_{state}", rho)
     ref = runner.sky(1, settings.trace).mean(axis=2)
@@ -83,17 +84,18 @@ def closure_sensors(bare: Scene, models: dict[str, TreeModel], form: str, grids:
     return ref, parts, n_groups
 
 
-def closure_table(bare: Scene, models: dict[str, TreeModel], form: str, grids: list[str],
+def closure_table(bare: Scene, *, models: dict[str, TreeModel], form: str, grids: list[str],
                   rho: float, folder: Path, settings: ClosureSettings,
-                  states: tuple[str, ...] = ("leaf_on",), echo=None) -> pd.DataFrame:
+                  states: tuple[str, ...] = ("leaf_on",)) -> pd.DataFrame:
     """One row per grid × state × light (:data:`COLUMNS`): the grid's mean of the reference
     and of the chain (:func:`closure_sensors`), their ratio and the chain's parts."""
     sizes = [len(bare.grids[g]) for g in grids]
     cuts = np.cumsum([0, *sizes])
     rows = []
     for state in states:
-        ref, parts, n_groups = closure_sensors(bare, models, form, grids, rho, folder,
-                                               settings, state, echo)
+        ref, parts, n_groups = closure_sensors(bare, models=models, form=form, grids=grids,
+                                               rho=rho, folder=folder, settings=settings,
+                                               state=state)
         for light, cols in LIGHTS.items():
             for k, g in enumerate(grids):
                 rs = slice(cuts[k], cuts[k + 1])

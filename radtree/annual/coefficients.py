@@ -25,6 +25,7 @@ source, so the ``-ab 0`` part of a sun-patch coefficient is exactly the one insi
 from __future__ import annotations
 
 import hashlib
+import logging
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -39,6 +40,8 @@ from radtree.fileio import atomic_path, write_text
 from radtree.light.sun import SUN_ANGLE_DEG
 from radtree.optics import Hole, Plastic, with_reflectance
 from radtree.scene import Scene
+
+log = logging.getLogger(__name__)
 
 SUN_UNIT = 1e6
 SKY_TEXT = ("# unit-radiance sky and ground: rcontrib bins it into Reinhart patches\n"
@@ -115,11 +118,10 @@ class CoefficientRunner:
     """Writes a scene once and computes its coefficients, caching each result by content."""
 
     def __init__(self, scene: Scene, grids: list[str], folder: Path,
-                 ground_reflectance: float | None, echo=None):
+                 ground_reflectance: float | None):
         self.scene = scene
         self.grids = list(grids)
         self.folder = folder.resolve()
-        self.echo = echo
         self.folder.mkdir(parents=True, exist_ok=True)
         self.scene_rad = self.folder / "scene.rad"
         text = scene_text(scene, ground_reflectance)
@@ -166,8 +168,7 @@ class CoefficientRunner:
         n = patch_count(mf)
 
         def compute() -> np.ndarray:
-            if self.echo:
-                self.echo(f"    rcontrib sky MF {mf} ({n} patches), {params.key()}")
+            log.info(f"    rcontrib sky MF {mf} ({n} patches), {params.key()}")
             octree = self._octree("sky", SKY_TEXT)
             argv = ["-n", str(params.nproc), *params.ambient(),
                     "-f", "reinhartb.cal", "-e", f"MF:{mf}", "-b", "rbin+1", "-bn",
@@ -186,8 +187,7 @@ class CoefficientRunner:
         key = f"{name}_ab{ab}_{params.key() if ab else 'direct'}_" + _digest(text)
 
         def compute() -> np.ndarray:
-            if self.echo:
-                self.echo(f"    rcontrib {name}: {len(mods)} suns, -ab {ab}")
+            log.info(f"    rcontrib {name}: {len(mods)} suns, -ab {ab}")
             octree = self._octree(f"suns_{name}", text)
             modfile = self.folder / f"suns_{name}.mod"
             write_text(modfile, "\n".join(mods) + "\n")

@@ -40,14 +40,13 @@ project's louvers scenario) and with the bare crown (:mod:`radtree.annual.branch
 
 from __future__ import annotations
 
-import json
+import logging
 import time
 from collections.abc import Callable
-from dataclasses import asdict, dataclass, field, replace
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 import numpy as np
-import pandas as pd
 
 import radtree.annual.standards as standards
 from radtree.annual.branches import BranchParams, build_leaf_off
@@ -61,16 +60,15 @@ from radtree.annual.schedule import (
     parse_occupancy,
 )
 from radtree.annual.skymatrix import Suns, Wea, patch_count
-from radtree.annual.tables import (
-    annual_tables,
-)
 from radtree.annual.weather_year import YearInputs, annual_ground_reflectance, annual_weather
 from radtree.config import Project, Scenario, effective_project
 from radtree.errors import ConfigError
-from radtree.fileio import atomic_path, write_text
 from radtree.light.units import PHOTOPIC_RGB, WHITE_EFFICACY
 from radtree.light.weather import WeatherSource
+from radtree.log import progress
 from radtree.scene import Scene
+
+log = logging.getLogger(__name__)
 
 LUX = WHITE_EFFICACY * np.array(PHOTOPIC_RGB)  # lux per Radiance R, G, B
 VARIANTS = ("without", "leaf_on", "leaf_off")
@@ -309,170 +307,136 @@ def with_season(project: Project, options: AnnualOptions) -> AnnualOptions:
     return replace(options, leaf=leaf_season(project))
 
 
-def compute_annual(project: Project, options: AnnualOptions | None = None,
-                   echo: Callable[[str], None] = print, progress: bool = False
+@dataclass(frozen=True)
+class AnnualPlan:
+    """What an annual run traces: the options (leaf season resolved), the scenarios with and
+    without the tree, the scenes of :data:`VARIANTS`, the grids, the ``rcontrib`` settings of
+    the sky and of the reflected sun, the ground reflectance (0–1) and the notes so far."""
+
+    options: AnnualOptions
+    with_sc: Scenario
+    without_sc: Scenario
+    scenes: dict[str, Scene]
+    grids: list[str]
+    trace: TraceParams
+    sun_trace: TraceParams
+    rho: float
+    notes: tuple[str, ...]
+
+
+def plan_annual(project: Project, options: AnnualOptions, *,
+                check: Callable[[Scenario], None] | None = None,
+                crown_notes: bool = True) -> AnnualPlan:
+    """The :class:`AnnualPlan` of ``options`` (season resolved): ``check`` refuses a leafed
+    scenario before any scene is built; ``crown_notes``: keep the leaf-off crown's notes."""
+    with_sc, without_sc, notes = choose_scenarios(project, options)
+    if check is not None:
+        check(with_sc)
+    scenes, grids, rec_ab, more = annual_scenes(project, with_sc, without_sc,
+                                                options.branches, options.grids)
+    eng = effective_project(project, with_sc).engine
+    ab = options.ab if options.ab is not None else (eng.ab if eng.ab is not None else rec_ab)
+    trace = TraceParams(ab=ab, ad=options.ad or eng.radiance.ad,
+                        lw=options.lw or eng.radiance.lw, nproc=options.nproc)
+    sun_trace = TraceParams(ab=ab, ad=options.sun_ad or max(128, trace.ad // 4),
+                            lw=options.sun_lw or max(trace.lw, SUN_LW_MIN), nproc=options.nproc)
+    return AnnualPlan(options, with_sc, without_sc, scenes, grids, trace, sun_trace,
+                      annual_ground_reflectance(project),
+                      tuple(notes + (more if crown_notes else [])))
+
+
+def plan_year(project: Project, plan: AnnualPlan) -> YearInputs:
+    """The year of the plan (:func:`radtree.annual.weather_year.annual_weather`)."""
+    o = plan.options
+    return annual_weather(project, epw=o.epw, mf=o.mf, sun_mf=o.sun_mf, rho=plan.rho)
+
+
+def by_grid(values: tuple[np.ndarray, np.ndarray], grids: list[str], scene: Scene
+            ) -> tuple[dict[str, np.ndarray], dict[str, np.ndarray]]:
+    """(total, direct) rows of all sensors (grid after grid) split into ``{grid: rows}``."""
+    tot, dire = values
+    total, direct = {}, {}
+    start = 0
+    for g in grids:
+        n = len(scene.grids[g])
+        total[g], direct[g] = tot[start:start + n], dire[start:start + n]
+        start += n
+    return total, direct
+
+
+def _trace_variants(plan: AnnualPlan, year: YearInputs, folder: Path,
+                    timing: dict[str, float]) -> tuple[dict, dict]:
+    """(total, direct) lux ``{variant: {grid: (sensors, hours)}}`` of the plan's scenes, their
+    coefficients cached in ``folder/<variant>``; a progress bar over the variants."""
+    total: dict[str, dict[str, np.ndarray]] = {}
+    direct: dict[str, dict[str, np.ndarray]] = {}
+    o = plan.options
+    for variant in progress(VARIANTS, desc="annual", unit="scene"):
+        tv = time.perf_counter()
+        scene = plan.scenes[variant]
+        log.info(f"  {variant}: {scene.n_triangles} triangles, "
+                 f"{sum(len(scene.grids[g]) for g in plan.grids)} sensors")
+        runner = CoefficientRunner(scene, plan.grids, folder / variant, plan.rho)
+        total[variant], direct[variant] = by_grid(
+            scene_year_lux(runner, year, o.mf, o.sun_mf, plan.trace, plan.sun_trace),
+            plan.grids, scene)
+        timing[f"{variant}_s"] = time.perf_counter() - tv
+    return total, direct
+
+
+def finish_annual(project: Project, plan: AnnualPlan, year: YearInputs,
+                  lux: tuple[dict, dict], *, grid_scene: Scene, timing: dict[str, float],
+                  t0: float, method_note: str | None = None, sunlight: bool = True
+                  ) -> AnnualResult:
+    """The :class:`AnnualResult` of the variants' (total, direct) ``lux``: the crown of each
+    hour (leaf season or phenology), occupancy, the sensors of ``grid_scene``, the notes
+    (``method_note`` before :data:`METHOD_NOTES`), EN 17037 sunlight when ``sunlight``."""
+    weather, wea = year[0], year[1]
+    total, direct = lux
+    o = plan.options
+    phen = phenology_of(project, o.species_phenology)
+    in_leaf, fraction, weight = crown_year(total, direct, plan.grids, wea, o.season, phen)
+    grid_geo = {g: {"points": grid_scene.grids[g].points,
+                    "normals": grid_scene.grids[g].normals} for g in plan.grids}
+    notes = [*plan.notes, f"Crown {o.season.describe() if phen is None else phen.describe()}.",
+             *([method_note] if method_note else []), *METHOD_NOTES]
+    sun = (standards.annual_sunlight(project, plan.scenes, plan.grids, o.sunlight_date,
+                                     in_leaf, wea) if sunlight else None)
+    timing["total_s"] = time.perf_counter() - t0
+    return AnnualResult(project=project, options=o, weather=weather, wea=wea, grids=grid_geo,
+                        total=total, direct=direct, in_leaf=in_leaf,
+                        occupied=occupied(wea.hour, o.occupancy),
+                        scenarios={"with": plan.with_sc.name, "without": plan.without_sc.name},
+                        trace=plan.trace, sun_trace=plan.sun_trace,
+                        ground_reflectance=plan.rho, notes=notes, timing=timing,
+                        leaf_fraction=fraction, leaf_weight=weight, phenology=phen,
+                        sunlight=sun)
+
+
+def compute_annual(project: Project, *, options: AnnualOptions | None = None
                    ) -> AnnualResult:
-    """Trace the three scenes and assemble 8760 hours of illuminance per sensor."""
+    """Trace the three scenes and assemble 8760 hours of illuminance per sensor (the default
+    ``dc`` method): plan, the year, the scenes' coefficients, the result. Messages through
+    :mod:`logging` (INFO), a progress bar over the scenes when the CLI turned bars on."""
     options = with_season(project, options or AnnualOptions())
     if options.method != "dc":
         raise ConfigError(f"compute_annual is the 'dc' method; for {options.method!r} use "
                           "radtree.annual.methods.compute")
     timing: dict[str, float] = {}
     t0 = time.perf_counter()
-    with_sc, without_sc, notes = choose_scenarios(project, options)
-    scenes, grids, rec_ab, crown_notes = annual_scenes(project, with_sc, without_sc,
-                                                       options.branches, options.grids)
-    notes += crown_notes
-    eng = effective_project(project, with_sc).engine
-    ab = options.ab if options.ab is not None else (eng.ab if eng.ab is not None else rec_ab)
-    trace = TraceParams(ab=ab, ad=options.ad or eng.ad, lw=options.lw or eng.lw,
-                        nproc=options.nproc)
-    sun_trace = TraceParams(ab=ab, ad=options.sun_ad or max(128, trace.ad // 4),
-                            lw=options.sun_lw or max(trace.lw, SUN_LW_MIN), nproc=options.nproc)
-    rho = annual_ground_reflectance(project)
+    plan = plan_annual(project, options)
     timing["scenes_s"] = time.perf_counter() - t0
-
     t1 = time.perf_counter()
-    work = project.results_dir / "annual"
-    year = annual_weather(project, options.epw, options.mf, options.sun_mf, rho, echo)
-    weather, wea, sky, suns, verts, weights, need, patch_dirs = year
+    year = plan_year(project, plan)
     timing["weather_s"] = time.perf_counter() - t1
-    echo(f"  weather: {weather.description}; {int((wea.dni + wea.dhi > 0).sum())} daylight "
-         f"hours, {len(suns)} sun positions, {len(need)} sun patches (MF {options.sun_mf})")
-    echo(f"  rcontrib: -ab {trace.ab} -ad {trace.ad} -lw {trace.lw:g} (sky, MF {options.mf}); "
-         f"-ad {sun_trace.ad} -lw {sun_trace.lw:g} (reflected sun); {trace.nproc} "
-         f"process(es); ground ρ {rho:.3f}")
-
-    total: dict[str, dict[str, np.ndarray]] = {}
-    direct: dict[str, dict[str, np.ndarray]] = {}
-    items = list(VARIANTS)
-    bar = None
-    if progress:
-        from tqdm import tqdm
-
-        bar = tqdm(total=len(items), desc="annual", unit="scene", leave=False)
-    try:
-        for variant in items:
-            tv = time.perf_counter()
-            scene = scenes[variant]
-            echo(f"  {variant}: {scene.n_triangles} triangles, "
-                 f"{sum(len(scene.grids[g]) for g in grids)} sensors")
-            runner = CoefficientRunner(scene, grids, work / "coefficients" / variant, rho,
-                                       echo=echo)
-            tot, dire = scene_year_lux(runner, year, options.mf, options.sun_mf, trace,
-                                       sun_trace)
-            total[variant], direct[variant] = {}, {}
-            start = 0
-            for g in grids:
-                n = len(scene.grids[g])
-                total[variant][g] = tot[start:start + n]
-                direct[variant][g] = dire[start:start + n]
-                start += n
-            timing[f"{variant}_s"] = time.perf_counter() - tv
-            if bar is not None:
-                bar.update(1)
-    finally:
-        if bar is not None:
-            bar.close()
-
-    phen = phenology_of(project, options.species_phenology)
-    in_leaf, fraction, weight = crown_year(total, direct, grids, wea, options.season, phen)
-    occ = occupied(wea.hour, options.occupancy)
-    grid_geo = {g: {"points": scenes["leaf_on"].grids[g].points,
-                    "normals": scenes["leaf_on"].grids[g].normals} for g in grids}
-    notes.append(f"Crown {options.season.describe() if phen is None else phen.describe()}.")
-    notes += METHOD_NOTES
-    sun = standards.annual_sunlight(project, scenes, grids, options.sunlight_date, in_leaf, wea)
-    timing["total_s"] = time.perf_counter() - t0
-    return AnnualResult(project=project, options=options, weather=weather, wea=wea,
-                        grids=grid_geo, total=total, direct=direct, in_leaf=in_leaf,
-                        occupied=occ, scenarios={"with": with_sc.name,
-                                                 "without": without_sc.name},
-                        trace=trace, sun_trace=sun_trace, ground_reflectance=rho, notes=notes, timing=timing,
-                        leaf_fraction=fraction, leaf_weight=weight, phenology=phen,
-                        sunlight=sun)
-
-
-@dataclass
-class AnnualOutcome:
-    result: AnnualResult
-    annual_csv: Path
-    summary_csv: Path
-    monthly_csv: Path
-    hourly: Path
-    meta: Path
-    figures: list[Path]
-
-
-def _write_csv(df: pd.DataFrame, path: Path) -> Path:
-    with atomic_path(path) as tmp:
-        df.to_csv(tmp, index=False, float_format="%.6g")
-    return path
-
-
-def write_annual(result: AnnualResult, figures: bool = True) -> AnnualOutcome:
-    """Write the tables, the hourly arrays, the run's facts and the figures."""
-    project = result.project
-    res = project.results_dir
-    annual, summary, monthly = annual_tables(result)
-    a = _write_csv(annual, res / "annual.csv")
-    s = _write_csv(summary, res / "annual_summary.csv")
-    m = _write_csv(monthly, res / "annual_monthly.csv")
-    hourly = res / "annual" / "hourly.npz"
-    arrays: dict[str, np.ndarray] = {
-        "month": result.wea.month, "day": result.wea.day, "hour": result.wea.hour,
-        "in_leaf": result.in_leaf, "occupied": result.occupied,
-    }
-    if result.leaf_fraction is not None and result.leaf_weight is not None:
-        arrays["leaf_fraction"] = result.leaf_fraction
-        arrays["leaf_weight"] = result.leaf_weight
-    for g, geo in result.grids.items():
-        arrays[f"points__{g}"] = geo["points"]
-        arrays[f"normals__{g}"] = geo["normals"]
-        for key in ("with", "without", "leaf_on", "leaf_off"):
-            arrays[f"total__{key}__{g}"] = result.total[key][g]
-            arrays[f"direct__{key}__{g}"] = result.direct[key][g]
-    hourly.parent.mkdir(parents=True, exist_ok=True)
-    with atomic_path(hourly) as tmp:
-        with open(tmp, "wb") as fh:
-            np.savez_compressed(fh, **arrays)  # type: ignore[arg-type]
-    o = result.options
-    meta = {
-        "weather": {"path": str(result.weather.path), "generated": result.weather.generated,
-                    "description": result.weather.description},
-        "scenarios": result.scenarios,
-        "leaf_on": o.season.leaf_on, "leaf_off": o.season.leaf_off,
-        "leaf_days": o.season.leaf_days(), "leaf_source": o.season.source,
-        "occupancy": list(o.occupancy), "occupied_hours": int(result.occupied.sum()),
-        "sky_mf": o.mf, "sun_mf": o.sun_mf, "method": o.method,
-        "rcontrib": {"ab": result.trace.ab, "ad": result.trace.ad, "lw": result.trace.lw,
-                     "sun_ad": result.sun_trace.ad, "sun_lw": result.sun_trace.lw,
-                     "processes": result.trace.nproc},
-        "ground_reflectance": result.ground_reflectance,
-        "branches": asdict(o.branches),
-        "grids": {g: len(v["points"]) for g, v in result.grids.items()},
-        "notes": result.notes, "timing": result.timing,
-    }
-    if result.phenology is not None:
-        meta["phenology"] = {"species": result.phenology.species.key,
-                             "latitude": result.phenology.latitude_deg,
-                             "describe": result.phenology.describe()}
-    standards.write_standards(project, standards.standards_table(
-        result.scenarios, list(result.grids), result.total, result.direct, result.wea.dhi,
-        result.occupied, result.sunlight, result.options.sunlight_date))
-    mp = write_text(res / "annual" / "annual_meta.json", json.dumps(meta, indent=2,
-                                                                     default=str))
-    figs: list[Path] = []
-    if figures:
-        from radtree.annual.report import write_figures
-
-        figs = write_figures(project)
-    return AnnualOutcome(result, a, s, m, hourly, mp, figs)
-
-
-def run_annual(project: Project, options: AnnualOptions | None = None,
-               echo: Callable[[str], None] = print, progress: bool = False,
-               figures: bool = True) -> AnnualOutcome:
-    """Compute and write the annual results (the Python API of ``radtree annual``)."""
-    result = compute_annual(project, options, echo, progress)
-    return write_annual(result, figures=figures)
+    weather, wea, _, suns, _, _, need, _ = year
+    trace, sun_trace = plan.trace, plan.sun_trace
+    log.info(f"  weather: {weather.description}; {int((wea.dni + wea.dhi > 0).sum())} "
+             f"daylight hours, {len(suns)} sun positions, {len(need)} sun patches "
+             f"(MF {options.sun_mf})")
+    log.info(f"  rcontrib: -ab {trace.ab} -ad {trace.ad} -lw {trace.lw:g} (sky, MF "
+             f"{options.mf}); -ad {sun_trace.ad} -lw {sun_trace.lw:g} (reflected sun); "
+             f"{trace.nproc} process(es); ground ρ {plan.rho:.3f}")
+    lux = _trace_variants(plan, year, project.results_dir / "annual" / "coefficients", timing)
+    return finish_annual(project, plan, year, lux, grid_scene=plan.scenes["leaf_on"],
+                         timing=timing, t0=t0)

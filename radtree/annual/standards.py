@@ -45,7 +45,7 @@ No blinds are operated.
 from __future__ import annotations
 
 from collections.abc import Callable
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 from datetime import datetime, timedelta, timezone
 from typing import TYPE_CHECKING
 
@@ -283,7 +283,7 @@ def annual_sunlight(project: Project, scenes: dict[str, Scene], grids: list[str]
     times, alt, az = sun_steps(site.latitude, site.longitude, site.utc_offset_hours,
                                int(str(site.date)[:4]), date)
     eng = seeded_engine()
-    params = replace(project.engine, rays=1)
+    params = project.engine.changed(rays=1)
     out: dict[str, dict[str, np.ndarray]] = {}
     for tree, variant in (("with", "leaf_on" if leafed else "leaf_off"),
                           ("without", "without")):

@@ -88,40 +88,28 @@ of it); the BSDF of a planar periodic sample holds no lateral displacement.
 from __future__ import annotations
 
 import hashlib
+import logging
 import os
 import time
 from collections.abc import Callable
-from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
 
-from radtree.annual.coefficients import CoefficientRunner, TraceParams, points_text, scene_text
+from radtree.annual.coefficients import TraceParams, points_text, scene_text
 from radtree.annual.facets import FacetGroup, facet_groups
-from radtree.annual.phenology import crown_year, phenology_of
-from radtree.annual.run import (
-    LUX,
-    METHOD_NOTES,
-    AnnualOptions,
-    AnnualResult,
-    annual_ground_reflectance,
-    annual_scenes,
-    choose_scenarios,
-    scene_year_lux,
-    with_season,
-)
-from radtree.annual.schedule import occupied
+from radtree.annual.run import LUX
 from radtree.annual.skymatrix import (
     patch_count,
 )
-from radtree.annual.weather_year import annual_weather
 from radtree.config import Project, Scenario, effective_project
 from radtree.engines.radiance import threephase as rad3
-from radtree.errors import ConfigError
 from radtree.optics import Bsdf
 from radtree.scene import Mesh, Scene
 from radtree.trees.bsdf_shell import BSDF_SHELL, WALL_CAP
 from radtree.trees.model import TreeModel
+
+log = logging.getLogger(__name__)
 
 STATES = ("leaf_on", "leaf_off")
 KLEMS = 145
@@ -151,8 +139,8 @@ def _without_shell(scene: Scene) -> Scene:
                  scene.materials, scene.grids, scene.notes, scene.ground_material)
 
 
-def state_xmls(project: Project, scenario: Scenario,
-               echo: Callable[[str], None]) -> dict[str, list[tuple[float, float, Path]]]:
+def state_xmls(project: Project, scenario: Scenario
+               ) -> dict[str, list[tuple[float, float, Path]]]:
     """Leaf-on bands (``tree.bsdf.xml`` or computed; a free crown's wall cap too) and the
     leaf-off branch-slab XML (for every band and the wall cap), each cached under
     ``build/bsdf/<scenario>/``."""
@@ -201,18 +189,24 @@ def _octree(folder: Path, name: str, scene: Scene, rho: float) -> Path:
 
 class ThreePhase:
     """The matrices of one crown (V once, D per group and, for free crowns, per state),
-    cached in ``folder`` by the text they were computed from."""
+    cached in ``folder`` by the text they were computed from.
 
-    def __init__(self, folder: Path, bare: Scene, models: dict[str, TreeModel], form: str,
+    ``bare``: the scene without a crown; ``models``: the BSDF crown of each leaf state
+    (:data:`STATES`); ``form``: ``dome`` or ``free``; ``grids`` the sensor grids traced;
+    ``rho`` the ground reflectance (0–1); ``mf`` the Reinhart sky subdivision; ``trace`` the
+    rfluxmtx settings; ``samples`` rays per Klems patch of the daylight matrices (``-c``);
+    ``level``, ``material_up``, ``tile_m``: the facet grouping (:func:`facet_groups`; 0:
+    :data:`GROUP_TILE_M`)."""
+
+    def __init__(self, folder: Path, *, bare: Scene, models: dict[str, TreeModel], form: str,
                  grids: list[str], rho: float, mf: int, trace: TraceParams,
-                 echo: Callable[[str], None], samples: int = 400,
-                 level: int = GROUP_LEVEL, material_up: bool = GROUP_MATERIAL_UP,
-                 tile_m: float = 0.0):
+                 samples: int = 400, level: int = GROUP_LEVEL,
+                 material_up: bool = GROUP_MATERIAL_UP, tile_m: float = 0.0):
         self.folder, self.samples = folder, samples
         folder.mkdir(parents=True, exist_ok=True)
         self.bare, self.models, self.grids, self.rho, self.mf = bare, models, grids, rho, mf
         self.inside = form == "dome"
-        self.trace, self.echo = trace, echo
+        self.trace = trace
         self.groups = facet_groups(models["leaf_on"], self.inside, tile_m or GROUP_TILE_M,
                                    (WALL_CAP,), level, material_up)
         self.points = points_text(bare, grids)
@@ -242,8 +236,8 @@ class ThreePhase:
 
         def compute() -> Path:
             t0 = time.perf_counter()
-            self.echo(f"    rfluxmtx view matrix: {self.n} sensors → {len(groups)} shell "
-                      f"groups × {KLEMS} + {patch_count(self.mf)} sky patches")
+            log.info(f"    rfluxmtx view matrix: {self.n} sensors → {len(groups)} shell "
+                     f"groups × {KLEMS} + {patch_count(self.mf)} sky patches")
             octree = _octree(self.folder, "view", scene, self.rho)
             m = rad3.view_matrix(self.folder, octree, self.points, self.n, receivers, ambient,
                                  self.trace.nproc)
@@ -315,10 +309,10 @@ class ThreePhase:
         name = f"daylight_{'room_' if room_side else ''}{state}_s"
         self.timing[name] = time.perf_counter() - t0
         if octree:
-            self.echo(f"    rfluxmtx daylight matrices ({state}{', room side' if room_side else ''}"
-                      f"): {len(groups)} groups (tiles seen from the sensors, the rest "
-                      f"merged), -c {self.samples}, "
-                      f"{self.timing[name]:.0f} s")
+            log.info(f"    rfluxmtx daylight matrices ({state}"
+                     f"{', room side' if room_side else ''}): {len(groups)} groups (tiles seen "
+                     f"from the sensors, the rest merged), -c {self.samples}, "
+                     f"{self.timing[name]:.0f} s")
         return out
 
     def transmission(self, state: str, groups: list[FacetGroup], reflection: bool = False
@@ -357,11 +351,6 @@ class ThreePhase:
         return dc.astype(np.float32)
 
 
-SUN_NOTES = {
-    "explicit": "both on the explicit crown (slats, bare branches) of each leaf state",
-    "bsdf": "both on the BSDF-crown scene of each leaf state",
-}
-
 
 def sky_lux(dc: np.ndarray, sky: np.ndarray) -> np.ndarray:
     """(sensors, hours) lux: the coefficients (sensors, patches, 3) times the sky matrix
@@ -372,103 +361,4 @@ def sky_lux(dc: np.ndarray, sky: np.ndarray) -> np.ndarray:
     return total
 
 
-def compute_annual_3phase(project: Project, options: AnnualOptions,
-                          echo: Callable[[str], None] = print) -> AnnualResult:
-    """The annual run of :func:`radtree.annual.run.compute_annual` by the three-phase method
-    (module text); the same :class:`AnnualResult`, variants ``leaf_on``/``leaf_off`` from the
-    crown BSDFs, ``without`` as the default method."""
-    options = with_season(project, options)
-    timing: dict[str, float] = {}
-    t0 = time.perf_counter()
-    with_sc, without_sc, notes = choose_scenarios(project, options)
-    if with_sc.model != "louvers":
-        raise ConfigError(f"--method 3phase needs a louvers crown (the BSDF is computed from "
-                          f"its slats); scenario '{with_sc.name}' is {with_sc.model!r}",
-                          source=str(project.source))
-    scenes, grids, rec_ab, _ = annual_scenes(project, with_sc, without_sc, options.branches,
-                                             options.grids)
-    eng = effective_project(project, with_sc).engine
-    ab = options.ab if options.ab is not None else (eng.ab if eng.ab is not None else rec_ab)
-    trace = TraceParams(ab=ab, ad=options.ad or eng.ad, lw=options.lw or eng.lw,
-                        nproc=options.nproc)
-    sun_trace = TraceParams(ab=ab, ad=options.sun_ad or max(128, trace.ad // 4),
-                            lw=options.sun_lw or max(trace.lw, 1e-3), nproc=options.nproc)
-    rho = annual_ground_reflectance(project)
-    t1 = time.perf_counter()
-    xmls = state_xmls(project, with_sc, echo)
-    models, form = crown_models(project, with_sc, xmls)
-    timing["bsdf_s"] = time.perf_counter() - t1
-    from radtree.pipeline.assemble import make_scene
-
-    bare = make_scene(project, replace(with_sc, model="none"), dense_grid=False).scene
-    timing["scenes_s"] = time.perf_counter() - t0
-
-    t1 = time.perf_counter()
-    work = project.results_dir / "annual"
-    year = annual_weather(project, options.epw, options.mf, options.sun_mf, rho, echo)
-    weather, wea, sky, suns, verts, weights, need, patch_dirs = year
-    timing["weather_s"] = time.perf_counter() - t1
-
-    def dc(scene: Scene, folder: Path, with_sky: bool) -> tuple[np.ndarray, np.ndarray]:
-        runner = CoefficientRunner(scene, grids, folder, rho, echo=echo)
-        return scene_year_lux(runner, year, options.mf, options.sun_mf, trace, sun_trace,
-                              with_sky)
-
-    echo(f"  3-phase: {form} crown, BSDFs {', '.join(sorted({Path(b[2]).name for s in STATES for b in xmls[s]}))}")
-    tp = ThreePhase(work / "threephase", bare, models, form, grids, rho, options.mf, trace,
-                    echo, options.daylight_samples, GROUP_LEVEL, GROUP_MATERIAL_UP)
-    t1 = time.perf_counter()
-    views, v_sky = tp.view()
-    timing["view_s"] = time.perf_counter() - t1
-    per: dict[str, tuple[np.ndarray, np.ndarray]] = {}
-    dcs: dict[str, np.ndarray] = {}
-    tv = time.perf_counter()
-    per["without"] = dc(scenes["without"], work / "coefficients" / "without", True)
-    timing["without_s"] = time.perf_counter() - tv
-    for state in STATES:
-        tv = time.perf_counter()
-        if options.sun_crown == "explicit":   # the default method's sun runs and cache
-            sun_tot, sun_dir = dc(scenes[state], work / "coefficients" / state, False)
-        else:
-            sun_tot, sun_dir = dc(_scene_with(bare, models[state]),
-                                  work / "threephase" / f"sun_{state}", False)
-        timing[f"{state}_sun_s"] = time.perf_counter() - tv
-        td = time.perf_counter()
-        dcs[state] = tp.coefficients(state, views, v_sky)
-        timing[f"{state}_matrices_s"] = time.perf_counter() - td
-        ts = time.perf_counter()
-        sky_tot = sky_lux(dcs[state], sky)
-        timing[f"{state}_sky_product_s"] = time.perf_counter() - ts
-        per[state] = ((sun_tot + sky_tot).astype(np.float32), sun_dir)
-        timing[f"{state}_s"] = time.perf_counter() - tv
-    timing.update({f"3phase_{k}": v for k, v in tp.timing.items()})
-
-    total: dict[str, dict[str, np.ndarray]] = {}
-    direct: dict[str, dict[str, np.ndarray]] = {}
-    for variant, (tot, dire) in per.items():
-        total[variant], direct[variant] = {}, {}
-        start = 0
-        for g in grids:
-            n = len(bare.grids[g])
-            total[variant][g], direct[variant][g] = tot[start:start + n], dire[start:start + n]
-            start += n
-    phen = phenology_of(project, options.species_phenology)
-    in_leaf, fraction, weight = crown_year(total, direct, grids, wea, options.season, phen)
-    grid_geo = {g: {"points": bare.grids[g].points, "normals": bare.grids[g].normals}
-                for g in grids}
-    notes.append(f"Crown {options.season.describe() if phen is None else phen.describe()}.")
-    notes.append(f"Method: three-phase (V·T·D·s with dctimestep; {len(tp.groups)} shell facet "
-                 "groups; the crown BSDFs leaf-on and leaf-off); direct and reflected sun as "
-                 f"the default method, {SUN_NOTES[options.sun_crown]}.")
-    notes += METHOD_NOTES
-    timing["total_s"] = time.perf_counter() - t0
-    return AnnualResult(project=project, options=options, weather=weather, wea=wea,
-                        grids=grid_geo, total=total, direct=direct, in_leaf=in_leaf,
-                        occupied=occupied(wea.hour, options.occupancy),
-                        scenarios={"with": with_sc.name, "without": without_sc.name},
-                        trace=trace, sun_trace=sun_trace, ground_reflectance=rho, notes=notes,
-                        timing=timing, leaf_fraction=fraction, leaf_weight=weight,
-                        phenology=phen)
-
-
-__all__ = ["FacetGroup", "Mesh", "ThreePhase", "compute_annual_3phase", "facet_groups"]
+__all__ = ["FacetGroup", "Mesh", "ThreePhase", "facet_groups", "sky_lux"]

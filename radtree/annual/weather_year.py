@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-from collections.abc import Callable
 from pathlib import Path
 
 import numpy as np
@@ -24,8 +23,8 @@ YearInputs = tuple[WeatherSource, Wea, np.ndarray, Suns, np.ndarray, np.ndarray,
                    np.ndarray, np.ndarray]
 
 
-def annual_weather(project: Project, epw: Path | None, mf: int, sun_mf: int, rho: float,
-                   echo: Callable[[str], None]) -> YearInputs:
+def annual_weather(project: Project, *, epw: Path | None, mf: int, sun_mf: int,
+                   rho: float) -> YearInputs:
     """The year's weather (``epw`` or the project's), refused unless within 0.5° of the site's
     latitude and longitude; its sky matrix (Reinhart MF ``mf``, ground reflectance ``rho``, 0–1); the
     hourly suns and the MF ``sun_mf`` patches they fall in.
@@ -34,7 +33,7 @@ def annual_weather(project: Project, epw: Path | None, mf: int, sun_mf: int, rho
     ``weights`` place each sun among its patch vertices, ``need`` lists the patches any sun uses
     (patch 0, the ground, left out) and ``patch_dirs`` are the patch directions (x east, y north,
     z up)."""
-    weather = find_weather(project, epw, echo)
+    weather = find_weather(project, epw)
     wea = epw_to_wea(weather.path, project.results_dir / "annual" / "weather" / "year.wea")
     site = project.site
     if abs(wea.latitude - site.latitude) > 0.5 or abs(-wea.longitude_west - site.longitude) > 0.5:

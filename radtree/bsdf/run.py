@@ -15,7 +15,6 @@ from __future__ import annotations
 
 import math
 import shutil
-from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -101,11 +100,11 @@ def summary_row(state: str, run: BsdfRun, k: KlemsBsdf) -> dict:
     return row
 
 
-def compute_crown_bsdfs(project: Project, scenario: Scenario, out: Path,
-                        states: tuple[str, ...] = STATES, nproc: int = 1,
-                        progress: Callable[[str], None] | None = None) -> CrownBsdfs:
+def compute_crown_bsdfs(project: Project, scenario: Scenario, out: Path, *,
+                        states: tuple[str, ...] = STATES, nproc: int = 1) -> CrownBsdfs:
     """Leaf-on/off XMLs of ``scenario`` in ``out`` (``<state>.xml``, work files in
-    ``out/work/<state>/``) and ``out/summary.csv``."""
+    ``out/work/<state>/``) and ``out/summary.csv``; ``nproc`` rfluxmtx processes. The
+    commands run are logged (INFO)."""
     tree, form = scenario_tree(project, scenario)
     settings = flux_settings(tree, form, nproc)
     on = leaf_on_sample(project, scenario)

@@ -56,9 +56,8 @@ from radtree.cli.options import CONTEXT, writes
                    "slats, as the dc method does) or through the BSDF crown.")
 @click.option("--sunlight-date", default="03-21", show_default=True, metavar="MM-DD",
               help="EN 17037 exposure to sunlight: the date (1 February – 21 March).")
-def annual_command(project: Path, leaf_on: str | None, leaf_off: str | None, mf: int,
-                   sun_mf: int,
-                   occupancy: str, epw: Path | None, with_scenario: str | None,
+def annual_command(*, project: Path, leaf_on: str | None, leaf_off: str | None, mf: int,
+                   sun_mf: int, occupancy: str, epw: Path | None, with_scenario: str | None,
                    without_scenario: str | None, ab: int | None, ad: int | None,
                    lw: float | None, processes: int, no_figures: bool,
                    sun_ad: int | None = None, sun_lw: float | None = None,
@@ -87,8 +86,7 @@ def annual_command(project: Path, leaf_on: str | None, leaf_off: str | None, mf:
         species_phenology=not use_dates, method=method, sun_crown=sun_crown,
         sunlight_date=sunlight_date)
     click.echo(f"annual: {proj.name}; leaf season {options.season.describe()}")
-    out = run_annual(proj, options, echo=click.echo, progress=True,
-                     figures=not no_figures)
+    out = run_annual(proj, options=options, figures=not no_figures)
     from radtree.annual.report import grid_summary
 
     for row in grid_summary(proj).itertuples(index=False):

@@ -46,7 +46,7 @@ def bsdf_command(project: Path, scenario: str, out: Path | None, samples: int | 
     sc = proj.scenario(scenario)
     out = out if out is not None else proj.results_dir / "bsdf" / sc.name
     states = ("leaf_on",) if leaf_on_only else STATES
-    result = compute_crown_bsdfs(proj, sc, out, states, nproc, progress=click.echo)
+    result = compute_crown_bsdfs(proj, sc, out, states=states, nproc=nproc)
     for _, row in result.summary.iterrows():
         click.echo(f"{row['state']}: T front (normal) {row['t_front_normal']:.4f}, R front "
                    f"{row['r_front_normal']:.4f}; diffuse T {row['t_front_diffuse']:.4f} / "

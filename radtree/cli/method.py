@@ -38,5 +38,5 @@ def method_command(project: Path, photons: int, radii: str, scenarios: tuple[str
             from None
     out = run_method_study(project, photons=photons, radii=rs,
                            scenarios=list(scenarios) or list(SCENARIOS),
-                           variants=list(variants) or None, file=file, echo=click.echo)
+                           variants=list(variants) or None, file=file)
     click.echo(f"wrote {out}")

@@ -33,8 +33,7 @@ def verify_command(full: bool, out: Path, page: Path | None,
     volume crown. Writes OUT (check, engine, expected, got, tolerance, passed)."""
     from radtree.verify.suite import run_verify
 
-    outcome = run_verify(out, full=full, backward=list(backward) or None,
-                         echo=lambda m: click.echo(f"  {m}"))
+    outcome = run_verify(out, full=full, backward=list(backward) or None)
     marks = {"pass": "ok  ", "fail": "FAIL", "unresolved": "??  "}
     for c in outcome.checks:
         click.echo(f"{marks[c.status]} {c.engine:8s} {c.check}: expected {c.expected:.5g}, "

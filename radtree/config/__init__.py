@@ -5,6 +5,7 @@ Import the public names from here: ``from radtree.config import Project, load_pr
 """
 
 from radtree.config.bsdf import REPRESENTATIONS, CrownBsdf
+from radtree.config.engine import ForwardParams, NumpyParams, RadianceParams
 from radtree.config.reader import find_project_file, load_project, parse_project, set_dotted
 from radtree.config.schema import (
     CROWN_MODELS,
@@ -56,5 +57,5 @@ __all__ = [
     "Project", "Scenario", "SchemaError", "Sensors", "Site", "Spec", "Street", "Tree",
     "check_fields", "check_key", "check_switches", "effective_project", "find_project_file",
     "known", "load_project", "lookup_key", "parse_project", "parse_time", "set_dotted",
-    "REPRESENTATIONS", "CrownBsdf",
+    "REPRESENTATIONS", "CrownBsdf", "ForwardParams", "NumpyParams", "RadianceParams",
 ]

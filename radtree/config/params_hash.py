@@ -63,9 +63,11 @@ def _project_payload(project: Any) -> dict[str, Any]:
                                  "office", "extra_geometry")}
     if payload["tree"].get("species") is None:  # no species: hashes unchanged
         payload["tree"].pop("species", None)
+    payload["engine"] = project.engine.flat()   # the file's flat table: hashes unchanged
     payload["engine"].pop("workers", None)
+    defaults = type(project.engine)().flat()
     for key in FORWARD_KEYS + PMAP_KEYS + ("dense_rays",):  # at defaults: hashes unchanged
-        if payload["engine"].get(key) == getattr(type(project.engine), key):
+        if payload["engine"].get(key) == defaults[key]:
             payload["engine"].pop(key, None)
     if project.honeybee is not None:   # absent otherwise: other projects' hashes unchanged
         payload["honeybee"] = {**d["honeybee"], "sha256": project.honeybee.digest()}

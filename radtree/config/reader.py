@@ -18,7 +18,7 @@ import tomllib
 from radtree.config.district import DISTRICT_KEYS, read_district
 from radtree.config.honeybee import read_honeybee
 from radtree.config.schema import Project, Scenario, Site, Street, parse_time
-from radtree.config.spec import SchemaError, Spec, spec_for, spec_of, toml_name
+from radtree.config.spec import SchemaError, Spec, spec_for, spec_of, table_fields, toml_name
 from radtree.config.species import find_species, tree_defaults, unknown_species_message
 from radtree.config.switches import (
     FIELD,
@@ -106,7 +106,7 @@ def _table(r: _Reader, table: str, base: Path, **given: Any) -> Any:
     holds (paths resolved), then ``given``; the table's unknown fields are rejected."""
     cls = TABLES[table]
     kwargs: dict[str, Any] = {}
-    for f in fields(cls):
+    for f in table_fields(cls):
         spec = spec_of(cls, f.name)
         key = toml_name(cls, f.name)
         if spec is None or f.name in given or not r.has(key):
@@ -160,7 +160,8 @@ def set_dotted(data: dict, key: str, value: Any) -> None:
 
 
 def parse_project(data: dict, path: Path) -> Project:
-    """The :class:`Project` of the TOML ``data`` of the file at ``path``."""
+    """The :class:`Project` of the TOML ``data`` of the file at ``path``: each table read in
+    turn (unknown tables and fields refused with the known ones listed)."""
     src = str(path)
     base = path.parent
     top = _Reader(data, "", src)
@@ -170,8 +171,30 @@ def parse_project(data: dict, path: Path) -> Project:
     measured = proj.optional_path("measured", base)
     measured_rows = proj.optional_path("measured_rows", base)
     proj.check_unknown(table_keys("project"))
+    site, honeybee, district = _site(top.sub("site", required=True), base, name)
+    street = _street(top.sub("street"), base)
+    light = _table(top.sub("light"), "light", base)
+    tree = _tree(top.sub("tree"), base)
+    sensors = _sensors(top.sub("sensors"), base, site.hours)
+    engine = _table(top.sub("engine"), "engine", base)
+    office = _table(top.sub("office"), "office", base) if top.has("office") else None
+    limits = _table(top.sub("limits"), "limits", base)
+    extra = _extra_geometry(top, base)
+    scenarios = _scenarios(top, src)
+    top.raw("sweep")  # read by radtree.sweep
+    top.check_unknown(TOP_TABLES)
+    return Project(name=name, root=path.parent, source=path, site=site, street=street,
+                   light=light, tree=tree, sensors=sensors, engine=engine,
+                   scenarios=scenarios, measured=measured, measured_rows=measured_rows,
+                   office=office, extra_geometry=tuple(extra), honeybee=honeybee,
+                   limits=limits, district=district)
 
-    s = top.sub("site", required=True)
+
+def _site(s: _Reader, base: Path, name: str) -> tuple[Site, Any, Any]:
+    """``[site]``: the Site (hours, the date — left out: the summer solstice of the site's
+    hemisphere —, the time zone and its standard offset), its Honeybee model and its
+    inventory district (:mod:`radtree.config.honeybee`, :mod:`radtree.config.district`)."""
+    src = s.source
     s.data = dict(s.data)  # [site] honeybee = "model.hbjson" (radtree.config.honeybee)
     honeybee = read_honeybee(s.data, base, src)
     district = read_district(s.data, base, src)   # [site] trees / buildings (own module)
@@ -183,7 +206,6 @@ def parse_project(data: dict, path: Path) -> Project:
     if len(set(hours)) != len(hours):
         raise s.error("hours", "hours repeat")
     lat = s.value("latitude", spec_for(Site, "latitude"), required=True)
-    # left out: the summer solstice of the site's hemisphere
     date = s.value("date", spec_for(Site, "date"), "2024-06-21" if lat >= 0 else "2024-12-21")
     zone, _fixed = site_time_zone(
         s.value("time_zone", Spec("str", optional=True), None),
@@ -195,53 +217,48 @@ def parse_project(data: dict, path: Path) -> Project:
                   utc_offset_hours=standard_offset_hours(zone, date),
                   **{k: s.value(k, spec_for(Site, k), required=True)
                      for k in ("latitude", "longitude")})
+    return site, honeybee, district
 
-    st = top.sub("street")
+
+def _street(st: _Reader, base: Path) -> Street:
+    """``[street]``; a ``ground_reflectance`` given as a file is the per-sun-angle table."""
     g = st.raw("ground_reflectance")
     ground: dict[str, Any] = {}
     if isinstance(g, str):
         ground = {"ground_reflectance": Street().ground_reflectance,
                   "ground_reflectance_table": st.optional_path("ground_reflectance", base)}
-    street = _table(st, "street", base, **ground)
+    return _table(st, "street", base, **ground)
 
-    li = top.sub("light")
-    light = _table(li, "light", base)
 
-    tr = top.sub("tree")
+def _tree(tr: _Reader, base: Path) -> Any:
+    """``[tree]`` and its crown tables, the species filling what they leave out."""
     filled = species_fill(tr)
     crowns = {t: _table(r, f"tree.{t}", base, **{k: v for k, v in filled.get(t, {}).items()
                                                    if not r.has(k)})
               for t, r in ((t, tr.sub(t)) for t in TREE_TABLES)}
-    tree = _table(tr, "tree", base, **crowns)
+    return _table(tr, "tree", base, **crowns)
 
-    se = top.sub("sensors")
+
+def _sensors(se: _Reader, base: Path, hours: tuple[str, ...]) -> Any:
+    """``[sensors]``; its ``dense_hours`` must be among the site's hours."""
     dense = se.value("dense_hours", spec_for(TABLES["sensors"], "dense_hours"), ())
     unknown = [h for h in dense if h not in hours]
     if unknown:
         raise se.error("dense_hours", f"{', '.join(unknown)} not among site.hours")
-    sensors = _table(se, "sensors", base, dense_hours=dense)
-    engine = _table(top.sub("engine"), "engine", base)
-    office = _table(top.sub("office"), "office", base) if top.has("office") else None
-    limits = _table(top.sub("limits"), "limits", base)
+    return _table(se, "sensors", base, dense_hours=dense)
 
-    # extra user geometry: [[geometry]] file = "x.obj", material = "name"
+
+def _extra_geometry(top: _Reader, base: Path) -> list[tuple[Path, str]]:
+    """Extra user geometry: ``[[geometry]] file = "x.obj", material = "name"``."""
     extra = []
     for i, item in enumerate(top.raw("geometry", []) or []):
-        r = _Reader(item, f"geometry[{i}]", src)
+        r = _Reader(item, f"geometry[{i}]", top.source)
         gpath = r.optional_path("file", base)
         if gpath is None:
             raise r.error("file", "missing (an OBJ/STL/PLY or .rad file)")
         extra.append((gpath, r.value("material", Spec("str"), required=True)))
         r.check_unknown(GEOMETRY_KEYS)
-
-    scenarios = _scenarios(top, src)
-    top.raw("sweep")  # read by radtree.sweep
-    top.check_unknown(TOP_TABLES)
-    return Project(name=name, root=path.parent, source=path, site=site, street=street,
-                   light=light, tree=tree, sensors=sensors, engine=engine,
-                   scenarios=scenarios, measured=measured, measured_rows=measured_rows,
-                   office=office, extra_geometry=tuple(extra), honeybee=honeybee,
-                   limits=limits, district=district)
+    return extra
 
 
 def species_fill(tr: _Reader) -> dict[str, dict[str, float]]:

@@ -15,6 +15,7 @@ from typing import Any, ClassVar
 from radtree.config.bsdf import REPRESENTATIONS, CrownBsdf
 from radtree.config.clumping import clumping_fields
 from radtree.config.crown_models import CROWN_MODELS
+from radtree.config.engine import EngineParams
 from radtree.config.honeybee import HoneybeeSite
 from radtree.config.limits import Limits
 from radtree.config.params_hash import params_hashes, plain
@@ -36,7 +37,6 @@ _PHOTO = photo_fields()
 _CLUMPING = clumping_fields()
 REFLECTION_MODES = ("traced", "calculated")
 WALL_POLICIES = ("clip", "refuse")    # a crown reaching a wall (radtree.trees.wall_policy)
-SAMPLING_CHOICES = ("sobol", "random")  # NumPy engine's first directions (engines/numpy/qmc)
 #: Presets of the louvers slat optics (the switch ``"louvers.reading"``): the study's reading
 #: (every layer fully covered, T 0.5 in the slat) and near-opaque leaves with open gaps.
 LOUVER_READINGS: dict[str, dict[str, float]] = {
@@ -310,71 +310,6 @@ class Office(Checked):
 
 
 @dataclass(frozen=True)
-class EngineParams(Checked):
-    """Tracing parameters. Radiance: ``ab`` (None = from the crown model), ``ad``, ``as_``
-    (written ``as`` in the file), ``ar``, ``aa``, ``lw``. The defaults (``-aa 0 -as 0``: no
-    irradiance cache, no super-sampling) are pure Monte Carlo: behind slat crowns the cache and
-    ``-as`` bias ``-I`` low by 4–8 % and the cache makes ``-ab 7`` runs take minutes instead of
-    seconds. NumPy engine: ``rays`` per sensor (``dense_rays`` per dense-map point), ``max_bounces``,
-    ``seed``, ``sampling`` (first directions ``"sobol"``-stratified or ``"random"``)."""
-
-    TABLE: ClassVar[str] = "engine"
-    name: str = "auto"  # a name of radtree.engines.registry (checked when the engine is chosen)
-    ab: int | None = field(default=None, metadata=meta(0, 20))
-    ad: int = field(default=2048, metadata=meta(1))
-    as_: int = field(default=0, metadata=meta(0, toml="as"))
-    ar: int = field(default=256, metadata=meta(1))
-    aa: float = field(default=0.0, metadata=meta(0.0, 1.0))
-    lw: float = field(default=0.0001, metadata=meta(0.0, 1.0))
-    rays: int = field(default=4096, metadata=meta(1))
-    max_bounces: int = field(default=8, metadata=meta(0))
-    seed: int = 1
-    sampling: str = field(default="sobol", metadata=meta(choices=SAMPLING_CHOICES))
-    workers: int = field(default=2, metadata=meta(1))
-    # forward engine (radtree.engines.forward.settings): photons per hour, flux threshold
-    # relative to a photon's launched flux, ray splitting (else Russian roulette), sun beam
-    # diameter aimed at the first grid (None = the whole scene), square detector side, batches
-    photons: int = field(default=1_000_000, metadata=meta(1))
-    forward_threshold: float = field(default=0.05, metadata=meta(0.0, 1.0, lo_open=True,
-                                                                    hi_open=True))
-    forward_splitting: bool = False
-    beam_diameter_m: float | None = field(default=None, metadata=meta(0.0, lo_open=True))
-    patch_m: float = field(default=0.5, metadata=meta(0.0, lo_open=True))
-    forward_batches: int = field(default=32, metadata=meta(2))  # per round (precision.py)
-    # forward engine: focused launch, innermost disc radius (m) around the target grid (None =
-    # start points uniform over the launch disc)
-    # (default 1 m, with forward_guide 0.8: the variance reduction that makes the precision target
-    # affordable — on reference-case A/B at 12:30 10–20× less time to a 2 % *estimated* error than the
-    # uniform launch, whose 64 M photons still left 3.5 %: benchmarks/forward.py)
-    forward_focus_m: float | None = field(default=1.0, metadata=meta(0.0, lo_open=True))
-    # forward engine: children per diffuse event near the target grid (1 = none), and how near
-    forward_split: int = field(default=1, metadata=meta(1))
-    forward_split_radius_m: float = field(default=2.0, metadata=meta(0.0, lo_open=True))
-    # forward engine: share of diffuse directions aimed at the target grid (0 = none), sphere
-    # (default 0.8 towards the sphere just holding the target grid's patches, None = that radius)
-    forward_guide: float = field(default=0.8, metadata=meta(0.0, 1.0, hi_open=True))
-    forward_guide_radius_m: float | None = field(default=None, metadata=meta(0.0, lo_open=True))
-    # forward engine: rounds of `photons` added until every traced grid's mean has this relative
-    # standard error (None = one round of `photons`), at most `max_photons` per hour (then a
-    # warning with the error reached): radtree.engines.forward.precision
-    target_rel_se: float | None = field(default=0.02, metadata=meta(0.0, 1.0, lo_open=True,
-                                                                    hi_open=True))
-    max_photons: int = field(default=16_000_000, metadata=meta(1))
-    # forward engine: the sun's direct beam computed at the sensor points (as the backward engines
-    # see it), sun photons tallied on the patches only once scattered: radtree.engines.forward.direct
-    forward_direct_sun: bool = True
-    # Radiance photon map (radtree.engines.radiance.pmap): global photons per hour (None = no
-    # photon map, plain rtrace -I), caustic photons (None = none), photons per density estimate
-    pmap_photons: int | None = field(default=None, metadata=meta(1))
-    pmap_caustic_photons: int | None = field(default=None, metadata=meta(1))
-    pmap_bandwidth: int = field(default=50, metadata=meta(1))
-    # the dense façade map (a figure) only: Radiance -lw (None = lw), NumPy paths (None = rays)
-    dense_lw: float | None = field(default=None, metadata=meta(0.0, 1.0))
-    dense_rays: int | None = field(default=None, metadata=meta(1))
-
-
-
-@dataclass(frozen=True)
 class Scenario(Checked):
     """One simulated case: a crown model, how ground-reflected light is handled, sky on/off.
 
@@ -446,7 +381,8 @@ class Project:
                           f"{', '.join(s.name for s in self.scenarios)})", source=str(self.source))
 
     def to_dict(self) -> dict[str, Any]:
-        return plain(self)
+        """Every table as plain data; ``engine`` flat, as the project file holds it."""
+        return {**plain(self), "engine": plain(self.engine.flat())}
 
     def params_hash(self, scenario: Scenario) -> str:
         """Short hash of everything that changes a scenario's numbers (input files by their

@@ -12,7 +12,7 @@ from __future__ import annotations
 
 import math
 import re
-from dataclasses import dataclass, fields
+from dataclasses import Field, dataclass, fields
 from datetime import date as _date
 from pathlib import Path
 from typing import Any, ClassVar
@@ -217,10 +217,28 @@ def meta(lo: float | None = None, hi: float | None = None, *, lo_open: bool = Fa
 _KINDS = {"float": "float", "int": "int", "bool": "bool", "str": "str", "Path": "path"}
 
 
+def table_fields(cls: type) -> list[Field]:
+    """The fields a table of the project file holds: those of dataclass ``cls``, with the
+    fields of its parameter groups (``cls.GROUPS``: attribute → dataclass, as
+    :class:`radtree.config.engine.EngineParams`) in place of each group — the table stays
+    flat in the file (``[engine] rays``) while the code holds ``params.numpy.rays``."""
+    groups: dict[str, type] = getattr(cls, "GROUPS", {})
+    out: list[Field] = []
+    for f in fields(cls):
+        out.extend(fields(groups[f.name]) if f.name in groups else (f,))
+    return out
+
+
+def table_field(cls: type, name: str) -> Field:
+    """Field ``name`` of dataclass ``cls`` or of one of its groups (:func:`table_fields`)."""
+    own = [f for f in fields(cls) if f.name == name]
+    return own[0] if own else next(f for f in table_fields(cls) if f.name == name)
+
+
 def spec_of(cls: type, name: str) -> Spec | None:
     """The :class:`Spec` of field ``name`` of dataclass ``cls`` (None: a nested table or a
-    field the file does not hold)."""
-    f = next(f for f in fields(cls) if f.name == name)
+    field the file does not hold); a field of one of its groups too (:func:`table_fields`)."""
+    f = table_field(cls, name)
     m = dict(f.metadata) or meta()
     text = str(f.type)
     parts = [p.strip() for p in text.split("|")]
@@ -243,7 +261,7 @@ def spec_for(cls: type, name: str) -> Spec:
 
 def toml_name(cls: type, name: str) -> str:
     """The name a field of ``cls`` has in the project file (``as_`` → ``as``)."""
-    f = next(f for f in fields(cls) if f.name == name)
+    f = table_field(cls, name)
     return dict(f.metadata).get("toml") or name
 
 

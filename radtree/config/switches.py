@@ -23,7 +23,7 @@ from __future__ import annotations
 
 import difflib
 from collections.abc import Iterable
-from dataclasses import dataclass, fields, replace
+from dataclasses import dataclass, replace
 from typing import Any
 
 from radtree.config.bsdf import CrownBsdf
@@ -45,7 +45,7 @@ from radtree.config.schema import (
     Street,
     Tree,
 )
-from radtree.config.spec import SchemaError, Spec, spec_of, toml_name
+from radtree.config.spec import SchemaError, Spec, spec_of, table_fields, toml_name
 from radtree.errors import ConfigError
 
 FIELD = "field"
@@ -86,7 +86,7 @@ def _field_keys() -> dict[str, Key]:
             for n, kind in (("name", "str"), ("measured", "path"), ("measured_rows", "path"))}
     for table, cls in TABLES.items():
         section = table.split(".")[0]
-        for f in fields(cls):
+        for f in table_fields(cls):
             s = spec_of(cls, f.name)
             if s is None:
                 continue

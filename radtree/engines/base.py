@@ -12,7 +12,6 @@ from __future__ import annotations
 
 import tempfile
 from abc import ABC, abstractmethod
-from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, ClassVar
@@ -173,5 +172,3 @@ class Engine(ABC):
             plan = self.prepare(scene, [state], params, ab, Path(tmp))
             return self.trace(plan, state.label, grids)
 
-
-Echo = Callable[[str], None]

@@ -11,6 +11,7 @@ the row ending at HH (00:00 from row 1).
 from __future__ import annotations
 
 import io
+import logging
 import math
 from dataclasses import dataclass
 from pathlib import Path
@@ -19,6 +20,8 @@ import pandas as pd
 
 from radtree.errors import ConfigError
 from radtree.light.clearsky import GENERATED_TAG, write_generated_epw
+
+log = logging.getLogger(__name__)
 
 MISSING_ILLUMINANCE = 999900  # EPW missing-value code of the illuminance fields is 999999
 _HEADER_LINES = 8
@@ -227,12 +230,12 @@ def _close(a: float, b: float, tol: float = 0.05) -> bool:
     return math.isclose(a, b, abs_tol=tol)
 
 
-def find_weather(project, epw: Path | None = None, echo=None) -> WeatherSource:
+def find_weather(project, epw: Path | None = None) -> WeatherSource:
     """The EPW of an annual run.
 
     In order: ``epw`` (command line), ``[light] epw`` of the project, a generated EPW shipped
     in ``PROJECT/data/`` (``*generated*.epw`` whose location matches the site), else a clear-sky
-    EPW generated now into ``PROJECT/results/annual/weather/``.
+    EPW generated now into ``PROJECT/results/annual/weather/`` (an INFO message says so).
     """
     site = project.site
     for cand, why in ((epw, "given on the command line"), (project.light.epw, "[light] epw")):
@@ -257,8 +260,7 @@ def find_weather(project, epw: Path | None = None, echo=None) -> WeatherSource:
                 and _close(w.utc_offset_hours, site.utc_offset_hours)
                 and _close(w.elevation_m, site.elevation_m, 1.0)):
             return WeatherSource(out, True, f"{out.name} (GENERATED clear sky, cached)")
-    if echo:
-        echo(f"  no EPW given: generating a clear-sky year for the site → {out}")
+    log.info(f"  no EPW given: generating a clear-sky year for the site → {out}")
     write_generated_epw(out, site.name, site.latitude, site.longitude, site.elevation_m,
                         site.utc_offset_hours)
     return WeatherSource(out, True, f"{out.name} (GENERATED clear sky for the site)")

@@ -170,5 +170,6 @@ def radiance_picture(project: Project, sc: Scenario, hour: str, size: int, out: 
     point = photo_point(project, tree, src)
     if src.direction != "upward":
         point = point + project.sensors.offset_m * axis   # off the wall the camera sits on
-    return fisheye_picture(plan, states[0].label, point, axis, up, size,
-                           built.ab if ab is None else ab, params.ad, out)
+    return fisheye_picture(plan, hour=states[0].label, viewpoint=point, direction=axis, up=up,
+                           size=size, ab=built.ab if ab is None else ab,
+                           ad=params.radiance.ad, out=out)

@@ -187,8 +187,9 @@ def ensure_bsdf(sample: SlabSample | RingSamples | PatchDepthSample, settings: F
                               "chord envelope is assembled ring by ring in the Klems basis)",
                               field="tree.bsdf.tensor_tree")
         subs = write_systems(folder, "ring", sample.rings, settings.tiles)
-        result = klems_bsdf_rings(folder, subs, settings, name, sample.thickness,
-                                  sample.width, sample.height, comment)
+        result = klems_bsdf_rings(folder, ring_folders=subs, settings=settings, name=name,
+                                  thickness=sample.thickness, width=sample.width,
+                                  height=sample.height, comment=comment)
         write_text(key_file, key + "\n")
         return result
     write_system(folder, sample.polygons, sample.materials, sample.width, sample.height,

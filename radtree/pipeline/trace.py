@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import math
 import tempfile
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
@@ -55,8 +55,8 @@ def trace_hours(project: Project, sc: Scenario, engine: str | Engine | None = No
     proj = effective_project(project, sc)
     use_ab = ab if ab is not None else scene_ab(
         proj, None if built.tree is None else built.tree.recommended_ab)
-    params = replace(proj.engine, rays=int(rays or proj.engine.rays),
-                     seed=int(proj.engine.seed if seed is None else seed))
+    params = proj.engine.changed(rays=int(rays or proj.engine.numpy.rays),
+                                 seed=int(proj.engine.seed if seed is None else seed))
     states = hour_states(project, sc, hours)
     with tempfile.TemporaryDirectory(prefix="radtree-trace-") as tmp:
         plan = eng.prepare(built.scene, states, params, use_ab, folder or Path(tmp))

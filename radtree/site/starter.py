@@ -32,7 +32,7 @@ import shutil
 import textwrap
 from collections import Counter
 from collections.abc import Callable
-from dataclasses import MISSING, dataclass, field, fields
+from dataclasses import MISSING, dataclass, field
 from datetime import date as _date
 from pathlib import Path
 from typing import Any
@@ -40,7 +40,7 @@ from typing import Any
 import tomlkit
 
 from radtree.config import Project, Scenario, load_project
-from radtree.config.spec import spec_of, toml_name
+from radtree.config.spec import spec_of, table_field, table_fields, toml_name
 from radtree.config.species import find_species
 from radtree.config.switches import TABLES, TREE_TABLES
 from radtree.config.timezone import fixed_name, parse_time_zone, standard_offset_hours
@@ -279,7 +279,7 @@ def _unit(name: str, kind: str, fraction: bool) -> str:
 
 
 def _default(cls: type, name: str) -> Any:
-    f = next(f for f in fields(cls) if f.name == name)
+    f = table_field(cls, name)
     if f.default is not MISSING:
         return f.default
     if f.default_factory is not MISSING:
@@ -318,7 +318,7 @@ def table(cls: type, values: dict[str, Any], notes: dict[str, str] | None = None
     t = tomlkit.table()
     for line in _doc_lines(cls):
         t.add(tomlkit.comment(line))
-    for f in fields(cls):
+    for f in table_fields(cls):
         spec = spec_of(cls, f.name)
         if spec is None:
             continue

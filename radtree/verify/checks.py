@@ -15,9 +15,9 @@
 
 from __future__ import annotations
 
+import logging
 import math
-from collections.abc import Callable
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -30,6 +30,8 @@ from radtree.scene import Mesh, Scene, SensorGrid, quad
 from radtree.verify.compare import backward_patch_mean, backward_patch_values, reduced_dome_project
 from radtree.verify.leaves import LEAF_DISTRIBUTIONS, leaf_layer, uncollided_transmission
 from radtree.verify.spheres import place_spheres, sphere_leaves, sphere_transmission
+
+log = logging.getLogger(__name__)
 
 FORWARD = ForwardEngine.name  # the Check rows' engine label
 DNI = 100000.0
@@ -109,12 +111,11 @@ def _layer_scene(lai: float, distribution: str, seed: int, leaf: float) -> Scene
     return Scene([layer], {"black": Plastic("black", 0.0)}, {"facade": det})
 
 
-def transmission_checks(realisations: int = 4, photons: int = 20_000, points: int = 64,
+def transmission_checks(*, realisations: int = 4, photons: int = 20_000, points: int = 64,
                         leaf: float = 0.07, engines: tuple[str, ...] = (FORWARD,),
                         lais: tuple[float, ...] = LAIS,
                         distributions: tuple[str, ...] = LEAF_DISTRIBUTIONS,
-                        zeniths: tuple[float, ...] = ZENITHS,
-                        progress: Callable[[str], None] | None = None) -> list[Check]:
+                        zeniths: tuple[float, ...] = ZENITHS) -> list[Check]:
     """Uncollided transmission for LAI 1 and 3 × the three leaf-angle distributions × sun
     zenith 0°, 30°, 60°: mean over the 36 detectors of ``realisations`` independent layers,
     its standard error from the spread of those (nearly independent) detector values: photon
@@ -154,18 +155,17 @@ def transmission_checks(realisations: int = 4, photons: int = 20_000, points: in
                     se = float(v.std(ddof=1) / math.sqrt(len(v))) if len(v) > 1 else 0.0
                     out.append(_checked(name, e, expected, float(v.mean()), se, 0.01,
                                         "exp(−G(θ)·LAI/cos θ) (Beer–Lambert, Ross G)"))
-                if progress:
-                    progress(f"{name}: expected {expected:.4f}, " + ", ".join(
-                        f"{e} {np.mean(got[e, z]):.4f}" for e in engines))
+                log.info(f"{name}: expected {expected:.4f}, " + ", ".join(
+                    f"{e} {np.mean(got[e, z]):.4f}" for e in engines))
     return out
 
 
 # ----------------------------------------------------------------- floating spheres
 
 
-def sphere_checks(realisations: int = 2, photons: int = 100_000, points: int = 32,
-                  engines: tuple[str, ...] = (FORWARD,), zeniths: tuple[float, ...] = ZENITHS,
-                  progress: Callable[[str], None] | None = None) -> list[Check]:
+def sphere_checks(*, realisations: int = 2, photons: int = 100_000, points: int = 32,
+                  engines: tuple[str, ...] = (FORWARD,), zeniths: tuple[float, ...] = ZENITHS
+                  ) -> list[Check]:
     """Uncollided transmission under RAMI-HET01-like floating spheres
     (:mod:`radtree.verify.spheres`; black leaves, no floor) on 36 horizontal 1 m detectors
     (6 m × 6 m at the floor) against the numerical integral over each detector of
@@ -207,9 +207,8 @@ def sphere_checks(realisations: int = 2, photons: int = 100_000, points: int = 3
             se = float(d.std(ddof=1) / math.sqrt(len(d)))
             out.append(_checked(name, e, expected, expected + float(d.mean()), se, 0.01,
                                 "numerical integral of the spheres' shadows (RAMI HET01)"))
-            if progress:
-                progress(f"{name}: expected {expected:.4f}, {e} "
-                         f"{expected + float(d.mean()):.4f} ± {se:.4f}")
+            log.info(f"{name}: expected {expected:.4f}, {e} "
+                     f"{expected + float(d.mean()):.4f} ± {se:.4f}")
     return out
 
 
@@ -276,10 +275,10 @@ class BackwardPlan:
     hours: tuple[str, ...] | None = None
 
 
-def agreement_checks(hours: tuple[str, ...] = ("12:30",), scenarios: tuple[str, ...] = ("A",),
+def agreement_checks(*, hours: tuple[str, ...] = ("12:30",), scenarios: tuple[str, ...] = ("A",),
                      photons: int = 16_000_000, backward: list[str] | None = None,
-                     crown: str = "louvers dome", plans: dict[str, BackwardPlan] | None = None,
-                     progress: Callable[[str], None] | None = None) -> list[Check]:
+                     crown: str = "louvers dome", plans: dict[str, BackwardPlan] | None = None
+                     ) -> list[Check]:
     """Forward vs backward engines on the reduced Mendoza louvers dome (or another ``crown``
     of :data:`radtree.verify.compare.REDUCED`): the 8 sensors' 0.5 m
     patch mean per scenario and hour (expected = the backward engine's value). Each backward
@@ -306,8 +305,8 @@ def agreement_checks(hours: tuple[str, ...] = ("12:30",), scenarios: tuple[str, 
             got, se = fw.grid_mean("facade")
             for e in active:
                 plan = plan_of[e]
-                params = proj.engine if plan.ad is None else replace(proj.engine,
-                                                                     ad=int(plan.ad))
+                params = (proj.engine if plan.ad is None
+                          else proj.engine.changed(ad=int(plan.ad)))
                 bw = backward_patch_mean(e, built.scene, st, "facade", 0.5, ab=built.ab,
                                          points=plan.points, rays=plan.rays, params=params)
                 comb = math.hypot(se, bw.stderr)
@@ -315,7 +314,6 @@ def agreement_checks(hours: tuple[str, ...] = ("12:30",), scenarios: tuple[str, 
                          f"mean, forward vs {e}")
                 out.append(_checked(label, FORWARD, bw.lux, got, comb, 0.02,
                                     f"{e} backward engine, same scene"))
-                if progress:
-                    progress(f"{label}: {e} {bw.lux:.1f} ± {bw.stderr:.1f}, forward "
-                             f"{got:.1f} ± {se:.1f}")
+                log.info(f"{label}: {e} {bw.lux:.1f} ± {bw.stderr:.1f}, forward "
+                         f"{got:.1f} ± {se:.1f}")
     return out

@@ -10,7 +10,7 @@ mean over the random points (spatial and Monte Carlo noise together).
 
 from __future__ import annotations
 
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
@@ -73,7 +73,7 @@ def backward_patch_values(engine: str, scene: Scene, state: SkyState, grid: str,
     sub = Scene(scene.meshes, scene.materials, {pg.name: pg}, scene.notes,
                 scene.ground_material, media=scene.media)
     base = params or EngineParams()
-    p = replace(base, rays=rays, seed=seed, max_bounces=ab, ab=ab)
+    p = base.changed(rays=rays, seed=seed, max_bounces=ab, ab=ab)
     res = get_engine(engine).trace_once(sub, state, p, ab)[pg.name]
     return res.lux.reshape(len(g), points)
 

@@ -24,7 +24,8 @@ they do: column ``slat_m``).
 
 from __future__ import annotations
 
-from collections.abc import Callable, Sequence
+import logging
+from collections.abc import Sequence
 from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any
@@ -36,6 +37,8 @@ from radtree.engines.registry import photon_engines
 from radtree.errors import RadtreeError
 from radtree.fileio import atomic_path
 from radtree.pipeline.trace import trace_scenario
+
+log = logging.getLogger(__name__)
 
 FOLDER = "method"
 HOURLY = "hourly.csv"
@@ -125,14 +128,14 @@ def _fitting(root: Path, ov: dict[str, Any], proj: Project, name: str, engine: s
 
 def run_method_study(root: Path, *, photons: int = 1_000_000, radii: Sequence[float] = RADII_M,
                      scenarios: Sequence[str] = SCENARIOS, variants: Sequence[str] | None = None,
-                     resume: bool = True, file: str = HOURLY,
-                     echo: Callable[[str], None] = print) -> Path:
+                     resume: bool = True, file: str = HOURLY) -> Path:
     """Trace every variant and the radius scan of the project in ``root``; write and return
     ``root/method/hourly.csv``. ``photons`` per hour for the forward runs (the project's count
     is the study's reading; fewer keep the scan affordable). The file is rewritten after every
     scenario; with ``resume`` the (variant, radius, scenario) already in it at the same photon
     count are kept and not traced again. ``file``: another name in ``method/`` (runs in
-    parallel write different files; the report reads them all)."""
+    parallel write different files; the report reads them all). Each traced scenario is
+    logged (INFO); one that cannot be traced is a warning and is left out."""
     base = load_project(root)
     chosen = [v for v in VARIANTS if variants is None or v.label in variants]
     jobs: list[tuple[Variant, float]] = [(v, base.tree.dome.radius_m) for v in chosen]
@@ -153,13 +156,14 @@ def run_method_study(root: Path, *, photons: int = 1_000_000, radii: Sequence[fl
             try:
                 h, use = _fitting(root, ov, proj, name, variant.engine)
             except RadtreeError as exc:
-                echo(f"  {variant.label}, dome {radius:g} m, {name}: not traced ({exc})")
+                log.warning(f"{variant.label}, dome {radius:g} m, {name}: not traced ({exc})")
                 continue
             h["variant"], h["radius_m"], h["engine"] = variant.label, radius, variant.engine
             h["slat_m"] = use.tree.louvers.slat_size_m
-            h["photons"] = photons if variant.engine in photon_engines() else proj.engine.rays
-            echo(f"  {variant.label}, dome {radius:g} m, {name}: "
-                 + " ".join(f"{v:.0f}" for v in h["lux"]))
+            h["photons"] = (photons if variant.engine in photon_engines()
+                            else proj.engine.numpy.rays)
+            log.info(f"  {variant.label}, dome {radius:g} m, {name}: "
+                     + " ".join(f"{v:.0f}" for v in h["lux"]))
             table = pd.concat([table, h[COLUMNS]], ignore_index=True)
             out.parent.mkdir(parents=True, exist_ok=True)
             with atomic_path(out) as tmp:   # after every scenario: an interrupted run resumes

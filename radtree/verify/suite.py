@@ -5,8 +5,8 @@ the free volume crown at three hours against NumPy and at noon against Radiance.
 
 from __future__ import annotations
 
+import logging
 import time
-from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -24,6 +24,8 @@ from radtree.verify.checks import (
     transmission_checks,
 )
 from radtree.verify.turbid import turbid_checks
+
+log = logging.getLogger(__name__)
 
 # Radiance at -ad 2048 over 64 points per patch took 206 s per scenario and hour on the reduced
 # dome (2 cores); at -ad 1024 over 32 points ≈ 75 s, so it is compared at noon only, while NumPy
@@ -54,37 +56,37 @@ class VerifyOutcome:
         return pd.DataFrame([c.row() for c in self.checks], columns=COLUMNS)
 
 
-def run_verify(out: Path, full: bool = False, backward: list[str] | None = None,
-               echo: Callable[[str], None] = print) -> VerifyOutcome:
+def run_verify(out: Path, *, full: bool = False, backward: list[str] | None = None
+               ) -> VerifyOutcome:
     """Every check; ``out`` is the CSV written. ``backward``: the backward engines compared
-    with the forward one (default every available one)."""
+    with the forward one (default every available one). Each check is logged (INFO) as it is
+    made."""
     t0 = time.perf_counter()
     checks: list[Check] = []
     if full:
-        checks += transmission_checks(realisations=16, photons=200_000, points=64,
-                                      progress=echo)
+        checks += transmission_checks(realisations=16, photons=200_000, points=64)
         checks += sphere_checks(realisations=8, photons=400_000, points=64,
-                                engines=(FORWARD, seeded_engine().name), progress=echo)
+                                engines=(FORWARD, seeded_engine().name))
         checks += energy_checks(photons=200_000)
-        checks += turbid_checks(rays=64_000, progress=echo)
+        checks += turbid_checks(rays=64_000)
         for crown in ("louvers dome", "free volume crown"):
             checks += agreement_checks(hours=("10:30", "12:30", "14:30"), scenarios=("A", "B"),
                                        photons=40_000_000, backward=backward, crown=crown,
-                                       plans=FULL_PLANS, progress=echo)
+                                       plans=FULL_PLANS)
         from radtree.engines.radiance.binaries import find_radiance
 
         if find_radiance() is not None:
             from radtree.verify.threephase import closure_checks
 
-            checks += closure_checks(progress=echo)
+            checks += closure_checks()
     else:
-        checks += transmission_checks(progress=echo)
-        checks += sphere_checks(progress=echo)
+        checks += transmission_checks()
+        checks += sphere_checks()
         checks += energy_checks()
-        checks += turbid_checks(progress=echo)
-        checks += agreement_checks(backward=backward, progress=echo)
+        checks += turbid_checks()
+        checks += agreement_checks(backward=backward)
         checks += agreement_checks(backward=backward, crown="free volume crown",
-                                   photons=4_000_000, progress=echo)
+                                   photons=4_000_000)
     outcome = VerifyOutcome(checks, Path(out), time.perf_counter() - t0)
     outcome.path.parent.mkdir(parents=True, exist_ok=True)
     with atomic_path(outcome.path) as tmp:

@@ -8,12 +8,14 @@ same XML, so its own accuracy is not what is checked.
 
 from __future__ import annotations
 
+import logging
 import tempfile
-from collections.abc import Callable
 from dataclasses import replace
 from pathlib import Path
 
 from radtree.verify.checks import Check
+
+log = logging.getLogger(__name__)
 
 #: the relative agreement the chain claims with a direct trace of the same BSDF scene
 CLAIM = 0.03
@@ -78,11 +80,11 @@ def write_project(root: Path) -> Path:
     return root
 
 
-def closure_checks(folder: Path | None = None, ad: int = 1024, samples: int = 200,
-                   progress: Callable[[str], None] | None = None) -> list[Check]:
+def closure_checks(folder: Path | None = None, *, ad: int = 1024, samples: int = 200
+                   ) -> list[Check]:
     """The façade's uniform-sky closure (leaf-on), ``ad`` ambient rays per sensor for V and
     the reference, ``samples`` rays per Klems patch for D; work files in ``folder`` (default
-    a temporary one)."""
+    a temporary one). Each check is logged (INFO) as it is made."""
     from radtree.annual.closure import ClosureSettings, closure_table
     from radtree.annual.coefficients import TraceParams
     from radtree.annual.threephase import GROUP_LEVEL, GROUP_MATERIAL_UP, crown_models
@@ -101,8 +103,9 @@ def closure_checks(folder: Path | None = None, ad: int = 1024, samples: int = 20
         bare = make_scene(project, replace(sc, model="none"), dense_grid=False).scene
         settings = ClosureSettings(TraceParams(ab=6, ad=ad, lw=1e-3), samples, GROUP_LEVEL,
                                    GROUP_MATERIAL_UP)
-        table = closure_table(bare, models, form, ["facade"],
-                              project.street.ground_reflectance, root / "closure", settings)
+        table = closure_table(bare, models=models, form=form, grids=["facade"],
+                              rho=project.street.ground_reflectance, folder=root / "closure",
+                              settings=settings)
     out = []
     for _, row in table.iterrows():
         if row["light"] != "sky":
@@ -112,6 +115,5 @@ def closure_checks(folder: Path | None = None, ad: int = 1024, samples: int = 20
         out.append(Check(name, "radiance", float(row["reference"]), float(row["chain"]),
                          CLAIM * float(row["reference"]),
                          reference="rcontrib on the same BSDF-crown scene"))
-        if progress:
-            progress(f"{name}: reference {row['reference']:.4f}, chain {row['chain']:.4f}")
+        log.info(f"{name}: reference {row['reference']:.4f}, chain {row['chain']:.4f}")
     return out

@@ -32,8 +32,8 @@ volume path tracers (e.g. Pharr, Jakob & Humphreys, Physically Based Rendering, 
 
 from __future__ import annotations
 
+import logging
 import math
-from collections.abc import Callable
 
 import numpy as np
 
@@ -47,6 +47,8 @@ from radtree.optics import Plastic, Trans
 from radtree.scene import Scene, SensorGrid, quad
 from radtree.trees.turbid import leaf_kind
 from radtree.verify.checks import Check
+
+log = logging.getLogger(__name__)
 
 RADIUS = 2.0
 CENTRE = (0.0, 0.0, 3.0)
@@ -95,9 +97,10 @@ def _params(ab: int, rays: int, seed: int) -> EngineParams:
     return EngineParams(name=ENGINE, max_bounces=ab, rays=rays, seed=seed)
 
 
-def turbid_checks(rays: int = 8000, seed: int = 7, forward_photons: int = 100_000,
-                  progress: Callable[[str], None] | None = None) -> list[Check]:
-    """The checks of the module text, as :class:`~radtree.verify.checks.Check` rows."""
+def turbid_checks(*, rays: int = 8000, seed: int = 7, forward_photons: int = 100_000
+                  ) -> list[Check]:
+    """The checks of the module text, as :class:`~radtree.verify.checks.Check` rows (each
+    logged, INFO)."""
     out: list[Check] = []
     black = Trans("black_leaf", 1e-9, 0.0, 0.0)   # trans needs R + T > 0: 1e-9, nil
     for x, lad in CASES:
@@ -126,10 +129,9 @@ def turbid_checks(rays: int = 8000, seed: int = 7, forward_photons: int = 100_00
                          f"{white.specular_transmittance:g} = 1)", ENGINE, want,
                          float(res.lux[0]), max(0.01 * want, 3.0 * _se(res))))
     out += forward_checks(forward_photons, seed)
-    if progress:
-        for c in out:
-            progress(f"{c.check}: expected {c.expected:.4g}, got {c.got:.4g} "
-                     f"({'ok' if c.passed else 'FAILED'})")
+    for c in out:
+        log.info(f"{c.check}: expected {c.expected:.4g}, got {c.got:.4g} "
+                 f"({'ok' if c.passed else 'FAILED'})")
     return out
 
 

@@ -13,6 +13,7 @@ from __future__ import annotations
 import time
 import zlib
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
@@ -95,14 +96,33 @@ def sun_source(scene: Scene, state: SkyState, settings: ForwardSettings, sphere
     return SunSource(sun, state.direct_normal_lux, target, settings.beam_diameter_m / 2.0, dist)
 
 
-def trace_forward(scene: Scene, state: SkyState, settings: ForwardSettings,
-                  grids: list[str] | None = None, *, backend: str = "auto", workers: int = 2,
-                  label: str | None = None) -> ForwardResult:
-    """Forward-trace one hour of ``scene`` on ``grids`` (default every grid). Sources: the sun
-    over the whole scene plus the sky and the distant ground glow of the hour (as the backward
-    engines see them), or — with ``settings.beam_diameter_m`` — the sun beam alone (the
-    study's surface source: no sky, no ground glow)."""
-    t0 = time.perf_counter()
+@dataclass(frozen=True)
+class _Hour:
+    """One hour's forward trace, planned: the grids ``names``, geometry and optics, patch
+    detectors, bounding sphere, sources (``direct``: the indices whose beam is counted at the
+    points), the random generator, the target grid's centre (m) and the variance reduction
+    near it (splitting, guiding)."""
+
+    scene: Scene
+    state: SkyState
+    settings: ForwardSettings
+    names: list[str]
+    geo: Any
+    optics: Any
+    det: PatchDetectors
+    sphere: Any
+    sources: list
+    direct: frozenset[int]
+    rng: np.random.Generator
+    target: np.ndarray
+    near: Splitting | None
+    guide: Guide | None
+
+
+def _plan(scene: Scene, state: SkyState, settings: ForwardSettings, grids: list[str] | None,
+          *, backend: str, workers: int, label: str | None) -> _Hour:
+    """The hour's :class:`_Hour`: detectors on ``grids``, the sources (the sun, and without a
+    beam the sky and ground glow), the generator seeded by the seed and the hour's label."""
     names = list(scene.grids) if grids is None else list(grids)
     missing = [g for g in names if g not in scene.grids]
     if missing:
@@ -133,76 +153,115 @@ def trace_forward(scene: Scene, state: SkyState, settings: ForwardSettings,
     if radius is None:  # the sphere just holding the target grid's patches
         corners = det.corners()[det.slices[aim]].reshape(-1, 3)
         radius = float(np.linalg.norm(corners - target, axis=1).max())
-    guide = (Guide(target, radius, settings.guide)
-             if settings.guide > 0 else None)
+    guide = Guide(target, radius, settings.guide) if settings.guide > 0 else None
+    return _Hour(scene, state, settings, names, geo, optics, det, sphere, sources, direct, rng,
+                 target, near, guide)
 
-    def new_tracer(batches: int) -> ForwardTracer:
-        return ForwardTracer(geo, optics, det, batches, threshold=settings.threshold,
-                             splitting=settings.splitting, max_bounces=settings.max_bounces,
-                             max_specular=settings.max_specular, chunk=settings.chunk, rng=rng,
-                             splitting_near=near, guide=guide)
 
-    tracer = new_tracer(settings.batches)
-    b = settings.batches
-    strata, n_pilot, pilot_segments = None, 0, 0
-    if settings.focus_m is not None and settings.beam_diameter_m is None and sources:
-        edges = ring_edges(float(settings.focus_m),
-                           sphere.radius + float(np.linalg.norm(target - sphere.centre)))
-        strata = [Stratum(i, a, b_) for i in range(len(sources))
-                  for a, b_ in zip(edges[:-1], edges[1:])]
-        per_ring = max(64, int(PILOT * settings.photons / len(strata)))
-        scout = new_tracer(1)
-        pilot(sources, strata, target, scout, per_ring, rng, direct)
-        n_pilot, pilot_segments = per_ring * len(strata), scout.segments
-        allocate(strata, max(settings.photons - n_pilot, b * len(strata)), b)
+def _tracer(h: _Hour, batches: int) -> ForwardTracer:
+    s = h.settings
+    return ForwardTracer(h.geo, h.optics, h.det, batches, threshold=s.threshold,
+                         splitting=s.splitting, max_bounces=s.max_bounces,
+                         max_specular=s.max_specular, chunk=s.chunk, rng=h.rng,
+                         splitting_near=h.near, guide=h.guide)
 
-    def one_round() -> tuple[int, np.ndarray]:
-        """Trace one round of photons into a fresh tally: its photons and (batches, detectors)
-        lux of each batch."""
-        tracer.tally = np.zeros((b, det.count))
-        if strata is not None:
-            trace_strata(sources, strata, target, tracer, settings.chunk, b, rng, direct)
-            n = sum(st.photons for st in strata)
-        else:
-            counts = _allot(settings.photons, [s.flux for s in sources], b)
-            for src, n_src in zip(sources, counts):
-                per_photon = src.flux / n_src
-                for c0 in range(0, n_src, settings.chunk):
-                    k = min(settings.chunk, n_src - c0)
-                    batch = (c0 + np.arange(k)) % b
-                    tracer.run(Photons.start(src.launch(k, per_photon, rng), batch,
-                                             src is sources[0] and bool(direct)))
-            n = sum(counts)
-        rows = tracer.tally * b / det.area
-        if direct:
-            rows += at_points  # the direct sun, exact at the points: the same in every batch
-        return n, rows
 
-    at_points = np.zeros(det.count)
-    if direct:
-        sun = np.asarray(state.sun.vector, float)
-        for name in names:
-            at_points[det.slices[name]] = direct_sun(geo, optics, scene.grids[name], sun,
-                                                     state.direct_normal_lux)
-    budget = Budget(settings.photons, settings.target_rel_se, settings.max_photons)
+def _focus(h: _Hour) -> tuple[list[Stratum] | None, int, int]:
+    """The focused launch's rings, their photons allotted by a pilot run (None without a
+    focus, with a beam or without sources), the pilot's photons and segments."""
+    s, b = h.settings, h.settings.batches
+    if s.focus_m is None or s.beam_diameter_m is not None or not h.sources:
+        return None, 0, 0
+    edges = ring_edges(float(s.focus_m),
+                       h.sphere.radius + float(np.linalg.norm(h.target - h.sphere.centre)))
+    strata = [Stratum(i, a, b_) for i in range(len(h.sources))
+              for a, b_ in zip(edges[:-1], edges[1:])]
+    per_ring = max(64, int(PILOT * s.photons / len(strata)))
+    scout = _tracer(h, 1)
+    pilot(h.sources, strata, h.target, scout, per_ring, h.rng, h.direct)
+    n_pilot = per_ring * len(strata)
+    allocate(strata, max(s.photons - n_pilot, b * len(strata)), b)
+    return strata, n_pilot, scout.segments
+
+
+def _at_points(h: _Hour) -> np.ndarray:
+    """The sun's direct light at the sensor points (lux; zeros when it is not counted there)."""
+    out = np.zeros(h.det.count)
+    if h.direct:
+        sun = np.asarray(h.state.sun.vector, float)
+        for name in h.names:
+            out[h.det.slices[name]] = direct_sun(h.geo, h.optics, h.scene.grids[name], sun,
+                                                 h.state.direct_normal_lux)
+    return out
+
+
+def _round(h: _Hour, tracer: ForwardTracer, strata: list[Stratum] | None,
+           at_points: np.ndarray) -> tuple[int, np.ndarray]:
+    """One round of photons into a fresh tally: its photons and (batches, detectors) lux of
+    each batch."""
+    s, b = h.settings, h.settings.batches
+    tracer.tally = np.zeros((b, h.det.count))
+    if strata is not None:
+        trace_strata(h.sources, strata, h.target, tracer, s.chunk, b, h.rng, h.direct)
+        n = sum(st.photons for st in strata)
+    else:
+        counts = _allot(s.photons, [src.flux for src in h.sources], b)
+        for src, n_src in zip(h.sources, counts):
+            per_photon = src.flux / n_src
+            for c0 in range(0, n_src, s.chunk):
+                k = min(s.chunk, n_src - c0)
+                batch = (c0 + np.arange(k)) % b
+                tracer.run(Photons.start(src.launch(k, per_photon, h.rng), batch,
+                                         src is h.sources[0] and bool(h.direct)))
+        n = sum(counts)
+    rows = tracer.tally * b / h.det.area
+    if h.direct:
+        rows += at_points  # the direct sun, exact at the points: the same in every batch
+    return n, rows
+
+
+def _rounds(h: _Hour, tracer: ForwardTracer, strata: list[Stratum] | None
+            ) -> tuple[int, np.ndarray, int, str | None]:
+    """Rounds of ``photons`` until the precision target or the cap
+    (:class:`~radtree.engines.forward.precision.Budget`): photons traced, (batches,
+    detectors) lux of every batch, rounds, the warning when the cap stopped the run."""
+    s = h.settings
+    at_points = _at_points(h)
+    budget = Budget(s.photons, s.target_rel_se, s.max_photons)
     traced, rows = 0, []
-    leg = settings.photons
+    leg = s.photons
     while leg > 0:
-        for _ in range(max(1, leg // settings.photons)):
-            n, r = one_round()
+        for _ in range(max(1, leg // s.photons)):
+            n, r = _round(h, tracer, strata, at_points)
             traced += n
             rows.append(r)
         per_batch = np.vstack(rows)
-        grid_batches = {name: per_batch[:, det.slices[name]].mean(axis=1) for name in names}
+        grid_batches = {name: per_batch[:, h.det.slices[name]].mean(axis=1)
+                        for name in h.names}
         leg = budget.next_leg(traced, worst_relative_se(grid_batches)[1])
-    warning = budget.warn_if_short(traced, grid_batches)
+    return traced, per_batch, len(rows), budget.warn_if_short(traced, grid_batches)
+
+
+def trace_forward(scene: Scene, state: SkyState, settings: ForwardSettings,
+                  grids: list[str] | None = None, *, backend: str = "auto", workers: int = 2,
+                  label: str | None = None) -> ForwardResult:
+    """Forward-trace one hour of ``scene`` on ``grids`` (default every grid). Sources: the sun
+    over the whole scene plus the sky and the distant ground glow of the hour (as the backward
+    engines see them), or — with ``settings.beam_diameter_m`` — the sun beam alone (the
+    study's surface source: no sky, no ground glow). Plan (:func:`_plan`), focus
+    (:func:`_focus`), rounds (:func:`_rounds`), the result."""
+    t0 = time.perf_counter()
+    h = _plan(scene, state, settings, grids, backend=backend, workers=workers, label=label)
+    tracer = _tracer(h, settings.batches)
+    strata, n_pilot, pilot_segments = _focus(h)
+    traced, per_batch, rounds, warning = _rounds(h, tracer, strata)
     out, per = {}, {}
-    for name in names:
-        per[name] = per_batch[:, det.slices[name]]
+    for name in h.names:
+        per[name] = per_batch[:, h.det.slices[name]]
         out[name] = GridResult(per[name].mean(axis=0),
                                per[name].std(axis=0, ddof=1) / np.sqrt(len(per[name])))
     return ForwardResult(out, tracer.ledger, traced, tracer.segments + pilot_segments,
-                         time.perf_counter() - t0, per, strata, n_pilot, len(rows), warning)
+                         time.perf_counter() - t0, per, strata, n_pilot, rounds, warning)
 
 
 def _allot(photons: int, fluxes: list[float], batches: int) -> list[int]:

@@ -141,17 +141,19 @@ class ForwardSettings:
 
     @classmethod
     def from_params(cls, params: EngineParams, ab: int | None = None) -> ForwardSettings:
-        """The settings of a project's ``[engine]`` table; ``ab`` (the scene's ``-ab``) caps the
-        diffuse events (default ``params.max_bounces``)."""
-        return cls(photons=params.photons, threshold=params.forward_threshold,
-                   splitting=params.forward_splitting, beam_diameter_m=params.beam_diameter_m,
-                   patch_m=params.patch_m, batches=params.forward_batches,
-                   max_bounces=int(params.max_bounces if ab is None else ab),
-                   seed=int(params.seed), focus_m=params.forward_focus_m,
-                   split=params.forward_split, split_radius_m=params.forward_split_radius_m,
-                   guide=params.forward_guide, guide_radius_m=params.forward_guide_radius_m,
-                   target_rel_se=params.target_rel_se, max_photons=params.max_photons,
-                   direct_sun=params.forward_direct_sun)
+        """The settings of a project's ``[engine]`` table (its forward group,
+        :class:`radtree.config.engine.ForwardParams`); ``ab`` (the scene's ``-ab``) caps the
+        diffuse events (default ``engine.max_bounces``)."""
+        f = params.forward
+        return cls(photons=f.photons, threshold=f.forward_threshold,
+                   splitting=f.forward_splitting, beam_diameter_m=f.beam_diameter_m,
+                   patch_m=f.patch_m, batches=f.forward_batches,
+                   max_bounces=int(params.numpy.max_bounces if ab is None else ab),
+                   seed=int(params.seed), focus_m=f.forward_focus_m,
+                   split=f.forward_split, split_radius_m=f.forward_split_radius_m,
+                   guide=f.forward_guide, guide_radius_m=f.forward_guide_radius_m,
+                   target_rel_se=f.target_rel_se, max_photons=f.max_photons,
+                   direct_sun=f.forward_direct_sun)
 
     def describe(self) -> str:
         source = ("sun over the whole scene" if self.beam_diameter_m is None

@@ -160,8 +160,25 @@ class ForwardTracer:
                 stack.append(children)
 
     def step(self, ph: Photons) -> Photons:
-        """One segment per photon: tally detectors, absorb, scatter; the children."""
-        geo, opt, led = self.geo, self.opt, self.ledger
+        """One segment per photon: tally detectors, absorb, scatter; the children. The
+        generator's draws come in the loop's order: the turbid crowns' collisions, their leaf
+        events, the event picks, the roulette, the new directions."""
+        ph, tri, t, met = self._advance(ph)
+        if len(ph) == 0:
+            return ph
+        p, nf, _, coef, mat = self._surface(ph, tri, t, met)
+        self._absorb(ph, coef, mat)
+        src, ev, cw = self._choose(ph, coef)
+        if len(src) == 0:
+            return ph.take(np.zeros(0, np.int64))
+        return self._children(ph, p, nf, src, ev, cw)
+
+    def _advance(self, ph: Photons
+                 ) -> tuple[Photons, np.ndarray, np.ndarray, np.ndarray | None]:
+        """The photons' segments to their first hits (or a turbid crown's leaf), tallied on the
+        detectors (not the direct beam's); photons leaving the scene are booked and dropped.
+        The photons still in the scene, their triangles, distances and leaf indices."""
+        geo, led = self.geo, self.ledger
         tri, t = geo.caster.first_hit(ph.o, ph.d)
         met = None
         if geo.media is not None:   # a leaf of a turbid crown first? (engines.common.turbid)
@@ -189,8 +206,14 @@ class ForwardTracer:
             keep = ~miss
             ph, tri, t = ph.take(keep), tri[keep], t[keep]
             met = None if met is None else met[keep]
-            if len(ph) == 0:
-                return ph
+        return ph, tri, t, met
+
+    def _surface(self, ph: Photons, tri: np.ndarray, t: np.ndarray, met: np.ndarray | None
+                 ) -> tuple[np.ndarray, ...]:
+        """Hit points, normals on the incoming side, cosines ray · geometric normal, event
+        coefficients (k, 4: diffuse R, diffuse T, specular T, mirror; leaf events and glass
+        filled in) and material indices of the hits."""
+        geo, opt = self.geo, self.opt
         p = ph.o + t[:, None] * ph.d
         ng = geo.normals[tri]
         cosd = np.einsum("ij,ij->i", ph.d, ng)
@@ -206,7 +229,12 @@ class ForwardTracer:
         if glass.any():
             tg, rg = glass_coefficients(cosd[glass], opt.glass_tn[mat][glass])
             coef[glass, 2], coef[glass, 3] = tg, rg
-        w = ph.w
+        return p, nf, cosd, coef, mat
+
+    def _absorb(self, ph: Photons, coef: np.ndarray, mat: np.ndarray) -> None:
+        """Book the flux absorbed per material and the flux of events beyond the bounce
+        caps (those events' coefficients set to 0)."""
+        led, w = self.ledger, ph.w
         led.absorbed += np.bincount(mat, w * (1.0 - coef.sum(axis=1)),
                                     minlength=len(led.materials))
         no_diff = ph.ndiff >= self.max_bounces
@@ -215,6 +243,13 @@ class ForwardTracer:
                             + (w[no_spec] * coef[no_spec, 2:].sum(axis=1)).sum())
         coef[no_diff, :2] = 0.0
         coef[no_spec, 2:] = 0.0
+
+    def _choose(self, ph: Photons, coef: np.ndarray
+                ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """The events that go on (source photon, event, flux): every event above the flux
+        threshold (ray splitting), or one event per photon picked ∝ its coefficient with
+        Russian roulette below the threshold."""
+        led, w = self.ledger, ph.w
         floor = self.threshold * ph.w0
         if self.splitting:
             ev = np.repeat(np.arange(4)[None, :], len(ph), axis=0).ravel()
@@ -224,26 +259,28 @@ class ForwardTracer:
             ev, src, cw = ev[live], src[live], cw[live]
             dead = cw < floor[src]
             led.killed += float(cw[dead].sum())
-            ev, src, cw = ev[~dead], src[~dead], cw[~dead]
-        else:
-            total = coef.sum(axis=1)
-            cw = w * total
-            cum = np.cumsum(coef, axis=1)
-            pick = self.rng.random(len(ph)) * total
-            ev = np.minimum((pick[:, None] >= cum).sum(axis=1), 3)
-            live = cw > 0
-            low = live & (cw < floor)
-            if low.any():
-                win = self.rng.random(int(low.sum())) * floor[low] < cw[low]
-                lw = cw[low]
-                led.killed += float(lw[~win].sum())
-                led.promoted += float((floor[low][win] - lw[win]).sum())
-                cw[low] = np.where(win, floor[low], 0.0)
-                live &= cw > 0
-            src = np.flatnonzero(live)
-            ev, cw = ev[live], cw[live]
-        if len(src) == 0:
-            return ph.take(np.zeros(0, np.int64))
+            return src[~dead], ev[~dead], cw[~dead]
+        total = coef.sum(axis=1)
+        cw = w * total
+        cum = np.cumsum(coef, axis=1)
+        pick = self.rng.random(len(ph)) * total
+        ev = np.minimum((pick[:, None] >= cum).sum(axis=1), 3)
+        live = cw > 0
+        low = live & (cw < floor)
+        if low.any():
+            win = self.rng.random(int(low.sum())) * floor[low] < cw[low]
+            lw = cw[low]
+            led.killed += float(lw[~win].sum())
+            led.promoted += float((floor[low][win] - lw[win]).sum())
+            cw[low] = np.where(win, floor[low], 0.0)
+            live &= cw > 0
+        return np.flatnonzero(live), ev[live], cw[live]
+
+    def _children(self, ph: Photons, p: np.ndarray, nf: np.ndarray, src: np.ndarray,
+                  ev: np.ndarray, cw: np.ndarray) -> Photons:
+        """The photons the chosen events send on: split near the target, new directions
+        (cosine or guided diffuse, mirror, undeviated), origins off the surface."""
+        led = self.ledger
         w0, nsplit = ph.w0[src], ph.nsplit[src]
         if self.near is not None:
             src, ev, cw, w0, nsplit = self._split(p, src, ev, cw, w0, nsplit)

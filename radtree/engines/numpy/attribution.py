@@ -227,15 +227,61 @@ def attribute_hour(scene: Scene, state: SkyState, params: EngineParams,
                  scene_optics(scene, state, geo.material_names))
     seed = params.seed if seed is None else seed
     return {g: _attribute_grid(hour, scene.grids[g], grid_rays(params, g),
-                               _grid_seed(seed, g), params.sampling, names)
+                               _grid_seed(seed, g), params.numpy.sampling, names)
             for g in grid_names}
 
 
-def _attribute_grid(hour: _Hour, grid: SensorGrid, n_paths: int, rng: np.random.Generator,
-                    sampling: str, names: list[str]) -> TreeAttribution:
+class _Sums:
+    """The paired differences (without − with trees, lux) of one grid's paths, summed per
+    tree and (sensor, replicate) — ``r`` replicates of the Sobol' first directions
+    (``first``), one with random sampling — with their squares per tree and sensor (random
+    sampling's standard error), the paths per cell and the differences no tree took."""
+
+    def __init__(self, n_own: int, n_s: int, n_paths: int, first: FirstDirections | None):
+        self.n_own, self.n_s, self.n_paths, self.first = n_own, n_s, n_paths, first
+        self.r = first.r if first is not None else 1
+        self.cells = n_s * self.r
+        self.sums = np.zeros(n_own * self.cells)   # per tree and (sensor, replicate)
+        self.squares = np.zeros(n_own * n_s)       # per tree and sensor
+        self.counts = np.zeros(self.cells)
+        self.loose = np.zeros(n_s)
+
+    def cell_of(self, pid: np.ndarray) -> np.ndarray:
+        return pid // self.n_paths * self.r + (
+            self.first.replicate(pid) if self.first is not None else 0)
+
+    def add(self, tree: np.ndarray, pid: np.ndarray, diff: np.ndarray) -> None:
+        n_own, cells, n_s = self.n_own, self.cells, self.n_s
+        self.sums[:] += np.bincount(tree * cells + self.cell_of(pid), diff,
+                                    minlength=n_own * cells)
+        self.squares[:] += np.bincount(tree * n_s + pid // self.n_paths, diff ** 2,
+                                       minlength=n_own * n_s)
+
+    def directions(self, pid: np.ndarray, nrm: np.ndarray) -> np.ndarray | None:
+        """The paths' first directions (None: cosine samples drawn by the tracer)."""
+        if self.first is None:
+            return None
+        u = self.first.uniforms(pid)
+        return cosine_directions(u[:, 0], u[:, 1], nrm[pid // self.n_paths])
+
+    def stderr(self) -> np.ndarray:
+        """(trees, sensors) standard errors of the removed light."""
+        per = self.sums.reshape(self.n_own, self.n_s, self.r)
+        cnt = self.counts.reshape(self.n_s, self.r)
+        n = cnt.sum(axis=1)
+        if self.first is not None:
+            return np.stack([replicate_stderr(per[i], cnt) for i in range(self.n_own)])
+        mean = per[:, :, 0] / n
+        m2 = self.squares.reshape(self.n_own, self.n_s) - n * mean ** 2
+        return np.sqrt(np.maximum(m2, 0.0) / np.maximum(n - 1.0, 1.0) / n)
+
+
+def _direct_sun_part(hour: _Hour, pts: np.ndarray, nrm: np.ndarray, n_own: int
+                     ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, dict]:
+    """The sensors' direct sun with and without the trees, the light removed given to the
+    one tree whose box the sun ray crosses (trees, sensors), what no box took, and per tree
+    the sensors whose sun ray crosses several boxes (traced without each later)."""
     with_t, bare_t, crowns = hour.with_t, hour.bare_t, hour.crowns
-    n_own = len(names)
-    pts, nrm = grid.points, grid.normals
     n_s = len(pts)
     direct_w = with_t.sensor_sun(pts, nrm)
     direct_o = bare_t.sensor_sun(pts, nrm)
@@ -254,43 +300,25 @@ def _attribute_grid(hour: _Hour, grid: SensorGrid, n_paths: int, rng: np.random.
     for sensor_ in np.flatnonzero(count > 1):
         for tree_ in np.flatnonzero(met_sun[sensor_]):
             later.setdefault(int(tree_), []).append(np.array([sensor_]))
-    if with_t.max_bounces <= 0:
-        _direct_without_one(hour, later, pts, nrm, direct_w, removed)
-        return TreeAttribution(names, removed, np.zeros((n_own, n_s)),
-                               GridResult(direct_w, np.zeros(n_s)),
-                               GridResult(direct_o, np.zeros(n_s)), unattributed)
-    n_paths = max(1, int(n_paths))
-    total = n_s * n_paths
-    first = FirstDirections(n_s, n_paths, rng) if sampling == "sobol" else None
-    key = stream_key(rng)
-    r = first.r if first is not None else 1
-    cells = n_s * r
-    sums = np.zeros(n_own * cells)       # per tree and (sensor, replicate): Σ differences
-    squares = np.zeros(n_own * n_s)      # per tree and sensor: Σ differences² (random sampling)
-    counts = np.zeros(cells)
-    loose = np.zeros(n_s)
-    tallies = (SensorTally(n_s, 1, first), SensorTally(n_s, 1, first))
-    several: list[tuple[np.ndarray, np.ndarray, np.ndarray]] = []  # pid, with-trees, boxes
+    return direct_w, direct_o, removed, unattributed, later
 
-    def cell_of(pid: np.ndarray) -> np.ndarray:
-        return pid // n_paths * r + (first.replicate(pid) if first is not None else 0)
 
-    def add(tree: np.ndarray, pid: np.ndarray, diff: np.ndarray) -> None:
-        sums[:] += np.bincount(tree * cells + cell_of(pid), diff, minlength=n_own * cells)
-        squares[:] += np.bincount(tree * n_s + pid // n_paths, diff ** 2, minlength=n_own * n_s)
-
-    def directions(pid: np.ndarray) -> np.ndarray | None:
-        if first is None:
-            return None
-        u = first.uniforms(pid)
-        return cosine_directions(u[:, 0], u[:, 1], nrm[pid // n_paths])
-
+def _paired_paths(hour: _Hour, grid: SensorGrid, sums: _Sums, key: int,
+                  tallies: tuple[SensorTally, SensorTally]
+                  ) -> list[tuple[np.ndarray, np.ndarray, np.ndarray]]:
+    """Every path traced with and without the trees (the same streams), each difference
+    given to the one tree whose box it crossed (or none); the paths that crossed several
+    boxes: (path ids, with-trees radiance, boxes crossed)."""
+    with_t, bare_t, crowns = hour.with_t, hour.bare_t, hour.crowns
+    pts, nrm, n_paths = grid.points, grid.normals, sums.n_paths
+    several: list[tuple[np.ndarray, np.ndarray, np.ndarray]] = []
+    total = len(pts) * n_paths
     batch = max(1, int(with_t.opts.batch_paths))
     for start in range(0, total, batch):
         pid = np.arange(start, min(total, start + batch))
         sensor = pid // n_paths
-        dirs = directions(pid)
-        met = np.zeros((len(pid), n_own), bool)
+        dirs = sums.directions(pid, nrm)
+        met = np.zeros((len(pid), sums.n_own), bool)
 
         def meet(path: np.ndarray, o: np.ndarray, d: np.ndarray, reach: np.ndarray,
                  met: np.ndarray = met) -> None:
@@ -305,14 +333,20 @@ def _attribute_grid(hour: _Hour, grid: SensorGrid, n_paths: int, rng: np.random.
         tallies[0].add(pid, sensor, math.pi * acc_w[:, None])
         tallies[1].add(pid, sensor, math.pi * acc_o[:, None])
         diff = math.pi * (acc_o - acc_w)
-        counts += np.bincount(cell_of(pid), minlength=cells)
+        sums.counts += np.bincount(sums.cell_of(pid), minlength=sums.cells)
         k = met.sum(axis=1)
         single = k == 1
-        add(met[single].argmax(axis=1), pid[single], diff[single])
-        loose += np.bincount(sensor[k == 0], diff[k == 0], minlength=n_s)
+        sums.add(met[single].argmax(axis=1), pid[single], diff[single])
+        sums.loose += np.bincount(sensor[k == 0], diff[k == 0], minlength=sums.n_s)
         if (k > 1).any():
             several.append((pid[k > 1], acc_w[k > 1], met[k > 1]))
-    # the paths that cross several trees' boxes, traced again without each of those trees
+    return several
+
+
+def _without_each(hour: _Hour, grid: SensorGrid, sums: _Sums, key: int,
+                  several: list[tuple[np.ndarray, np.ndarray, np.ndarray]]) -> None:
+    """The paths that crossed several trees' boxes, traced again without each of them."""
+    pts, nrm, n_paths = grid.points, grid.normals, sums.n_paths
     crossed = {int(t) for _, _, m in several for t in np.flatnonzero(m.any(axis=0))}
     for tree in sorted(crossed):
         tracer = hour.without(tree)
@@ -322,22 +356,36 @@ def _attribute_grid(hour: _Hour, grid: SensorGrid, n_paths: int, rng: np.random.
                 continue
             p = pid[sel]
             acc_i = tracer.paths(pts[p // n_paths], nrm[p // n_paths],
-                                 PathStreams(key, p.astype(np.uint64)), dirs=directions(p))
-            add(np.full(len(p), tree), p, math.pi * (acc_i - acc_w[sel]))
+                                 PathStreams(key, p.astype(np.uint64)),
+                                 dirs=sums.directions(p, nrm))
+            sums.add(np.full(len(p), tree), p, math.pi * (acc_i - acc_w[sel]))
+
+
+def _attribute_grid(hour: _Hour, grid: SensorGrid, n_paths: int, rng: np.random.Generator,
+                    sampling: str, names: list[str]) -> TreeAttribution:
+    """The grid's attribution: the direct sun, then (with diffuse bounces) ``n_paths``
+    paired paths per sensor and the paths that crossed several trees again without each."""
+    pts, nrm = grid.points, grid.normals
+    n_own, n_s = len(names), len(pts)
+    direct_w, direct_o, removed, unattributed, later = _direct_sun_part(hour, pts, nrm, n_own)
+    if hour.with_t.max_bounces <= 0:
+        _direct_without_one(hour, later, pts, nrm, direct_w, removed)
+        return TreeAttribution(names, removed, np.zeros((n_own, n_s)),
+                               GridResult(direct_w, np.zeros(n_s)),
+                               GridResult(direct_o, np.zeros(n_s)), unattributed)
+    n_paths = max(1, int(n_paths))
+    first = FirstDirections(n_s, n_paths, rng) if sampling == "sobol" else None
+    key = stream_key(rng)
+    sums = _Sums(n_own, n_s, n_paths, first)
+    tallies = (SensorTally(n_s, 1, first), SensorTally(n_s, 1, first))
+    several = _paired_paths(hour, grid, sums, key, tallies)
+    _without_each(hour, grid, sums, key, several)
     _direct_without_one(hour, later, pts, nrm, direct_w, removed)
-    per = sums.reshape(n_own, n_s, r)
-    cnt = counts.reshape(n_s, r)
-    n = cnt.sum(axis=1)
-    removed += per.sum(axis=2) / n
-    unattributed += loose / n
-    if first is not None:
-        se = np.stack([replicate_stderr(per[i], cnt) for i in range(n_own)])
-    else:
-        mean = per[:, :, 0] / n
-        m2 = squares.reshape(n_own, n_s) - n * mean ** 2
-        se = np.sqrt(np.maximum(m2, 0.0) / np.maximum(n - 1.0, 1.0) / n)
+    n = sums.counts.reshape(n_s, sums.r).sum(axis=1)
+    removed += sums.sums.reshape(n_own, n_s, sums.r).sum(axis=2) / n
+    unattributed += sums.loose / n
     (res_w,), (res_o,) = tallies[0].results(direct_w), tallies[1].results(direct_o)
-    return TreeAttribution(names, removed, se, res_w, res_o, unattributed)
+    return TreeAttribution(names, removed, sums.stderr(), res_w, res_o, unattributed)
 
 
 def _direct_without_one(hour: _Hour, later: dict[int, list[np.ndarray]], pts: np.ndarray,

@@ -33,7 +33,7 @@ Light sources and physics, chosen to behave like Radiance:
   specular only, with Radiance's angular ``glass`` formulas (Fresnel at n = 1.52 with the
   transmissivity along the refracted path, multiple internal reflections): transmission T(θ)
   and mirror reflection R(θ) (≈ 8 % at normal incidence).
-* **Bounces** — ``params.max_bounces`` counts diffuse segments exactly like ``rtrace -ab``:
+* **Bounces** — ``params.numpy.max_bounces`` counts diffuse segments exactly like ``rtrace -ab``:
   the sensor's sample is bounce 1, the surface at the end of the last allowed segment still
   gets its direct sun but no further diffuse ray. Specular events (T_s, glass, mirror) do not
   count as bounces (capped separately). Path weights are multiplied by the surface's total
@@ -50,7 +50,6 @@ depend neither on ``workers`` nor on ``batch_paths``.
 
 from __future__ import annotations
 
-import math
 import threading
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
@@ -70,7 +69,7 @@ from radtree.engines.common.geometry import (
 from radtree.engines.common.kernel import describe as kernel_describe
 from radtree.engines.common.kernel import kernel
 from radtree.engines.common.raycast import embree_available
-from radtree.engines.common.sampling import cosine_hemisphere, cosine_rows, mirror, uniform_cone
+from radtree.engines.common.sampling import cosine_hemisphere
 from radtree.engines.common.streams import (
     FIRST_DIRECTIONS,
     SENSOR_SUN_ROULETTE,
@@ -78,10 +77,10 @@ from radtree.engines.common.streams import (
     PathStreams,
     as_draws,
 )
-from radtree.engines.numpy.shadow import kernel_tables, transmittance
+from radtree.engines.numpy.bounce import Batch, BounceSteps
+from radtree.engines.numpy.shadow import kernel_tables
 from radtree.engines.numpy.shadow import rows as _rows
 from radtree.light.sky import SkyState
-from radtree.light.sun import SUN_HALF_ANGLE_DEG
 
 __all__ = ["DEFAULT_OPTIONS", "ENGINE_NAME", "GLASS_INDEX", "Environment", "Geometry", "Optics",
            "TraceOptions", "describe", "glass_coefficients", "scene_geometry", "scene_optics"]
@@ -128,26 +127,7 @@ def describe(backend: str = "auto") -> str:
 # --------------------------------------------------------------------------- the tracer
 
 
-def _cumulative(coef: np.ndarray) -> np.ndarray:
-    """Running sums (4, k) of the event coefficients (4, k) down the rows (``np.cumsum``
-    along the events, in the same order)."""
-    cum = np.empty_like(coef)
-    cum[0] = coef[0]
-    for j in range(1, len(coef)):
-        np.add(cum[j - 1], coef[j], out=cum[j])
-    return cum
-
-
-def _event(pick: np.ndarray, cum: np.ndarray) -> np.ndarray:
-    """Index (k,) of the event each ``pick`` (k, in [0, total)) falls into, from the running
-    sums ``cum`` (4, k): how many running sums are ≤ the pick, at most 3."""
-    ev = np.zeros(len(pick), np.int64)
-    for row in cum:
-        ev += pick >= row
-    return np.minimum(ev, 3, out=ev)
-
-
-class _Tracer:
+class _Tracer(BounceSteps):
     def __init__(self, geo: Geometry, optics: Optics, state: SkyState, params: EngineParams,
                  opts: TraceOptions, more: Sequence[tuple[SkyState, Optics]] = ()):
         """``more``: further hour states (with their optics) traced in the same batch — path
@@ -158,7 +138,7 @@ class _Tracer:
         self.opt = optics
         self.env = Environment(state)
         self.state = state
-        self.max_bounces = int(params.max_bounces)
+        self.max_bounces = int(params.numpy.max_bounces)
         self.opts = opts
         self.workers = max(1, int(getattr(params, "workers", 2) or 1))
         self.eps = opts.epsilon if opts.epsilon is not None else max(1e-5, 2e-6 * geo.size)
@@ -202,41 +182,6 @@ class _Tracer:
         self.tri_pack: np.ndarray | None = None
         if kernel() is not None:
             self.tri_pack = kernel_tables(geo.normals, geo.v0, self.tri_ts, self.sun_cos)
-
-    def sky(self, d: np.ndarray, hour: np.ndarray | None) -> np.ndarray:
-        """Luminance seen along escaping directions ``d`` (each path's own hour state)."""
-        if hour is None:
-            return self.env(d)
-        out = np.empty(len(d))
-        for h in np.unique(hour):
-            m = hour == h
-            out[m] = self.envs[h](d[m])
-        return out
-
-    # -- sun
-    def sun_directions(self, k: int, rng: Draws | np.random.Generator) -> np.ndarray:
-        if self.opts.sun_disc:
-            return uniform_cone(self.sun, math.radians(SUN_HALF_ANGLE_DEG), k, rng)
-        return np.broadcast_to(self.sun, (k, 3))
-
-    def shadow(self, origins: np.ndarray, dirs: np.ndarray,
-               rng: Draws | np.random.Generator | None = None, parallel: bool = True,
-               hour: np.ndarray | int | None = None) -> np.ndarray:
-        """Transmittance towards the sun: 1 if free, product of specular passes, else 0.
-
-        With ``rng``, faint shadow rays are continued by Russian roulette (unbiased); without,
-        the product is exact (the sensors' own direct sun); ``rng``: one stream per shadow
-        ray (:class:`~radtree.engines.common.streams.Draws`, the layer crossed appended to its
-        place) or a plain ``Generator``; ``parallel``:
-        whether the ray caster may split its queries over threads (not inside a part thread);
-        ``hour``: the hour state(s) whose point sun ``dirs`` are (per-triangle tables of the
-        cosines and offsets), None for other directions (a sampled sun disc).
-        """
-        vis = transmittance(self, origins, dirs, rng, parallel, hour)
-        if self.media is not None and len(vis):   # the turbid crowns' mean transmittance
-            on = (vis > 0).nonzero()[0]
-            vis[on] *= self.media.transmittance(origins[on], _rows(dirs, on), parallel)
-        return vis
 
     def sensor_sun(self, points: np.ndarray, normals: np.ndarray, dirs: np.ndarray | None = None,
                    rng: Draws | np.random.Generator | None = None, state: int | None = None
@@ -286,157 +231,26 @@ class _Tracer:
         the sun (``reach`` ∞, blocked or not) — without changing a number
         (the tree attribution, :mod:`radtree.engines.numpy.attribution`)."""
         k = len(points)
-        acc = np.zeros(k)
-        alive = np.arange(k)
-        o = np.array(points, float)
-        d = (cosine_hemisphere(np.asarray(normals, float), rng.rows(None, *FIRST_DIRECTIONS)) if dirs is None
-             else np.array(dirs, float))
-        beta = np.ones(k)
-        depth = np.ones(k, np.int64)
-        nspec = np.zeros(k, np.int64)
-        if hour is not None:  # contiguous int64 (the C kernel's surface pass needs it)
-            hour = np.ascontiguousarray(hour, dtype=np.int64)
-        geo, eps = self.geo, self.eps
-        thr = self.opts.roulette_weight
+        first = (cosine_hemisphere(np.asarray(normals, float),
+                                   rng.rows(None, *FIRST_DIRECTIONS)) if dirs is None
+                 else np.array(dirs, float))
+        b = Batch(np.zeros(k), np.arange(k), np.array(points, float), first, np.ones(k),
+                  np.ones(k, np.int64), np.zeros(k, np.int64),
+                  # contiguous int64 (the C kernel's surface pass needs it)
+                  None if hour is None else np.ascontiguousarray(hour, dtype=np.int64),
+                  orders)
         bounce = 0
-        while len(alive):
+        while len(b.alive):
             bounce += 1
-            tri, t = self.caster.first_hit(o, d, parallel)
-            met = None
-            if self.media is not None:   # a leaf of a turbid crown before the surface?
-                met, t = self.media.collide(o, d, t, rng.rows(alive, bounce, 5), parallel)
-                tri = np.where(met >= 0, max(self.n_tri - 1, 0), tri)   # a placeholder row
-            miss = tri < 0
-            if segments is not None:
-                segments(alive, o, d, np.where(miss, np.inf, t))
-            if miss.any():
-                mi = miss.nonzero()[0]
-                am, dm, bm = alive[mi], d.take(mi, axis=0), beta[mi]
-                if escapes is not None:
-                    escapes(am, dm, bm)
-                got = bm * self.sky(dm, None if hour is None else hour[mi])
-                acc[am] += got
-                if orders is not None:
-                    orders[am, depth[mi] - 1] += got
-                hi = (~miss).nonzero()[0]
-                alive, o, d, beta, depth, nspec, tri, t = (
-                    alive[hi], o.take(hi, axis=0), d.take(hi, axis=0), beta[hi], depth[hi],
-                    nspec[hi], tri[hi], t[hi])
-                if met is not None:
-                    met = met[hi]
-                if hour is not None:
-                    hour = hour[hi]
-                if len(alive) == 0:
-                    break
-            k_mod = kernel() if self.tri_pack is not None else None
-            if k_mod is not None and tri.dtype == np.int64:
-                # the same numbers in one pass (radtree.engines.common.kernel)
-                n_a = len(alive)
-                p, nf, cosd, coef = (np.empty((n_a, 3)), np.empty((n_a, 3)), np.empty(n_a),
-                                     np.empty((4, n_a)))
-                k_mod.surface(tri, t, o, d, self.tri_pack, self.tri_coef_t if hour is None
-                              else self.tri_coefs_flat_t, None if hour is None else
-                              np.asarray(hour, np.int64), self.n_tri, p, nf, cosd, coef)
-            else:
-                p = t[:, None] * d
-                p += o
-                ng = geo.normals.take(tri, axis=0)
-                cosd = np.einsum("ij,ij->i", d, ng)
-                front = cosd < 0
-                nf = np.where(front[:, None], ng, -ng)  # normal on the side the ray came from
-                # diffuse R, diffuse T, specular T, mirror (a copy, (4, k): one row per event)
-                coef = (self.tri_coef_t.take(tri, axis=1) if hour is None else
-                        self.tri_coefs_flat_t.take(hour * self.n_tri + tri, axis=1))
-            if met is not None and self.media is not None and (met >= 0).any():
-                mi = (met >= 0).nonzero()[0]   # leaf events: drawn normal, leaf optics
-                nf[mi], coef[:, mi] = self.media.leaf_events(
-                    met[mi], d.take(mi, axis=0), rng.rows(alive.take(mi), bounce, 6))
-                cosd[mi] = -1.0
-            rd, td = coef[0], coef[1]
-
-            # next-event estimation towards the sun
-            if self.sun_on:
-                sd = (self.sun_directions(len(alive), rng.rows(alive, bounce, 0)) if hour is None
-                      else self.suns.take(hour, axis=0))
-                if k_mod is not None:  # the same numbers in one pass
-                    n_a = len(alive)
-                    f, ni, so = np.empty(n_a), np.empty(n_a, np.int64), np.empty((n_a, 3))
-                    m = k_mod.nee(nf, sd, rd, td, self.dnis if hour is not None else None,
-                                  None if hour is None else np.asarray(hour, np.int64), eps,
-                                  p, f, ni, so)
-                    ni, so = ni[:m], so[:m]
-                else:
-                    cs = np.einsum("ij,ij->i", nf, sd)
-                    f = np.where(cs > 0, rd * cs, -td * cs) / math.pi
-                    if hour is not None:
-                        f *= self.dnis[hour]   # 0 where that hour's sun is off
-                    ni = (f > 0).nonzero()[0]
-                    if len(ni):
-                        so = nf.take(ni, axis=0)
-                        so *= (eps * np.sign(cs[ni]))[:, None]
-                        so += p.take(ni, axis=0)
-                if len(ni):
-                    vis = self.shadow(so, _rows(sd, ni), rng.rows(alive.take(ni), bounce, 1),
-                                      parallel,
-                                      None if self.opts.sun_disc else
-                                      0 if hour is None else hour[ni])
-                    if segments is not None:
-                        segments(alive.take(ni), so, _rows(sd, ni), np.full(len(ni), np.inf))
-                    got = beta[ni] * (self.dni if hour is None else 1.0) * f[ni] * vis
-                    an = alive[ni]
-                    acc[an] += got
-                    if orders is not None:
-                        orders[an, depth[ni] - 1] += got
-
-            # scattering events: diffuse reflect, diffuse transmit, specular transmit, mirror
-            if self.glass_any:
-                glass = self.tri_glass[tri] if met is None else self.tri_glass[tri] & (met < 0)
-                if glass.any():
-                    tg, rg = glass_coefficients(cosd[glass], self.tri_glass_tn[tri][glass])
-                    coef[2, glass] = tg
-                    coef[3, glass] = rg
-            coef[:2] *= depth < self.max_bounces
-            coef[2:] *= nspec < self.opts.max_specular
-            cum = _cumulative(coef)   # the last row: the total, summed in order
-            total = cum[3]
-            beta = beta * total
-            u = rng.rows(alive, bounce, 2).random(len(alive))
-            low = beta < thr
-            survive = (total > 0) & (~low | (u * thr < beta))
-            beta = np.where(low, thr, beta)
-            pick = rng.rows(alive, bounce, 3).random(len(alive)) * total
-            ev = _event(pick, cum)
-
-            si = survive.nonzero()[0]
-            if len(si) < len(alive):
-                alive, p, d, nf, beta, depth, nspec, ev = (
-                    alive[si], p.take(si, axis=0), d.take(si, axis=0), nf.take(si, axis=0),
-                    beta[si],
-                    depth[si], nspec[si], ev[si])
-                if hour is not None:
-                    hour = hour[si]
-            if len(alive) == 0:
+            h = self.hit(b, rng, bounce, parallel, escapes, segments)
+            if h is None:
                 break
-            new_d = d.copy()
-            side = np.ones(len(alive))  # +1: leave on the incoming side, -1: cross
-            diff_r, diff_t = ev == 0, ev == 1
-            diffuse = diff_r | diff_t
-            if diffuse.any():
-                di = diffuse.nonzero()[0]
-                axis = np.empty((3, len(di)))  # ±n_f, one row per axis
-                np.multiply(nf.take(di, axis=0).T, np.where(diff_r[di], 1.0, -1.0), out=axis)
-                new_d[di] = cosine_rows(axis, rng.rows(alive.take(di), bounce, 4)).T
-            spec_t, mir = ev == 2, ev == 3
-            if mir.any():
-                new_d[mir] = mirror(d[mir], nf[mir])
-            side[diff_t | spec_t] = -1.0
-            nf *= (eps * side)[:, None]
-            nf += p
-            o = nf
-            d = new_d
-            depth = depth + diffuse
-            nspec = nspec + (spec_t | mir)
-        return acc
+            p, nf, cosd, coef = self.surface(b, h, rng, bounce)
+            if self.sun_on:
+                self.sun_event(b, p, nf, coef, rng, bounce, parallel, segments)
+            if not self.scatter(b, h, p, nf, cosd, coef, rng, bounce):
+                break
+        return b.acc
 
     def paths_split(self, points: np.ndarray, normals: np.ndarray, streams: PathStreams,
                     dirs: np.ndarray | None = None, orders: np.ndarray | None = None,

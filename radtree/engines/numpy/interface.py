@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -45,14 +45,14 @@ class NumpyEngine(InProcessEngine):
         return {**super().provenance(), "numpy_kernel": kernel_name()}
 
     def sampling(self, params: EngineParams) -> str:
-        dense = (f" ({params.dense_rays} per dense-map point)"
-                 if params.dense_rays is not None else "")
-        return f"{params.rays} rays/sensor{dense}, {params.sampling} sampling, seed {params.seed}"
+        p = params.numpy
+        dense = f" ({p.dense_rays} per dense-map point)" if p.dense_rays is not None else ""
+        return f"{p.rays} rays/sensor{dense}, {p.sampling} sampling, seed {params.seed}"
 
     def prepare(self, scene: Scene, states: list[SkyState], params: EngineParams, ab: int,
                 folder: Path | None = None) -> NumpyPlan:
         return NumpyPlan(scene, {s.label: s for s in states},
-                         replace(params, ab=ab, max_bounces=ab))
+                         params.changed(ab=ab, max_bounces=ab))
 
     def trace(self, plan: NumpyPlan, label: str, grids: list[str] | None = None
               ) -> dict[str, GridResult]:
@@ -77,10 +77,10 @@ class NumpyEngine(InProcessEngine):
         (:mod:`radtree.engines.numpy.attribution`)."""
         from radtree.engines.numpy.attribution import attribute_hour
 
-        return attribute_hour(scene, state, replace(params, ab=ab, max_bounces=ab), grids,
+        return attribute_hour(scene, state, params.changed(ab=ab, max_bounces=ab), grids,
                               owners, seed)
 
     def commands(self, plan: NumpyPlan, label: str) -> list[str]:
         st = plan.states[label]
         return [f"numpy engine: {st.time}, {plan.scene.n_triangles} triangles, "
-                f"{plan.params.rays} rays/sensor, -ab {plan.params.max_bounces}"]
+                f"{plan.params.numpy.rays} rays/sensor, -ab {plan.params.numpy.max_bounces}"]

@@ -7,7 +7,6 @@ from __future__ import annotations
 import math
 import zlib
 from collections.abc import Sequence
-from dataclasses import replace
 
 import numpy as np
 
@@ -108,8 +107,8 @@ def _tracer(scene: Scene, state: SkyState, params: EngineParams, grids: list[str
     missing = [g for g in names if g not in scene.grids]
     if missing:
         raise EngineError(f"unknown sensor grid(s): {', '.join(missing)}")
-    if params.rays < 1:
-        raise EngineError(f"engine.rays must be ≥ 1, got {params.rays}")
+    if params.numpy.rays < 1:
+        raise EngineError(f"engine.rays must be ≥ 1, got {params.numpy.rays}")
     geo = scene_geometry(scene, options.backend, int(getattr(params, "workers", 2) or 1))
     extra = [(st, scene_optics(scene, st, geo.material_names)) for st in more]
     return _Tracer(geo, scene_optics(scene, state, geo.material_names), state, params,
@@ -123,7 +122,7 @@ def trace(scene: Scene, state: SkyState, params: EngineParams, grids: list[str] 
     tracer, names = _tracer(scene, state, params, grids, options)
     seed = params.seed if seed is None else seed
     return {name: _trace_grid(tracer, scene.grids[name], grid_rays(params, name),
-                              _grid_seed(seed, name), params.sampling)[0]
+                              _grid_seed(seed, name), params.numpy.sampling)[0]
             for name in names}
 
 
@@ -140,7 +139,7 @@ def trace_states(scene: Scene, states: list[SkyState], params: EngineParams,
     tracer, names = _tracer(scene, states[0], params, grids, options, states[1:])
     seed = params.seed if seed is None else seed
     per_grid = {name: _trace_grid(tracer, scene.grids[name], grid_rays(params, name),
-                                  _grid_seed(seed, name), params.sampling,
+                                  _grid_seed(seed, name), params.numpy.sampling,
                                   n_states=len(states))
                 for name in names}
     return [{name: res[h] for name, res in per_grid.items()} for h in range(len(states))]
@@ -154,14 +153,14 @@ def trace_bounce_ladder(scene: Scene, state: SkyState, params: EngineParams,
     largest: the result at ``-ab k`` sums the contributions of bounce order ≤ k, an unbiased
     estimate of a separate trace at ``max_bounces = k`` (the same paths: the steps of the
     ladder carry correlated, not independent, noise). ``-ab 0``: the direct sun alone."""
-    tracer, names = _tracer(scene, state, replace(params, max_bounces=max(ab_values)), grids,
+    tracer, names = _tracer(scene, state, params.changed(max_bounces=max(ab_values)), grids,
                             options)
     seed = params.seed if seed is None else seed
     out: dict[int, dict[str, GridResult]] = {ab: {} for ab in ab_values}
     for name in names:
         grid = scene.grids[name]
         res = _trace_grid(tracer, grid, grid_rays(params, name), _grid_seed(seed, name),
-                          params.sampling, ladder=True)
+                          params.numpy.sampling, ladder=True)
         for ab in ab_values:
             out[ab][name] = res[ab - 1] if ab > 0 else GridResult(
                 np.zeros(len(grid)) if options.sun_disc
@@ -172,9 +171,9 @@ def trace_bounce_ladder(scene: Scene, state: SkyState, params: EngineParams,
 def grid_rays(params: EngineParams, grid: str) -> int:
     """Paths per sensor of ``grid``: ``engine.dense_rays`` for the dense façade maps when set,
     else ``engine.rays``."""
-    if is_dense_grid(grid) and params.dense_rays is not None:
-        return int(params.dense_rays)
-    return int(params.rays)
+    if is_dense_grid(grid) and params.numpy.dense_rays is not None:
+        return int(params.numpy.dense_rays)
+    return int(params.numpy.rays)
 
 
 def trace_hour(scene: Scene, state: SkyState, params: EngineParams,
@@ -182,7 +181,7 @@ def trace_hour(scene: Scene, state: SkyState, params: EngineParams,
                ) -> dict[str, GridResult]:
     """Illuminance (lux) and its Monte Carlo standard error per sensor of each grid, one hour.
 
-    ``params.rays`` paths per sensor, ``params.max_bounces`` diffuse bounces (like ``-ab``),
+    ``params.numpy.rays`` paths per sensor, ``params.numpy.max_bounces`` diffuse bounces (like ``-ab``),
     ``seed`` (default ``params.seed``): the same seed gives identical numbers; each grid draws
     from its own stream (seed, grid name), so a grid's values do not depend on which other
     grids are traced.

@@ -24,10 +24,10 @@ The optional tensor tree (``h=-sc<2^N>``, ``rttree_reduce``) follows genBSDF's `
 
 from __future__ import annotations
 
+import logging
 import math
 import os
 import time
-from collections.abc import Callable
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, replace
 from pathlib import Path
@@ -39,6 +39,8 @@ from radtree.engines.radiance.materials import material_text
 from radtree.errors import EngineError
 from radtree.fileio import write_text
 from radtree.optics import KLEMS_FULL_RINGS, Material
+
+log = logging.getLogger(__name__)
 
 EPS = 1e-5
 #: photopic Y of Radiance RGB (the weights genBSDF passes to rmtxop -c)
@@ -160,13 +162,12 @@ PASSES = (("face.dat", "behind.dat", "tf", "rf"), ("behind.dat", "face.dat", "tb
 KEYS = ("tf", "rf", "tb", "rb")
 
 
-def flux_passes(folder: Path, settings: FluxSettings,
-                progress: Callable[[str], None] | None = None) -> None:
+def flux_passes(folder: Path, settings: FluxSettings) -> None:
     """Both rfluxmtx passes in ``folder`` (after :func:`write_system`): ``tf.dat``,
-    ``rf.dat``, ``tb.dat``, ``rb.dat``, photopic flux factors F[out, in]."""
+    ``rf.dat``, ``tb.dat``, ``rb.dat``, photopic flux factors F[out, in]. Each command line is
+    logged (INFO) before it runs."""
     for cmd, (trans, refl, tkey, rkey) in zip(flux_commands(settings), PASSES):
-        if progress:
-            progress(" ".join(cmd))
+        log.info(" ".join(cmd))
         run(cmd, cwd=folder)
         _to_y(folder, trans, f"{tkey}.dat")
         _to_y(folder, refl, f"{rkey}.dat")
@@ -188,12 +189,12 @@ def wrap_klems(folder: Path, name: str, thickness: float, width: float, height: 
 
 
 def klems_bsdf(folder: Path, settings: FluxSettings, name: str, thickness: float,
-               width: float, height: float, comment: str = "",
-               progress: Callable[[str], None] | None = None) -> BsdfRun:
+               width: float, height: float, comment: str = "") -> BsdfRun:
     """Run both rfluxmtx passes in ``folder`` (after :func:`write_system`) and wrap the four
-    Klems matrices into ``folder/<name>.xml``; checkBSDF must accept it."""
+    Klems matrices into ``folder/<name>.xml`` (sample ``thickness``, ``width``, ``height``
+    in m); checkBSDF must accept it."""
     t0 = time.perf_counter()
-    flux_passes(folder, settings, progress)
+    flux_passes(folder, settings)
     xml = wrap_klems(folder, name, thickness, width, height, comment)
     return BsdfRun(xml, check_bsdf(xml), time.perf_counter() - t0)
 
@@ -239,10 +240,9 @@ def reciprocal_rings(flux: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
     return out
 
 
-def klems_bsdf_rings(folder: Path, ring_folders: list[Path], settings: FluxSettings,
+def klems_bsdf_rings(folder: Path, *, ring_folders: list[Path], settings: FluxSettings,
                      name: str, thickness: float, width: float, height: float,
-                     comment: str = "", progress: Callable[[str], None] | None = None
-                     ) -> BsdfRun:
+                     comment: str = "") -> BsdfRun:
     """One Klems XML from one sample per incident θ ring: both rfluxmtx passes in each of
     ``ring_folders`` (after :func:`write_system`), the columns of ring k's incident patches
     taken from ring k's run, made reciprocal (:func:`reciprocal_rings`), wrapped into
@@ -253,7 +253,7 @@ def klems_bsdf_rings(folder: Path, ring_folders: list[Path], settings: FluxSetti
     flux = {key: np.zeros((ring.size, ring.size)) for key in KEYS}
     single = replace(settings, nproc=1)
     with ThreadPoolExecutor(max_workers=max(1, min(settings.nproc, len(ring_folders)))) as pool:
-        list(pool.map(lambda sub: flux_passes(sub, single, progress), ring_folders))
+        list(pool.map(lambda sub: flux_passes(sub, single), ring_folders))
     for k, sub in enumerate(ring_folders):
         cols = ring == k
         for key in KEYS:

@@ -25,33 +25,40 @@ ENGINE_NAME = "radiance"
 DEFAULT_AB = 2
 
 
-def run_hour(plan: BuildPlan, hour: str, dry_run: bool = False,
-             echo=None, grids: list[str] | None = None) -> dict[str, GridResult]:
-    """Build the hour's octree and trace every grid; return lux per grid.
-
-    With ``dry_run`` the commands are only passed to ``echo`` (e.g. print) and nothing runs.
-    """
-    folder = plan.folder
-    oct_rel = f"octrees/{hour}.oct"
-    # the hours' shared inputs (compiled meshes, prototype octrees): listed by a dry run,
-    # else made once by ensure_shared_inputs
-    commands: list[tuple[list[str], str | None, str]] = [
+def _hour_steps(plan: BuildPlan, hour: str, grids: list[str] | None, *, shared: bool
+                ) -> list[tuple[list[str], str | None, str]]:
+    """The hour's commands as (argv, stdin file, stdout file) relative to the folder: the
+    shared inputs (compiled meshes, prototype octrees) when ``shared``, the octree, the photon
+    map when asked for, one ``rtrace`` per grid of ``grids`` (None: every grid)."""
+    steps: list[tuple[list[str], str | None, str]] = [
         (argv, None, out) for argv, out in [*plan.mesh_commands(), *plan.prototype_commands()]
-    ] if dry_run else []
-    commands.append((plan.oconv_command(hour), None, oct_rel))
+    ] if shared else []
+    steps.append((plan.oconv_command(hour), None, f"octrees/{hour}.oct"))
     mkpmap = plan.mkpmap_command(hour)
     if mkpmap is not None:
-        commands.append((mkpmap, None, f"pmaps/{hour}.log"))
+        steps.append((mkpmap, None, f"pmaps/{hour}.log"))
+    for g in plan.grids:
+        if grids is None or g in grids:
+            steps.append((plan.rtrace_command(hour, g), f"grids/{g}.pts",
+                          f"results/{hour}_{g}.rgb"))
+    return steps
+
+
+def hour_commands(plan: BuildPlan, hour: str, *, grids: list[str] | None = None) -> list[str]:
+    """The shell lines that trace the hour (``(cd FOLDER && argv < in > out)``), the hours'
+    shared inputs first; nothing runs."""
+    return [f"(cd {plan.folder} && " + " ".join(argv) + (f" < {stdin}" if stdin else "")
+            + f" > {stdout})" for argv, stdin, stdout in _hour_steps(plan, hour, grids,
+                                                                      shared=True)]
+
+
+def run_hour(plan: BuildPlan, hour: str, *, grids: list[str] | None = None
+             ) -> dict[str, GridResult]:
+    """Build the hour's octree and trace every grid (or ``grids``); return lux per grid."""
+    folder = plan.folder
+    commands = _hour_steps(plan, hour, grids, shared=False)
     use = [g for g in plan.grids if grids is None or g in grids]
-    for g in use:
-        commands.append((plan.rtrace_command(hour, g), f"grids/{g}.pts",
-                         f"results/{hour}_{g}.rgb"))
-    if dry_run:
-        for argv, stdin, stdout in commands:
-            line = " ".join(argv) + (f" < {stdin}" if stdin else "") + f" > {stdout}"
-            if echo:
-                echo(f"(cd {folder} && {line})")
-        return {}
+    mkpmap = plan.mkpmap_command(hour)
     (folder / "octrees").mkdir(exist_ok=True)
     (folder / "results").mkdir(exist_ok=True)
     if mkpmap is not None:

@@ -8,7 +8,7 @@ from typing import TYPE_CHECKING
 from radtree.engines.base import Engine, GridResult
 from radtree.engines.radiance.binaries import find_radiance, require_radiance
 from radtree.engines.radiance.binaries import version as radiance_version
-from radtree.engines.radiance.engine import run_hour
+from radtree.engines.radiance.engine import hour_commands, run_hour
 from radtree.engines.radiance.pmap import PhotonMap
 from radtree.engines.radiance.writer import (
     BuildPlan,
@@ -60,7 +60,7 @@ class RadianceEngine(Engine):
 
     def sampling(self, params: EngineParams) -> str:
         pm = PhotonMap.from_params(params)
-        return f"-ad {params.ad} -lw {params.lw:g}" + (f", {pm.describe()}" if pm else "")
+        return f"-ad {params.radiance.ad} -lw {params.radiance.lw:g}" + (f", {pm.describe()}" if pm else "")
 
     def prepare(self, scene: Scene, states: list[SkyState], params: EngineParams, ab: int,
                 folder: Path | None = None) -> BuildPlan:
@@ -107,7 +107,5 @@ class RadianceEngine(Engine):
         return run_hour(plan, label, grids=grids)
 
     def commands(self, plan: BuildPlan, label: str) -> list[str]:
-        lines: list[str] = []
-        run_hour(plan, label, dry_run=True, echo=lines.append)
-        return lines
+        return hour_commands(plan, label)
 

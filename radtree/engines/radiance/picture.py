@@ -31,9 +31,12 @@ def fisheye_command(octree: str, viewpoint: np.ndarray, direction: np.ndarray, u
             "-ab", str(ab), "-ad", str(ad), "-aa", "0", "-as", "0", "-lw", "1e-4", octree]
 
 
-def fisheye_picture(plan: BuildPlan, hour: str, viewpoint: np.ndarray, direction: np.ndarray,
-                    up: np.ndarray, size: int, ab: int, ad: int, out: Path) -> tuple[Path, Path]:
-    """Render ``out``.hdr and ``out``.bmp (tone-mapped) of the plan's hour (label HHMM)."""
+def fisheye_picture(plan: BuildPlan, *, hour: str, viewpoint: np.ndarray,
+                    direction: np.ndarray, up: np.ndarray, size: int, ab: int, ad: int,
+                    out: Path) -> tuple[Path, Path]:
+    """Render ``out``.hdr and ``out``.bmp (tone-mapped) of the plan's hour (label HHMM): a
+    ``size`` px fisheye from ``viewpoint`` (m) looking along ``direction``, ``up`` upwards,
+    traced with ``-ab ab -ad ad``."""
     folder = plan.folder
     (folder / "octrees").mkdir(exist_ok=True)
     ensure_shared_inputs(plan)   # compiled meshes, prototype octrees

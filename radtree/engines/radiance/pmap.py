@@ -40,10 +40,10 @@ class PhotonMap:
     def from_params(cls, params: EngineParams) -> PhotonMap | None:
         """The project's photon map, or None when ``pmap_photons`` is unset (the counts were
         checked, ≥ 1, when the project was read)."""
-        if params.pmap_photons is None:
+        if params.radiance.pmap_photons is None:
             return None
-        return cls(int(params.pmap_photons), params.pmap_caustic_photons,
-                   int(params.pmap_bandwidth))
+        return cls(int(params.radiance.pmap_photons), params.radiance.pmap_caustic_photons,
+                   int(params.radiance.pmap_bandwidth))
 
     def files(self, hour: str) -> list[tuple[str, str]]:
         """(option, photon map file) pairs of ``hour`` (label HHMM), relative to the folder."""

@@ -16,7 +16,7 @@ build/<scenario>/
 from __future__ import annotations
 
 from collections.abc import Mapping
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, field
 from functools import cache
 from pathlib import Path
 
@@ -85,9 +85,10 @@ def rtrace_options(params: EngineParams, ab: int) -> list[str]:
     With a photon map (``pmap_photons``) rtrace computes one ambient bounce (final gathering)."""
     if PhotonMap.from_params(params) is not None:
         ab = FINAL_GATHER_AB
+    r = params.radiance
     return [
-        "-h", "-I", FIXED_SEED, "-ab", str(ab), "-ad", str(params.ad), "-as", str(params.as_),
-        "-ar", str(params.ar), "-aa", f"{params.aa:g}", "-lw", f"{params.lw:g}",
+        "-h", "-I", FIXED_SEED, "-ab", str(ab), "-ad", str(r.ad), "-as", str(r.as_),
+        "-ar", str(r.ar), "-aa", f"{r.aa:g}", "-lw", f"{r.lw:g}",
     ]
 
 
@@ -95,9 +96,9 @@ def grid_rtrace_options(params: EngineParams, ab: int, grids: list[str]) -> dict
     """rtrace options of the grids traced differently: the dense façade maps with
     ``-lw engine.dense_lw`` (when set and a map is in ``grids``)."""
     maps = [g for g in grids if is_dense_grid(g)]
-    if params.dense_lw is None or not maps:
+    if params.radiance.dense_lw is None or not maps:
         return {}
-    options = rtrace_options(replace(params, lw=params.dense_lw), ab)
+    options = rtrace_options(params.changed(lw=params.radiance.dense_lw), ab)
     return {g: options for g in maps}
 
 
