@@ -88,8 +88,8 @@ def test_modules_are_small():
 #: the ratchet (issue 42): at most this many functions over ``tests.shape.MAX_LINES`` lines and
 #: with more than ``tests.shape.MAX_POSITIONAL`` positional parameters. Lower the figures when a
 #: change shortens the lists (``python -m tests.shape`` prints them); never raise them.
-MAX_LONG_FUNCTIONS = 17
-MAX_WIDE_FUNCTIONS = 33
+MAX_LONG_FUNCTIONS = 0
+MAX_WIDE_FUNCTIONS = 0
 
 
 def test_function_ratchet():
