@@ -96,7 +96,7 @@ def build_homogeneous(tree: Tree, sensors: Sensors, street: Street, frame: Facad
     ab = max(MIN_AB, crossings + 3)
     notes.append(f"Radiance: diffuse transmission only reaches the sensors through ambient "
                  f"bounces; -ab {ab} (the sheet's {crossings} crossing(s) + 3: -ab 3 reads "
-                 f"about 4 % low on the reference-case dome, `radtree simulate --convergence`).")
+                 f"about 4 % low on the reference-case dome, `radtree convergence`).")
     info["area_m2"] = float(sum(m.area() for m in meshes if m.material == SHELL))
     return TreeModel(meshes=meshes, materials=materials, notes=notes,
                      recommended_ab=ab, info=info, form=form, model="homogeneous")

@@ -287,7 +287,7 @@ def build_perforated(tree: Tree, sensors: Sensors, street: Street, frame: Facade
         f"{100 * pattern.openness:.2f} %).")
     notes.append(f"Radiance: holes pass direct sun as shadow rays; -ab {PERFORATED_AB} covers "
                  "ground, wall and sheet inter-reflections (-ab 3 reads about 4 % low: "
-                 "`radtree simulate --convergence`).")
+                 "`radtree convergence`).")
     photo = (provenance(src, [pattern.photo], {"hole_fraction": hole_fraction})
              if src is not None and pattern.photo is not None else None)
     return TreeModel(meshes=meshes, materials=materials, notes=notes, recommended_ab=PERFORATED_AB,

@@ -45,7 +45,7 @@ Ambient bounces. The light that crosses many slats does so mostly as *specular*
 transmission (followed by shadow and specular rays, not ambient bounces); only the diffuse
 share (T_d, R) needs ``-ab``. The recommended ``-ab`` therefore does not grow with the
 crossing count: min(crossings + 2, :data:`VOLUME_AB_CAP`), measured with
-``radtree simulate --convergence`` (figures at :data:`VOLUME_AB_CAP`).
+``radtree convergence`` (figures at :data:`VOLUME_AB_CAP`).
 
 Realisations. A façade sensor sees the slats just in front of it at large solid angles, so one
 realisation (one ``louvers.seed``) of the reference-case crowns scatters in global permeability by
@@ -71,7 +71,7 @@ MAX_VOLUME_SLATS = 200_000
 DRAW_BLOCK = 1024  # slats drawn per block (nested realisations, see _draw_nested)
 # Radiance -ab for volume crowns: light crossing many slats does so mostly by specular
 # transmission, which needs no ambient bounce, so the façade mean converges by -ab 6 (within
-# 0.1 % on reference-case F); `radtree simulate examples/mendoza-street --convergence -s F` prints the
+# 0.1 % on reference-case F); `radtree convergence examples/mendoza-street -s F` prints the
 # ladder, figures in docs/benchmarks.md.
 VOLUME_AB_CAP = 6
 
@@ -125,7 +125,7 @@ def volume_ab_note(ab: int) -> str:
             "bounce; on reference-case scenario F, crossings 15, the façade mean moved 0.1 % "
             "from -ab 6 to -ab 8 at 13:30 (1457 → 1456 lx) and to -ab 12 at 10:30 "
             "(1089 → 1090 lx), and −1.1 % from -ab 6 to -ab 5 — check with radtree "
-            "simulate --convergence).")
+            "convergence).")
 
 
 def clipped_volume(spec: CrownRowSpec, samples: int = 400_000, seed: int = 0
