@@ -212,11 +212,51 @@ def choose_holes(sky_fraction: np.ndarray, solid_angle: np.ndarray) -> np.ndarra
     return holes
 
 
-def build_perforated(tree: Tree, sensors: Sensors, street: Street, frame: FacadeFrame,
+@dataclass(frozen=True)
+class _Sheet:
+    """The sheet before the holes: triangles, where they are seen from, and the form's parts."""
+
+    verts: np.ndarray
+    faces: np.ndarray
+    camera: np.ndarray
+    notes: list[str]
+    info: dict[str, float]
+    trunks: Mesh | None = None
+
+
+def build_perforated(tree: Tree, *, sensors: Sensors, street: Street, frame: FacadeFrame,
                      form: str, source: str | None = None,
                      pattern: GapPattern | None = None) -> TreeModel:
-    """Build the perforated crown; ``pattern`` overrides the configured photo / random gaps."""
+    """Build the perforated crown; ``pattern`` overrides the configured photo / random gaps:
+    check, choose the gap pattern, build the form's sheet, cut its holes, assemble."""
     perf = tree.perforated
+    _check_perforated(perf, source)
+    src = photo_source(tree)
+    if pattern is None:
+        pattern = _pattern_of(perf, src=src, source=source)
+    if form == "dome":
+        sheet = _dome_sheet(tree, sensors=sensors, street=street, source=source)
+    else:
+        sheet = _free_sheet(tree, sensors=sensors, street=street, frame=frame, source=source)
+    materials: dict = {SHELL: Plastic(SHELL, perf.reflectance)}
+    meshes: list[Mesh] = []
+    if sheet.trunks is not None:
+        materials[TRUNK] = Plastic(TRUNK, BARK_REFLECTANCE)
+        meshes.append(sheet.trunks)
+    info: dict[str, float] = {"openness_pattern": pattern.openness,
+                              "reflectance": perf.reflectance, **sheet.info}
+    kept, hole_fraction = _cut_holes(sheet, pattern, info=info)
+    meshes.insert(0, Mesh("crown_shell", SHELL, frame.to_world(sheet.verts), kept))
+    notes = [*sheet.notes, *_perforated_notes(perf, pattern, form=form,
+                                               hole_fraction=hole_fraction)]
+    photo = (provenance(src, [pattern.photo], {"hole_fraction": hole_fraction})
+             if src is not None and pattern.photo is not None else None)
+    return TreeModel(meshes=meshes, materials=materials, notes=notes, recommended_ab=PERFORATED_AB,
+                     info=info, form=form, model="perforated", photo=photo)
+
+
+def _check_perforated(perf: Perforated, source: str | None) -> None:
+    """Reflectance 0–1 and a resolution the mesh limit allows."""
     if not 0.0 <= perf.reflectance <= 1.0:
         raise ConfigError(f"got {perf.reflectance}, expected 0–1", source=source,
                           field="tree.perforated.reflectance")
@@ -224,48 +264,56 @@ def build_perforated(tree: Tree, sensors: Sensors, street: Street, frame: Facade
         raise ConfigError(f"got {perf.resolution}, expected 4–{MAX_RESOLUTION} rings "
                           "(triangles ≈ 5.1·resolution²)", source=source,
                           field="tree.perforated.resolution")
-    src = photo_source(tree)
-    if pattern is None:
-        if src is None and not 0.0 <= perf.openness <= 1.0:
-            raise ConfigError(f"got {perf.openness}, expected 0–1", source=source,
-                              field="tree.perforated.openness")
-        pattern = (photo_gap_pattern(perf, source, src) if src is not None
-                   else gap_pattern_for(perf, source))
-    materials: dict = {SHELL: Plastic(SHELL, perf.reflectance)}
-    meshes: list[Mesh] = []
-    notes: list[str] = []
-    info: dict[str, float] = {"openness_pattern": pattern.openness,
-                              "reflectance": perf.reflectance}
-    if form == "dome":
-        spec = dome_spec(tree, sensors, street, source)
-        camera = spec.centre
-        verts, faces = spec.shell(perf.resolution)
-        notes.extend(dome_notes(spec))
-        notes.append("Camera point = dome centre.")
-        info["dome_radius_m"] = spec.radius
-        tri = verts[faces]
-    else:
-        spec_r = crown_row_spec(tree, sensors, street, source)
-        camera = spec_r.camera(sensors)
-        level = int(min(5, max(2, round(math.log2(63.43 * perf.resolution / 180.0)))))
-        vs, fs, off = [], [], 0
-        for i in range(spec_r.count):
-            v, f, on_wall = spec_r.envelope(i, level)
-            vs.append(v)
-            fs.append(f[~on_wall] + off)
-            off += len(v)
-        verts, faces = np.vstack(vs), np.vstack(fs)
-        tri = verts[faces]
-        tv, tf = spec_r.trunks()
-        materials[TRUNK] = Plastic(TRUNK, BARK_REFLECTANCE)
-        meshes.append(Mesh("tree_trunks", TRUNK, frame.to_world(tv), tf))
-        notes.extend(row_notes(spec_r, tree, sensors))
-        notes.append("The perforated sheet is the crowns' envelope open towards the wall: every "
-                     "line of sight from the camera (sensor centre on the wall) through a crown "
-                     "crosses it once, as in the photo.")
-        info["clip_plane_n_m"] = spec_r.n_clip
-    omega = triangle_solid_angles(tri, camera)
-    frac = face_sky_fractions(tri, camera, pattern.is_sky)
+
+
+def _pattern_of(perf: Perforated, *, src: PhotoSource | None, source: str | None
+                ) -> GapPattern:
+    """The gap pattern of the [tree] photo if any, else :func:`gap_pattern_for`."""
+    if src is None and not 0.0 <= perf.openness <= 1.0:
+        raise ConfigError(f"got {perf.openness}, expected 0–1", source=source,
+                          field="tree.perforated.openness")
+    return (photo_gap_pattern(perf, source, src) if src is not None
+            else gap_pattern_for(perf, source))
+
+
+def _dome_sheet(tree: Tree, *, sensors: Sensors, street: Street, source: str | None
+                ) -> _Sheet:
+    """The sensor dome's hemisphere, seen from the dome centre."""
+    spec = dome_spec(tree, sensors, street, source)
+    verts, faces = spec.shell(tree.perforated.resolution)
+    notes = [*dome_notes(spec), "Camera point = dome centre."]
+    return _Sheet(verts, faces, spec.centre, notes, {"dome_radius_m": spec.radius})
+
+
+def _free_sheet(tree: Tree, *, sensors: Sensors, street: Street, frame: FacadeFrame,
+                source: str | None) -> _Sheet:
+    """The free crowns' envelopes open towards the wall, seen from the sensor centre; trunks."""
+    spec_r = crown_row_spec(tree, sensors, street, source)
+    camera = spec_r.camera(sensors)
+    level = int(min(5, max(2, round(math.log2(63.43 * tree.perforated.resolution / 180.0)))))
+    vs, fs, off = [], [], 0
+    for i in range(spec_r.count):
+        v, f, on_wall = spec_r.envelope(i, level)
+        vs.append(v)
+        fs.append(f[~on_wall] + off)
+        off += len(v)
+    tv, tf = spec_r.trunks()
+    trunks = Mesh("tree_trunks", TRUNK, frame.to_world(tv), tf)
+    notes = list(row_notes(spec_r, tree, sensors))
+    notes.append("The perforated sheet is the crowns' envelope open towards the wall: every "
+                 "line of sight from the camera (sensor centre on the wall) through a crown "
+                 "crosses it once, as in the photo.")
+    return _Sheet(np.vstack(vs), np.vstack(fs), camera, notes,
+                  {"clip_plane_n_m": spec_r.n_clip}, trunks)
+
+
+def _cut_holes(sheet: _Sheet, pattern: GapPattern, *, info: dict[str, float]
+               ) -> tuple[np.ndarray, float]:
+    """The faces kept and the holes' share of the sheet's solid angle; the figures go into
+    ``info``."""
+    tri = sheet.verts[sheet.faces]
+    omega = triangle_solid_angles(tri, sheet.camera)
+    frac = face_sky_fractions(tri, sheet.camera, pattern.is_sky)
     holes = choose_holes(frac, omega)
     covered = float(omega.sum())
     hole_fraction = float(omega[holes].sum() / covered) if covered > 0 else 0.0
@@ -273,22 +321,22 @@ def build_perforated(tree: Tree, sensors: Sensors, street: Street, frame: Facade
         "hole_fraction": hole_fraction,
         "sky_fraction_sampled": float(np.sum(frac * omega) / covered) if covered > 0 else 0.0,
         "sheet_solid_angle_sr": covered,
-        "faces_total": float(len(faces)),
+        "faces_total": float(len(sheet.faces)),
         "holes": float(holes.sum()),
         "direct_transmission": hole_fraction,
     })
-    kept = faces[~holes]
-    meshes.insert(0, Mesh("crown_shell", SHELL, frame.to_world(verts), kept))
+    return sheet.faces[~holes], hole_fraction
+
+
+def _perforated_notes(perf: Perforated, pattern: GapPattern, *, form: str,
+                      hole_fraction: float) -> list[str]:
+    """The model and its Radiance -ab note."""
     where = "the dome centre" if form == "dome" else "the sensor centre on the wall"
-    notes.append(
+    return [
         f"Model: perforated — opaque sheet (reflectance {perf.reflectance:g}, T = 0) with holes "
         f"from {pattern.source}. Holes are absent faces; seen from {where} they cover "
         f"{100 * hole_fraction:.2f} % of the sheet's solid angle (pattern openness "
-        f"{100 * pattern.openness:.2f} %).")
-    notes.append(f"Radiance: holes pass direct sun as shadow rays; -ab {PERFORATED_AB} covers "
-                 "ground, wall and sheet inter-reflections (-ab 3 reads about 4 % low: "
-                 "`radtree convergence`).")
-    photo = (provenance(src, [pattern.photo], {"hole_fraction": hole_fraction})
-             if src is not None and pattern.photo is not None else None)
-    return TreeModel(meshes=meshes, materials=materials, notes=notes, recommended_ab=PERFORATED_AB,
-                     info=info, form=form, model="perforated", photo=photo)
+        f"{100 * pattern.openness:.2f} %).",
+        f"Radiance: holes pass direct sun as shadow rays; -ab {PERFORATED_AB} covers "
+        "ground, wall and sheet inter-reflections (-ab 3 reads about 4 % low: "
+        "`radtree convergence`)."]
