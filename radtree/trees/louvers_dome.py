@@ -146,76 +146,97 @@ def _dome_layer(r: float, lv: Louvers, rng: np.random.Generator) -> np.ndarray:
     tan β) plus a random step of ±¼ cell, so the pattern has no long-range order (long-range
     order would make two layers' gaps correlate, a moiré that biases the stack).
     """
+    quads = []
+    for face in DOME_FACES:
+        cells = _face_cells(face, r=r, lv=lv, rng=rng)
+        quads.append(_face_quads(face, cells, r=r, lv=lv))
+    return np.concatenate(quads, axis=0)
+
+
+def _face_cells(face: tuple, *, r: float, lv: Louvers, rng: np.random.Generator
+                ) -> np.ndarray:
+    """The slats of one cube face as angle cells (k, 4): (a_lo, a_hi, b_lo, b_hi), rows one
+    slat high seen from the centre, each row's offset sheared along the branches."""
+    A, P, Q, (a0, a1), (b0, b1) = face
     s, f = lv.slat_size_m, lv.cover_fraction
     tanb = math.tan(math.radians(lv.branch_inclination_deg))
-    quads = []
-    for A, P, Q, (a0, a1), (b0, b1) in DOME_FACES:
-        a_mid = 0.5 * (a0 + a1)
+    a_mid = 0.5 * (a0 + a1)
 
-        def c_at(a: np.ndarray, b: np.ndarray, A=A, P=P, Q=Q) -> np.ndarray:
-            d = _face_dir(A, P, Q, np.tan(a), np.tan(b))
-            d = d / np.linalg.norm(d, axis=-1, keepdims=True)
-            return slat_normals(d.reshape(-1, 3), lv.inclination_deg)[1].reshape(np.shape(a))
+    def c_at(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+        d = _face_dir(A, P, Q, np.tan(a), np.tan(b))
+        d = d / np.linalg.norm(d, axis=-1, keepdims=True)
+        return slat_normals(d.reshape(-1, 3), lv.inclination_deg)[1].reshape(np.shape(a))
 
-        def row_density(b: np.ndarray, a_mid=a_mid, c_at=c_at) -> np.ndarray:
-            am = np.full_like(b, a_mid)
-            hb = _metric(np.tan(am), np.tan(b))[1]
-            return r * hb / (s * c_at(am, b))
+    def row_density(b: np.ndarray) -> np.ndarray:
+        am = np.full_like(b, a_mid)
+        hb = _metric(np.tan(am), np.tan(b))[1]
+        return r * hb / (s * c_at(am, b))
 
-        b_edges = _partition(b0, b1, row_density)
-        offset = rng.uniform(0.0, 1.0)
-        cells = []
-        for j in range(len(b_edges) - 1):
-            bl, bh = b_edges[j], b_edges[j + 1]
-            bm = 0.5 * (bl + bh)
+    b_edges = _partition(b0, b1, row_density)
+    offset = rng.uniform(0.0, 1.0)
+    cells = []
+    for j in range(len(b_edges) - 1):
+        bl, bh = b_edges[j], b_edges[j + 1]
+        bm = 0.5 * (bl + bh)
+        if j > 0:
+            c_row = float(c_at(np.array([a_mid]), np.array([bm]))[0])
+            offset = (offset + c_row * f / tanb + rng.uniform(-0.25, 0.25)) % 1.0
+        a_lo, a_hi = _row_cells((a0, a1), bm, offset=offset, r=r, lv=lv, rng=rng)
+        for i in range(len(a_lo)):
+            cells.append((a_lo[i], a_hi[i], bl, bh))
+    return np.array(cells)
 
-            def cell_density(a: np.ndarray, bm=bm) -> np.ndarray:
-                return r * f * _metric(np.tan(a), np.tan(np.full_like(a, bm)))[0] / s
 
-            x = np.linspace(a0, a1, 257)
-            mid = 0.5 * (x[1:] + x[:-1])
-            cum = np.concatenate([[0.0], np.cumsum(cell_density(mid) * np.diff(x))])
-            total = cum[-1]
-            if j > 0:
-                c_row = float(c_at(np.array([a_mid]), np.array([bm]))[0])
-                offset = (offset + c_row * f / tanb + rng.uniform(-0.25, 0.25)) % 1.0
-            if f >= 1.0:
-                # full cover: cells are the slats; partial cells at the row ends are merged
-                cuts = offset + np.arange(-1, int(math.ceil(total)) + 2)
-                cuts = cuts[(cuts > 0.0) & (cuts < total)]
-                edges = _tidy_ends(np.concatenate([[0.0], cuts, [total]]))
-                lo_u, hi_u = edges[:-1], edges[1:]
-            else:
-                # the row continues past the face edge: one slat of f cell units at a random
-                # place in every cell, cut at the face edge, so the chance of meeting a slat is
-                # f everywhere along the row (also at the face seams that all layers share)
-                left = offset + np.arange(-1, int(math.ceil(total)) + 1)
-                left = left + rng.uniform(0.0, 1.0 - f, len(left))
-                lo_u, hi_u = np.clip(left, 0.0, total), np.clip(left + f, 0.0, total)
-                keep = hi_u - lo_u > 1e-9
-                lo_u, hi_u = lo_u[keep], hi_u[keep]
-            a_lo, a_hi = np.interp(lo_u, cum, x), np.interp(hi_u, cum, x)
-            for i in range(len(a_lo)):
-                cells.append((a_lo[i], a_hi[i], bl, bh))
-        cl = np.array(cells)
-        X1, X2 = np.tan(cl[:, 0]), np.tan(cl[:, 1])
-        Y1, Y2 = np.tan(cl[:, 2]), np.tan(cl[:, 3])
-        cx = np.stack([X1, X2, X2, X1], axis=1)
-        cy = np.stack([Y1, Y1, Y2, Y2], axis=1)
-        D = _face_dir(A, P, Q, cx, cy)  # (k, 4, 3) corner directions (not unit)
-        dc = _face_dir(A, P, Q, 0.5 * (X1 + X2), 0.5 * (Y1 + Y2))
-        dc = dc / np.linalg.norm(dc, axis=1)[:, None]
-        m, _ = slat_normals(dc, lv.inclination_deg)
-        md = np.einsum("kj,kcj->kc", m, D) / np.linalg.norm(D, axis=2)
-        if np.any(md < 0.05):
-            raise ConfigError(
-                f"slats of {s:g} m are too large for a slat shell of radius {r:.2f} m (a slat "
-                "would be seen edge-on across its own cell): use smaller slats or a larger "
-                "dome", field="tree.louvers.slat_size_m")
-        t = r / np.einsum("kj,kcj->kc", m, D)  # plane m·x = r (m·dc)… through r·dc
-        t = t * np.einsum("kj,kj->k", m, dc)[:, None]
-        quads.append(t[:, :, None] * D)
-    return np.concatenate(quads, axis=0)
+def _row_cells(a_range: tuple[float, float], bm: float, *, offset: float, r: float,
+               lv: Louvers, rng: np.random.Generator) -> tuple[np.ndarray, np.ndarray]:
+    """The slats' angle spans (a_lo, a_hi) along the row at b = ``bm`` starting at ``offset``
+    (cell units)."""
+    a0, a1 = a_range
+    s, f = lv.slat_size_m, lv.cover_fraction
+    x = np.linspace(a0, a1, 257)
+    mid = 0.5 * (x[1:] + x[:-1])
+    density = r * f * _metric(np.tan(mid), np.tan(np.full_like(mid, bm)))[0] / s
+    cum = np.concatenate([[0.0], np.cumsum(density * np.diff(x))])
+    total = cum[-1]
+    if f >= 1.0:
+        # full cover: cells are the slats; partial cells at the row ends are merged
+        cuts = offset + np.arange(-1, int(math.ceil(total)) + 2)
+        cuts = cuts[(cuts > 0.0) & (cuts < total)]
+        edges = _tidy_ends(np.concatenate([[0.0], cuts, [total]]))
+        lo_u, hi_u = edges[:-1], edges[1:]
+    else:
+        # the row continues past the face edge: one slat of f cell units at a random
+        # place in every cell, cut at the face edge, so the chance of meeting a slat is
+        # f everywhere along the row (also at the face seams that all layers share)
+        left = offset + np.arange(-1, int(math.ceil(total)) + 1)
+        left = left + rng.uniform(0.0, 1.0 - f, len(left))
+        lo_u, hi_u = np.clip(left, 0.0, total), np.clip(left + f, 0.0, total)
+        keep = hi_u - lo_u > 1e-9
+        lo_u, hi_u = lo_u[keep], hi_u[keep]
+    return np.interp(lo_u, cum, x), np.interp(hi_u, cum, x)
+
+
+def _face_quads(face: tuple, cl: np.ndarray, *, r: float, lv: Louvers) -> np.ndarray:
+    """The slat quads (k, 4, 3) of one face's angle cells ``cl``: each cell's slat, tilted
+    as :func:`slat_normals` says, in the plane through r·(cell centre direction)."""
+    A, P, Q = face[:3]
+    X1, X2 = np.tan(cl[:, 0]), np.tan(cl[:, 1])
+    Y1, Y2 = np.tan(cl[:, 2]), np.tan(cl[:, 3])
+    cx = np.stack([X1, X2, X2, X1], axis=1)
+    cy = np.stack([Y1, Y1, Y2, Y2], axis=1)
+    D = _face_dir(A, P, Q, cx, cy)  # (k, 4, 3) corner directions (not unit)
+    dc = _face_dir(A, P, Q, 0.5 * (X1 + X2), 0.5 * (Y1 + Y2))
+    dc = dc / np.linalg.norm(dc, axis=1)[:, None]
+    m, _ = slat_normals(dc, lv.inclination_deg)
+    md = np.einsum("kj,kcj->kc", m, D) / np.linalg.norm(D, axis=2)
+    if np.any(md < 0.05):
+        raise ConfigError(
+            f"slats of {lv.slat_size_m:g} m are too large for a slat shell of radius {r:.2f} m "
+            "(a slat would be seen edge-on across its own cell): use smaller slats or a larger "
+            "dome", field="tree.louvers.slat_size_m")
+    t = r / np.einsum("kj,kcj->kc", m, D)  # plane m·x = r (m·dc)… through r·dc
+    t = t * np.einsum("kj,kj->k", m, dc)[:, None]
+    return t[:, :, None] * D
 
 
 def build_dome_louvers(spec: DomeSpec, lv: Louvers, sensors: Sensors,
