@@ -19,6 +19,7 @@ facets' outward normals, each with the slats as a facet of that orientation sees
 
 from __future__ import annotations
 
+from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
@@ -149,6 +150,20 @@ def normal_bands(verts: np.ndarray, faces: np.ndarray, bands: list[tuple[float, 
                            faces, bands)
 
 
+@dataclass(frozen=True)
+class _Shell:
+    """The form's meshes and materials (BSDF bands, wall cap, trunks), notes and info."""
+
+    meshes: list[Mesh] = field(default_factory=list)
+    materials: dict = field(default_factory=dict)
+    notes: list[str] = field(default_factory=list)
+    info: dict[str, float] = field(default_factory=dict)
+
+    def add(self, name: str, material: object, mesh: Mesh) -> None:
+        self.materials[name] = material
+        self.meshes.append(mesh)
+
+
 def build_bsdf_crown(tree: Tree, sensors: Sensors, street: Street, frame: FacadeFrame,
                      form: str, bands: list[tuple[float, float, Path]], recommended_ab: int,
                      source: str | None = None) -> TreeModel:
@@ -158,55 +173,69 @@ def build_bsdf_crown(tree: Tree, sensors: Sensors, street: Street, frame: Facade
     (the envelope's faces on the wall-side clip plane) their own XML."""
     wall = [b[2] for b in bands if (b[0], b[1]) == WALL_BAND]
     bands = [b for b in bands if (b[0], b[1]) != WALL_BAND]
-    materials: dict = {}
-    meshes: list[Mesh] = []
-    notes: list[str] = []
     if form == "dome":
-        spec = dome_spec(tree, sensors, street, source)
-        verts, faces = spec.shell(max(3, (tree.bsdf.segments or spec.segments) // 4))
-        verts = frame.to_world(verts)
-        centre = frame.to_world(spec.centre[None, :])[0]
-        for name, mat, fs in dome_bands(verts, inward(verts, faces, centre), centre, bands,
-                                        frame.normal, tree.bsdf.sectors):
-            materials[name] = mat
-            meshes.append(Mesh(name, name, verts, fs))
-        notes.extend(dome_notes(spec))
-        info = {"dome_radius_m": spec.radius, "bsdf_bands": float(len(bands))}
+        shell = _dome_shell(tree, sensors=sensors, street=street, frame=frame, bands=bands,
+                            source=source)
     else:
-        spec_r = crown_row_spec(tree, sensors, street, source)
-        level = icosphere_level(360.0 / tree.crown.segments)
-        verts_all, faces_all, caps, base = [], [], [], 0
-        for i in range(spec_r.count):
-            v, f, on_wall = spec_r.envelope(i, level)
-            inner = frame.to_world(spec_r.hull_point(i)[None, :])[0]
-            if wall and np.any(on_wall):     # the cap in cells, wound inwards
-                t = frame.to_world(cap_cells(v[f[on_wall]], CAP_CELL_M).reshape(-1, 3))
-                caps.append((t, inward(t, np.arange(len(t)).reshape(-1, 3), inner)))
-                f = f[~on_wall]
-            v = frame.to_world(v)
-            verts_all.append(v)
-            faces_all.append(inward(v, f, inner) + base)
-            base += len(v)
-        verts, faces = np.concatenate(verts_all), np.concatenate(faces_all)
-        for name, mat, fs in normal_bands(verts, faces, bands):
-            materials[name] = mat
-            meshes.append(Mesh(name, name, verts, fs))
-        if caps:
-            name = WALL_CAP
-            materials[name] = Bsdf(name, str(Path(wall[0]).resolve()))
-            cv = np.concatenate([c[0] for c in caps])
-            offsets = np.cumsum([0] + [len(c[0]) for c in caps[:-1]])
-            cf = np.concatenate([c[1] + o for c, o in zip(caps, offsets)])
-            meshes.append(Mesh(name, name, cv, cf))
-        tv, tf = spec_r.trunks()
-        materials[TRUNK] = Plastic(TRUNK, BARK_REFLECTANCE)
-        meshes.append(Mesh("tree_trunks", TRUNK, frame.to_world(tv), tf))
-        notes.extend(row_notes(spec_r, tree, sensors))
-        info = {"clip_plane_n_m": spec_r.n_clip}
+        shell = _free_shell(tree, sensors=sensors, street=street, frame=frame, bands=bands,
+                            wall=wall, source=source)
+    notes, info = shell.notes, shell.info
     notes.append(f"Representation: BSDF — the crown is a shell of the Radiance BSDF material "
                  f"({', '.join(Path(b[2]).name for b in bands)}, Klems 145 × 145), the planar "
                  "periodic sample of its slat layer; no slats are traced. A BSDF moves light only in direction, not "
                  "sideways: light entering a thick layer at one place leaves it at the same place.")
-    info["area_m2"] = float(sum(m.area() for m in meshes if m.material.startswith(BSDF_SHELL)))
-    return TreeModel(meshes=meshes, materials=materials, notes=notes,
+    info["area_m2"] = float(sum(m.area() for m in shell.meshes
+                                if m.material.startswith(BSDF_SHELL)))
+    return TreeModel(meshes=shell.meshes, materials=shell.materials, notes=notes,
                      recommended_ab=recommended_ab, info=info, form=form, model="louvers")
+
+
+def _dome_shell(tree: Tree, *, sensors: Sensors, street: Street, frame: FacadeFrame,
+                bands: list[tuple[float, float, Path]], source: str | None) -> _Shell:
+    """The sensor dome's hemisphere cut into elevation bands (and façade sectors)."""
+    spec = dome_spec(tree, sensors, street, source)
+    verts, faces = spec.shell(max(3, (tree.bsdf.segments or spec.segments) // 4))
+    verts = frame.to_world(verts)
+    centre = frame.to_world(spec.centre[None, :])[0]
+    shell = _Shell(info={"dome_radius_m": spec.radius, "bsdf_bands": float(len(bands))})
+    for name, mat, fs in dome_bands(verts, inward(verts, faces, centre), centre, bands,
+                                    frame.normal, tree.bsdf.sectors):
+        shell.add(name, mat, Mesh(name, name, verts, fs))
+    shell.notes.extend(dome_notes(spec))
+    return shell
+
+
+def _free_shell(tree: Tree, *, sensors: Sensors, street: Street, frame: FacadeFrame,
+                bands: list[tuple[float, float, Path]], wall: list[Path],
+                source: str | None) -> _Shell:
+    """The free crowns' envelopes in bands by their facets' normals, the wall caps (when
+    ``wall`` gives their XML) and the trunks."""
+    spec_r = crown_row_spec(tree, sensors, street, source)
+    level = icosphere_level(360.0 / tree.crown.segments)
+    verts_all, faces_all, caps, base = [], [], [], 0
+    for i in range(spec_r.count):
+        v, f, on_wall = spec_r.envelope(i, level)
+        inner = frame.to_world(spec_r.hull_point(i)[None, :])[0]
+        if wall and np.any(on_wall):     # the cap in cells, wound inwards
+            t = frame.to_world(cap_cells(v[f[on_wall]], CAP_CELL_M).reshape(-1, 3))
+            caps.append((t, inward(t, np.arange(len(t)).reshape(-1, 3), inner)))
+            f = f[~on_wall]
+        v = frame.to_world(v)
+        verts_all.append(v)
+        faces_all.append(inward(v, f, inner) + base)
+        base += len(v)
+    verts, faces = np.concatenate(verts_all), np.concatenate(faces_all)
+    shell = _Shell(info={"clip_plane_n_m": spec_r.n_clip})
+    for name, mat, fs in normal_bands(verts, faces, bands):
+        shell.add(name, mat, Mesh(name, name, verts, fs))
+    if caps:
+        cv = np.concatenate([c[0] for c in caps])
+        offsets = np.cumsum([0] + [len(c[0]) for c in caps[:-1]])
+        cf = np.concatenate([c[1] + o for c, o in zip(caps, offsets)])
+        shell.add(WALL_CAP, Bsdf(WALL_CAP, str(Path(wall[0]).resolve())),
+                  Mesh(WALL_CAP, WALL_CAP, cv, cf))
+    tv, tf = spec_r.trunks()
+    shell.add(TRUNK, Plastic(TRUNK, BARK_REFLECTANCE),
+              Mesh("tree_trunks", TRUNK, frame.to_world(tv), tf))
+    shell.notes.extend(row_notes(spec_r, tree, sensors))
+    return shell
