@@ -77,50 +77,40 @@ def _to_back(polygons: dict[str, np.ndarray], margin: float = 1e-3
     return out, float(-(allz.min() + dz))
 
 
+@dataclass(frozen=True)
+class _SlabGrid:
+    """The planar sample's slats: sides ``e1`` (along x) and ``e2`` (in the slat plane),
+    cosine ``c0`` of the slat tilt from the layer normal, row pitch (m), cell width (m) and
+    the cell's slats along x and rows along y."""
+
+    e1: np.ndarray
+    e2: np.ndarray
+    c0: float
+    pitch_y: float
+    cell_x: float
+    nx: int
+    ny: int
+
+    @property
+    def width(self) -> float:
+        return self.nx * self.cell_x
+
+    @property
+    def height(self) -> float:
+        return self.ny * self.pitch_y
+
+
 def dome_slab(tree: Tree, sensors: Sensors, street: Street, elevation_deg: float = 30.0,
               source: str | None = None) -> SlabSample:
-    """The dome's slat shells as a planar periodic stack (see the module text)."""
+    """The dome's slat shells as a planar periodic stack (see the module text): the slats as
+    tilted at ``elevation_deg``, laid row by row in every layer, checked, shifted back."""
     lv = tree.louvers
     spec = dome_spec(tree, sensors, street, source)
     radii = dome_layer_radii(spec, lv, sensors, source)
     s, f = lv.slat_size_m, lv.cover_fraction
-    el = math.radians(elevation_deg)
-    d = np.array([[0.0, math.cos(el), math.sin(el)]])        # outward, seen from the centre
-    up = np.array([0.0, -math.sin(el), math.cos(el)])        # towards higher elevation
-    m, c = slat_normals(d, lv.inclination_deg)
-    m_local = np.array([m[0, 0], float(m[0] @ up), -float(m[0] @ d[0])])   # outward = −z
-    c0 = float(c[0])
-    # the slat's second side: in the slat plane, perpendicular to x
-    e2 = np.cross(m_local, [1.0, 0.0, 0.0])
-    e2 /= np.linalg.norm(e2)
-    e2 *= np.sign(e2[1]) or 1.0
-    e1 = np.array([1.0, 0.0, 0.0])
-    pitch_y = s * abs(e2[1])                                 # a row is one slat high, seen along z
-    cell_x = s / f
-    nx = CELL_SLATS
-    ny = max(2, int(round(CELL_SLATS * s / pitch_y)))
-    width, height = nx * cell_x, ny * pitch_y
-    tanb = math.tan(math.radians(lv.branch_inclination_deg))
-    rng_root = np.random.SeedSequence(lv.seed)
-    layers = []
-    for k, child in enumerate(rng_root.spawn(len(radii))):
-        rng = np.random.default_rng(child)
-        z = -(float(radii[k]) - float(radii[0]))
-        offset = rng.uniform(0.0, 1.0)
-        for j in range(ny):
-            if j > 0:
-                offset = (offset + c0 * f / tanb + rng.uniform(-0.25, 0.25)) % 1.0
-            left = (offset + np.arange(nx)) * cell_x
-            if f < 1.0:
-                left = left + rng.uniform(0.0, (1.0 - f) * cell_x, nx)
-            xc = left + 0.5 * s
-            yc = (j + 0.5) * pitch_y
-            centres = np.stack([xc, np.full(nx, yc), np.full(nx, z)], axis=1)
-            h1 = np.array([-0.5, 0.5, 0.5, -0.5]) * s
-            h2 = np.array([-0.5, -0.5, 0.5, 0.5]) * s
-            layers.append(centres[:, None, :] + h1[None, :, None] * e1 + h2[None, :, None] * e2)
-    quads = np.concatenate(layers)
-    depth = 0.5 * s * abs(e2[2])
+    g = _slab_grid(lv, elevation_deg)
+    quads = _slab_quads(radii, lv, grid=g)
+    depth = 0.5 * s * abs(g.e2[2])
     spacing = float(radii[1] - radii[0]) if len(radii) > 1 else float("inf")
     if depth >= 0.5 * spacing:
         raise ConfigError(f"slat layers would touch in the planar sample (slat depth ±{depth:.2f}"
@@ -128,19 +118,65 @@ def dome_slab(tree: Tree, sensors: Sensors, street: Street, elevation_deg: float
                           field="tree.louvers.layers")
     polys, thickness = _to_back({LEAF: quads})
     optics = LouverOptics.of(lv)
+    tilt = math.degrees(math.acos(min(1.0, g.c0)))
     notes = [f"Planar sample of the dome's {lv.layers} slat shells: layers "
              f"{spacing if len(radii) > 1 else 0:.3f} m apart (the dome's radii "
              f"{radii[0]:.2f}–{radii[-1]:.2f} m), slats {s:g} m, cover {f:g}, tilted "
-             f"{math.degrees(math.acos(min(1.0, c0))):.1f}° from the layer normal (the dome's "
+             f"{tilt:.1f}° from the layer normal (the dome's "
              f"slats where the shell is seen {elevation_deg:g}° above the horizon); periodic "
-             f"cell {width:.2f} × {height:.2f} m, {len(quads)} slats. "
+             f"cell {g.width:.2f} × {g.height:.2f} m, {len(quads)} slats. "
              + optics.describe() + "."]
     info = {"layers": float(lv.layers), "layer_spacing_m": spacing if len(radii) > 1 else 0.0,
-            "slat_tilt_deg": math.degrees(math.acos(min(1.0, c0))),
+            "slat_tilt_deg": tilt,
             "elevation_deg": elevation_deg, "slats": float(len(quads)),
             "tau_crown_direct": optics.tau_crown_direct}
-    return SlabSample("dome_leaf_on", polys, {LEAF: optics.material()}, width, height,
+    return SlabSample("dome_leaf_on", polys, {LEAF: optics.material()}, g.width, g.height,
                       thickness, notes, info)
+
+
+def _slab_grid(lv: Louvers, elevation_deg: float) -> _SlabGrid:
+    """The dome's slats where the shell is seen ``elevation_deg`` above the horizon, in the
+    sample's frame (x along the shell's horizontal tangent, outward = −z)."""
+    s, f = lv.slat_size_m, lv.cover_fraction
+    el = math.radians(elevation_deg)
+    d = np.array([[0.0, math.cos(el), math.sin(el)]])        # outward, seen from the centre
+    up = np.array([0.0, -math.sin(el), math.cos(el)])        # towards higher elevation
+    m, c = slat_normals(d, lv.inclination_deg)
+    m_local = np.array([m[0, 0], float(m[0] @ up), -float(m[0] @ d[0])])   # outward = −z
+    # the slat's second side: in the slat plane, perpendicular to x
+    e2 = np.cross(m_local, [1.0, 0.0, 0.0])
+    e2 /= np.linalg.norm(e2)
+    e2 *= np.sign(e2[1]) or 1.0
+    pitch_y = s * abs(e2[1])                                 # a row is one slat high, seen along z
+    return _SlabGrid(np.array([1.0, 0.0, 0.0]), e2, float(c[0]), pitch_y, s / f, CELL_SLATS,
+                     max(2, int(round(CELL_SLATS * s / pitch_y))))
+
+
+def _slab_quads(radii: np.ndarray, lv: Louvers, *, grid: _SlabGrid) -> np.ndarray:
+    """Slat quads (k, 4, 3) of every layer (z = −(r − r₀)), rows sheared along the branches
+    as on the dome (one seeded stream per layer, as :func:`~radtree.trees.louvers_dome`)."""
+    s, f = lv.slat_size_m, lv.cover_fraction
+    nx, cell_x, pitch_y = grid.nx, grid.cell_x, grid.pitch_y
+    tanb = math.tan(math.radians(lv.branch_inclination_deg))
+    h1 = np.array([-0.5, 0.5, 0.5, -0.5]) * s
+    h2 = np.array([-0.5, -0.5, 0.5, 0.5]) * s
+    layers = []
+    for k, child in enumerate(np.random.SeedSequence(lv.seed).spawn(len(radii))):
+        rng = np.random.default_rng(child)
+        z = -(float(radii[k]) - float(radii[0]))
+        offset = rng.uniform(0.0, 1.0)
+        for j in range(grid.ny):
+            if j > 0:
+                offset = (offset + grid.c0 * f / tanb + rng.uniform(-0.25, 0.25)) % 1.0
+            left = (offset + np.arange(nx)) * cell_x
+            if f < 1.0:
+                left = left + rng.uniform(0.0, (1.0 - f) * cell_x, nx)
+            xc = left + 0.5 * s
+            yc = (j + 0.5) * pitch_y
+            centres = np.stack([xc, np.full(nx, yc), np.full(nx, z)], axis=1)
+            layers.append(centres[:, None, :] + h1[None, :, None] * grid.e1
+                          + h2[None, :, None] * grid.e2)
+    return np.concatenate(layers)
 
 
 def volume_slab(lv: Louvers, vertical_semi_axis_m: float, depth_m: float,
