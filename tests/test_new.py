@@ -108,13 +108,13 @@ def test_inputs_summarised_per_species(tmp_path: Path) -> None:
     info = read_inputs(tp, None, None)
     assert info.lines() == ["4 trees — Morus alba: 1; morus_alba: 1; Platanus × acerifolia: 1; "
                             "Ginkgo biloba: 1 (not in the species library)"]
-    site, why = site_facts(None, info)
+    site, why = site_facts(None, inputs=info)
     assert (site["latitude"], site["longitude"], site["time_zone"]) == \
         (-32.889, -68.8445, "America/Argentina/Mendoza")
     assert "looked up from the coordinates" in why and "elevation 0 m (ASSUMED" in why
     csv_info = read_inputs(cp, None, None)
     assert csv_info.lines() == ["2 trees — Melia azedarach: 2"]
-    assert site_facts(None, csv_info)[0]["latitude"] == -32.85
+    assert site_facts(None, inputs=csv_info)[0]["latitude"] == -32.85
     hb = tmp_path / "model.hbjson"
     hb.write_text(json.dumps({"type": "Model", "rooms": [{"identifier": "r1"},
                                                         {"identifier": "r2"}]}))
@@ -162,7 +162,7 @@ def test_new_refuses_to_overwrite_and_bad_requests(tmp_path: Path) -> None:
 
 def test_site_from_inputs_and_epw(tmp_path: Path) -> None:
     tp, _ = _inventory(tmp_path)
-    site, why = site_facts(EPW, read_inputs(tp, None, None))
+    site, why = site_facts(EPW, inputs=read_inputs(tp, None, None))
     assert (site["latitude"], site["longitude"], site["time_zone"],
             site["elevation_m"]) == (-32.889, -68.8445, "UTC-3", 750.0)
     assert why.startswith("latitude/longitude the centroid of the inputs' coordinates; time zone")
@@ -172,7 +172,8 @@ def test_site_from_inputs_and_epw(tmp_path: Path) -> None:
          "properties": {"species": "tilia_cordata"}}]}))
     with pytest.raises(ConfigError, match="the EPW .* is for latitude -32.89, longitude -68.83, "
                        "more than 0.5° from the site"):
-        site_facts(EPW, read_inputs(far, None, None))
+        site_facts(EPW, inputs=read_inputs(far, None, None))
     with pytest.raises(ConfigError, match="standard time UTC-3 h, but the time zone "
                        "Europe/Madrid has standard time UTC\\+1 h"):
-        site_facts(EPW, read_inputs(tp, None, None), Location(time_zone="Europe/Madrid"))
+        site_facts(EPW, inputs=read_inputs(tp, None, None),
+                   where=Location(time_zone="Europe/Madrid"))

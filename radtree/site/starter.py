@@ -47,7 +47,7 @@ from radtree.config.timezone import fixed_name, parse_time_zone, standard_offset
 from radtree.errors import ConfigError
 from radtree.fileio import write_text
 from radtree.light.sun import daylight_hours
-from radtree.light.weather import read_epw
+from radtree.light.weather import Epw, read_epw
 from radtree.site.inventory import read_features
 
 TEMPLATES = ("street", "office", "district")
@@ -199,7 +199,7 @@ def zone_at(latitude: float, longitude: float) -> str | None:
     return TimezoneFinder().timezone_at(lng=longitude, lat=latitude)
 
 
-def site_facts(epw: Path | None, inputs: Inputs, where: Location | None = None
+def site_facts(epw: Path | None, *, inputs: Inputs, where: Location | None = None
                ) -> tuple[dict[str, Any], str]:
     """The ``[site]`` place and where it came from, in order: ``--lat/--lon`` (``where``); the
     inputs' longitude/latitude centroid (the site origin of their local frame); the EPW. The
@@ -207,62 +207,60 @@ def site_facts(epw: Path | None, inputs: Inputs, where: Location | None = None
     (timezonefinder). Elevation: ``--elevation``, else the EPW's, else 0 m (said so). Without
     any of them: ConfigError asking for ``--lat/--lon``."""
     where = where or Location()
-    centre = _centroid(inputs)
     w = read_epw(epw) if epw is not None else None
-    said: list[str] = []
-    if where.latitude is not None:
-        lat, lon = float(where.latitude), float(where.longitude)  # type: ignore[arg-type]
-        said.append("latitude/longitude from --lat/--lon")
-    elif centre is not None:
-        lat, lon = centre[1], centre[0]
-        said.append("latitude/longitude the centroid of the inputs' coordinates")
-    elif w is not None:
-        lat, lon = w.latitude, w.longitude
-        said.append(f"latitude/longitude from the EPW {epw.name}")  # type: ignore[union-attr]
-    else:
-        raise ConfigError("radtree new needs the site: give --lat LAT --lon LON (degrees, "
-                          "north and east positive) and --tz Area/City (e.g. --lat 40.42 "
-                          "--lon -3.70 --tz Europe/Madrid), or an EPW, or geographic inputs")
+    lat, lon, said_place = _place(where, centre=_centroid(inputs), w=w)
     # inputs far from the site: each feature is checked by the inventory readers
     # (radtree.site.inventory.check_spread), naming the feature
     if w is not None and (abs(w.latitude - lat) > 0.5 or abs(w.longitude - lon) > 0.5):
         raise ConfigError(f"the EPW {epw} is for latitude {w.latitude}, longitude "
                           f"{w.longitude}, more than 0.5° from the site ({lat:g}, {lon:g}): "
                           "give the site's EPW, or leave --epw out (clear-sky weather)")
-    if where.time_zone is not None:
-        zone = where.time_zone
-        said.append("time zone from --tz/--utc")
-    elif w is not None:
-        zone = fixed_name(w.utc_offset_hours)
-        said.append(f"time zone the EPW's standard time {zone} (no daylight saving: give --tz "
-                    "Area/City for clock times with daylight saving)")
-    else:
-        found = zone_at(lat, lon)
-        if found is None:
-            raise ConfigError(f"no time zone known at latitude {lat:g}, longitude {lon:g}: "
-                              "give --tz Area/City or --utc ±H")
-        zone = found
-        said.append(f"time zone {zone} looked up from the coordinates (timezonefinder)")
+    zone, said_zone = _zone(where, lat=lat, lon=lon, w=w)
     if w is not None and abs(standard_offset_hours(zone) - w.utc_offset_hours) > 1e-6:
         raise ConfigError(f"the EPW {epw} is in standard time UTC{w.utc_offset_hours:+g} h, "
                           f"but the time zone {zone} has standard time "
                           f"UTC{standard_offset_hours(zone):+g} h: give the site's EPW or "
                           "the right --tz")
-    if where.elevation_m is not None:
-        elevation = float(where.elevation_m)
-        said.append("elevation from --elevation")
-    elif w is not None:
-        elevation = float(w.elevation_m)
-        said.append("elevation from the EPW")
-    else:
-        elevation = 0.0
-        said.append("elevation 0 m (ASSUMED: give --elevation)")
+    elevation, said_elevation = (
+        (float(where.elevation_m), "elevation from --elevation") if where.elevation_m is not None
+        else (float(w.elevation_m), "elevation from the EPW") if w is not None
+        else (0.0, "elevation 0 m (ASSUMED: give --elevation)"))
     name = (w.path.stem.replace("_", " ") if w is not None and where.latitude is None
             else f"site at {abs(lat):.4f}°{'N' if lat >= 0 else 'S'} "
                  f"{abs(lon):.4f}°{'E' if lon >= 0 else 'W'}")
     site = {"name": name, "latitude": round(lat, 5), "longitude": round(lon, 5),
             "elevation_m": elevation, "time_zone": zone}
-    return site, "; ".join(said)
+    return site, "; ".join([said_place, said_zone, said_elevation])
+
+
+def _place(where: Location, *, centre: tuple[float, float] | None, w: Epw | None
+           ) -> tuple[float, float, str]:
+    """Latitude, longitude (degrees) and where they came from (:func:`site_facts`)."""
+    if where.latitude is not None:
+        lat, lon = float(where.latitude), float(where.longitude)  # type: ignore[arg-type]
+        return lat, lon, "latitude/longitude from --lat/--lon"
+    if centre is not None:
+        return centre[1], centre[0], "latitude/longitude the centroid of the inputs' coordinates"
+    if w is not None:
+        return w.latitude, w.longitude, f"latitude/longitude from the EPW {w.path.name}"
+    raise ConfigError("radtree new needs the site: give --lat LAT --lon LON (degrees, "
+                      "north and east positive) and --tz Area/City (e.g. --lat 40.42 "
+                      "--lon -3.70 --tz Europe/Madrid), or an EPW, or geographic inputs")
+
+
+def _zone(where: Location, *, lat: float, lon: float, w: Epw | None) -> tuple[str, str]:
+    """The time zone and where it came from (:func:`site_facts`)."""
+    if where.time_zone is not None:
+        return where.time_zone, "time zone from --tz/--utc"
+    if w is not None:
+        zone = fixed_name(w.utc_offset_hours)
+        return zone, (f"time zone the EPW's standard time {zone} (no daylight saving: give "
+                      "--tz Area/City for clock times with daylight saving)")
+    found = zone_at(lat, lon)
+    if found is None:
+        raise ConfigError(f"no time zone known at latitude {lat:g}, longitude {lon:g}: "
+                          "give --tz Area/City or --utc ±H")
+    return found, f"time zone {found} looked up from the coordinates (timezonefinder)"
 
 
 # ---------------------------------------------------------------- the document
@@ -339,9 +337,10 @@ def _comments(t: Any, lines: list[str]) -> None:
             t.add(tomlkit.comment(part))
 
 
-def document(template: str, site: dict[str, Any], site_source: str, data: dict[str, str],
+def document(template: str, *, site: dict[str, Any], site_source: str, data: dict[str, str],
              light: dict[str, Any], inputs: Inputs, species: str) -> Any:
-    """The commented project document of ``template``."""
+    """The commented project document of ``template``: the header, ``[project]``, ``[site]``
+    (:func:`_site_table`), the schema's tables with the values decided, two scenarios."""
     doc = tomlkit.document()
     _comments(doc, [f"radtree project written by `radtree new` (template {template!r}).",
                     "Units: metres, degrees (azimuth clockwise from north), lux, local clock "
@@ -356,6 +355,36 @@ def document(template: str, site: dict[str, Any], site_source: str, data: dict[s
                              "optional"))
     proj.add(tomlkit.comment('measured_rows = "data/…"   # per-row measured means; optional'))
     doc.add("project", proj)
+    doc.add("site", _site_table(site, data=data, template=template))
+    span = _east_west_span_m(inputs)
+    street_len = TABLES["street"]().length_m
+    doc.add("street", table(TABLES["street"], {} if span + 40.0 <= street_len else {
+        "length_m": float(math.ceil((span + 40.0) / 10.0) * 10.0)},
+        {"length_m": "covers the inventory's trees along the façade, 20 m beyond each end"}))
+    doc.add("light", table(TABLES["light"], light,
+                           {"sky": "Perez sky of the weather's diffuse illuminance",
+                            "weather": "clear-sky needs no file; epw = \"data/site.epw\" for "
+                                       "measured or typical-year weather"}))
+    tree = table(TABLES["tree"], {"form": "free", "species": species},
+                 {"species": "fills leaf optics, tilt and permeability left out below"})
+    for sub in TREE_TABLES:
+        tree.add(sub, table(TABLES[f"tree.{sub}"], {}))
+    doc.add("tree", tree)
+    for name in ("sensors", "engine", "limits") + (("office",) if template == "office" else ()):
+        doc.add(name, table(TABLES[name], {}))
+    scenarios = tomlkit.aot()
+    for name, model, what in (("trees", "louvers", "the crowns (louvers model)"),
+                              ("open", "none", "the same site without trees")):
+        sc = table(TABLES_SCENARIO, {"name": name, "model": model, "reflection": "traced",
+                                     "description": what})
+        sc.add(tomlkit.comment('switches = {}   # dotted keys, e.g. {"louvers.layers" = 6}'))
+        scenarios.append(sc)
+    doc.add("scenario", scenarios)
+    return doc
+
+
+def _site_table(site: dict[str, Any], *, data: dict[str, str], template: str) -> Any:
+    """``[site]``: the place, the date (popped from ``site``) and its sunlit hours, the data."""
     date = site.pop("date")
     args = (site["latitude"], site["longitude"], site["elevation_m"],
             parse_time_zone(site["time_zone"]), date)
@@ -382,35 +411,7 @@ def document(template: str, site: dict[str, Any], site_source: str, data: dict[s
     for line in (DISTRICT_LINES if template == "district" else []) + (
             HONEYBEE_LINES if "honeybee" in data else []):
         s.add(tomlkit.comment(line))
-    doc.add("site", s)
-    span = _east_west_span_m(inputs)
-    street_len = TABLES["street"]().length_m
-    doc.add("street", table(TABLES["street"], {} if span + 40.0 <= street_len else {
-        "length_m": float(math.ceil((span + 40.0) / 10.0) * 10.0)},
-        {"length_m": "covers the inventory's trees along the façade, 20 m beyond each end"}))
-    doc.add("light", table(TABLES["light"], light,
-                           {"sky": "Perez sky of the weather's diffuse illuminance",
-                            "weather": "clear-sky needs no file; epw = \"data/site.epw\" for "
-                                       "measured or typical-year weather"}))
-    tree = table(TABLES["tree"], {"form": "free", "species": species},
-                 {"species": "fills leaf optics, tilt and permeability left out below"})
-    for sub in TREE_TABLES:
-        tree.add(sub, table(TABLES[f"tree.{sub}"], {}))
-    doc.add("tree", tree)
-    doc.add("sensors", table(TABLES["sensors"], {}))
-    doc.add("engine", table(TABLES["engine"], {}))
-    doc.add("limits", table(TABLES["limits"], {}))
-    if template == "office":
-        doc.add("office", table(TABLES["office"], {}))
-    scenarios = tomlkit.aot()
-    for name, model, what in (("trees", "louvers", "the crowns (louvers model)"),
-                              ("open", "none", "the same site without trees")):
-        sc = table(TABLES_SCENARIO, {"name": name, "model": model, "reflection": "traced",
-                                     "description": what})
-        sc.add(tomlkit.comment('switches = {}   # dotted keys, e.g. {"louvers.layers" = 6}'))
-        scenarios.append(sc)
-    doc.add("scenario", scenarios)
-    return doc
+    return s
 
 
 # ---------------------------------------------------------------- the command's function
@@ -457,7 +458,7 @@ def new_project(folder: Path, trees: Path | None = None, buildings: Path | None 
     if target.exists():
         raise ConfigError(f"{target} exists already: radtree new does not overwrite a project")
     inputs = read_inputs(trees, buildings, honeybee)
-    site, site_source = site_facts(epw, inputs, where)
+    site, site_source = site_facts(epw, inputs=inputs, where=where)
     site["date"] = (where.date if where is not None and where.date
                     else "2024-06-21" if site["latitude"] >= 0 else "2024-12-21")
     known = [s for s, _ in inputs.species.most_common() if find_species(s)]
@@ -475,7 +476,8 @@ def new_project(folder: Path, trees: Path | None = None, buildings: Path | None 
         light: dict[str, Any] = ({"weather": "epw", "epw": _copy(Path(epw), data_dir, made),
                                   "sky": "perez"} if epw is not None
                                  else {"weather": "clear-sky", "sky": "perez"})
-        doc = document(template, site, site_source, data, light, inputs, species)
+        doc = document(template, site=site, site_source=site_source, data=data,
+                       light=light, inputs=inputs, species=species)
         write_text(tmp, tomlkit.dumps(doc))
         try:
             project = load_project(tmp)         # what build will read, as written
