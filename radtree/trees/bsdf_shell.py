@@ -159,7 +159,8 @@ class _Shell:
     notes: list[str] = field(default_factory=list)
     info: dict[str, float] = field(default_factory=dict)
 
-    def add(self, name: str, material: object, mesh: Mesh) -> None:
+    def add(self, name: str, *, material: object, mesh: Mesh) -> None:
+        """One material and its mesh."""
         self.materials[name] = material
         self.meshes.append(mesh)
 
@@ -200,7 +201,7 @@ def _dome_shell(tree: Tree, *, sensors: Sensors, street: Street, frame: FacadeFr
     shell = _Shell(info={"dome_radius_m": spec.radius, "bsdf_bands": float(len(bands))})
     for name, mat, fs in dome_bands(verts, inward(verts, faces, centre), centre, bands,
                                     frame.normal, tree.bsdf.sectors):
-        shell.add(name, mat, Mesh(name, name, verts, fs))
+        shell.add(name, material=mat, mesh=Mesh(name, name, verts, fs))
     shell.notes.extend(dome_notes(spec))
     return shell
 
@@ -227,15 +228,15 @@ def _free_shell(tree: Tree, *, sensors: Sensors, street: Street, frame: FacadeFr
     verts, faces = np.concatenate(verts_all), np.concatenate(faces_all)
     shell = _Shell(info={"clip_plane_n_m": spec_r.n_clip})
     for name, mat, fs in normal_bands(verts, faces, bands):
-        shell.add(name, mat, Mesh(name, name, verts, fs))
+        shell.add(name, material=mat, mesh=Mesh(name, name, verts, fs))
     if caps:
         cv = np.concatenate([c[0] for c in caps])
         offsets = np.cumsum([0] + [len(c[0]) for c in caps[:-1]])
         cf = np.concatenate([c[1] + o for c, o in zip(caps, offsets)])
-        shell.add(WALL_CAP, Bsdf(WALL_CAP, str(Path(wall[0]).resolve())),
-                  Mesh(WALL_CAP, WALL_CAP, cv, cf))
+        shell.add(WALL_CAP, material=Bsdf(WALL_CAP, str(Path(wall[0]).resolve())),
+                  mesh=Mesh(WALL_CAP, WALL_CAP, cv, cf))
     tv, tf = spec_r.trunks()
-    shell.add(TRUNK, Plastic(TRUNK, BARK_REFLECTANCE),
-              Mesh("tree_trunks", TRUNK, frame.to_world(tv), tf))
+    shell.add(TRUNK, material=Plastic(TRUNK, BARK_REFLECTANCE),
+              mesh=Mesh("tree_trunks", TRUNK, frame.to_world(tv), tf))
     shell.notes.extend(row_notes(spec_r, tree, sensors))
     return shell

@@ -137,7 +137,7 @@ def dome_slat_bound(radii: np.ndarray, lv: Louvers) -> int:
     return int(math.ceil(1.5 * est)) + 40 * len(radii)
 
 
-def _dome_layer(r: float, lv: Louvers, rng: np.random.Generator) -> np.ndarray:
+def _dome_layer(r: float, *, lv: Louvers, rng: np.random.Generator) -> np.ndarray:
     """Slat quads (k, 4, 3) of one shell of radius r around the origin.
 
     Rows (constant b) are as high as one slat seen from the centre (so they pack the shell
@@ -149,7 +149,7 @@ def _dome_layer(r: float, lv: Louvers, rng: np.random.Generator) -> np.ndarray:
     quads = []
     for face in DOME_FACES:
         cells = _face_cells(face, r=r, lv=lv, rng=rng)
-        quads.append(_face_quads(face, cells, r=r, lv=lv))
+        quads.append(_face_quads(face, cells=cells, r=r, lv=lv))
     return np.concatenate(quads, axis=0)
 
 
@@ -181,13 +181,13 @@ def _face_cells(face: tuple, *, r: float, lv: Louvers, rng: np.random.Generator
         if j > 0:
             c_row = float(c_at(np.array([a_mid]), np.array([bm]))[0])
             offset = (offset + c_row * f / tanb + rng.uniform(-0.25, 0.25)) % 1.0
-        a_lo, a_hi = _row_cells((a0, a1), bm, offset=offset, r=r, lv=lv, rng=rng)
+        a_lo, a_hi = _row_cells((a0, a1), bm=bm, offset=offset, r=r, lv=lv, rng=rng)
         for i in range(len(a_lo)):
             cells.append((a_lo[i], a_hi[i], bl, bh))
     return np.array(cells)
 
 
-def _row_cells(a_range: tuple[float, float], bm: float, *, offset: float, r: float,
+def _row_cells(a_range: tuple[float, float], *, bm: float, offset: float, r: float,
                lv: Louvers, rng: np.random.Generator) -> tuple[np.ndarray, np.ndarray]:
     """The slats' angle spans (a_lo, a_hi) along the row at b = ``bm`` starting at ``offset``
     (cell units)."""
@@ -216,12 +216,12 @@ def _row_cells(a_range: tuple[float, float], bm: float, *, offset: float, r: flo
     return np.interp(lo_u, cum, x), np.interp(hi_u, cum, x)
 
 
-def _face_quads(face: tuple, cl: np.ndarray, *, r: float, lv: Louvers) -> np.ndarray:
-    """The slat quads (k, 4, 3) of one face's angle cells ``cl``: each cell's slat, tilted
+def _face_quads(face: tuple, *, cells: np.ndarray, r: float, lv: Louvers) -> np.ndarray:
+    """The slat quads (k, 4, 3) of one face's angle cells ``cells``: each cell's slat, tilted
     as :func:`slat_normals` says, in the plane through r·(cell centre direction)."""
     A, P, Q = face[:3]
-    X1, X2 = np.tan(cl[:, 0]), np.tan(cl[:, 1])
-    Y1, Y2 = np.tan(cl[:, 2]), np.tan(cl[:, 3])
+    X1, X2 = np.tan(cells[:, 0]), np.tan(cells[:, 1])
+    Y1, Y2 = np.tan(cells[:, 2]), np.tan(cells[:, 3])
     cx = np.stack([X1, X2, X2, X1], axis=1)
     cy = np.stack([Y1, Y1, Y2, Y2], axis=1)
     D = _face_dir(A, P, Q, cx, cy)  # (k, 4, 3) corner directions (not unit)
@@ -251,7 +251,7 @@ def build_dome_louvers(spec: DomeSpec, lv: Louvers, sensors: Sensors,
     ss = np.random.SeedSequence(lv.seed)
     layers = []
     for r, child in zip(radii, ss.spawn(len(radii))):
-        layers.append(_dome_layer(float(r), lv, np.random.default_rng(child)))
+        layers.append(_dome_layer(float(r), lv=lv, rng=np.random.default_rng(child)))
     quads = np.concatenate(layers, axis=0)
     dist = np.linalg.norm(quads, axis=2)
     if dist.max() > spec.radius + 1e-6:

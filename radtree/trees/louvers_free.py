@@ -126,7 +126,7 @@ def _layer_slats(spec: CrownRowSpec, *, ti: int, layer: int, grid: _FreeGrid,
     step = np.minimum(grid.climb, 0.25 * spacing / max((BRANCH_SLATS - 1) / 2.0, 1.0))
     zc = z_layer + q * step
     ok &= spacing >= grid.min_spacing
-    corners = _corners(plan, zc, sigma, grid=grid, ex=ex, ey=ey)
+    corners = _corners(plan, zc=zc, sigma=sigma, grid=grid, ex=ex, ey=ey)
     qv = (((corners[:, :, 0] - c[0]) ** 2 + (corners[:, :, 1] - c[1]) ** 2) / a**2
           + (corners[:, :, 2] - c[2]) ** 2 / b**2)
     ok &= np.all(qv <= 1.0, axis=1)
@@ -136,7 +136,7 @@ def _layer_slats(spec: CrownRowSpec, *, ti: int, layer: int, grid: _FreeGrid,
     return kept, n_cut, int(np.sum(~ok & (rho < a)))
 
 
-def _corners(plan: np.ndarray, zc: np.ndarray, sigma: np.ndarray, *, grid: _FreeGrid,
+def _corners(plan: np.ndarray, *, zc: np.ndarray, sigma: np.ndarray, grid: _FreeGrid,
              ex: np.ndarray, ey: np.ndarray) -> np.ndarray:
     """Slat corners (k, 4, 3): (±s/2 along rows, ±s·cosα/2 across), rising σ·tanα across the
     rows, around the slats' plan centres ``plan`` at heights ``zc``."""

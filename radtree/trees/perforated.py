@@ -230,7 +230,7 @@ def build_perforated(tree: Tree, *, sensors: Sensors, street: Street, frame: Fac
     """Build the perforated crown; ``pattern`` overrides the configured photo / random gaps:
     check, choose the gap pattern, build the form's sheet, cut its holes, assemble."""
     perf = tree.perforated
-    _check_perforated(perf, source)
+    _check_perforated(perf, source=source)
     src = photo_source(tree)
     if pattern is None:
         pattern = _pattern_of(perf, src=src, source=source)
@@ -245,9 +245,9 @@ def build_perforated(tree: Tree, *, sensors: Sensors, street: Street, frame: Fac
         meshes.append(sheet.trunks)
     info: dict[str, float] = {"openness_pattern": pattern.openness,
                               "reflectance": perf.reflectance, **sheet.info}
-    kept, hole_fraction = _cut_holes(sheet, pattern, info=info)
+    kept, hole_fraction = _cut_holes(sheet, pattern=pattern, info=info)
     meshes.insert(0, Mesh("crown_shell", SHELL, frame.to_world(sheet.verts), kept))
-    notes = [*sheet.notes, *_perforated_notes(perf, pattern, form=form,
+    notes = [*sheet.notes, *_perforated_notes(perf, pattern=pattern, form=form,
                                                hole_fraction=hole_fraction)]
     photo = (provenance(src, [pattern.photo], {"hole_fraction": hole_fraction})
              if src is not None and pattern.photo is not None else None)
@@ -255,7 +255,7 @@ def build_perforated(tree: Tree, *, sensors: Sensors, street: Street, frame: Fac
                      info=info, form=form, model="perforated", photo=photo)
 
 
-def _check_perforated(perf: Perforated, source: str | None) -> None:
+def _check_perforated(perf: Perforated, *, source: str | None) -> None:
     """Reflectance 0–1 and a resolution the mesh limit allows."""
     if not 0.0 <= perf.reflectance <= 1.0:
         raise ConfigError(f"got {perf.reflectance}, expected 0–1", source=source,
@@ -307,7 +307,7 @@ def _free_sheet(tree: Tree, *, sensors: Sensors, street: Street, frame: FacadeFr
                   {"clip_plane_n_m": spec_r.n_clip}, trunks)
 
 
-def _cut_holes(sheet: _Sheet, pattern: GapPattern, *, info: dict[str, float]
+def _cut_holes(sheet: _Sheet, *, pattern: GapPattern, info: dict[str, float]
                ) -> tuple[np.ndarray, float]:
     """The faces kept and the holes' share of the sheet's solid angle; the figures go into
     ``info``."""
@@ -328,7 +328,7 @@ def _cut_holes(sheet: _Sheet, pattern: GapPattern, *, info: dict[str, float]
     return sheet.faces[~holes], hole_fraction
 
 
-def _perforated_notes(perf: Perforated, pattern: GapPattern, *, form: str,
+def _perforated_notes(perf: Perforated, *, pattern: GapPattern, form: str,
                       hole_fraction: float) -> list[str]:
     """The model and its Radiance -ab note."""
     where = "the dome centre" if form == "dome" else "the sensor centre on the wall"

@@ -108,8 +108,8 @@ def dome_slab(tree: Tree, sensors: Sensors, street: Street, elevation_deg: float
     spec = dome_spec(tree, sensors, street, source)
     radii = dome_layer_radii(spec, lv, sensors, source)
     s, f = lv.slat_size_m, lv.cover_fraction
-    g = _slab_grid(lv, elevation_deg)
-    quads = _slab_quads(radii, lv, grid=g)
+    g = _slab_grid(lv, elevation_deg=elevation_deg)
+    quads = _slab_quads(radii, lv=lv, grid=g)
     depth = 0.5 * s * abs(g.e2[2])
     spacing = float(radii[1] - radii[0]) if len(radii) > 1 else float("inf")
     if depth >= 0.5 * spacing:
@@ -134,7 +134,7 @@ def dome_slab(tree: Tree, sensors: Sensors, street: Street, elevation_deg: float
                       thickness, notes, info)
 
 
-def _slab_grid(lv: Louvers, elevation_deg: float) -> _SlabGrid:
+def _slab_grid(lv: Louvers, *, elevation_deg: float) -> _SlabGrid:
     """The dome's slats where the shell is seen ``elevation_deg`` above the horizon, in the
     sample's frame (x along the shell's horizontal tangent, outward = −z)."""
     s, f = lv.slat_size_m, lv.cover_fraction
@@ -152,7 +152,7 @@ def _slab_grid(lv: Louvers, elevation_deg: float) -> _SlabGrid:
                      max(2, int(round(CELL_SLATS * s / pitch_y))))
 
 
-def _slab_quads(radii: np.ndarray, lv: Louvers, *, grid: _SlabGrid) -> np.ndarray:
+def _slab_quads(radii: np.ndarray, *, lv: Louvers, grid: _SlabGrid) -> np.ndarray:
     """Slat quads (k, 4, 3) of every layer (z = −(r − r₀)), rows sheared along the branches
     as on the dome (one seeded stream per layer, as :func:`~radtree.trees.louvers_dome`)."""
     s, f = lv.slat_size_m, lv.cover_fraction
