@@ -130,7 +130,32 @@ def scan_permeability(project: Project, scenario: str = "A",
                       values: Sequence[float] = (0.45, 0.5, 0.55, 0.6, 0.65),
                       rays: int = 2048, seed: int = 1) -> PermeabilityScan:
     """Scan ``field`` (a crown switch such as ``louvers.transmittance``) over ``values`` for
-    ``scenario`` of ``project``; see the module docstring for the columns."""
+    ``scenario`` of ``project``; see the module docstring for the columns.
+
+    Plan (checks, measured hourly means, the traces) → execute (worker processes) → publish
+    (one row per value)."""
+    sc0, m = _checked_inputs(project, scenario=scenario, field=field, values=values)
+    jobs = _scan_jobs(project, sc0=sc0, scenario=scenario, field=field, values=values)
+    workers = min(usable_cores(), len(jobs))
+    threads = max(1, usable_cores() // workers)
+    log.info("%d traces (%d values × 3 + 2 references, %d rays/sensor) in %d process%s",
+             len(jobs), len(values), rays, workers, "es" if workers > 1 else "")
+    out = spawned_map(_run_job, [(kind, with_threads(p, threads), sc, rays, seed)
+                                 for kind, p, sc in jobs], workers)
+    open_street, unob = out[0], out[1]
+    log.info("open street: Σ façade %.0f lx; unobstructed reference (sun + %g lx sky): "
+             "Σ %.0f lx", open_street[0], project.light.diffuse_horizontal_lux, unob[0])
+    hours: list[str] = list(m.index)
+    rows = [_scan_row(v, out=out[2 + 3 * k: 5 + 3 * k], open_street=open_street, unob=unob,
+                      measured=m, hours=hours, field=field, scenario=scenario)
+            for k, v in enumerate(values)]
+    return PermeabilityScan(scenario, field, pd.DataFrame(rows), hours)
+
+
+def _checked_inputs(project: Project, *, scenario: str, field: str,   # type: ignore[no-untyped-def]
+                    values: Sequence[float]):
+    """The scanned scenario and the measured hourly façade means at the project's hours, or
+    the error naming what is missing (values typed and bounded, a crown, measured data)."""
     for v in values:  # a switch of the one registry, each value typed and bounded
         check_key(field, v, source=str(project.source), where=f"switches.{field}")
     sc0 = next((s for s in project.scenarios if s.name == scenario), None)
@@ -157,7 +182,13 @@ def scan_permeability(project: Project, scenario: str = "A",
     m = m.reindex(list(project.site.hours))
     if not values:
         raise ConfigError("no values to scan", field=field)
+    return sc0, m
 
+
+def _scan_jobs(project: Project, *, sc0: Scenario, scenario: str, field: str,
+               values: Sequence[float]) -> list[_Job]:
+    """Every trace, each independent: the open street and the unobstructed reference, then per
+    value the crown's façade sum (project light, Perez sky) and its hourly fit."""
     sky_project = replace(project, light=replace(project.light, sky="perez"))
     open_sc = Scenario("open", "none", "traced", switches=dict(sc0.switches))
     crowns, fits = [], []
@@ -170,32 +201,28 @@ def scan_permeability(project: Project, scenario: str = "A",
     jobs: list[_Job] = [("sum", project, open_sc), ("sum", unobstructed_project(project), open_sc)]
     for crown, fit in zip(crowns, fits, strict=True):
         jobs += [("sum", project, crown), ("sum", sky_project, crown), ("hourly", project, fit)]
-    workers = min(usable_cores(), len(jobs))
-    threads = max(1, usable_cores() // workers)
-    log.info("%d traces (%d values × 3 + 2 references, %d rays/sensor) in %d process%s",
-             len(jobs), len(values), rays, workers, "es" if workers > 1 else "")
-    out = spawned_map(_run_job, [(kind, with_threads(p, threads), sc, rays, seed)
-                                 for kind, p, sc in jobs], workers)
-    open_street, unob = out[0], out[1]
-    log.info("open street: Σ façade %.0f lx; unobstructed reference (sun + %g lx sky): "
-             "Σ %.0f lx", open_street[0], project.light.diffuse_horizontal_lux, unob[0])
-    rows = []
-    hours: list[str] = list(m.index)
-    for k, v in enumerate(values):
-        street, sky, hourly = out[2 + 3 * k: 5 + 3 * k]
-        p_street = _ratio(street, open_street)
-        p_unob = _ratio(sky, unob)
-        s = hourly.reindex(m.index).to_numpy()
-        row = {"value": float(v), "permeability_street": p_street[0],
-               "permeability_street_se": p_street[1], "permeability_unobstructed": p_unob[0],
-               "permeability_unobstructed_se": p_unob[1], "nrmse": nrmse(m.to_numpy(), s),
-               "nmbe": nmbe(m.to_numpy(), s), "r": pearson_r(m.to_numpy(), s)}
-        row.update({t: float(x) for t, x in zip(hours, s, strict=True)})
-        rows.append(row)
-        log.info("  %s = %g: permeability %.2f %% (street) / %.2f %% (unobstructed); %s nRMSE "
-                 "%.3f, nMBE %+.3f", field, v, 100 * p_street[0], 100 * p_unob[0], scenario,
-                 row["nrmse"], row["nmbe"])
-    return PermeabilityScan(scenario, field, pd.DataFrame(rows), hours)
+    return jobs
+
+
+def _scan_row(v: float, *, out: Sequence[Any], open_street: Any, unob: Any,
+              measured: pd.Series, hours: list[str], field: str,
+              scenario: str) -> dict[str, float]:
+    """The table row of one scanned value (logged): permeabilities with their standard errors,
+    the fit statistics against ``measured`` and the hourly façade means."""
+    street, sky, hourly = out
+    p_street = _ratio(street, open_street)
+    p_unob = _ratio(sky, unob)
+    m = measured
+    s = hourly.reindex(m.index).to_numpy()
+    row = {"value": float(v), "permeability_street": p_street[0],
+           "permeability_street_se": p_street[1], "permeability_unobstructed": p_unob[0],
+           "permeability_unobstructed_se": p_unob[1], "nrmse": nrmse(m.to_numpy(), s),
+           "nmbe": nmbe(m.to_numpy(), s), "r": pearson_r(m.to_numpy(), s)}
+    row.update({t: float(x) for t, x in zip(hours, s, strict=True)})
+    log.info("  %s = %g: permeability %.2f %% (street) / %.2f %% (unobstructed); %s nRMSE "
+             "%.3f, nMBE %+.3f", field, v, 100 * p_street[0], 100 * p_unob[0], scenario,
+             row["nrmse"], row["nmbe"])
+    return row
 
 
 def write_scan(scan: PermeabilityScan, folder: Path) -> tuple[Path, Path]:

@@ -187,6 +187,27 @@ def load_campaign(path: str | os.PathLike, project: Project | None = None) -> Ca
     """Read a campaign TOML file (relative data paths are relative to the file)."""
     p = Path(path)
     src = str(p)
+    head, group_tables = _campaign_tables(p)
+    days, hours = _days_hours(head, src=src, project=project)
+    base = p.parent
+    groups = [_sensor_group(g, where=f"group[{i}]", src=src, base=base)
+              for i, g in enumerate(group_tables)]
+    dn = _get(head, "direct_normal", dict, src, "campaign", {})
+    rays = _get(head, "rays", int, src, "campaign")
+    return Campaign(
+        name=str(_get(head, "name", str, src, "campaign", p.stem)),
+        days=tuple(str(d) for d in days), hours=tuple(hours), groups=tuple(groups),
+        noise=float(_get(head, "noise", (int, float), src, "campaign", DEFAULT_CAMPAIGN_NOISE)),
+        noise_lux=float(_get(head, "noise_lux", (int, float), src, "campaign", 0.0)),
+        rays=rays, synthetic=bool(_get(head, "synthetic", bool, src, "campaign", False)),
+        description=str(_get(head, "description", str, src, "campaign", "")),
+        direct_normal=tuple((str(k), _relative(str(v), base=base)) for k, v in dn.items()),
+        source=p)
+
+
+def _campaign_tables(p: Path) -> tuple[dict[str, Any], Any]:
+    """The file's ``[campaign]`` table (its keys checked) and its ``[[group]]`` entries."""
+    src = str(p)
     try:
         data = tomllib.loads(p.read_text(encoding="utf-8"))
     except FileNotFoundError:
@@ -202,6 +223,12 @@ def load_campaign(path: str | os.PathLike, project: Project | None = None) -> Ca
     if extra:
         raise ConfigError(f"unknown key(s) {', '.join(extra)} (known: {', '.join(sorted(known))})",
                           source=src, field="campaign")
+    return head, data.get("group", []) or []
+
+
+def _days_hours(head: dict[str, Any], *, src: str,
+                project: Project | None) -> tuple[list[Any], list[str]]:
+    """The campaign's days and hours (HH:MM), defaulting to the project's date and hours."""
     days = _get(head, "days", list, src, "campaign",
                 [project.site.date] if project is not None else None)
     hours = _get(head, "hours", list, src, "campaign",
@@ -213,54 +240,46 @@ def load_campaign(path: str | os.PathLike, project: Project | None = None) -> Ca
         hours = [normalise_time(str(h)) for h in hours]
     except Exception as exc:
         raise ConfigError(str(exc), source=src, field="campaign.hours") from None
-    base = p.parent
+    return days, hours
 
-    def rel(v: str) -> str:
-        q = Path(v)
-        return str((q if q.is_absolute() else (base / q)).resolve())
 
-    groups = []
-    for i, g in enumerate(data.get("group", []) or []):
-        where = f"group[{i}]"
-        if not isinstance(g, dict):
-            raise ConfigError("each [[group]] must be a table", source=src, field=where)
-        gknown = {"name", "report", "grid", "height_m", "orientation", "points", "measured",
-                  "description"}
-        gextra = sorted(set(g) - gknown)
-        if gextra:
-            raise ConfigError(f"unknown key(s) {', '.join(gextra)} (known: "
-                              f"{', '.join(sorted(gknown))})", source=src, field=where)
-        meas = _get(g, "measured", dict, src, where, {})
-        pts = _get(g, "points", list, src, where, [])
-        bad = [pt for pt in pts if not isinstance(pt, list) or len(pt) != 3]
-        if bad:
-            raise ConfigError(f"points must be [u, d, z] lists of three numbers (m), got "
-                              f"{bad[0]!r}", source=src, field=f"{where}.points")
-        try:
-            groups.append(SensorGroup(
-                name=str(_get(g, "name", str, src, where, "")), report=_get(g, "report", str, src,
-                                                                           where, "mean"),
-                grid=_get(g, "grid", str, src, where),
-                height_m=_get(g, "height_m", (int, float), src, where),
-                orientation=_get(g, "orientation", str, src, where, "facade"),
-                points=tuple((float(pt[0]), float(pt[1]), float(pt[2])) for pt in pts),
-                measured=tuple((str(k), rel(str(v))) for k, v in meas.items()),
-                description=str(_get(g, "description", str, src, where, ""))))
-        except ConfigError as exc:
-            raise ConfigError(str(exc), source=src, field=where) from None
-        except (TypeError, ValueError) as exc:
-            raise ConfigError(f"points must be lists of three numbers ({exc})", source=src,
-                              field=where) from None
-    dn = _get(head, "direct_normal", dict, src, "campaign", {})
-    rays = _get(head, "rays", int, src, "campaign")
-    return Campaign(
-        name=str(_get(head, "name", str, src, "campaign", p.stem)),
-        days=tuple(str(d) for d in days), hours=tuple(hours), groups=tuple(groups),
-        noise=float(_get(head, "noise", (int, float), src, "campaign", DEFAULT_CAMPAIGN_NOISE)),
-        noise_lux=float(_get(head, "noise_lux", (int, float), src, "campaign", 0.0)),
-        rays=rays, synthetic=bool(_get(head, "synthetic", bool, src, "campaign", False)),
-        description=str(_get(head, "description", str, src, "campaign", "")),
-        direct_normal=tuple((str(k), rel(str(v))) for k, v in dn.items()), source=p)
+def _relative(v: str, *, base: Path) -> str:
+    """``v`` resolved, relative to ``base`` (the campaign file's folder) unless absolute."""
+    q = Path(v)
+    return str((q if q.is_absolute() else (base / q)).resolve())
+
+
+def _sensor_group(g: Any, *, where: str, src: str, base: Path) -> SensorGroup:
+    """One ``[[group]]`` table (``where``: ``group[i]``) as a checked SensorGroup."""
+    if not isinstance(g, dict):
+        raise ConfigError("each [[group]] must be a table", source=src, field=where)
+    gknown = {"name", "report", "grid", "height_m", "orientation", "points", "measured",
+              "description"}
+    gextra = sorted(set(g) - gknown)
+    if gextra:
+        raise ConfigError(f"unknown key(s) {', '.join(gextra)} (known: "
+                          f"{', '.join(sorted(gknown))})", source=src, field=where)
+    meas = _get(g, "measured", dict, src, where, {})
+    pts = _get(g, "points", list, src, where, [])
+    bad = [pt for pt in pts if not isinstance(pt, list) or len(pt) != 3]
+    if bad:
+        raise ConfigError(f"points must be [u, d, z] lists of three numbers (m), got "
+                          f"{bad[0]!r}", source=src, field=f"{where}.points")
+    try:
+        return SensorGroup(
+            name=str(_get(g, "name", str, src, where, "")), report=_get(g, "report", str, src,
+                                                                       where, "mean"),
+            grid=_get(g, "grid", str, src, where),
+            height_m=_get(g, "height_m", (int, float), src, where),
+            orientation=_get(g, "orientation", str, src, where, "facade"),
+            points=tuple((float(pt[0]), float(pt[1]), float(pt[2])) for pt in pts),
+            measured=tuple((str(k), _relative(str(v), base=base)) for k, v in meas.items()),
+            description=str(_get(g, "description", str, src, where, "")))
+    except ConfigError as exc:
+        raise ConfigError(str(exc), source=src, field=where) from None
+    except (TypeError, ValueError) as exc:
+        raise ConfigError(f"points must be lists of three numbers ({exc})", source=src,
+                          field=where) from None
 
 
 def campaign_table(c: Campaign, relative_to: Path | None = None) -> dict[str, Any]:

@@ -54,13 +54,44 @@ def scene_ab(project: Project, tree_ab: int | None) -> int:
 
 
 def make_scene(project: Project, scenario: Scenario, dense_grid: bool | None = None) -> BuiltScene:
-    """The in-memory scene of one scenario: street canyon, crown model, sensor grids."""
+    """The in-memory scene of one scenario: street canyon, crown model, sensor grids.
+
+    Plan (the site: canyon, office block or Honeybee rooms) → execute (the crown model) →
+    publish (user geometry, ``-ab``, triangle limit, the BuiltScene)."""
     if project.district is not None:   # [site] trees / buildings
         from radtree.pipeline.district import district_scene
 
         return district_scene(project, scenario, dense_grid, scene_ab, BuiltScene)  # type: ignore[no-any-return]
     project = effective_project(project, scenario)
     frame = facade_frame(project)
+    meshes, materials, grids, notes = _site_parts(project, frame=frame, dense_grid=dense_grid)
+    t0 = time.perf_counter()
+    info: dict[str, float] = {}
+    tree = None
+    if scenario.model != "none":
+        tree = _crown(project, scenario=scenario, frame=frame)
+        clash = set(tree.materials) & set(materials)
+        if clash:
+            raise RadtreeError(f"crown model materials clash with the street's: {clash}")
+        materials.update(tree.materials)
+        meshes = meshes + list(tree.meshes)
+        notes += list(tree.notes)
+        info = dict(tree.info)
+    geometry_seconds = time.perf_counter() - t0
+    if project.extra_geometry:
+        from radtree.site.user_geometry import load_user_meshes
+
+        meshes = meshes + load_user_meshes(project.extra_geometry, materials)
+    ab = scene_ab(project, None if tree is None else tree.recommended_ab)
+    scene = Scene(meshes, materials, grids, notes, media=None if tree is None else tree.media)
+    check_triangles(project, scenario, scene.n_triangles)
+    return BuiltScene(scenario, scene, ab, notes, scene.n_triangles, geometry_seconds, info, tree)
+
+
+def _site_parts(project: Project, *, frame: FacadeFrame,   # type: ignore[no-untyped-def]
+                dense_grid: bool | None):
+    """Meshes, materials, sensor grids and notes of the street canyon, with the office block
+    or the Honeybee model's rooms when the project has them."""
     materials: dict = dict(street_materials(project.street))
     meshes = street_meshes(project.street, frame)
     use_dense = project.sensors.dense_grid if dense_grid is None else dense_grid
@@ -90,32 +121,18 @@ def make_scene(project: Project, scenario: Scenario, dense_grid: bool | None = N
                                "rename them in the model")
         grids.update(hbp.grids)
         notes = list(hbp.notes)
-    t0 = time.perf_counter()
-    info: dict[str, float] = {}
+    return meshes, materials, grids, notes
+
+
+def _crown(project: Project, *, scenario: Scenario, frame: FacadeFrame):   # type: ignore[no-untyped-def]
+    """The scenario's crown model (its switches applied): a BSDF crown, else the built one."""
+    from radtree.trees.build import apply_switches, build_tree
+
+    crown, _ = apply_switches(project.tree, dict(scenario.switches),
+                              source=str(project.source))
     tree = None
-    if scenario.model != "none":
-        from radtree.trees.build import apply_switches, build_tree
+    if crown.representation == "bsdf":   # imported only then: it pulls in trimesh (~1 s)
+        from radtree.pipeline.crown_bsdf import bsdf_crown
 
-        crown, _ = apply_switches(project.tree, dict(scenario.switches),
-                                  source=str(project.source))
-        if crown.representation == "bsdf":   # imported only then: it pulls in trimesh (~1 s)
-            from radtree.pipeline.crown_bsdf import bsdf_crown
-
-            tree = bsdf_crown(project, scenario, frame)
-        tree = tree or build_tree(project, scenario, frame)
-        clash = set(tree.materials) & set(materials)
-        if clash:
-            raise RadtreeError(f"crown model materials clash with the street's: {clash}")
-        materials.update(tree.materials)
-        meshes = meshes + list(tree.meshes)
-        notes += list(tree.notes)
-        info = dict(tree.info)
-    geometry_seconds = time.perf_counter() - t0
-    if project.extra_geometry:
-        from radtree.site.user_geometry import load_user_meshes
-
-        meshes = meshes + load_user_meshes(project.extra_geometry, materials)
-    ab = scene_ab(project, None if tree is None else tree.recommended_ab)
-    scene = Scene(meshes, materials, grids, notes, media=None if tree is None else tree.media)
-    check_triangles(project, scenario, scene.n_triangles)
-    return BuiltScene(scenario, scene, ab, notes, scene.n_triangles, geometry_seconds, info, tree)
+        tree = bsdf_crown(project, scenario, frame)
+    return tree or build_tree(project, scenario, frame)

@@ -27,75 +27,115 @@ INVENTORY_MODELS = ("louvers", "none")
 
 def district_scene(project: Project, scenario: Scenario, dense_grid: bool | None,
                    scene_ab, built_scene_cls):   # type: ignore[no-untyped-def]
-    """The BuiltScene of ``scenario`` for an inventory project (see the module doc)."""
+    """The BuiltScene of ``scenario`` for an inventory project (see the module doc).
+
+    Plan (inputs, species and crown–wall checks, the site: buildings or street canyon) →
+    execute (the crowns) → publish (the scene, its ``-ab``, the BuiltScene)."""
     project = effective_project(project, scenario)
-    d = project.district
     inputs = load_district(project)
-    # species are checked for every scenario (also 'none'): nothing is built with a bad one
-    notes: list[str] = []
-    clips: dict = {}
-    if inputs.trees:
-        from radtree.trees.district import species_of, wall_clips
-
-        species_of(inputs.trees, str(d.trees))
-        # the crown–wall policy for every scenario (also 'none'): a refusal stops them all
-        clips, wall_notes = wall_clips(project, inputs.trees, inputs.walls, str(d.trees))
-        notes += wall_notes
-    materials: dict[str, Material]
+    notes, clips = _inventory_checks(project, inputs=inputs)
     if inputs.buildings:
-        meshes, walls = building_meshes(inputs.buildings)
-        materials = {**walls, "ground": street_materials(project.street)["ground"]}
-        meshes.append(ground_mesh(inputs.buildings, inputs.trees))
-        grids = facade_grids(inputs.facades, d.facade_spacing_m, d.window_height_m,
-                             project.sensors.offset_m, d.facade_chunk)
-        notes.append(f"District: {len(inputs.buildings)} buildings, {len(inputs.facades)} "
-                     f"façades with sensors ({sum(len(g) for g in grids.values())} sensors "
-                     f"every {d.facade_spacing_m:g} m, {d.window_height_m:g} m above each "
-                     f"storey floor), {len(inputs.trees)} trees.")
+        meshes, materials, grids = _buildings_site(project, inputs=inputs, notes=notes)
     else:
-        frame = inputs.street_frame or FacadeFrame(azimuth_deg=project.street.facade_azimuth_deg)
-        if inputs.placement:
-            notes.append(inputs.placement)
-        materials = dict(street_materials(project.street))
-        meshes = street_meshes(project.street, frame)
-        grids = street_grids(project.sensors, frame, project.sensors.dense_grid
-                             if dense_grid is None else dense_grid)
-        notes.append(f"street canyon {project.street.width_m:g} m wide with "
-                     f"{len(inputs.trees)} inventory tree(s)")
+        meshes, materials, grids = _street_site(project, inputs=inputs, dense_grid=dense_grid,
+                                                notes=notes)
     t0 = time.perf_counter()
-    tree = None
-    prototypes: dict = {}
-    instances: list = []
-    if scenario.model not in INVENTORY_MODELS:
-        raise ConfigError(f"got {scenario.model!r}: inventory crowns are built with the louvers "
-                          f"model (or none)", source=str(project.source),
-                          field=f"scenario {scenario.name}.model")
-    if scenario.model != "none" and inputs.trees:
-        from radtree.trees.build import apply_switches
-        from radtree.trees.district import inventory_crowns
-
-        tr, _ = apply_switches(project.tree, scenario.switches, source=str(project.source),
-                               root=project.root)
-        if tr.representation == "explicit" and 0 < d.turbid_above < len(inputs.trees):
-            from dataclasses import replace
-
-            tr = replace(tr, representation="turbid")   # [site] turbid_above (config.district)
-            notes.append(f"{len(inputs.trees)} trees > [site] turbid_above = {d.turbid_above}: "
-                         "the crowns are turbid media (set turbid_above = 0 for slats).")
-        if tr.representation == "turbid":   # one turbid crown per tree, no slats
-            from radtree.trees.turbid import inventory_turbid
-
-            tree = inventory_turbid(project, inputs.trees, tr)
-        else:
-            tree = inventory_crowns(project, inputs.trees, tr, instancing=d.instancing, clips=clips)
+    tree = _inventory_crowns(project, scenario=scenario, inputs=inputs, clips=clips, notes=notes)
+    if tree is not None:
         clash = set(tree.materials) & set(materials)
         if clash:
             raise RadtreeError(f"crown materials clash with the buildings': {clash}")
         materials.update(tree.materials)
         meshes = meshes + list(tree.meshes)
-        prototypes, instances = tree.prototypes, tree.instances
         notes += tree.notes
     seconds = time.perf_counter() - t0
+    return _publish(project, scenario=scenario, meshes=meshes, materials=materials, grids=grids,
+                    notes=notes, tree=tree, seconds=seconds, scene_ab=scene_ab,
+                    built_scene_cls=built_scene_cls)
+
+
+def _inventory_checks(project: Project, *, inputs) -> tuple[list[str], dict]:   # type: ignore[no-untyped-def]
+    """The notes so far and the crown–wall clips; species are checked for every scenario
+    (also 'none'): nothing is built with a bad one."""
+    notes: list[str] = []
+    clips: dict = {}
+    if inputs.trees:
+        from radtree.trees.district import species_of, wall_clips
+
+        d = project.district
+        species_of(inputs.trees, str(d.trees))
+        # the crown–wall policy for every scenario (also 'none'): a refusal stops them all
+        clips, wall_notes = wall_clips(project, inputs.trees, inputs.walls, str(d.trees))
+        notes += wall_notes
+    return notes, clips
+
+
+def _buildings_site(project: Project, *, inputs, notes: list[str]):   # type: ignore[no-untyped-def]
+    """Extruded footprints, one ground rectangle and the façade grids (appends a note)."""
+    d = project.district
+    materials: dict[str, Material]
+    meshes, walls = building_meshes(inputs.buildings)
+    materials = {**walls, "ground": street_materials(project.street)["ground"]}
+    meshes.append(ground_mesh(inputs.buildings, inputs.trees))
+    grids = facade_grids(inputs.facades, d.facade_spacing_m, d.window_height_m,
+                         project.sensors.offset_m, d.facade_chunk)
+    notes.append(f"District: {len(inputs.buildings)} buildings, {len(inputs.facades)} "
+                 f"façades with sensors ({sum(len(g) for g in grids.values())} sensors "
+                 f"every {d.facade_spacing_m:g} m, {d.window_height_m:g} m above each "
+                 f"storey floor), {len(inputs.trees)} trees.")
+    return meshes, materials, grids
+
+
+def _street_site(project: Project, *, inputs, dense_grid: bool | None,   # type: ignore[no-untyped-def]
+                 notes: list[str]):
+    """The street canyon and its façade circle (and dense map) (appends notes)."""
+    frame = inputs.street_frame or FacadeFrame(azimuth_deg=project.street.facade_azimuth_deg)
+    if inputs.placement:
+        notes.append(inputs.placement)
+    materials: dict[str, Material] = dict(street_materials(project.street))
+    meshes = street_meshes(project.street, frame)
+    grids = street_grids(project.sensors, frame, project.sensors.dense_grid
+                         if dense_grid is None else dense_grid)
+    notes.append(f"street canyon {project.street.width_m:g} m wide with "
+                 f"{len(inputs.trees)} inventory tree(s)")
+    return meshes, materials, grids
+
+
+def _inventory_crowns(project: Project, *, scenario: Scenario, inputs,   # type: ignore[no-untyped-def]
+                      clips: dict, notes: list[str]):
+    """One crown per inventory tree (louvers slats or turbid media), or None (model 'none' or
+    no trees); refuses any other model. Appends the turbid_above note."""
+    d = project.district
+    if scenario.model not in INVENTORY_MODELS:
+        raise ConfigError(f"got {scenario.model!r}: inventory crowns are built with the louvers "
+                          f"model (or none)", source=str(project.source),
+                          field=f"scenario {scenario.name}.model")
+    if scenario.model == "none" or not inputs.trees:
+        return None
+    from radtree.trees.build import apply_switches
+    from radtree.trees.district import inventory_crowns
+
+    tr, _ = apply_switches(project.tree, scenario.switches, source=str(project.source),
+                           root=project.root)
+    if tr.representation == "explicit" and 0 < d.turbid_above < len(inputs.trees):
+        from dataclasses import replace
+
+        tr = replace(tr, representation="turbid")   # [site] turbid_above (config.district)
+        notes.append(f"{len(inputs.trees)} trees > [site] turbid_above = {d.turbid_above}: "
+                     "the crowns are turbid media (set turbid_above = 0 for slats).")
+    if tr.representation == "turbid":   # one turbid crown per tree, no slats
+        from radtree.trees.turbid import inventory_turbid
+
+        return inventory_turbid(project, inputs.trees, tr)
+    return inventory_crowns(project, inputs.trees, tr, instancing=d.instancing, clips=clips)
+
+
+def _publish(project: Project, *, scenario: Scenario, meshes, materials, grids,   # type: ignore[no-untyped-def]
+             notes: list[str], tree, seconds: float, scene_ab, built_scene_cls):
+    """The Scene (``notes`` shared with it: the instancing note lands in both), its ``-ab``
+    and the BuiltScene."""
+    prototypes: dict = {} if tree is None else tree.prototypes
+    instances: list = [] if tree is None else tree.instances
     scene = Scene(meshes, materials, grids, notes, prototypes=prototypes, instances=instances,
                   media=None if tree is None else tree.media)
     if instances:

@@ -287,24 +287,7 @@ def sweep_section_data(project_root: str | Path, scenario: str = "A") -> dict[st
     metric = "nrmse" if "nrmse" in set(s["metric"]) else "facade_mean_lux"
     s_m = s[s["metric"] == metric].sort_values("effect_range", ascending=False)
     top = s_m.iloc[0]
-    lux = s[s["metric"] == "facade_mean_lux"].set_index("parameter")
-    nmbe = s[s["metric"] == "nmbe"].set_index("parameter")
-    head = ["parameter", f"{METRIC_LABELS.get(metric, metric)} range", "low → high at",
-            "Spearman ρ"]
-    if metric == "nrmse":
-        head += ["nMBE range", "façade lux range"]
-    rows = []
-    for _, r in s_m.iterrows():
-        cells = [f"{_fmt(r['effect_low'], metric)} – {_fmt(r['effect_high'], metric)}",
-                 f"{r['value_at_low']} → {r['value_at_high']}",
-                 "—" if pd.isna(r["spearman_rho"]) else f"{r['spearman_rho']:+.2f}"]
-        if metric == "nrmse":
-            p = r["parameter"]
-            cells.append(f"{nmbe.loc[p, 'effect_low']:+.3f} – {nmbe.loc[p, 'effect_high']:+.3f}"
-                         if p in nmbe.index else "—")
-            cells.append(f"{lux.loc[p, 'effect_low']:,.0f} – {lux.loc[p, 'effect_high']:,.0f}"
-                         if p in lux.index else "—")
-        rows.append({"parameter": str(r["parameter"]), "cells": cells})
+    head, rows = _effect_rows(s, ranked=s_m, metric=metric)
     png = out / "tornado.png"
     failures = out / "failures.csv"
     return {
@@ -327,3 +310,29 @@ def sweep_section_data(project_root: str | Path, scenario: str = "A") -> dict[st
         "failures": len(pd.read_csv(failures)) if failures.exists() else 0,
         "failures_file": str(failures),
     }
+
+
+def _effect_rows(s: pd.DataFrame, *, ranked: pd.DataFrame,
+                 metric: str) -> tuple[list[str], list[dict[str, Any]]]:
+    """The table's header and one row per parameter of ``ranked`` (``s``'s rows of ``metric``,
+    largest effect first): its range, the values at the ends, Spearman ρ, and with nRMSE also
+    the nMBE range (fraction) and the façade illuminance range (lux)."""
+    lux = s[s["metric"] == "facade_mean_lux"].set_index("parameter")
+    nmbe = s[s["metric"] == "nmbe"].set_index("parameter")
+    head = ["parameter", f"{METRIC_LABELS.get(metric, metric)} range", "low → high at",
+            "Spearman ρ"]
+    if metric == "nrmse":
+        head += ["nMBE range", "façade lux range"]
+    rows = []
+    for _, r in ranked.iterrows():
+        cells = [f"{_fmt(r['effect_low'], metric)} – {_fmt(r['effect_high'], metric)}",
+                 f"{r['value_at_low']} → {r['value_at_high']}",
+                 "—" if pd.isna(r["spearman_rho"]) else f"{r['spearman_rho']:+.2f}"]
+        if metric == "nrmse":
+            p = r["parameter"]
+            cells.append(f"{nmbe.loc[p, 'effect_low']:+.3f} – {nmbe.loc[p, 'effect_high']:+.3f}"
+                         if p in nmbe.index else "—")
+            cells.append(f"{lux.loc[p, 'effect_low']:,.0f} – {lux.loc[p, 'effect_high']:,.0f}"
+                         if p in lux.index else "—")
+        rows.append({"parameter": str(r["parameter"]), "cells": cells})
+    return head, rows

@@ -168,6 +168,31 @@ def write_build(scene: Scene, states: list[SkyState], params: EngineParams, ab: 
 
     _write(folder / "materials.rad", materials_text(scene.materials, scene.ground_material))
     scene_files = ["materials.rad"]
+    geometry_files, meshes, prototypes = _write_geometry(scene, folder=folder)
+    for grid in scene.grids.values():
+        _write(folder / "grids" / f"{grid.name}.pts", grid.to_pts())
+    for name, cal in ANALYTIC_SKY_CAL.items():
+        _write(folder / "skies" / f"{name}.cal", f"{{ {name} sky: relative luminance }}\n{cal}")
+    hour_files = _write_hours(scene, states=states, folder=folder, install=install,
+                              geometry_files=geometry_files)
+    # oconv order: materials, hour's ground material, geometry, sky
+    plan = BuildPlan(folder=folder, hours=[s.label for s in states], grids=list(scene.grids),
+                     scene_files=scene_files, hour_files=hour_files,
+                     rtrace_opts=rtrace_options(params, ab),
+                     states={s.label: s for s in states},
+                     hour_grids=dict(hour_grids or {}), prototypes=prototypes,
+                     meshes=meshes, photon_map=PhotonMap.from_params(params),
+                     grid_opts=grid_rtrace_options(params, ab, list(scene.grids)))
+    write_makefile(plan, install, scenario)
+    return plan
+
+
+def _write_geometry(scene: Scene, *, folder: Path
+                    ) -> tuple[list[str], dict[str, str], dict[str, str]]:
+    """Write ``geometry/``: one file per solid mesh (polygons, or a ``mesh`` primitive whose
+    .rtm the runner / Makefile compiles), the instancing prototypes and ``instances.rad``.
+    Returns the geometry files (relative), the meshes (rtm → obj) and the prototypes
+    (octree → rad file)."""
     geometry_files = []
     meshes: dict[str, str] = {}
     for mesh in scene.own_solid_meshes():
@@ -189,11 +214,14 @@ def write_build(scene: Scene, states: list[SkyState], params: EngineParams, ab: 
             prototypes[prototype_octree(name)] = rel
         _write(folder / "geometry" / "instances.rad", instances_text(scene))
         geometry_files.append("geometry/instances.rad")
-    for grid in scene.grids.values():
-        _write(folder / "grids" / f"{grid.name}.pts", grid.to_pts())
-    for name, cal in ANALYTIC_SKY_CAL.items():
-        _write(folder / "skies" / f"{name}.cal", f"{{ {name} sky: relative luminance }}\n{cal}")
+    return geometry_files, meshes, prototypes
 
+
+def _write_hours(scene: Scene, *, states: list[SkyState], folder: Path,
+                 install: RadianceInstall | None,
+                 geometry_files: list[str]) -> dict[str, list[str]]:
+    """Write each hour's ground material (a Plastic ground only) and sky; returns each hour's
+    oconv files after materials.rad: ground material, geometry, sky."""
     hour_files: dict[str, list[str]] = {}
     ground = scene.materials.get(scene.ground_material)
     for st in states:
@@ -209,16 +237,7 @@ def write_build(scene: Scene, states: list[SkyState], params: EngineParams, ab: 
         _write(folder / rel_sky, sky_text(st, install))
         files.append(rel_sky)
         hour_files[st.label] = files
-    # oconv order: materials, hour's ground material, geometry, sky
-    plan = BuildPlan(folder=folder, hours=[s.label for s in states], grids=list(scene.grids),
-                     scene_files=scene_files, hour_files=hour_files,
-                     rtrace_opts=rtrace_options(params, ab),
-                     states={s.label: s for s in states},
-                     hour_grids=dict(hour_grids or {}), prototypes=prototypes,
-                     meshes=meshes, photon_map=PhotonMap.from_params(params),
-                     grid_opts=grid_rtrace_options(params, ab, list(scene.grids)))
-    write_makefile(plan, install, scenario)
-    return plan
+    return hour_files
 
 
 @cache
