@@ -260,12 +260,13 @@ def test_cli_choices_and_reference_rows_come_from_the_registry():
 
     choices = next(p for p in export_command.params if p.name == "fmt").type.choices
     assert list(choices) == list(EXPORT_FORMATS) == list(FORMATS) == [
-        "honeybee", "idf", "schedule", "gltf", "obj"]
+        "honeybee", "idf", "schedule", "honeybee-scene", "gltf", "obj"]
     rows = reference_rows()
     assert [r[0] for r in rows] == list(EXPORT_FORMATS)
     assert rows[2] == ("schedule", EXPORT_FORMATS["schedule"].summary,
                        "crown, schedules, extra:honeybee")
-    assert rows[3][2] == "scene"
+    assert rows[3][2] == "honeybee_model, scene, extra:honeybee"
+    assert rows[4][2] == "scene"
     for name, fmt in EXPORT_FORMATS.items():
         assert callable(fmt.writer()), name
         assert fmt.needs <= set(NEEDS)

@@ -14,8 +14,9 @@ from radtree.export.schedule_options import DEFINITIONS
 
 def _help() -> str:
     """The command's help: a line per format of the registry."""
-    rows = "\n".join(textwrap.fill(fmt.summary, 92, initial_indent=f"{name:<9} ",
-                                   subsequent_indent=" " * 10)
+    width = max(map(len, EXPORT_FORMATS)) + 1
+    rows = "\n".join(textwrap.fill(fmt.summary, 92, initial_indent=f"{name:<{width}} ",
+                                   subsequent_indent=" " * (width + 1))
                      for name, fmt in EXPORT_FORMATS.items())
     traced = textwrap.fill(f"{', '.join(formats_needing('schedules'))}: each crown's "
                            "transmittance along the sun for 8760 hours (--definition total: "

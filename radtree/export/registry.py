@@ -118,6 +118,11 @@ EXPORT_FORMATS: dict[str, ExportFormat] = {
     "schedule": _f("honeybee:export_schedule", "crown_transmittance.csv (8760 rows, a column "
                    "per crown) and its Schedule:File objects (crown_transmittance.idf)",
                    "crown", "schedules", extra="honeybee"),
+    "honeybee-scene": _f("honeybee_scene:export_hbjson_scene", "radtree_scene.hbjson: what "
+                         "radtree traces, leaf by leaf (crowns, trunks, ground; the street "
+                         "without a Honeybee model) as ShadeMesh with Radiance modifiers, for "
+                         "Ladybug Tools' Radiance recipes", "scene", "honeybee_model",
+                         extra="honeybee"),
     "gltf": _f("scene_files:export_gltf", "<scenario>_scene.glb: the whole scene for any 3-D "
                "viewer, coloured by material", "scene"),
     "obj": _f("scene_files:export_obj", "<scenario>_scene.obj: the same as Wavefront OBJ",

@@ -38,6 +38,8 @@ from radtree.optics import Glass, Material, Plastic, Trans
 from radtree.scene import Mesh, SensorGrid, quad
 
 GROUND_GAP_M = 0.01
+#: name prefix of the scene meshes made from the Honeybee model (one per modifier)
+MESH_PREFIX = "hb_"
 """The ground plane sits this far below the model's lowest point (coincident surfaces of two
 materials would be ambiguous for a ray tracer)."""
 RADIANCE_GLASS_INDEX = 1.52
@@ -228,7 +230,7 @@ def honeybee_parts(hb: HoneybeeSite, margin_m: float = 40.0,
     meshes = []
     for name, parts in by_mod.items():
         tri = np.concatenate(parts).reshape(-1, 3)
-        meshes.append(Mesh(f"hb_{name}", name, tri, np.arange(len(tri)).reshape(-1, 3)))
+        meshes.append(Mesh(f"{MESH_PREFIX}{name}", name, tri, np.arange(len(tri)).reshape(-1, 3)))
     allv = np.concatenate([m.vertices for m in meshes])
     lo, hi = allv.min(axis=0) - margin_m, allv.max(axis=0) + margin_m
     z = min(0.0, float(allv[:, 2].min()) - GROUND_GAP_M)
