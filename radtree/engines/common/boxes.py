@@ -28,7 +28,8 @@ _BOX_FACES = np.array([[0, 1, 3], [0, 3, 2], [4, 6, 7], [4, 7, 5], [0, 4, 5], [0
 class BoxProxies:
     """Proxy boxes around the volumes ``lo`` … ``hi`` ((n, 3) each, m, world frame)."""
 
-    def __init__(self, lo: np.ndarray, hi: np.ndarray, backend: str = "auto", workers: int = 1):
+    def __init__(self, lo: np.ndarray, *, hi: np.ndarray, backend: str = "auto",
+                 workers: int = 1):
         n = len(lo)
         self.n = n
         margin = (BOX_MARGIN * (1.0 + 4.0 * (np.arange(n) % MARGIN_STEPS) / MARGIN_STEPS))[:, None]
@@ -74,7 +75,7 @@ class BoxProxies:
         return key // self.n, key % self.n
 
 
-def clip_to_planes(o: np.ndarray, d: np.ndarray, planes: np.ndarray, t0: np.ndarray,
+def clip_to_planes(o: np.ndarray, *, d: np.ndarray, planes: np.ndarray, t0: np.ndarray,
                    t1: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """[t0, t1] of the rays ``o + t d`` cut by the half-spaces ``planes`` ((k, p, 4): keep
     n·x ≥ c per row (n_x, n_y, n_z, c); rows of zeros with c = −1 keep everything); empty:

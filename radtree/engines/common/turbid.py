@@ -75,7 +75,7 @@ def _plain(draws: Draws, n: int) -> np.ndarray:
     return np.asarray(rng.random(n))
 
 
-def leaf_optics(kinds: list[LeafKind], materials: dict[str, Material]
+def leaf_optics(kinds: list[LeafKind], *, materials: dict[str, Material]
                 ) -> tuple[np.ndarray, np.ndarray]:
     """Per leaf kind: the share of leaves met that deflect, 1 − T_s, and the deflecting
     events' probabilities (kinds, 2): diffuse reflection R/(1 − T_s), diffuse transmission
@@ -93,7 +93,7 @@ def leaf_optics(kinds: list[LeafKind], materials: dict[str, Material]
     return pass_, np.stack([r / pass_, td / pass_], 1)
 
 
-def leaf_normals(kind: np.ndarray, kinds: list[LeafKind], d: np.ndarray, draws: Draws
+def leaf_normals(kind: np.ndarray, *, kinds: list[LeafKind], d: np.ndarray, draws: Draws
                  ) -> np.ndarray:
     """Normals (k, 3) of the leaves met by rays along ``d``, on the side the rays came from:
     drawn from each ray's leaf kind (``kind`` index into ``kinds``) weighted by |n·Ω|
@@ -125,7 +125,7 @@ def leaf_normals(kind: np.ndarray, kinds: list[LeafKind], d: np.ndarray, draws: 
 
 
 
-def first_hits(ray: np.ndarray, which: np.ndarray, tc: np.ndarray, *, met: np.ndarray,
+def first_hits(ray: np.ndarray, *, which: np.ndarray, tc: np.ndarray, met: np.ndarray,
                dist: np.ndarray) -> None:
     """Superposed media: each ray's nearest collision among its (``ray``, ``which``, distance
     ``tc``) candidates written into ``met`` / ``dist`` (the minimum of independent free
@@ -145,9 +145,10 @@ class MediumTracer:
         self.media = media
         self.n = len(media)
         half = np.stack([media.a, media.a, media.b], 1)
-        self.boxes = BoxProxies(media.centres - half, media.centres + half, backend, workers)
+        self.boxes = BoxProxies(media.centres - half, hi=media.centres + half, backend=backend,
+                                workers=workers)
         self.axes = half
-        self.pass_, self.events = leaf_optics(media.kinds, materials)
+        self.pass_, self.events = leaf_optics(media.kinds, materials=materials)
 
     def corners(self) -> np.ndarray:
         """(8·n, 3) corners of the crowns' proxy boxes (a forward source must enclose them)."""
@@ -185,7 +186,7 @@ class MediumTracer:
         root = np.sqrt(np.maximum(disc, 0.0))
         t0 = np.maximum((-b - root) / a, 0.0)
         t1 = np.where(disc > 0, (-b + root) / a, -1.0)
-        return clip_to_planes(o, d, self.media.planes[crown], t0, t1)
+        return clip_to_planes(o, d=d, planes=self.media.planes[crown], t0=t0, t1=t1)
 
     def _sigma(self, d: np.ndarray, crown: np.ndarray) -> np.ndarray:
         """Deflecting collisions per metre, σ_c(1 − T_s), for the pairs' directions ``d``."""
@@ -215,7 +216,7 @@ class MediumTracer:
         ray, crown, tc = ray[inside], crown[inside], tc[inside]
         if len(ray) == 0:
             return met, dist
-        first_hits(ray, crown, tc, met=met, dist=dist)
+        first_hits(ray, which=crown, tc=tc, met=met, dist=dist)
         return met, dist
 
     def leaf_events(self, crown: np.ndarray, d: np.ndarray, draws: Draws
@@ -225,7 +226,7 @@ class MediumTracer:
         transmit, specular transmit (0: folded into σ), mirror (0)."""
         k = len(crown)
         kind = self.media.kind[crown]
-        normal = leaf_normals(kind, self.media.kinds, d, draws)
+        normal = leaf_normals(kind, kinds=self.media.kinds, d=d, draws=draws)
         coef = np.zeros((4, k))
         coef[:2] = self.events[kind].T
         return normal, coef
