@@ -1,8 +1,10 @@
 """Turbid-medium crowns on voxel grids, and scenes that mix them with spheroid crowns.
 
-A voxel crown is an axis-aligned box of nx × ny × nz cubic voxels of side v (m) whose lower
-corner (least x, y, z; x east, y north, z up, metres) stands at ``origin``; voxel (i, j, k)
-spans origin + (i, j, k)·v … + v and holds a constant one-sided plant area density u_ijk
+A voxel crown is a box of nx × ny × nz cubic voxels of side v (m) whose corner of voxel
+(0, 0, 0) stands at ``origin`` (x east, y north, z up, metres); its axes are the horizontal
+unit vector e_i (``axis_i``, world x by default), e_j = z × e_i and z, so voxel (i, j, k)
+spans origin + i·v·e_i + j·v·e_j + k·v·z … one voxel further (a grid placed on a trunk of a
+façade's row has its axes along and away from the façade) and holds a constant one-sided plant area density u_ijk
 (m²/m³; a LiDAR inversion, :mod:`radtree.lidar.voxels`, or a file of an AMAPVox-like tool,
 :mod:`radtree.trees.voxel_file`). Each crown may be cut by half-spaces like the spheroids of
 :class:`radtree.media.TurbidCrowns` (the wall-side plane, the planes shared with neighbours).
@@ -38,7 +40,8 @@ class VoxelCrowns:
     """Voxel crowns: ``origins`` (n, 3) m of each grid's lower corner, voxel side ``size_m``
     (n,) m, ``pads`` the distinct density arrays (nx, ny, nz) m²/m³, ``pad_of`` (n,) the
     array of each crown, ``kind`` (n,) index into ``kinds``, ``planes`` (n, p, 4): each crown
-    keeps the points x with n·x ≥ c for each row (n_x, n_y, n_z, c)."""
+    keeps the points x with n·x ≥ c for each row (n_x, n_y, n_z, c); ``axis_i`` (n, 2) the
+    world (x, y) of each grid's first axis (module text)."""
 
     origins: np.ndarray
     size_m: np.ndarray
@@ -47,6 +50,7 @@ class VoxelCrowns:
     kind: np.ndarray
     kinds: list[LeafKind]
     planes: np.ndarray = field(default_factory=lambda: np.zeros((0, 0, 4)))
+    axis_i: np.ndarray = field(default_factory=lambda: np.array([1.0, 0.0]))
 
     def __post_init__(self) -> None:
         """Scalars broadcast to one per crown; ValueError for a grid that is not 3-D,
@@ -58,6 +62,8 @@ class VoxelCrowns:
         self.pad_of = np.broadcast_to(np.asarray(self.pad_of, np.int64), (n,)).copy()
         self.kind = np.broadcast_to(np.asarray(self.kind, np.int64), (n,)).copy()
         self.pads = [np.ascontiguousarray(p, dtype=float) for p in self.pads]
+        axis = np.broadcast_to(np.asarray(self.axis_i, float), (n, 2))
+        self.axis_i = axis / np.linalg.norm(axis, axis=1)[:, None]
         planes = np.asarray(self.planes, float)
         self.planes = (np.zeros((n, 0, 4)) if planes.size == 0 else planes.reshape(n, -1, 4))
         for p in self.pads:
@@ -75,11 +81,13 @@ class VoxelCrowns:
     @classmethod
     def of(cls, origins: np.ndarray, *, size_m: float | np.ndarray, pads: list[np.ndarray],
            pad_of: int | np.ndarray = 0, kind: int | np.ndarray = 0,
-           kinds: list[LeafKind], planes: np.ndarray | None = None) -> VoxelCrowns:
+           kinds: list[LeafKind], planes: np.ndarray | None = None,
+           axis_i: np.ndarray | tuple[float, float] = (1.0, 0.0)) -> VoxelCrowns:
         """Crowns from per-crown arrays or scalars shared by all."""
         return cls(np.asarray(origins, float), np.asarray(size_m, float), list(pads),
                    np.asarray(pad_of, np.int64), np.asarray(kind, np.int64), kinds,
-                   np.zeros((0, 0, 4)) if planes is None else planes)
+                   np.zeros((0, 0, 4)) if planes is None else planes,
+                   np.asarray(axis_i, float))
 
     def __len__(self) -> int:
         return len(self.origins)
@@ -93,15 +101,30 @@ class VoxelCrowns:
         shapes = np.array([p.shape for p in self.pads], np.int64).reshape(-1, 3)
         return shapes[self.pad_of]
 
-    def upper(self) -> np.ndarray:
-        """(n, 3) upper corners (greatest x, y, z) of the grids, m."""
-        return self.origins + self.dims() * self.size_m[:, None]
+    def basis(self) -> np.ndarray:
+        """(n, 3, 3): rows e_i, e_j, z of each grid in world coordinates."""
+        ei = np.column_stack([self.axis_i, np.zeros(len(self))])
+        ej = np.column_stack([-self.axis_i[:, 1], self.axis_i[:, 0], np.zeros(len(self))])
+        z = np.tile([0.0, 0.0, 1.0], (len(self), 1))
+        return np.stack([ei, ej, z], 1)
+
+    def to_world(self, i: int, grid_points: np.ndarray) -> np.ndarray:
+        """Points (k, 3) in crown ``i``'s grid frame (m from its origin) → world."""
+        return self.origins[i] + np.asarray(grid_points, float) @ self.basis()[i]
+
+    def bounds(self) -> tuple[np.ndarray, np.ndarray]:
+        """((n, 3) least, (n, 3) greatest world x, y, z of each grid's box), m."""
+        corners = np.array([[i & 1, (i >> 1) & 1, (i >> 2) & 1] for i in range(8)], float)
+        ext = self.dims() * self.size_m[:, None]
+        local = corners[None] * ext[:, None, :]                     # (n, 8, 3)
+        world = self.origins[:, None, :] + np.einsum("nkj,nji->nki", local, self.basis())
+        return world.min(axis=1), world.max(axis=1)
 
     def _kept(self, i: int) -> np.ndarray:
         """Which voxels of crown ``i`` have their centre inside its half-spaces."""
         p = self.pads[self.pad_of[i]]
         idx = np.indices(p.shape).reshape(3, -1).T
-        centres = self.origins[i] + (idx + 0.5) * self.size_m[i]
+        centres = self.to_world(i, (idx + 0.5) * self.size_m[i])
         keep = np.ones(len(idx), bool)
         for pl in self.planes[i]:
             keep &= centres @ pl[:3] >= pl[3]

@@ -137,3 +137,18 @@ def test_shared_density_arrays_and_validation():
         VoxelCrowns.of(np.zeros((1, 3)), size_m=1.0, pads=[pad[0]], kinds=[KIND])
     with pytest.raises(EngineError, match="trans"):
         VoxelTracer(vc, materials={})
+
+
+def test_a_turned_grid_is_the_same_grid():
+    """A grid turned 30° about z with the rays turned with it: the same transmittances."""
+    pad = _pad(8)
+    a = math.radians(30.0)
+    rot = np.array([[math.cos(a), -math.sin(a), 0.0], [math.sin(a), math.cos(a), 0.0],
+                    [0.0, 0.0, 1.0]])
+    base = VoxelTracer(VoxelCrowns.of(ORIGIN[None], size_m=SIZE, pads=[pad], kinds=[KIND]),
+                       materials=MATS)
+    turned = VoxelTracer(VoxelCrowns.of((rot @ ORIGIN)[None], size_m=SIZE, pads=[pad],
+                                        kinds=[KIND], axis_i=rot[:2, 0]), materials=MATS)
+    o, d = _rays(40, 9)
+    np.testing.assert_allclose(turned.transmittance(o @ rot.T, d @ rot.T),
+                               base.transmittance(o, d), rtol=1e-9, atol=1e-12)

@@ -85,7 +85,7 @@ def media_bounds(media: Media | None) -> np.ndarray:
         half = np.stack([crowns.a, crowns.a, crowns.b], 1)
         out += [crowns.centres - half, crowns.centres + half]
     if voxels is not None:
-        out += [voxels.origins, voxels.upper()]
+        out += list(voxels.bounds())
     return np.vstack(out)
 
 

@@ -1,9 +1,11 @@
 """Free paths through voxel crowns (:class:`radtree.media_voxels.VoxelCrowns`) for the NumPy
 engine and the forward light tracer — the voxel form of :mod:`radtree.engines.common.turbid`.
 
-Which grids a ray crosses: each grid's box is a proxy in a ray caster
-(:class:`~radtree.engines.common.boxes.BoxProxies`); per candidate (ray, grid) pair the exact
-interval is the ray's slab interval in the box, cut by the crown's half-spaces.
+Which grids a ray crosses: each grid's box (its world bounds, when the grid is turned about
+the vertical) is a proxy in a ray caster (:class:`~radtree.engines.common.boxes.BoxProxies`);
+per candidate (ray, grid) pair the ray is taken into the grid's frame (a rotation about z:
+lengths, and so t, unchanged) and the exact interval is its slab interval in the grid's box,
+cut by the crown's half-spaces.
 
 Free paths are sampled **exactly** for the piecewise-constant density by an optical-depth walk
 (regular tracking, not delta tracking): the pair's voxels are visited in the order the ray
@@ -77,8 +79,10 @@ class VoxelTracer:
         starts = np.concatenate([[0], np.cumsum(sizes)[:-1]])
         self.values = np.concatenate([p.ravel() for p in media.pads])   # C order (i, j, k)
         self.offset = starts[media.pad_of]
-        self.lo, self.hi = media.origins, media.upper()
-        self.boxes = BoxProxies(self.lo, hi=self.hi, backend=backend, workers=workers)
+        self.basis = media.basis()
+        self.extent = self.dims * media.size_m[:, None]
+        lo, hi = media.bounds()
+        self.boxes = BoxProxies(lo, hi=hi, backend=backend, workers=workers)
         self.pass_, self.events = leaf_optics(media.kinds, materials=materials)
 
     def corners(self) -> np.ndarray:
@@ -90,6 +94,13 @@ class VoxelTracer:
         table = np.array([names.index(k.material) for k in self.media.kinds], np.int64)
         return table[self.media.kind[grid]]
 
+    def to_grid(self, o: np.ndarray, d: np.ndarray, grid: np.ndarray
+                ) -> tuple[np.ndarray, np.ndarray]:
+        """Pairs' origins and directions (k, 3) in their grids' frames (m from the origin)."""
+        b = self.basis[grid]
+        return (np.einsum("kij,kj->ki", b, o - self.media.origins[grid]),
+                np.einsum("kij,kj->ki", b, d))
+
     def crossings(self, o: np.ndarray, d: np.ndarray, tmax: np.ndarray, parallel: bool = True
                   ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
         """(ray, grid, t_in, t_out) of every grid the rays ``o + t d`` (0 ≤ t ≤ ``tmax``)
@@ -98,7 +109,8 @@ class VoxelTracer:
         if len(ray) == 0:
             return _EMPTY
         oo, dd = np.asarray(o, float)[ray], np.asarray(d, float)[ray]
-        t0, t1 = slab_interval(oo, d=dd, lo=self.lo[grid], hi=self.hi[grid])
+        og, dg = self.to_grid(oo, dd, grid)
+        t0, t1 = slab_interval(og, d=dg, lo=np.zeros_like(og), hi=self.extent[grid])
         t0, t1 = clip_to_planes(oo, d=dd, planes=self.media.planes[grid], t0=np.maximum(t0, 0.0),
                                 t1=t1)
         t1 = np.minimum(t1, tmax[ray])
@@ -118,7 +130,7 @@ class VoxelTracer:
     def walk(self, o: np.ndarray, *, d: np.ndarray, grid: np.ndarray, t0: np.ndarray,
              t1: np.ndarray, target: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
         """The DDA walk of the module text for pairs (ray ``o + t d`` in ``grid`` over
-        [``t0``, ``t1``]): (t where the plant-area path integral reaches ``target``, inf
+        [``t0``, ``t1``]; ``o``, ``d`` in the grid's frame, :meth:`to_grid`): (t where the plant-area path integral reaches ``target``, inf
         where it does not or without a target; the integral Σ u_i ℓ_i over the whole walk or
         up to the hit, m²/m²)."""
         k = len(grid)
@@ -127,7 +139,7 @@ class VoxelTracer:
             return hit, area
         size = self.media.size_m[grid][:, None]
         dims = self.dims[grid]
-        q = (o + t0[:, None] * d - self.lo[grid]) / size
+        q = (o + t0[:, None] * d) / size
         idx = np.clip(np.floor(q), 0, dims - 1).astype(np.int64)
         step = np.where(d >= 0, 1, -1)
         with np.errstate(divide="ignore", invalid="ignore"):
@@ -182,7 +194,8 @@ class VoxelTracer:
         live = np.isfinite(target)
         ray, grid, t0, t1, dd, target = (ray[live], grid[live], t0[live], t1[live], dd[live],
                                          target[live])
-        tc, _ = self.walk(np.asarray(o, float)[ray], d=dd, grid=grid, t0=t0, t1=t1, target=target)
+        og, dg = self.to_grid(np.asarray(o, float)[ray], dd, grid)
+        tc, _ = self.walk(og, d=dg, grid=grid, t0=t0, t1=t1, target=target)
         ok = np.isfinite(tc)
         first_hits(ray[ok], which=grid[ok] + self.first_id, tc=tc[ok], met=met, dist=dist)
         return met, dist
@@ -204,6 +217,7 @@ class VoxelTracer:
         ray, grid, t0, t1 = self.crossings(o, d, np.full(len(o), np.inf), parallel)
         tau = np.zeros(len(o))
         if len(ray):
-            _, area = self.walk(np.asarray(o, float)[ray], d=d[ray], grid=grid, t0=t0, t1=t1)
+            og, dg = self.to_grid(np.asarray(o, float)[ray], d[ray], grid)
+            _, area = self.walk(og, d=dg, grid=grid, t0=t0, t1=t1)
             np.add.at(tau, ray, self._coef(d[ray], grid) * area)
         return np.exp(-tau)
