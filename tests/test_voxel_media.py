@@ -160,7 +160,7 @@ def test_verify_rows_pass():
     from radtree.verify.voxels import path_area, voxel_checks
 
     rows = voxel_checks(rays=2000, forward_photons=40_000)
-    assert len(rows) == 8 and all(r.passed for r in rows), [str(r) for r in rows]
+    assert len(rows) == 9 and all(r.passed for r in rows), [str(r) for r in rows]
     # the independent optical depth: straight up a uniform column of 3 voxels of 0.5 m
     pad = np.full((1, 1, 3), 2.0)
     area = path_area(pad, np.zeros(3), 0.5, np.array([[0.2, 0.2, -1.0]]),
