@@ -93,6 +93,12 @@ def test_voxel_file_crowns_on_every_trunk(tmp_path: Path, frame) -> None:
     assert sum(v for k, v in info.items() if "_z" in k) == pytest.approx(4.5)
     assert "Turbid voxel crowns" in " ".join(tm.notes) and tm.meshes[0].name == "tree_trunks"
     assert input_files(project)["tree_voxels"].startswith("crown.csv sha256:")
+    from radtree.pipeline.manifest import manifest
+
+    rec = manifest(project, engines=[])["crown_voxels"]
+    assert rec["voxel_size_m"] == 0.5 and rec["voxels"] == [3, 3, 3] and len(rec["sha256"]) == 64
+    assert rec["leaf_area_m2_per_crown"] == pytest.approx(4.5)
+    assert rec["profile"][2] == {"z_bottom_m": 4.75, "z_top_m": 5.25, "leaf_area_m2": 2.25}
     with pytest.raises(ConfigError, match="is free-standing"):
         build_tree(project, Scenario("d", "louvers", form="dome"), frame)
 

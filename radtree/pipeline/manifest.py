@@ -47,6 +47,11 @@ def manifest(project, extra: dict[str, Any] | None = None,
         "inputs": input_files(project),
         "params_hash": project.params_hashes(project.scenarios),
     })
+    from radtree.trees.turbid_voxels import voxel_record
+
+    voxels = voxel_record(project.tree, str(project.source))
+    if voxels is not None:   # a turbid voxel crown: its file, voxel size, leaf area, profile
+        d["crown_voxels"] = voxels
     if extra:
         d.update(extra)
     return d

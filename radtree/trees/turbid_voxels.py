@@ -18,9 +18,9 @@ density array) cut by the row's wall-side plane and the planes shared with neigh
 louvers' ``clumping``). Without ``points`` or ``voxels`` the spheroid turbid crowns are built
 (:func:`radtree.trees.turbid.build_turbid`).
 
-The manifest (the build's ``info``) records the voxel size, the total leaf area and its
-vertical profile (per layer, one crown, uncut); the input file's sha256 is in the manifest's
-inputs (:func:`radtree.pipeline.manifest.input_files`).
+The crown's ``info`` (a build's facts) and the manifests of builds and results
+(:func:`voxel_record`, under ``crown_voxels``) record the file and its sha256, the voxel size,
+the leaf area of one crown and its vertical profile (per layer, uncut).
 """
 
 from __future__ import annotations
@@ -76,6 +76,22 @@ def _grid(tree: Tree, source: str | None) -> tuple[np.ndarray, float, np.ndarray
             f"{'' if tree.voxels_size_m else ', side from their spacing'}), placed by its "
             "coordinates from each trunk base")
     return vf.pad, vf.size_m, vf.corner, info, what
+
+
+def voxel_record(tree: Tree, source: str | None = None) -> dict | None:
+    """The manifest's record of a turbid voxel crown (module text); None for other crowns."""
+    path = tree.points if tree.points is not None else tree.voxels
+    if tree.representation != "turbid" or path is None:
+        return None
+    from radtree.fileio import file_sha256
+
+    pad, size, corner, _, _ = _grid(tree, source)
+    per = pad.sum(axis=(0, 1)) * size ** 3
+    bottoms = corner[2] + np.arange(len(per)) * size
+    return {"file": str(path), "sha256": file_sha256(path), "voxel_size_m": size,
+            "voxels": list(pad.shape), "leaf_area_m2_per_crown": float(per.sum()),
+            "profile": [{"z_bottom_m": round(float(z), 6), "z_top_m": round(float(z + size), 6),
+                         "leaf_area_m2": float(a)} for z, a in zip(bottoms, per)]}
 
 
 def voxel_row(spec: CrownRowSpec, frame: FacadeFrame, *, pad: np.ndarray, size_m: float,
