@@ -166,3 +166,27 @@ def test_verify_rows_pass():
     area = path_area(pad, np.zeros(3), 0.5, np.array([[0.2, 0.2, -1.0]]),
                      np.array([[0.0, 0.0, 1.0]]))
     assert area[0] == pytest.approx(3.0)
+
+
+def test_overlapping_grids_compose_like_their_sum():
+    """Two grids (different voxel sizes, one shifted) over the same space: the same
+    transmittance and uncollided share as their densities added — min of the free paths."""
+    fine = np.random.default_rng(12).random((4, 4, 4))
+    coarse = np.random.default_rng(13).random((2, 2, 2))
+    two = VoxelCrowns.of(np.zeros((2, 3)), size_m=np.array([0.5, 1.0]), pads=[fine, coarse],
+                         pad_of=np.array([0, 1]), kinds=[KIND])
+    summed = fine + np.repeat(np.repeat(np.repeat(coarse, 2, 0), 2, 1), 2, 2)
+    one = VoxelCrowns.of(np.zeros((1, 3)), size_m=0.5, pads=[summed], kinds=[KIND])
+    t_two, t_one = (VoxelTracer(m, materials=MATS) for m in (two, one))
+    rng = np.random.default_rng(14)
+    o = rng.uniform(-1, 3, (50, 3))
+    tgt = rng.uniform(0, 2, (50, 3))
+    d = (tgt - o) / np.linalg.norm(tgt - o, axis=1)[:, None]
+    np.testing.assert_allclose(t_two.transmittance(o, d), t_one.transmittance(o, d),
+                               rtol=1e-9)
+    n = 80_000
+    oo, dd = np.tile([0.3, 0.7, -1.0], (n, 1)), np.tile([0.0, 0.0, 1.0], (n, 1))
+    met, _ = t_two.collide(oo, dd, np.full(n, np.inf), GeneratorDraws(np.random.default_rng(2)))
+    want = t_one.transmittance(oo[:1], dd[:1])[0]
+    assert float(np.mean(met < 0)) == pytest.approx(want, abs=3 * math.sqrt(want / n))
+    assert set(np.unique(met)) == {-1, 0, 1}
