@@ -124,7 +124,6 @@ def leaf_normals(kind: np.ndarray, *, kinds: list[LeafKind], d: np.ndarray, draw
     return normal
 
 
-
 def first_hits(ray: np.ndarray, *, which: np.ndarray, tc: np.ndarray, met: np.ndarray,
                dist: np.ndarray) -> None:
     """Superposed media: each ray's nearest collision among its (``ray``, ``which``, distance
@@ -136,6 +135,7 @@ def first_hits(ray: np.ndarray, *, which: np.ndarray, tc: np.ndarray, met: np.nd
     first[1:] = ray[1:] != ray[:-1]
     met[ray[first]] = which[first]
     dist[ray[first]] = tc[first]
+
 
 class MediumTracer:
     """The media of one scene, ready for the engine's queries (see the module text)."""
