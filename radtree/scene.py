@@ -10,7 +10,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from radtree.media import TurbidCrowns
+from radtree.media_voxels import Media
 from radtree.optics import Hole, Material
 
 
@@ -153,8 +153,9 @@ class Scene:
     ground_material: str = "ground"
     prototypes: dict[str, list[Mesh]] = field(default_factory=dict)
     instances: list[Instance] = field(default_factory=list)
-    #: turbid-medium crowns (``[tree] representation = "turbid"``; :mod:`radtree.media`)
-    media: TurbidCrowns | None = None
+    #: turbid-medium crowns (``[tree] representation = "turbid"``): spheroids, voxel grids or
+    #: both (:mod:`radtree.media`, :mod:`radtree.media_voxels`)
+    media: Media | None = None
 
     def __post_init__(self) -> None:
         for m in [*self.meshes, *(p for ms in self.prototypes.values() for p in ms)]:

@@ -23,7 +23,7 @@ from radtree.trees.registry import (
     crown_model,
     crown_model_rows,
 )
-from radtree.trees.turbid import build_turbid
+from radtree.trees.turbid_voxels import build_turbid_crowns
 
 
 def test_the_schema_and_the_cli_take_their_choices_from_the_registry():
@@ -47,7 +47,7 @@ def test_a_model_outside_the_registry_is_refused_on_load_and_by_the_registry():
 
 def test_builders_are_resolved_by_representation_with_explicit_as_the_fallback():
     assert crown_builder("louvers") is build_louvers
-    assert crown_builder("louvers", "turbid") is build_turbid
+    assert crown_builder("louvers", "turbid") is build_turbid_crowns   # spheroids or voxels
     assert crown_builder("louvers", "bsdf") is build_louvers   # the shell: pipeline.crown_bsdf
     assert crown_builder("homogeneous", "turbid") is build_homogeneous
     assert crown_builder("none", "turbid") is no_crown

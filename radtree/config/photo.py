@@ -65,7 +65,8 @@ def photo_of(tree: Any) -> tuple[Path | None, str, tuple[float, float, float] | 
 ADDED_DEFAULTS: dict[str, dict[str, Any]] = {
     "": {"photo": None, "lens": "equidistant", "mask": None, "photo_direction": "facade",
          "photo_x_m": 2.0, "photo_distance_m": 3.0, "photo_height_m": 1.5,
-         "photo_zenith_deg": 90.0, "accept_poor_fit": False},
+         "photo_zenith_deg": 90.0, "accept_poor_fit": False, "voxels": None,
+         "voxels_size_m": None},
     "perforated": {"seed": 1, "realisations": 1},
     "louvers": {"inclination_distribution": "fixed", "ellipsoid_x": 1.0, **CLUMPING_DEFAULTS},
 }

@@ -199,12 +199,26 @@ class Tree(Checked):
     #: the same in row, inventory and Honeybee projects (radtree.trees.wall_policy)
     wall_policy: str = field(default="clip", metadata=meta(choices=WALL_POLICIES))
     #: one tree's points (LAS/LAZ with its ground): free louvers crowns filled voxel by voxel
-    #: with its plant area density (radtree.trees.points_crown); voxel size in m (None: 5
-    #: point spacings)
+    #: with its plant area density (radtree.trees.points_crown) — with representation =
+    #: "turbid", turbid voxel crowns of that density (radtree.trees.turbid_voxels); voxel size
+    #: in m (None: 5 point spacings)
     points: Path | None = field(default=None)
     points_voxel_m: float | None = field(default=None, metadata=meta(0.05, 20.0))
+    #: a crown as a voxel grid of plant area density, for representation = "turbid" (CSV with
+    #: columns x_m, y_m, z_m — voxel centres in m from the trunk base, x along the façade, y
+    #: away from it, z up — and pad_m2_m3, m²/m³; voxels left out are empty: the format of
+    #: radtree.trees.voxel_file); placed on every trunk of the free row
+    voxels: Path | None = field(default=None)
+    #: the voxel side of ``voxels`` in m (None: the smallest spacing of the centres)
+    voxels_size_m: float | None = field(default=None, metadata=meta(0.01, 20.0))
 
     def check(self) -> None:
+        if self.voxels is not None and self.points is not None:
+            raise self.fail("voxels", "give tree.voxels or tree.points, not both")
+        if self.voxels is not None and self.representation != "turbid":
+            raise self.fail("voxels", f"a voxel crown is a turbid medium: set representation = "
+                            f"\"turbid\" (got {self.representation!r}), or use tree.points "
+                            "for slats")
         if (self.leaf_on is None) != (self.leaf_off is None):
             raise self.fail("leaf_on" if self.leaf_on is None else "leaf_off",
                             "give both leaf_on and leaf_off (MM-DD), or neither")

@@ -22,7 +22,7 @@ def input_files(project) -> dict[str, str]:
                    ("epw", project.light.epw),
                    ("ground_reflectance", project.street.ground_reflectance_table),
                    ("photo", project.tree.perforated.photo), ("tree_photo", project.tree.photo),
-                   ("tree_points", project.tree.points)):
+                   ("tree_points", project.tree.points), ("tree_voxels", project.tree.voxels)):
         if p is not None:
             paths[key] = p
     return {k: f"{Path(v).name} sha256:{file_sha256(Path(v))}" for k, v in paths.items()
@@ -47,6 +47,11 @@ def manifest(project, extra: dict[str, Any] | None = None,
         "inputs": input_files(project),
         "params_hash": project.params_hashes(project.scenarios),
     })
+    from radtree.trees.turbid_voxels import voxel_record
+
+    voxels = voxel_record(project.tree, str(project.source))
+    if voxels is not None:   # a turbid voxel crown: its file, voxel size, leaf area, profile
+        d["crown_voxels"] = voxels
     if extra:
         d.update(extra)
     return d

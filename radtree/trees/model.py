@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
-from radtree.media import TurbidCrowns
+from radtree.media_voxels import Media
 from radtree.optics import Material
 from radtree.scene import Instance, Mesh
 from radtree.site.frame import FacadeFrame
@@ -43,7 +43,7 @@ class TreeModel:
     prototypes: dict[str, list[Mesh]] = field(default_factory=dict)
     instances: list[Instance] = field(default_factory=list)
     from_cache: bool = False  # loaded from the build cache (radtree.cache), not built
-    media: TurbidCrowns | None = None  # turbid-medium crowns (radtree.trees.turbid)
+    media: Media | None = None  # turbid-medium crowns (radtree.trees.turbid)
 
     def __post_init__(self) -> None:
         for m in [*self.meshes, *(p for ms in self.prototypes.values() for p in ms)]:

@@ -16,8 +16,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from radtree.engines.common.media import MediaTracer, media_bounds, media_digest, media_tracer
 from radtree.engines.common.raycast import RayCaster, make_caster
-from radtree.engines.common.turbid import MediumTracer
 from radtree.errors import EngineError
 from radtree.light.sky import SkyState, sky_luminance
 from radtree.optics import Glass, Hole, Plastic, Trans
@@ -55,12 +55,11 @@ class Geometry:
         allp = np.vstack(pts)
         self.size = float(np.ptp(allp, axis=0).max()) if len(allp) else 1.0
         self.caster: RayCaster = make_caster(self.vertices, self.faces, backend, workers)
-        self.media: MediumTracer | None = None   # turbid crowns, None without
-        if scene.media is not None and len(scene.media):
-            self.media = MediumTracer(scene.media, scene.materials, backend, workers)
-            tc = scene.media
-            box = np.vstack([tc.centres - np.stack([tc.a, tc.a, tc.b], 1),
-                             tc.centres + np.stack([tc.a, tc.a, tc.b], 1)])
+        # turbid crowns (spheroids, voxel grids; radtree.engines.common.media), None without
+        self.media: MediaTracer | None = media_tracer(
+            scene.media, materials=scene.materials, backend=backend, workers=workers)
+        if self.media is not None:
+            box = media_bounds(scene.media)
             self.size = max(self.size, float(np.ptp(np.vstack([allp, box]), axis=0).max()))
 
 
@@ -93,9 +92,7 @@ def _fingerprint(scene: Scene, backend: str, workers: int) -> str:
     for g in scene.grids.values():
         h.update(np.ascontiguousarray(g.points).tobytes())
     if scene.media is not None:   # turbid crowns: their envelopes and densities
-        for a in (scene.media.centres, scene.media.a, scene.media.b, scene.media.lad,
-                  scene.media.planes):
-            h.update(np.ascontiguousarray(a).tobytes())
+        h.update(media_digest(scene.media))
     return h.hexdigest()
 
 

@@ -3,9 +3,10 @@ the forward light tracer (:mod:`radtree.engines.forward.tracer`: the same collis
 events from its generator, the absorbed flux booked to the leaf material).
 
 Which crowns a ray crosses: every crown's bounding box (12 triangles, 1–5 cm larger than the
-spheroid, the margin differing from crown to crown) is a proxy mesh in its own ray caster (Embree when available); the faces a ray
-crosses name the candidate crowns (:meth:`MediumTracer.crossings`: repeated first-hit queries
-until the ray leaves the last box or passes its end), then the exact spheroid interval, cut by
+spheroid, the margin differing from crown to crown) is a proxy mesh in its own ray caster
+(Embree when available; :mod:`radtree.engines.common.boxes`); the faces a ray crosses name
+the candidate crowns (:meth:`MediumTracer.crossings`: repeated first-hit queries until the ray
+leaves the last box or passes its end), then the exact spheroid interval, cut by
 the crown's half-spaces, is solved per (ray, crown) pair. Memory: O(crowns + rays in a batch),
 whatever the leaf count.
 
@@ -33,23 +34,17 @@ import math
 
 import numpy as np
 
-from radtree.engines.common.raycast import make_caster
+from radtree.engines.common.boxes import BoxProxies, clip_to_planes
 from radtree.engines.common.streams import Draws, PathStreams
 from radtree.errors import EngineError
-from radtree.media import TurbidCrowns
+from radtree.media import LeafKind, TurbidCrowns
 from radtree.optics import Material, Trans
 from radtree.scene import Scene
 
 COLLIDE = 5        # stream site of the free-path draws (the loop's own sites are 0–4)
 NORMALS = 6        # stream site of the leaf-normal draws
 PAIR_SHIFT = 40    # (path, crown) streams: path number + (crown + 1) · 2⁴⁰
-MAX_FACES = 4096   # proxy faces one ray may cross (a safety bound)
 MAX_TRIES = 64     # rejection rounds for the leaf normals (then the last draw is kept)
-BOX_MARGIN = 0.01  # m added to the proxy boxes (times 1–5, crown by crown)
-MARGIN_STEPS = 23  # distinct margins (neighbours in a row never share one)
-
-_BOX_FACES = np.array([[0, 1, 3], [0, 3, 2], [4, 6, 7], [4, 7, 5], [0, 4, 5], [0, 5, 1],
-                       [2, 3, 7], [2, 7, 6], [0, 2, 6], [0, 6, 4], [1, 5, 7], [1, 7, 3]])
 
 
 def refuse_media(scene: Scene, engine: str) -> None:
@@ -80,43 +75,84 @@ def _plain(draws: Draws, n: int) -> np.ndarray:
     return np.asarray(rng.random(n))
 
 
+def leaf_optics(kinds: list[LeafKind], *, materials: dict[str, Material]
+                ) -> tuple[np.ndarray, np.ndarray]:
+    """Per leaf kind: the share of leaves met that deflect, 1 − T_s, and the deflecting
+    events' probabilities (kinds, 2): diffuse reflection R/(1 − T_s), diffuse transmission
+    T_d/(1 − T_s); EngineError for a leaf material that is not ``trans`` or passes all."""
+    r, td, ts = np.zeros(len(kinds)), np.zeros(len(kinds)), np.zeros(len(kinds))
+    for k, kind in enumerate(kinds):
+        m = materials.get(kind.material)
+        if not isinstance(m, Trans):
+            raise EngineError(f"turbid crowns: leaf material '{kind.material}' must be a "
+                              f"trans material, got {type(m).__name__}")
+        r[k], td[k], ts[k] = m.reflectance, m.diffuse_transmittance, m.specular_transmittance
+    if np.any(ts >= 1.0):
+        raise EngineError("turbid crowns: leaves with specular transmittance 1 block nothing")
+    pass_ = 1.0 - ts
+    return pass_, np.stack([r / pass_, td / pass_], 1)
+
+
+def leaf_normals(kind: np.ndarray, *, kinds: list[LeafKind], d: np.ndarray, draws: Draws
+                 ) -> np.ndarray:
+    """Normals (k, 3) of the leaves met by rays along ``d``, on the side the rays came from:
+    drawn from each ray's leaf kind (``kind`` index into ``kinds``) weighted by |n·Ω|
+    (rejection: inclination by the kind's inverse CDF, azimuth uniform, accepted with
+    probability |n·Ω|)."""
+    k = len(kind)
+    normal = np.zeros((k, 3))
+    todo = np.arange(k)
+    for attempt in range(MAX_TRIES):
+        sub = draws.rows(todo, attempt)
+        u1, u2, u3 = (sub.random(len(todo)) for _ in range(3))
+        theta = np.empty(len(todo))
+        kt = kind[todo]
+        for j, lk in enumerate(kinds):
+            m = kt == j
+            if m.any():
+                theta[m] = np.interp(u1[m], lk.incl_cdf, lk.incl_edges)
+        phi = 2.0 * math.pi * u2
+        st = np.sin(theta)
+        n = np.stack([st * np.cos(phi), st * np.sin(phi), np.cos(theta)], 1)
+        normal[todo] = n
+        ok = u3 < np.abs(np.einsum("ij,ij->i", n, d[todo]))
+        todo = todo[~ok]
+        if len(todo) == 0:
+            break
+    flip = np.einsum("ij,ij->i", normal, d) > 0
+    normal[flip] *= -1.0
+    return normal
+
+
+def first_hits(ray: np.ndarray, *, which: np.ndarray, tc: np.ndarray, met: np.ndarray,
+               dist: np.ndarray) -> None:
+    """Superposed media: each ray's nearest collision among its (``ray``, ``which``, distance
+    ``tc``) candidates written into ``met`` / ``dist`` (the minimum of independent free
+    paths is the first collision in their sum)."""
+    order = np.lexsort((tc, ray))
+    ray, which, tc = ray[order], which[order], tc[order]
+    first = np.ones(len(ray), bool)
+    first[1:] = ray[1:] != ray[:-1]
+    met[ray[first]] = which[first]
+    dist[ray[first]] = tc[first]
+
+
 class MediumTracer:
     """The media of one scene, ready for the engine's queries (see the module text)."""
 
     def __init__(self, media: TurbidCrowns, materials: dict[str, Material],
                  backend: str = "auto", workers: int = 1):
         self.media = media
-        n = len(media)
-        self.n = n
-        # margins differ crown by crown (1–5 cm): overlapping neighbours' boxes then have no
-        # coplanar faces, one of which a ray stepping past the other would miss
-        margin = (BOX_MARGIN * (1.0 + 4.0 * (np.arange(n) % MARGIN_STEPS) / MARGIN_STEPS))[:, None]
-        lo = media.centres - np.stack([media.a, media.a, media.b], 1) - margin
-        hi = media.centres + np.stack([media.a, media.a, media.b], 1) + margin
-        corners = np.array([[i & 1, (i >> 1) & 1, (i >> 2) & 1] for i in range(8)], float)
-        verts = lo[:, None, :] + corners[None] * (hi - lo)[:, None, :]
-        faces = _BOX_FACES[None] + 8 * np.arange(n)[:, None, None]
-        self.box_corners = verts.reshape(-1, 3)
-        self.caster = make_caster(self.box_corners, faces.reshape(-1, 3), backend, workers)
-        self.face_crown = np.repeat(np.arange(n), 12)
-        self.axes = np.stack([media.a, media.a, media.b], 1)
-        kinds = media.kinds
-        r, td, ts = np.zeros(len(kinds)), np.zeros(len(kinds)), np.zeros(len(kinds))
-        for k, kind in enumerate(kinds):
-            m = materials.get(kind.material)
-            if not isinstance(m, Trans):
-                raise EngineError(f"turbid crowns: leaf material '{kind.material}' must be a "
-                                  f"trans material, got {type(m).__name__}")
-            r[k], td[k], ts[k] = m.reflectance, m.diffuse_transmittance, m.specular_transmittance
-        if np.any(ts >= 1.0):
-            raise EngineError("turbid crowns: leaves with specular transmittance 1 block nothing")
-        self.pass_ = 1.0 - ts                      # the share of leaves met that deflect
-        self.events = np.stack([r / self.pass_, td / self.pass_], 1)   # (kinds, 2)
-        self.scale = max(1.0, float(np.ptp(np.vstack([lo, hi]), axis=0).max()))
+        self.n = len(media)
+        half = np.stack([media.a, media.a, media.b], 1)
+        self.boxes = BoxProxies(media.centres - half, hi=media.centres + half, backend=backend,
+                                workers=workers)
+        self.axes = half
+        self.pass_, self.events = leaf_optics(media.kinds, materials=materials)
 
     def corners(self) -> np.ndarray:
         """(8·n, 3) corners of the crowns' proxy boxes (a forward source must enclose them)."""
-        return self.box_corners
+        return self.boxes.corners
 
     def material_index(self, crown: np.ndarray, names: list[str]) -> np.ndarray:
         """Index in ``names`` of the leaf material of each crown in ``crown``."""
@@ -128,33 +164,9 @@ class MediumTracer:
                   ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
         """(ray, crown, t_in, t_out) of every crown whose envelope the rays ``o + t d``
         (0 ≤ t ≤ ``tmax``) cross, t in metres along the unit ``d``."""
-        k = len(o)
-        idx = np.arange(k)
-        cur = np.array(o, float)
-        dd = np.asarray(d, float)
-        done = np.zeros(k)
-        step = 1e-6 * self.scale
-        rays, crowns = [], []
-        for _ in range(MAX_FACES):
-            if len(idx) == 0:
-                break
-            tri, t = self.caster.first_hit(cur, dd, parallel)
-            hit = tri >= 0
-            if not hit.any():
-                break
-            rays.append(idx[hit])
-            crowns.append(self.face_crown[tri[hit]])
-            t_all = done[hit] + t[hit]
-            go = t_all < tmax[idx[hit]]
-            keep = hit.nonzero()[0][go]
-            idx, dd = idx[keep], dd[keep]
-            cur = cur[keep] + (t[keep] + step)[:, None] * dd
-            done = t_all[go] + step
-        if not rays:
+        ray, crown = self.boxes.candidates(o, d, tmax, parallel)
+        if len(ray) == 0:
             return (np.zeros(0, np.int64), np.zeros(0, np.int64), np.zeros(0), np.zeros(0))
-        key = np.unique(np.concatenate(rays).astype(np.int64) * self.n
-                        + np.concatenate(crowns).astype(np.int64))
-        ray, crown = key // self.n, key % self.n
         t0, t1 = self._interval(np.asarray(o, float)[ray], np.asarray(d, float)[ray], crown)
         t1 = np.minimum(t1, tmax[ray])
         ok = t1 > t0
@@ -174,17 +186,7 @@ class MediumTracer:
         root = np.sqrt(np.maximum(disc, 0.0))
         t0 = np.maximum((-b - root) / a, 0.0)
         t1 = np.where(disc > 0, (-b + root) / a, -1.0)
-        planes = self.media.planes
-        for j in range(planes.shape[1]):
-            pl = planes[crown, j]
-            nd = np.einsum("ij,ij->i", pl[:, :3], d)
-            no = np.einsum("ij,ij->i", pl[:, :3], o) - pl[:, 3]
-            with np.errstate(divide="ignore", invalid="ignore"):
-                tp = -no / nd
-            t0 = np.where(nd > 0, np.maximum(t0, tp), t0)
-            t1 = np.where(nd < 0, np.minimum(t1, tp), t1)
-            t1 = np.where((nd == 0) & (no < 0), -1.0, t1)
-        return t0, t1
+        return clip_to_planes(o, d=d, planes=self.media.planes[crown], t0=t0, t1=t1)
 
     def _sigma(self, d: np.ndarray, crown: np.ndarray) -> np.ndarray:
         """Deflecting collisions per metre, σ_c(1 − T_s), for the pairs' directions ``d``."""
@@ -214,12 +216,7 @@ class MediumTracer:
         ray, crown, tc = ray[inside], crown[inside], tc[inside]
         if len(ray) == 0:
             return met, dist
-        order = np.lexsort((tc, ray))
-        ray, crown, tc = ray[order], crown[order], tc[order]
-        first = np.ones(len(ray), bool)
-        first[1:] = ray[1:] != ray[:-1]
-        met[ray[first]] = crown[first]
-        dist[ray[first]] = tc[first]
+        first_hits(ray, which=crown, tc=tc, met=met, dist=dist)
         return met, dist
 
     def leaf_events(self, crown: np.ndarray, d: np.ndarray, draws: Draws
@@ -229,27 +226,7 @@ class MediumTracer:
         transmit, specular transmit (0: folded into σ), mirror (0)."""
         k = len(crown)
         kind = self.media.kind[crown]
-        normal = np.zeros((k, 3))
-        todo = np.arange(k)
-        for attempt in range(MAX_TRIES):
-            sub = draws.rows(todo, attempt)
-            u1, u2, u3 = (sub.random(len(todo)) for _ in range(3))
-            theta = np.empty(len(todo))
-            kt = kind[todo]
-            for j, lk in enumerate(self.media.kinds):
-                m = kt == j
-                if m.any():
-                    theta[m] = np.interp(u1[m], lk.incl_cdf, lk.incl_edges)
-            phi = 2.0 * math.pi * u2
-            st = np.sin(theta)
-            n = np.stack([st * np.cos(phi), st * np.sin(phi), np.cos(theta)], 1)
-            normal[todo] = n
-            ok = u3 < np.abs(np.einsum("ij,ij->i", n, d[todo]))
-            todo = todo[~ok]
-            if len(todo) == 0:
-                break
-        flip = np.einsum("ij,ij->i", normal, d) > 0
-        normal[flip] *= -1.0
+        normal = leaf_normals(kind, kinds=self.media.kinds, d=d, draws=draws)
         coef = np.zeros((4, k))
         coef[:2] = self.events[kind].T
         return normal, coef

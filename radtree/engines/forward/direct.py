@@ -11,7 +11,8 @@ So, with a whole-scene sun, the forward engine splits the light as a backward en
 * the **direct sun** — the sun's beam, undeviated (through specular transmissions only) — is
   computed at each sensor point, E = E_dn · max(0, n·s) · Π T_s, the product over the surfaces
   the ray from the point towards the sun crosses of their specular transmittance (``Trans``
-  T_s, ``Glass`` T(θ) by Radiance's formulas, opaque surfaces 0): exact, no noise;
+  T_s, ``Glass`` T(θ) by Radiance's formulas, opaque surfaces 0), times the turbid crowns'
+  mean transmittance exp(−τ) along it (as the NumPy engine's shadow rays): exact, no noise;
 * sun photons are **not tallied** on the patches until their first diffuse event or mirror
   reflection (what remains is scattered light, smooth across a patch); sky and ground-glow
   photons are tallied from the start as before.
@@ -66,5 +67,7 @@ def direct_sun(geo: Geometry, optics: Optics, grid: SensorGrid, sun: np.ndarray,
             break
     else:
         tau[live] = 0.0
+    if geo.media is not None:   # turbid crowns: their exact mean transmittance exp(−τ)
+        tau *= geo.media.transmittance(np.asarray(grid.points, float)[idx], d)
     out[idx] *= tau
     return out

@@ -26,6 +26,7 @@ from jinja2 import Template
 import radtree
 from radtree.config import EngineParams
 from radtree.engines.common.turbid import refuse_media
+from radtree.engines.common.voxels import refuse_voxels
 from radtree.engines.radiance.binaries import FIXED_SEED, RadianceInstall
 from radtree.engines.radiance.materials import material_text
 from radtree.engines.radiance.meshes import (
@@ -160,6 +161,7 @@ def write_build(scene: Scene, states: list[SkyState], params: EngineParams, ab: 
 
     ``hour_grids`` maps an hour label (HHMM) to the grids the Makefile traces then (default:
     every grid at every hour)."""
+    refuse_voxels(scene, engine="radiance")
     refuse_media(scene, "radiance")
     folder.mkdir(parents=True, exist_ok=True)
     (folder / "geometry").mkdir(exist_ok=True)
