@@ -149,3 +149,22 @@ def test_bad_outline_names_the_feature(tmp_path: Path) -> None:
     with pytest.raises(ConfigError, match=r"feature 'T9'.*crown_outline is not a simple "
                                           r"polygon \(Self-intersection"):
         read_trees(path, "local", -32.8895, -68.8458)
+
+
+def test_outline_reaching_a_wall_is_clipped_there(tmp_path: Path) -> None:
+    """A crown of radius 2.5 m, 5 m from a wall, whose outline (an ellipse of semi-axes 2 m
+    and 6 m) reaches 1 m into the building: the wall is found by the outline's reach and the
+    crown is cut at the clip plane in front of it (policy "clip"), every slat south of it."""
+    from radtree.trees.envelope import clip_plane
+    from tests.test_district import box
+
+    ring = np.column_stack([2.0 * np.cos(THETA), 5.0 + 6.0 * np.sin(THETA)])
+    trees = [point("T1", 0.0, 5.0, crown_outline=_ring(ring))]
+    p = load_project(district(tmp_path, trees=trees, buildings=[box("N1", -15, 10, 15, 22)]))
+    scene, meshes = _leaves(p)
+    (mesh,) = meshes.values()
+    wall = 10.0 - clip_plane(p.tree, p.sensors)
+    assert mesh.vertices[:, 1].max() <= wall + 1e-9
+    assert mesh.vertices[:, 1].max() > wall - 0.05       # it does reach the plane
+    assert any("crowns cut at the wall; crown volume removed: the crown of tree 'T1'" in n
+               for n in scene.notes)
