@@ -180,7 +180,10 @@ class CrownRowSpec:
 
     def envelope(self, i: int, subdivisions: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Crown i's envelope: local vertices, faces, and a mask of faces on the wall-side
-        clip plane (the "wall cap"). Faces on the planes shared with neighbours are dropped."""
+        clip plane (the "wall cap"). Faces on the planes shared with neighbours are dropped.
+        Spheroids only: a crown following an outline has no hull mesh (ValueError)."""
+        if self.outline is not None:
+            raise ValueError("a crown following its outline has no envelope mesh")
         import trimesh  # here: importing it takes ~1 s, and most builds never get here
 
         sphere = trimesh.creation.icosphere(subdivisions=subdivisions)
