@@ -168,3 +168,19 @@ def test_outline_reaching_a_wall_is_clipped_there(tmp_path: Path) -> None:
     assert mesh.vertices[:, 1].max() > wall - 0.05       # it does reach the plane
     assert any("crowns cut at the wall; crown volume removed: the crown of tree 'T1'" in n
                for n in scene.notes)
+
+
+def test_turbid_crowns_stay_spheroids_with_a_note(tmp_path: Path) -> None:
+    """Turbid inventory crowns keep the spheroid of crown_diameter_m and say so."""
+    trees = [point("T1", 0.0, 3.0, crown_outline=_ring(L_RING + [0.0, 3.0]))]
+    root = district(tmp_path, trees=trees, buildings=None)
+    toml = root / "radtree.toml"
+    toml.write_text(toml.read_text().replace('form = "free"',
+                                             'form = "free"\nrepresentation = "turbid"'))
+    from radtree.pipeline.assemble import make_scene
+
+    p = load_project(root)
+    scene = make_scene(p, p.scenario("T")).scene
+    assert scene.media is not None and scene.media.a[0] == pytest.approx(2.5)
+    assert any("1 tree(s) have a crown_outline that is not round: turbid crowns stay "
+               "spheroids" in n for n in scene.notes)
