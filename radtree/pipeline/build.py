@@ -279,6 +279,8 @@ def draw_model_png(folder: Path) -> None:
 
 def _build_one(project: Project, sc: Scenario, engine: Any, build_root: Path) -> dict:
     """Write ``build/<sc>/``; return its build facts."""
+    from radtree.trees.points_crown import points_record
+
     t0 = time.perf_counter()
     states = hour_states(project, sc)
     prep = time.perf_counter() - t0
@@ -296,6 +298,8 @@ def _build_one(project: Project, sc: Scenario, engine: Any, build_root: Path) ->
             "params_hash": project.params_hash(sc),
             "photo": getattr(built.tree, "photo", None),
             "crown_from_cache": bool(getattr(built.tree, "from_cache", False)),
+            "points_crown": points_record(effective_project(project, sc).tree.points,
+                                          built.info),
             "seconds": {"preparation": prep, "geometry": built.geometry_seconds,
                         "writing": time.perf_counter() - t1},
         }

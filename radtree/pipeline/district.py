@@ -124,7 +124,14 @@ def _inventory_crowns(project: Project, *, scenario: Scenario, inputs,   # type:
         notes.append(f"{len(inputs.trees)} trees > [site] turbid_above = {d.turbid_above}: "
                      "the crowns are turbid media (set turbid_above = 0 for slats).")
     if tr.representation == "turbid":   # one turbid crown per tree, no slats
+        from radtree.trees.district import tree_outline
         from radtree.trees.turbid import inventory_turbid
+
+        shaped = [t.id for t in inputs.trees if tree_outline(t)[0] is not None]
+        if shaped:
+            notes.append(f"{len(shaped)} tree(s) have a crown_outline that is not round: "
+                         "turbid crowns stay spheroids of their crown_diameter_m (slat crowns "
+                         "follow outlines; the turbid tracer knows spheroids only).")
 
         return inventory_turbid(project, inputs.trees, tr)
     return inventory_crowns(project, inputs.trees, tr, instancing=d.instancing, clips=clips)

@@ -271,7 +271,7 @@ def check_trees_against_buildings(trees: list[InventoryTree], buildings: list[Bu
                                   field=f"feature {t.id!r}")
             if t.crown_base_m < b.height_m:
                 gap = poly.exterior.distance(p)   # type: ignore[attr-defined]
-                if gap < t.crown_radius_m + margin:
+                if gap < t.plan_reach_m + margin:   # the outline's farthest, if any
                     q = nearest_points(poly.exterior, p)[0]   # type: ignore[attr-defined]
                     foot = np.array([q.x, q.y])
                     normal = (np.array([t.x, t.y]) - foot) / max(gap, 1e-12)

@@ -196,6 +196,8 @@ class InventoryTree:
     crown_shape: str | None = None
     photo: str | None = None
     trunk_diameter_m: float | None = None
+    #: the crown's plan outline, a ring of (x, y) in the local frame (m), or None
+    outline: tuple[tuple[float, float], ...] | None = None
 
     @property
     def crown_radius_m(self) -> float:
@@ -204,6 +206,15 @@ class InventoryTree:
     @property
     def vertical_radius_m(self) -> float:
         return (self.height_m - self.crown_base_m) / 2.0
+
+    @property
+    def plan_reach_m(self) -> float:
+        """The farthest the crown may reach from the trunk in plan (m): the crown radius, or
+        the farthest outline vertex when that is farther."""
+        if not self.outline:
+            return self.crown_radius_m
+        ring = np.asarray(self.outline) - [self.x, self.y]
+        return max(self.crown_radius_m, float(np.hypot(ring[:, 0], ring[:, 1]).max()))
 
 
 def read_trees(path: Path, frame_crs: str, latitude: float, longitude: float
@@ -231,8 +242,42 @@ def read_trees(path: Path, frame_crs: str, latitude: float, longitude: float
             f.id, float(x), float(y), str(f.props["species"]).strip(), h, d, base,
             (str(f.props["crown_shape"]) if f.props.get("crown_shape") else None),
             (str(f.props["photo"]) if f.props.get("photo") else None),
-            None if td < 0 else td))
+            None if td < 0 else td, crown_outline(f, frame=frame, src=src)))
     return trees, frame
+
+
+def crown_outline(f: Feature, *, frame: LocalFrame, src: str
+                  ) -> tuple[tuple[float, float], ...] | None:
+    """The feature's ``crown_outline`` in the local frame (m): a ring of [x, y] in the
+    inventory's coordinates (as ``radtree lidar segment`` writes it) or a GeoJSON Polygon
+    (its outer ring); None without one. ConfigError naming the feature for a ring that is
+    not a simple polygon of at least 0.01 m² (a trunk outside it: the crown stays a
+    spheroid, :mod:`radtree.trees.district`)."""
+    from shapely.geometry import Polygon
+    from shapely.validation import explain_validity
+
+    raw = f.props.get("crown_outline")
+    if raw is None or raw == "":
+        return None
+    where = f"feature {f.id!r}"
+    if isinstance(raw, dict) and raw.get("type") == "Polygon":
+        raw = (raw.get("coordinates") or [None])[0]
+    try:
+        ring = np.array([[float(v) for v in c[:2]] for c in raw])
+    except (TypeError, ValueError, IndexError):
+        raise ConfigError("crown_outline is not a ring of [x, y] (or a GeoJSON Polygon)",
+                          source=src, field=where) from None
+    if len(ring) < 3 or not np.all(np.isfinite(ring)):
+        raise ConfigError(f"crown_outline has {len(ring)} point(s), expected a ring of at "
+                          "least 3 (or remove it: the crown is then a spheroid)", source=src,
+                          field=where)
+    x, y = frame.to_local(ring[:, 0], ring[:, 1])
+    poly = Polygon(np.column_stack([x, y]))
+    if not poly.is_valid or poly.area < 0.01:
+        why = explain_validity(poly) if not poly.is_valid else f"{poly.area:.3g} m²"
+        raise ConfigError(f"crown_outline is not a simple polygon ({why}): fix or remove it "
+                          "(the crown is then a spheroid)", source=src, field=where)
+    return tuple((float(a), float(b)) for a, b in zip(x, y))
 
 
 def _geographic(crs: str) -> bool:

@@ -35,6 +35,7 @@ Can. J. For. Res. 49, doi:10.1139/cjfr-2018-0213 (hemispheR's LX, LXG1, LXG2).
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from functools import lru_cache
 
 import numpy as np
@@ -117,14 +118,15 @@ def _unit_ball(rng: np.random.Generator, n: int) -> np.ndarray:
 
 
 def clustered_slat_centres(rng: np.random.Generator, offsets: np.ndarray, centre: np.ndarray,
-                           a: float, b: float, slat: float, omega: float, radius: float
-                           ) -> tuple[np.ndarray, int]:
+                           *, to_crown: Callable[[np.ndarray], np.ndarray], slat: float,
+                           omega: float, radius: float) -> tuple[np.ndarray, int]:
     """Slat centres grouped in clusters: the k slats' ``offsets`` (uniform in the unit ball)
     scaled to the cluster radius about a cluster drawn at random for each slat (cluster
-    centres uniform in the spheroid (a, a, b) about ``centre``, k/m of them); also the number
-    of clusters."""
+    centres uniform in the crown about ``centre``: ``to_crown`` maps points uniform in the
+    unit ball to offsets uniform in the crown, e.g. ×(a, a, b) for a spheroid; k/m of them);
+    also the number of clusters."""
     n_cl = max(1, int(round(len(offsets) / slats_per_cluster(omega, radius, slat))))
-    cl = np.asarray(centre, float) + _unit_ball(rng, n_cl) * np.array([a, a, b])
+    cl = np.asarray(centre, float) + to_crown(_unit_ball(rng, n_cl))
     which = rng.integers(0, n_cl, len(offsets))
     return cl[which] + radius * offsets, n_cl
 

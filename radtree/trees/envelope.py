@@ -33,6 +33,7 @@ import numpy as np
 from radtree.config import Sensors, Street, Tree
 from radtree.errors import ConfigError
 from radtree.trees.geometry import cylinder_mesh, hemisphere_mesh
+from radtree.trees.outline import CrownOutline
 from radtree.trees.wall_policy import WallReach, apply_wall_policy
 
 CLIP_MARGIN_M = 0.005  # crown stops this far in front of the sensors when clearance is 0
@@ -103,10 +104,41 @@ class CrownRowSpec:
     strips: np.ndarray  # (count, 2) u-limits of each crown's share of the row (±inf: none)
     trunk_radius: float
     trunk_top: float
+    #: a one-crown row's plan outline (:mod:`radtree.trees.outline`): the crown follows it
+    outline: CrownOutline | None = None
+
+    def __post_init__(self) -> None:
+        if self.outline is not None and len(self.centres) != 1:
+            raise ValueError("a crown outline is for a row of one crown")
 
     @property
     def count(self) -> int:
         return len(self.centres)
+
+    @property
+    def max_radius(self) -> float:
+        """The farthest plan reach of a crown from its trunk axis (m): a, or the outline's."""
+        return self.a if self.outline is None else self.outline.max_radius_m
+
+    def reach(self, offsets: np.ndarray) -> np.ndarray:
+        """The crown's plan radius r(θ) towards plan offsets (…, 2) from its trunk axis (m):
+        a for the spheroid, the outline's radial function otherwise."""
+        if self.outline is None:
+            return np.full(np.shape(offsets)[:-1], self.a)
+        return self.outline.reach(offsets)
+
+    def crown_volume(self) -> float:
+        """Volume of one unclipped crown (m³): 4/3·π a² b, or 4/3·b·A with A the outline's
+        plan area (:mod:`radtree.trees.outline`)."""
+        area = math.pi * self.a ** 2 if self.outline is None else self.outline.area_m2
+        return 4.0 / 3.0 * area * self.b
+
+    def from_ball(self, x: np.ndarray) -> np.ndarray:
+        """Offsets from a crown's centre of points ``x`` (k, 3) uniform in the unit ball,
+        mapped to points uniform in the crown: x·(a, a, b), or into the outline."""
+        if self.outline is None:
+            return np.asarray(x, float) * np.array([self.a, self.a, self.b])
+        return self.outline.from_ball(x, b=self.b)
 
     def crown_ids(self, points: np.ndarray) -> np.ndarray:
         """The crown each local point (k, 3) belongs to by its share of the row (``strips``,
@@ -132,7 +164,8 @@ class CrownRowSpec:
         p = np.asarray(points, float).reshape(-1, 3)
         res = np.zeros(len(p), bool)
         for c, (lo, hi) in zip(self.centres, self.strips):
-            a, b = self.a - margin, self.b - margin
+            a = self.reach(p[:, :2] - c[:2]) - margin
+            b = self.b - margin
             horizontal = (p[:, 0] - c[0]) ** 2 + (p[:, 1] - c[1]) ** 2
             q = horizontal / a**2 + (p[:, 2] - c[2]) ** 2 / b**2
             res |= ((q <= 1.0) & (p[:, 1] >= self.n_clip + margin) & (p[:, 0] >= lo)
@@ -147,7 +180,10 @@ class CrownRowSpec:
 
     def envelope(self, i: int, subdivisions: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Crown i's envelope: local vertices, faces, and a mask of faces on the wall-side
-        clip plane (the "wall cap"). Faces on the planes shared with neighbours are dropped."""
+        clip plane (the "wall cap"). Faces on the planes shared with neighbours are dropped.
+        Spheroids only: a crown following an outline has no hull mesh (ValueError)."""
+        if self.outline is not None:
+            raise ValueError("a crown following its outline has no envelope mesh")
         import trimesh  # here: importing it takes ~1 s, and most builds never get here
 
         sphere = trimesh.creation.icosphere(subdivisions=subdivisions)

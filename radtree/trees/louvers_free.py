@@ -2,7 +2,8 @@
 the assembled crown: :mod:`radtree.trees.louvers`).
 
 ``layers`` nested lens-shaped surfaces inside each spheroid,
-z_k(ρ) = z_c + h(ρ)·(2(k + ½)/N − 1) with h(ρ) = b·√(1 − ρ²/a²), so every vertical line
+z_k(ρ) = z_c + h(ρ)·(2(k + ½)/N − 1) with h(ρ) = b·√(1 − ρ²/a²) (a crown following its
+outline: a → r(θ), :mod:`radtree.trees.outline`), so every vertical line
 through a crown crosses each layer exactly once. Slats are exact squares of side s with their
 tilt axis along the rows, so their plan projections are s × s·cos α rectangles; rows are
 s·cos α apart with a random heading per layer: a vertical beam meets a slat in each layer
@@ -34,7 +35,7 @@ def free_slat_bound(spec: CrownRowSpec, lv: Louvers) -> int:
     """Upper bound on the number of slats of the free form (documented, tested)."""
     s = lv.slat_size_m
     cos_a = max(math.cos(math.radians(lv.inclination_deg)), 0.05)
-    per_layer = math.pi * (spec.a + s) ** 2 * lv.cover_fraction / (s * s * cos_a)
+    per_layer = math.pi * (spec.max_radius + s) ** 2 * lv.cover_fraction / (s * s * cos_a)
     return int(math.ceil(spec.count * lv.layers * per_layer))
 
 
@@ -99,7 +100,7 @@ def _layer_slats(spec: CrownRowSpec, *, ti: int, layer: int, grid: _FreeGrid,
                  rng: np.random.Generator) -> tuple[list[np.ndarray], int, int]:
     """One layer of crown ``ti``: (kept slat polygons, slats cut, slats dropped)."""
     s, N, dx, dy = grid.s, grid.N, grid.dx, grid.dy
-    a, b = spec.a, spec.b
+    a, b = spec.max_radius, spec.b
     c = spec.centres[ti]
     lo, hi = spec.strips[ti]
     psi = rng.uniform(0.0, 2.0 * math.pi)
@@ -118,8 +119,9 @@ def _layer_slats(spec: CrownRowSpec, *, ti: int, layer: int, grid: _FreeGrid,
     sigma = rng.choice([-1.0, 1.0], len(J))
     plan = c[:2][None, :] + xs[:, None] * ex + ys[:, None] * ey
     rho = np.hypot(plan[:, 0] - c[0], plan[:, 1] - c[1])
-    ok = rho < a
-    h = b * np.sqrt(np.clip(1.0 - (rho / a) ** 2, 0.0, 1.0))
+    r = spec.reach(plan - c[:2])   # a, or the outline's r(θ)
+    ok = rho < r
+    h = b * np.sqrt(np.clip(1.0 - (rho / r) ** 2, 0.0, 1.0))
     spacing = 2.0 * h / N
     z_layer = c[2] + h * (2.0 * (layer + 0.5) / N - 1.0)
     q = np.mod(Ii, BRANCH_SLATS) - (BRANCH_SLATS - 1) / 2.0
@@ -127,13 +129,14 @@ def _layer_slats(spec: CrownRowSpec, *, ti: int, layer: int, grid: _FreeGrid,
     zc = z_layer + q * step
     ok &= spacing >= grid.min_spacing
     corners = _corners(plan, zc=zc, sigma=sigma, grid=grid, ex=ex, ey=ey)
-    qv = (((corners[:, :, 0] - c[0]) ** 2 + (corners[:, :, 1] - c[1]) ** 2) / a**2
+    d = corners[:, :, :2] - c[:2]
+    qv = ((d[..., 0] ** 2 + d[..., 1] ** 2) / spec.reach(d) ** 2
           + (corners[:, :, 2] - c[2]) ** 2 / b**2)
     ok &= np.all(qv <= 1.0, axis=1)
     ok &= ~trunk_clash(rho, corners[:, :, 2].min(axis=1), spec, s)
     ok &= touches_share(corners, spec, lo, hi)
     kept, n_cut = cut_to_share(corners[ok], spec, lo, hi)
-    return kept, n_cut, int(np.sum(~ok & (rho < a)))
+    return kept, n_cut, int(np.sum(~ok & (rho < r)))
 
 
 def _corners(plan: np.ndarray, *, zc: np.ndarray, sigma: np.ndarray, grid: _FreeGrid,

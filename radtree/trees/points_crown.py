@@ -22,6 +22,7 @@ the façade (u) and y away from it (n). Slats are then clipped like the volume a
 from __future__ import annotations
 
 import math
+from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -132,3 +133,29 @@ def points_note(tree: Tree, info: dict[str, float], slats: int) -> str:
             f"{tree.louvers.slat_size_m:g} m fill it voxel by voxel "
             f"({int(info['slats_cut'])} cut at the wall-side or shared planes, "
             f"{int(info['slats_dropped'])} dropped at the trunks).")
+
+
+def points_record(points: str | Path | None, info: dict[str, float]) -> dict[str, Any] | None:
+    """The build manifest's record of a crown from points (None for other crowns): the point
+    file (name, SHA-256), voxel size (m), mean point spacing (m), projection G, total leaf
+    (plant) area (m², one crown) and its vertical profile — per layer of one voxel, bottom and
+    top (m above the street), leaf area (m²) and leaf area per metre of height (m²/m)."""
+    if points is None or "points_leaf_area_m2" not in info:
+        return None
+    from radtree.fileio import file_sha256
+
+    path = Path(points)
+    v = float(info["points_voxel_m"])
+    layers = sorted((float(k.split("_z")[1].split("_")[0]), float(val))
+                    for k, val in info.items() if k.startswith("points_leaf_area_m2_z"))
+    return {
+        "file": path.name,
+        "sha256": file_sha256(path) if path.is_file() else None,
+        "voxel_m": round(v, 6), "point_spacing_m": float(info["points_spacing_m"]),
+        "g_vertical": float(info["points_g_vertical"]),
+        "leaf_area_m2": float(info["points_leaf_area_m2"]),
+        "profile": {"z_bottom_m": [round(z, 4) for z, _ in layers],
+                    "z_top_m": [round(z + v, 4) for z, _ in layers],
+                    "leaf_area_m2": [a for _, a in layers],
+                    "leaf_area_m2_per_m": [a / v for _, a in layers]},
+    }

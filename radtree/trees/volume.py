@@ -16,7 +16,8 @@ the vertical at a uniformly random azimuth. The density is
 
 (``crossings`` = ``louvers.crossings``, or ``layers`` when it is 0), so that a vertical line
 through the crown centre crosses ``crossings · cover_fraction`` slats on average. Each crown
-gets round(ρ · V_spheroid) slats; slats are then treated exactly like the layered free crowns'
+gets round(ρ · V) slats (V = 4/3 π a² b; a crown following its outline, 4/3 b A with
+centres uniform in that body, :mod:`radtree.trees.outline`); slats are then treated exactly like the layered free crowns'
 (:func:`radtree.trees.crown_clip.touches_share`, :func:`~radtree.trees.crown_clip.cut_to_share`,
 :func:`~radtree.trees.crown_clip.trunk_clash`): dropped where they would cut the trunk or lie
 wholly outside the crown's share of the row, cut at the wall-side clip plane and at the planes
@@ -104,7 +105,7 @@ def volume_density(lv: Louvers, b: float) -> float:
 
 def volume_slat_bound(spec: CrownRowSpec, lv: Louvers) -> int:
     """Slats drawn (before dropping): count · round(ρ · 4/3 π a² b)."""
-    per = volume_density(lv, spec.b) * 4.0 / 3.0 * math.pi * spec.a**2 * spec.b
+    per = volume_density(lv, spec.b) * spec.crown_volume()
     return spec.count * int(round(per))
 
 
@@ -131,8 +132,9 @@ def volume_ab_note(ab: int) -> str:
 def clipped_volume(spec: CrownRowSpec, samples: int = 400_000, seed: int = 0
                    ) -> tuple[float, float]:
     """(volume, standard error) in m³ of the union of the clipped crowns, by Monte Carlo."""
-    lo = spec.centres.min(axis=0) - [spec.a, spec.a, spec.b]
-    hi = spec.centres.max(axis=0) + [spec.a, spec.a, spec.b]
+    r = spec.max_radius
+    lo = spec.centres.min(axis=0) - [r, r, spec.b]
+    hi = spec.centres.max(axis=0) + [r, r, spec.b]
     lo[1] = max(lo[1], spec.n_clip)
     box = float(np.prod(hi - lo))
     rng = np.random.default_rng(seed)
@@ -166,8 +168,9 @@ def _slat_corners(centres: np.ndarray, phi: np.ndarray, s: float,
 
 
 def slats_per_crown(spec: CrownRowSpec, lv: Louvers) -> int:
-    """Slats drawn in each crown spheroid: round(ρ · 4/3 π a² b)."""
-    return int(round(volume_density(lv, spec.b) * 4.0 / 3.0 * math.pi * spec.a ** 2 * spec.b))
+    """Slats drawn in each crown: round(ρ · V), V = 4/3 π a² b for the spheroid, 4/3 b A
+    for a crown following its outline (:meth:`CrownRowSpec.crown_volume`)."""
+    return int(round(volume_density(lv, spec.b) * spec.crown_volume()))
 
 
 def draw_crown_slats(rng: np.random.Generator, spec: CrownRowSpec, lv: Louvers, ti: int,
@@ -176,15 +179,14 @@ def draw_crown_slats(rng: np.random.Generator, spec: CrownRowSpec, lv: Louvers, 
     ``lv.clumping`` < 1, :mod:`radtree.trees.clumping`), normal azimuths φ and inclinations
     (rad; one for a fixed inclination), and the number of clusters (0 unclumped)."""
     c = spec.centres[ti]
-    a, b = spec.a, spec.b
     x, phi = _draw_nested(rng, per)
     n_cl = 0
     if lv.clumping < 1.0:   # slats grouped in clusters
         centres, n_cl = clustered_slat_centres(
-            np.random.default_rng([lv.seed, ti, 11]), x, c, a, b, lv.slat_size_m,
-            lv.clumping, lv.cluster_radius_m)
+            np.random.default_rng([lv.seed, ti, 11]), x, c, to_crown=spec.from_ball,
+            slat=lv.slat_size_m, omega=lv.clumping, radius=lv.cluster_radius_m)
     else:
-        centres = c + x * np.array([a, a, b])
+        centres = c + spec.from_ball(x)
     tilt: float | np.ndarray = math.radians(lv.inclination_deg)
     if lv.inclination_distribution == "ellipsoidal":
         tilt = draw_inclinations(np.random.default_rng([lv.seed, ti, 7]), per, lv.ellipsoid_x)

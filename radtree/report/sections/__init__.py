@@ -25,6 +25,7 @@ from radtree.resources import template_environment
 OPTIONAL = ("office", "sweep", "realisations", "permeability_scan", "diagnose", "annual",
             "direct_sun", "photo_check", "method", "facades")
 OPTIONAL += ("honeybee", "view3d")  # type: ignore[assignment]  # issue 19 (own line: merges)
+OPTIONAL += ("points_crown",)  # type: ignore[assignment]  # issue 41 (own line: merges)
 #: issue 38: the tree impact (first), the light traced, and the core sections by name (their
 #: templates read the page context ``c``; ``data`` is then empty)
 OPTIONAL += ("impact", "light", "scenarios", "hourly", "statistics", "rows", "maps",  # type: ignore[assignment]

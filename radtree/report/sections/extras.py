@@ -156,11 +156,13 @@ def extra_sections(project: Project, out: Path, table: pd.DataFrame | None = Non
     from radtree.report.sections.method import method_section_data
     from radtree.report.sections.models3d import honeybee_data, view3d_data
     from radtree.report.sections.photo import photo_sections
+    from radtree.report.sections.points import points_sections
 
     secs = _office(project, out) + _inventory_and_annual(project, out)
     table = read_results(project) if table is None else table
     secs += _section("honeybee", honeybee_data(project, table, out), "Honeybee model")
     secs += _section("view3d", view3d_data(project, table, out), "3-D view")
     secs += _studies(project, out) + photo_sections(project, out)
+    secs += points_sections(project, out, table)
     return secs + _section("method", method_section_data(project, out), "The study's method",
                            "the study's method: variants, findings, dome-radius scan")

@@ -219,6 +219,7 @@ def site_plan(project: Project, results: pd.DataFrame, impact: pd.DataFrame, pai
     from matplotlib.patches import Circle, Polygon
 
     from radtree.figures import new_figure, save_png
+    from radtree.trees.district import tree_outline
 
     cmap = colormaps["RdBu"]
     fig = new_figure(7.2, 5.6, 110)
@@ -242,16 +243,20 @@ def site_plan(project: Project, results: pd.DataFrame, impact: pd.DataFrame, pai
         ax.add_collection(LineCollection(segs, colors=cols, linewidths=4.5))
         ranks = ({str(t): int(r) for t, r in zip(ranking["tree"], ranking["rank"])}
                  if ranking is not None else {})
-        for t in inputs.trees:
-            ax.add_patch(Circle((t.x, t.y), t.crown_radius_m, facecolor=(0.2, 0.6, 0.2, 0.3),
-                                edgecolor=(0.1, 0.4, 0.1, 0.8), linewidth=0.5))
+        for t in inputs.trees:   # a crown following its outline drawn as the outline
+            look = {"facecolor": (0.2, 0.6, 0.2, 0.3), "edgecolor": (0.1, 0.4, 0.1, 0.8),
+                    "linewidth": 0.5}
+            ax.add_patch(Polygon(np.asarray(t.outline), closed=True, **look)
+                         if tree_outline(t)[0] is not None
+                         else Circle((t.x, t.y), t.crown_radius_m, **look))
             if ranks.get(str(t.id), 99) <= 5:
                 ax.annotate(f"#{ranks[str(t.id)]}", (t.x, t.y), ha="center", va="center",
                             fontsize=8, weight="bold")
         what = ("each simulated façade (thick line just outside it) coloured by the change "
                 "of its mean illuminance over the day; building footprints grey, tree crowns "
-                "green to scale" + ("; #1–#5: the trees that remove most light (Table "
-                                    "'trees ranked')" if ranks else ""))
+                "green to scale (their outlines where they follow one)"
+                + ("; #1–#5: the trees that remove most light (Table 'trees ranked')"
+                   if ranks else ""))
     else:
         per = sensor_change(results[~results["grid"].astype(str).isin(["facade_map"])], pair)
         lim = max(1.0, float(np.nanmax(np.abs(per["change_pct"])))) if len(per) else 1.0
