@@ -47,8 +47,10 @@ lbt-recipes 0.29.1, queenbee-local 1.0.3, honeybee-radiance 1.66.299, ``--lbt-pa
   hourly rtrace at 6 hours, the enhanced recipe 0.966–1.000; at the other 2 (October mornings,
   the sun just behind the opposite building) radtree 1.126–1.156 and lbt 1.113–1.154: both
   annual methods take reflected sun from sky patches that straddle the building's edge.
-* radtree annual itself moves between runs (rcontrib ``-n 2`` shares the work between
-  processes, so the sample sequence is not fixed): an earlier run of the same command read
+* radtree annual itself moves between fresh runs (its coefficients are cached per scene and
+  parameters, so only a first run samples anew; two fresh runs with ``-j 1`` — one rcontrib
+  process — still differed by up to 451 lx on one sensor-hour and 0.01–0.12 % in total, so the
+  cause is not the process split; not found): an earlier run of the same command read
   sDA 81.2 / 82.3 (model), 59.4 / 36.5 (crown) and 0.997–1.007 of the reference at those 6
   hours — the run-to-run spread of sDA (≈ 4 pp) is itself larger than the 3 pp target.
 * Where they differ: in diffuse-dominated hours (radtree 200–400 lx) the enhanced recipe reads
