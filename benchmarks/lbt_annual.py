@@ -47,12 +47,13 @@ lbt-recipes 0.29.1, queenbee-local 1.0.3, honeybee-radiance 1.66.299, ``--lbt-pa
   hourly rtrace at 6 hours, the enhanced recipe 0.966–1.000; at the other 2 (October mornings,
   the sun just behind the opposite building) radtree 1.126–1.156 and lbt 1.113–1.154: both
   annual methods take reflected sun from sky patches that straddle the building's edge.
-* radtree annual itself moves between fresh runs (its coefficients are cached per scene and
-  parameters, so only a first run samples anew; two fresh runs with ``-j 1`` — one rcontrib
-  process — still differed by up to 451 lx on one sensor-hour and 0.01–0.12 % in total, so the
-  cause is not the process split; not found): an earlier run of the same command read
-  sDA 81.2 / 82.3 (model), 59.4 / 36.5 (crown) and 0.997–1.007 of the reference at those 6
-  hours — the run-to-run spread of sDA (≈ 4 pp) is itself larger than the 3 pp target.
+* radtree annual moved between fresh runs when this was measured (an earlier run of the same
+  command read sDA 81.2 / 82.3 without and 59.4 / 36.5 with the crown, and 0.997–1.007 of the
+  reference at those 6 hours): ``rcontrib -n 2`` let its two children take rays as they came
+  free. Since then the points are split into fixed chunks, one single-process rcontrib each
+  (:mod:`radtree.annual.coefficients`): two fresh ``-j 2`` runs are bit-identical
+  (``tests/test_annual_determinism.py``); a fresh run now differs from the table's radtree
+  column by that same Monte Carlo spread (≈ 4 pp of sDA), itself larger than the 3 pp target.
 * Where they differ: in diffuse-dominated hours (radtree 200–400 lx) the enhanced recipe reads
   a median 0.89–0.91 of radtree; DA and sDA count hours and sensors across 300 lx, so a few
   per cent near 300 lx move them by 5–10 pp. The plain recipe smears the sun over the sky

@@ -26,6 +26,7 @@ from __future__ import annotations
 
 import hashlib
 import logging
+from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -53,8 +54,9 @@ SKY_TEXT = ("# unit-radiance sky and ground: rcontrib bins it into Reinhart patc
 class TraceParams:
     """rcontrib settings of the indirect runs (``-ab``, ``-ad``, ``-lw``) and processes.
 
-    The runs sample with :data:`~radtree.engines.radiance.binaries.FIXED_SEED`, so one
-    process gives the same coefficients every time."""
+    The runs sample with :data:`~radtree.engines.radiance.binaries.FIXED_SEED`, and the
+    points are split into ``nproc`` fixed chunks (one single-process ``rcontrib`` each), so the
+    same ``nproc`` gives the same coefficients every time."""
 
     ab: int
     ad: int
@@ -140,12 +142,20 @@ class CoefficientRunner:
             run(["oconv", str(self.scene_rad), str(light)], stdout_path=tmp)
         return octree
 
-    def _rcontrib(self, argv: list[str], octree: Path, ncols: int,
-                  scale: float = 1.0) -> np.ndarray:
+    def _rcontrib(self, argv: list[str], octree: Path, ncols: int, scale: float = 1.0, *,
+                  nproc: int = 1) -> np.ndarray:
+        """``rcontrib`` over the sensor points, in ``nproc`` contiguous chunks of points, one
+        single-process ``rcontrib`` each, run side by side: unlike ``rcontrib -n`` (whose
+        children take rays as they come free, so each draws a different sample sequence from
+        run to run) the same ``nproc`` gives the same coefficients every time."""
         cmd = ["rcontrib", "-I+", "-h-", "-faf", "-V+", "-dj", "0", "-dc", "1", "-dt", "0",
                *argv, str(octree)]
-        out = run(cmd, stdin=self.pts_text.encode(), cwd=self.folder)
-        a = np.frombuffer(out, dtype=np.float32)
+        lines = self.pts_text.splitlines(keepends=True)
+        bounds = np.linspace(0, len(lines), max(1, min(nproc, len(lines))) + 1).astype(int)
+        chunks = ["".join(lines[a:b]).encode() for a, b in zip(bounds[:-1], bounds[1:])]
+        with ThreadPoolExecutor(max_workers=len(chunks)) as pool:
+            parts = list(pool.map(lambda text: run(cmd, stdin=text, cwd=self.folder), chunks))
+        a = np.frombuffer(b"".join(parts), dtype=np.float32)
         expected = self.n_sensors * ncols * 3
         if a.size != expected:
             raise EngineError(f"rcontrib gave {a.size} values, expected {expected}",
@@ -170,10 +180,9 @@ class CoefficientRunner:
         def compute() -> np.ndarray:
             log.info(f"    rcontrib sky MF {mf} ({n} patches), {params.key()}")
             octree = self._octree("sky", SKY_TEXT)
-            argv = ["-n", str(params.nproc), *params.ambient(),
-                    "-f", "reinhartb.cal", "-e", f"MF:{mf}", "-b", "rbin+1", "-bn",
-                    "Nrbins+1", "-m", "skyglow"]
-            return self._rcontrib(argv, octree, n)
+            argv = [*params.ambient(), "-f", "reinhartb.cal", "-e", f"MF:{mf}", "-b",
+                    "rbin+1", "-bn", "Nrbins+1", "-m", "skyglow"]
+            return self._rcontrib(argv, octree, n, nproc=params.nproc)
 
         return self._cached("sky", f"mf{mf}_{params.key()}", compute)
 
@@ -191,7 +200,7 @@ class CoefficientRunner:
             octree = self._octree(f"suns_{name}", text)
             modfile = self.folder / f"suns_{name}.mod"
             write_text(modfile, "\n".join(mods) + "\n")
-            argv = ["-n", str(params.nproc), *params.ambient(ab), "-M", str(modfile)]
-            return self._rcontrib(argv, octree, len(mods), SUN_UNIT)
+            argv = [*params.ambient(ab), "-M", str(modfile)]
+            return self._rcontrib(argv, octree, len(mods), SUN_UNIT, nproc=params.nproc)
 
         return self._cached(f"sun_{name}", key, compute)
