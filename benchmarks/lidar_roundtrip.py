@@ -84,7 +84,7 @@ def main() -> int:
                    footprint_rays=args.footprint_rays, seed=args.seed)
     pts, areas, _ = scan_street(trees, scan, lv)
     beams = None if args.vertical else {
-        "origins": lambda t: scan.origins(t.xyz, t.source_id),
+        "origins": lambda t: scan.origins(t.xyz, line=t.source_id),
         "g_of_mu": lambda mu: projection_g(mu, lv.inclination_deg)}
     with tempfile.TemporaryDirectory() as tmp:
         tile_path = write_scan(pts, Path(tmp) / "street.laz")

@@ -21,13 +21,13 @@ def test_traverse_lengths_and_cells() -> None:
     """A segment (0.5, 0.5, 3.5) → (2.5, 0.5, 0.5) in a 3 × 1 × 4 grid of 1 m cells: pieces
     sum to its length √13, in the cells it crosses, in order of the walk."""
     o, e = np.array([[0.5, 0.5, 3.5]]), np.array([[2.5, 0.5, 0.5]])
-    seg, cell, length = traverse(o, e, lo=np.zeros(3), size=1.0, shape=(3, 1, 4))
+    seg, cell, length = traverse(o, end=e, lo=np.zeros(3), size=1.0, shape=(3, 1, 4))
     assert length.sum() == pytest.approx(math.sqrt(13.0))
     ijk = np.array(np.unravel_index(cell, (3, 1, 4))).T
     assert ijk[0].tolist() == [0, 0, 3] and ijk[-1].tolist() == [2, 0, 0]
     assert set(seg.tolist()) == {0}
     # a segment starting outside the grid keeps only its inside pieces
-    _, _, inside = traverse(np.array([[0.5, 0.5, 9.0]]), np.array([[0.5, 0.5, 0.0]]),
+    _, _, inside = traverse(np.array([[0.5, 0.5, 9.0]]), end=np.array([[0.5, 0.5, 0.0]]),
                             lo=np.zeros(3), size=1.0, shape=(3, 1, 4))
     assert inside.sum() == pytest.approx(4.0)
 
@@ -96,12 +96,13 @@ def test_sidelap_lines_and_origins(tmp_path: Path) -> None:
     path = write_points(tmp_path / "seam.laz", pts.xyz, pts.classification,
                         source_id=pts.line, gps_time=pts.time)
     tile = read_tile(path)
-    org = scan.origins(tile.xyz, tile.source_id)
+    org = scan.origins(tile.xyz, line=tile.source_id)
     assert np.allclose(org[:, 2], 300.0)
     assert np.allclose(org[tile.source_id == 1, 0], 150.0)
     assert np.allclose(org[tile.source_id == 0, 0], 0.0)
     assert np.allclose(org[:, 1], tile.xyz[:, 1], atol=1e-3)   # beams across the track
-    neg = AlsScan(heading_deg=0.0).origins(np.array([[-70.0, 0.0, 0.0]]), np.array([65535]))
+    neg = AlsScan(heading_deg=0.0).origins(np.array([[-70.0, 0.0, 0.0]]),
+                                           line=np.array([65535]))
     assert neg[0, 0] == pytest.approx(-150.0)   # line −1 read back from uint16
 
 

@@ -58,7 +58,7 @@ class Beams:
     weight: np.ndarray
 
 
-def traverse(origin: np.ndarray, end: np.ndarray, *, lo: np.ndarray, size: float,
+def traverse(origin: np.ndarray, *, end: np.ndarray, lo: np.ndarray, size: float,
              shape: tuple[int, int, int]) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """The cells each segment origin → end crosses in the grid of ``shape`` cells of
     ``size`` from corner ``lo`` (x, y, z): (segment index, flat cell index, length m) for
@@ -117,7 +117,7 @@ def beam_density(beams: Beams, *, lo: np.ndarray, size: float, shape: tuple[int,
     d /= np.maximum(np.linalg.norm(d, axis=1), 1e-12)[:, None]
     w = beams.weight
     g = np.asarray(g_of_mu(np.abs(d[:, 2])), float) * w
-    seg, cell, length = traverse(beams.origin, beams.end, lo=lo, size=size, shape=shape)
+    seg, cell, length = traverse(beams.origin, end=beams.end, lo=lo, size=size, shape=shape)
     n = int(np.prod(shape))
     optical = np.bincount(cell, weights=g[seg] * length, minlength=n)
     k = np.floor((beams.end - lo) / size).astype(np.int64)

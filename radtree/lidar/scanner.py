@@ -65,7 +65,7 @@ class AlsScan(Checked):
         across = np.array([math.cos(h), -math.sin(h)])  # to its right
         return along, across
 
-    def origins(self, xyz: np.ndarray, line: np.ndarray) -> np.ndarray:
+    def origins(self, xyz: np.ndarray, *, line: np.ndarray) -> np.ndarray:
         """Where the beam of each return (x, y, z m; ``line``: its flight line) was fired:
         the beam lies in the vertical plane across the line through the return, so the
         origin is the return's along-track position on line ``line``, at the altitude."""
@@ -147,28 +147,38 @@ def scan_als(vertices: np.ndarray, faces: np.ndarray, face_class: np.ndarray,
                + (r * np.sin(phi))[..., None] * e2[:, None, :]).reshape(-1, 3)
     dirs = np.repeat(d, m, axis=0)
     loc, ray, tri = mesh.ray.intersects_location(origins, dirs, multiple_hits=False)
-    rng_dist = np.einsum("ij,ij->i", loc - origins[ray], dirs[ray])
-    pulse = ray // m
-    order = np.lexsort((rng_dist, pulse))
-    pulse, dist, loc, tri = pulse[order], rng_dist[order], loc[order], tri[order]
-    # a new return where the pulse changes or the range jumps by ≥ range_resolution_m
+    xyz, cls, number, total, pulse_of = echoes(loc, pulse=ray // m, dist=np.einsum(
+        "ij,ij->i", loc - origins[ray], dirs[ray]), tri=tri, face_class=face_class,
+        pulses=k, resolution_m=scan.range_resolution_m)
+    keep = number <= scan.max_returns
+    xyz, cls, number, pulse_of = xyz[keep], cls[keep], number[keep], pulse_of[keep]
+    total = np.minimum(total[keep], scan.max_returns)
+    return ScanPoints(xyz, cls, number, total, lines[pulse_of], pulse_of / PULSE_RATE_HZ)
+
+
+def echoes(loc: np.ndarray, *, pulse: np.ndarray, dist: np.ndarray, tri: np.ndarray,
+           face_class: np.ndarray, pulses: int, resolution_m: float
+           ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """Sub-ray hits (``loc`` (h, 3), their pulse, range m, face) grouped into returns: sorted
+    by range within a pulse, a new return where the range jumps by ≥ ``resolution_m``; each
+    at the mean of its hits, with its first hit's class. (xyz, class, return number, number
+    of returns of the pulse, pulse) per return, in pulse order."""
+    order = np.lexsort((dist, pulse))
+    pulse, dist, loc, tri = pulse[order], dist[order], loc[order], tri[order]
     new = np.ones(len(pulse), bool)
-    new[1:] = (pulse[1:] != pulse[:-1]) | (np.diff(dist) >= scan.range_resolution_m)
+    new[1:] = (pulse[1:] != pulse[:-1]) | (np.diff(dist) >= resolution_m)
     ret = np.cumsum(new) - 1
-    n_ret = ret[-1] + 1 if len(ret) else 0
+    n_ret = int(ret[-1] + 1) if len(ret) else 0
     xyz = np.zeros((n_ret, 3))
     np.add.at(xyz, ret, loc)
-    xyz /= np.bincount(ret, minlength=n_ret)[:, None]
-    cls = np.asarray(face_class)[tri[new]]
+    xyz /= np.maximum(np.bincount(ret, minlength=n_ret), 1)[:, None]
+    cls = np.asarray(face_class)[tri[new]].astype(np.uint8)
     pulse_of = pulse[new]
     first = np.ones(n_ret, bool)
     first[1:] = pulse_of[1:] != pulse_of[:-1]
     number = np.arange(n_ret) - np.maximum.accumulate(np.where(first, np.arange(n_ret), 0)) + 1
-    keep = number <= scan.max_returns
-    xyz, cls, number, pulse_of = xyz[keep], cls[keep], number[keep], pulse_of[keep]
-    total = np.bincount(pulse_of, minlength=k)[pulse_of]
-    return ScanPoints(xyz, cls.astype(np.uint8), number.astype(np.uint8),
-                      total.astype(np.uint8), lines[pulse_of], pulse_of / PULSE_RATE_HZ)
+    total = np.bincount(pulse_of, minlength=pulses)[pulse_of]
+    return xyz, cls, number.astype(np.uint8), total.astype(np.uint8), pulse_of
 
 
 def ground_plane(lo: tuple[float, float], hi: tuple[float, float], margin: float = 50.0

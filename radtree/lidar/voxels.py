@@ -133,10 +133,12 @@ def plant_area_density(xy: np.ndarray, heights: np.ndarray, size_m: float, g: fl
 
 
 def _beam_pad(tile: Tile, *, heights: np.ndarray, origin: np.ndarray, size: float,
-              g_of_mu: Callable[[np.ndarray], np.ndarray], ground_m: float = 0.5
+              g_of_mu: Callable[[np.ndarray], np.ndarray], ground_m: float = 0.5,
+              empty: tuple[np.ndarray, np.ndarray] | None = None
               ) -> tuple[float, float, np.ndarray]:
     """(x0, y0, pad) by following every point's beam (:mod:`radtree.lidar.beams`) on the grid
-    over the points' extent, heights 0 … the highest point."""
+    over the points' extent, heights 0 … the highest point; shots without a return
+    (``empty``: origins, directions) run 1 km on, shifted by the median terrain."""
     from radtree.lidar.beams import Beams, beam_density
 
     xy = tile.xyz[:, :2]
@@ -147,7 +149,15 @@ def _beam_pad(tile: Tile, *, heights: np.ndarray, origin: np.ndarray, size: floa
     start = np.asarray(origin, float) - np.column_stack(
         [np.zeros((len(xy), 2)), tile.xyz[:, 2] - heights])   # terrain under the return
     weight = 1.0 / np.maximum(tile.number_of_returns, 1).astype(float)
-    beams = Beams(start, end, heights >= ground_m, weight)
+    hit = heights >= ground_m
+    if empty is not None and len(empty[0]):
+        shift = np.array([0.0, 0.0, float(np.median(tile.xyz[:, 2] - heights))])
+        eo = np.asarray(empty[0], float) - shift
+        start = np.vstack([start, eo])
+        end = np.vstack([end, eo + 1000.0 * np.asarray(empty[1], float)])
+        hit = np.r_[hit, np.zeros(len(eo), bool)]
+        weight = np.r_[weight, np.ones(len(eo))]
+    beams = Beams(start, end, hit, weight)
     pad, _, _ = beam_density(beams, lo=np.array([x0, y0, 0.0]), size=size,
                              shape=(int(nx), int(ny), nz), g_of_mu=g_of_mu)
     return float(x0), float(y0), pad
@@ -156,13 +166,17 @@ def _beam_pad(tile: Tile, *, heights: np.ndarray, origin: np.ndarray, size: floa
 def tree_voxels(path: str | Path, g: float, size_m: float | None = None,
                 ground: str = "class", field: str = "tree.points_voxel_m", *,
                 origins: Callable[[Tile], np.ndarray] | None = None,
-                g_of_mu: Callable[[np.ndarray], np.ndarray] | None = None) -> VoxelGrid:
+                g_of_mu: Callable[[np.ndarray], np.ndarray] | None = None,
+                empty: Callable[[Tile], tuple[np.ndarray, np.ndarray]] | None = None
+                ) -> VoxelGrid:
     """The plant area density grid of the one tree in ``path`` (module text); ConfigError
     naming the file and the fix for an empty or one-point tree, no ground, a voxel finer
     than the point spacing supports. With ``origins`` (where each point's beam was fired,
     (n, 3) in the tile's coordinates, e.g. :meth:`radtree.lidar.scanner.AlsScan.origins`)
     the beams are followed along their own paths (:mod:`radtree.lidar.beams`, G from
-    ``g_of_mu``, else ``g`` for every direction) instead of taken as vertical."""
+    ``g_of_mu``, else ``g`` for every direction) instead of taken as vertical; ``empty`` gives
+    the (origins, unit directions) of the shots that returned nothing (a terrestrial scan's
+    sky shots, :meth:`radtree.lidar.tls.TlsScan.empty_shots`), followed out of the grid."""
     tile: Tile = read_tile(path)
     if not 0.0 < g <= 1.0:
         raise ConfigError(f"projection G = {g:g}, expected 0 < G ≤ 1", source=tile.source)
@@ -187,6 +201,7 @@ def tree_voxels(path: str | Path, g: float, size_m: float | None = None,
         x0, y0, pad = plant_area_density(tile.xyz[:, :2], heights, size, g)
     else:
         x0, y0, pad = _beam_pad(tile, heights=heights, origin=origins(tile), size=size,
-                                g_of_mu=g_of_mu or (lambda mu: np.full(np.shape(mu), g)))
+                                g_of_mu=g_of_mu or (lambda mu: np.full(np.shape(mu), g)),
+                                empty=None if empty is None else empty(tile))
     returns = np.column_stack([tile.xyz[veg, :2], heights[veg]])
     return VoxelGrid(x0, y0, size, pad, g, spacing, returns)
