@@ -125,3 +125,26 @@ def test_street_round_trip_floors(tmp_path: Path) -> None:
         assert seg.trees[r].height_m == pytest.approx(trees[c].height_m, abs=0.5)
         assert seg.trees[r].crown_diameter_m == pytest.approx(2 * trees[c].crown_radius_m,
                                                               rel=0.10)
+
+
+def test_few_beams_a_voxel_unbiased_and_occluded_voxels_filled() -> None:
+    """Two beams a 1 m column through a layer of optical depth 0.53 (hit with probability
+    1 − e^−0.53): with ½ added to both counts the mean estimate is 0.98 τ (binomial
+    expectation; the former rule gave 1.08 τ); 20 000 columns, within 3 %. A voxel no beam
+    reached under plant area takes its layer's mean, one above the lowest return not."""
+    rng = np.random.default_rng(7)
+    n = 20_000
+    xy = np.repeat(np.column_stack([np.arange(n) % 200, np.arange(n) // 200]) + 0.5, 2, axis=0)
+    hit = rng.random(2 * n) < 1 - math.exp(-0.53)
+    h = np.where(hit, 5.5, 0.0)
+    _, _, pad = plant_area_density(xy, h, 1.0, 1.0)
+    assert pad[..., 5].mean() == pytest.approx(0.98 * 0.53, rel=0.03)
+    from radtree.lidar.voxels import fill_occluded
+
+    p = np.zeros((2, 1, 4))
+    p[:, 0, 3] = 0.4
+    p[1, 0, 2] = 0.6
+    entering = np.ones_like(p)
+    entering[0, 0, 2] = entering[0, 0, 1] = 0          # occluded under column 0's top voxel
+    out, filled = fill_occluded(p, entering, lowest_k=2)
+    assert filled == 1 and out[0, 0, 2] == pytest.approx(0.6) and out[0, 0, 1] == 0.0

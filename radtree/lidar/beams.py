@@ -18,9 +18,9 @@ Beer–Lambert's law over the voxel (MacArthur & Horn 1969; the voxel form with 
 mean path length of Béland et al. 2014, Agric. For. Meteorol. 184:82–97, and of AMAPVox,
 Vincent et al. 2017, doi:10.18167/DVN1/6WHPRN) gives
 
-    PAD = −ln( max(N − I, ½) / N ) / l̄_G                    (m²/m³)
+    PAD = −ln( (N − I + ½) / (N + ½) ) / l̄_G                 (m²/m³)
 
-with the same continuity correction as the vertical column inversion
+with the same correction of the log of a binomial proportion as the vertical column inversion
 (:mod:`radtree.lidar.voxels`), which this is exactly when every beam is vertical (l_b = Δz,
 G constant). Not the maximum-likelihood I / Σ G·l_b over the beams' free paths (Pimont et al.
 2018, Remote Sens. Environ. 215:343–370): on the synthetic street's crowns it blew up where one
@@ -133,7 +133,7 @@ def beam_density(beams: Beams, *, lo: np.ndarray, size: float, shape: tuple[int,
     first[1:] = pair[1:] != pair[:-1]
     entering = np.bincount(cell[first], weights=w[seg[first]], minlength=n)
     with np.errstate(divide="ignore", invalid="ignore"):
-        gap = np.maximum(entering - hits, 0.5 * np.minimum(w.max(initial=1.0), 1.0)) / entering
+        gap = (np.maximum(entering - hits, 0.0) + 0.5) / (entering + 0.5)   # module text
         path = optical / entering
         pad = np.where((entering > 0) & (path > 0), -np.log(np.minimum(gap, 1.0)) / path, 0.0)
     return pad.reshape(shape), entering.reshape(shape), hits.reshape(shape)
