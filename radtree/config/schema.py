@@ -203,6 +203,11 @@ class Tree(Checked):
     #: point spacings)
     points: Path | None = field(default=None)
     points_voxel_m: float | None = field(default=None, metadata=meta(0.05, 20.0))
+    #: the terrestrial scan positions of ``points`` (TOML of [[scan]] tables,
+    #: radtree.lidar.tls): the inversion then follows every beam from its scanner, the shots
+    #: without return included; voxel size ``points_voxel_m`` or 1 m (None: airborne,
+    #: vertical beams)
+    points_scans: Path | None = field(default=None)
 
     def check(self) -> None:
         if (self.leaf_on is None) != (self.leaf_off is None):

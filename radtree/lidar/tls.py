@@ -23,7 +23,8 @@ has one return at most: the first surface along a thin beam.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, fields
+from pathlib import Path
 from typing import ClassVar
 
 import numpy as np
@@ -161,3 +162,51 @@ def tls_beams(scans: list[TlsScan]) -> dict:
         return np.vstack(orig), np.vstack(dirs)
 
     return {"origins": origins, "empty": empty}
+
+
+def write_scans(path: str | Path, scans: list[TlsScan]) -> Path:
+    """The scan positions as TOML, one ``[[scan]]`` table each (what ``tree.points_scans``
+    reads: :func:`read_scans`)."""
+    from radtree.fileio import write_text
+    from radtree.tomlout import dumps
+
+    rows = [{f.name: getattr(s, f.name) for f in fields(s)} for s in scans]
+    write_text(Path(path), dumps({"scan": rows}, header="# terrestrial scan positions "
+                                 "(radtree.lidar.tls): metres, degrees"))
+    return Path(path)
+
+
+def read_scans(path: str | Path) -> list[TlsScan]:
+    """The ``[[scan]]`` tables of ``path`` (TOML, fields of :class:`TlsScan`); ConfigError
+    naming the file, the field and the fix."""
+    import tomllib
+
+    from radtree.config.spec import SchemaError
+    from radtree.errors import ConfigError
+
+    src = str(path)
+    try:
+        data = tomllib.loads(Path(path).read_text())
+    except (OSError, tomllib.TOMLDecodeError) as exc:
+        raise ConfigError(f"cannot read the scan positions ({exc}): a TOML file of [[scan]] "
+                          "tables (x_m, y_m, z_m, step_deg, …)", source=src) from None
+    tables = data.get("scan")
+    if not isinstance(tables, list) or not tables:
+        raise ConfigError("no [[scan]] table: give one per scan position (x_m, y_m, z_m, "
+                          "step_deg, zenith_min_deg, …, position_id)", source=src)
+    known = {f.name for f in fields(TlsScan)}
+    out = []
+    for i, t in enumerate(tables):
+        unknown = sorted(set(t) - known)
+        if unknown:
+            raise ConfigError(f"scan {i + 1}: unknown field {unknown[0]!r} (known: "
+                              f"{', '.join(sorted(known))})", source=src, field="scan")
+        try:
+            out.append(TlsScan(**t))
+        except SchemaError as exc:
+            raise ConfigError(f"scan {i + 1}: {exc.detail}", source=src, field=exc.key) from None
+    ids = [s.position_id for s in out]
+    if len(set(ids)) != len(ids):
+        raise ConfigError(f"position_id {ids}: each scan needs its own (the LAS point source id "
+                          "of its points)", source=src, field="tls.position_id")
+    return out
