@@ -40,7 +40,7 @@ rounded up to 5 cm), so a column holds about 25 beams; finer than 3·s (fewer th
 column, when one beam more or less moves a layer's gap by more than 10 %) is refused. Terrestrial
 scans (beams from a scanner on the ground) break the vertical-beam assumption, and so do
 airborne beams off nadir where overlapping strips cross (the synthetic street of
-``benchmarks/lidar_roundtrip.py``: leaf area within 10 % for 10/20 trees as columns, 17/20
+``benchmarks/lidar_roundtrip.py``: leaf area within 10 % for 7/20 trees as columns, 18/20
 along the beams): when the caller knows where each beam was fired (``origins``), the beams are
 followed along their own paths instead (:mod:`radtree.lidar.beams`, the same Beer–Lambert law
 per voxel, exactly this inversion for vertical beams).
