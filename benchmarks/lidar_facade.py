@@ -31,8 +31,12 @@ load 6.6): leaf area from the scans −2.0 % (per realisation −5.3 … +1.4 %)
 0.982 ± 0.004 (8/8 within 5 %); 13:30 1.122 ± 0.147, pairs 0.84–1.53 (1/8) — NOT met, and not
 resolvable with 8 realisations at 26 % scatter; map 13:30 1.024 ± 0.012, pairs 0.96–1.08 (7/8
 within 5 %). The rebuilt crowns still shade the map ≈ 9 % less than the originals (open −
-crown: 5 078 against 5 605 lx), consistent with their lowest 2 m still ≈ 23 % short of leaf area
-(ALS from above reaches a dense crown's bottom with a beam or two a column).
+crown: 5 078 against 5 605 lx), consistent with their lowest 2 m still ≈ 23 % short of leaf area.
+That is occlusion, not the estimator: of the ≈ 37 voxels (1.25 m) holding leaves in the layer
+3.75–5 m, 4–8 got no beam and 18–22 one or two (a vertical path crosses 4 slats, so
+≈ e^−4 = 2 % of the 31 beams a column get through); over realisations 1–4 that layer came out
+15.6, 18.5, 9.5, 8.0 m² for 18.7, 22.5, 22.3, 23.1 m² (before filling the unreached voxels).
+More beams at the bottom (denser or multi-return scans, or a terrestrial scan) is the fix.
 
     python benchmarks/lidar_facade.py [--seeds 8] [--hours 10:30 13:30] [--map-hour 13:30]
         [--crossings 4] [--voxel M]
