@@ -70,7 +70,7 @@ def test_tilted_beams_recover_a_turbid_layer(tmp_path: Path) -> None:
     the well-sampled middle is within 6 % of 0.6; taken as vertical columns the same points
     give the layer's plant area wrong by more than 10 % (the beams' path per layer is
     1/cos 30° longer, and they cross columns)."""
-    origin, end = tilted_layer(0.6, 30.0, 90_000, seed=5)
+    origin, end = tilted_layer(0.6, 30.0, 40_000, seed=5)
     cls = np.where(end[:, 2] > 0.01, 5, 2)
     path = write_points(tmp_path / "tilt.laz", end, cls)
     grid = tree_voxels(path, 0.5, 1.0, origins=lambda t: origin,
