@@ -1,6 +1,6 @@
 """Crowns from points: the Beer–Lambert voxel inversion against an analytic turbid layer, its
-errors, the synthetic scanner against geometry, ``[tree] points`` crowns, and a small round
-trip (radtree's crowns → synthetic scan → trees and leaf area)."""
+errors, the synthetic scanner against geometry and ``[tree] points`` crowns (the street round
+trip: tests/test_lidar_beams.py)."""
 
 from __future__ import annotations
 
@@ -126,24 +126,3 @@ def test_points_crown_filled_voxel_by_voxel(one_tree, frame) -> None:
     assert input_files(project)["tree_points"].startswith("tree.laz sha256:")
     with pytest.raises(ConfigError, match="a crown from points is free-standing"):
         build_tree(project, Scenario("d", "louvers", form="dome"), frame)
-
-
-def test_round_trip_three_trees(tmp_path: Path) -> None:
-    """Three of the synthetic street's crowns → scan → segment: count exact, heights within
-    0.5 m, crown diameters within 10 % (benchmarks/lidar_roundtrip.py: the 20-tree street)."""
-    from radtree.lidar.evaluate import match_tops
-    from radtree.lidar.segment import segment_tile
-    from radtree.lidar.tile import read_tile
-    from radtree.trees.synthetic_scan import scan_street, synthetic_street, write_scan
-
-    trees = synthetic_street(3, seed=0)
-    pts, _, _ = scan_street(trees, AlsScan())
-    seg = segment_tile(read_tile(write_scan(pts, tmp_path / "street.laz")))
-    assert len(seg.trees) == 3
-    det = np.array([[t.top_x, t.top_y] for t in seg.trees])
-    pairs = match_tops(det, np.array([[t.x, t.y] for t in trees]), 2.0)
-    assert len(pairs) == 3
-    for r, c, _ in pairs:
-        assert seg.trees[r].height_m == pytest.approx(trees[c].height_m, abs=0.5)
-        assert seg.trees[r].crown_diameter_m == pytest.approx(2 * trees[c].crown_radius_m,
-                                                              rel=0.10)

@@ -83,6 +83,8 @@ def _project_payload(project: Any) -> dict[str, Any]:
         payload["light"].pop("weather", None)    # inferred from the file: as before
     for key in ("leaf_on", "leaf_off", "accept_poor_fit"):   # change no traced hour
         payload["tree"].pop(key, None)
+    if payload["tree"].get("points_scans") is None:   # airborne points: hashes unchanged
+        payload["tree"].pop("points_scans", None)
     if project.district is not None:   # inventory inputs: relative path + content (_file_key)
         payload["district"] = d["district"]
         if payload["district"].get("turbid_above") == 500:   # at its default: hashes unchanged

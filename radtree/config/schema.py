@@ -211,6 +211,11 @@ class Tree(Checked):
     voxels: Path | None = field(default=None)
     #: the voxel side of ``voxels`` in m (None: the smallest spacing of the centres)
     voxels_size_m: float | None = field(default=None, metadata=meta(0.01, 20.0))
+    #: the terrestrial scan positions of ``points`` (TOML of [[scan]] tables,
+    #: radtree.lidar.tls): the inversion then follows every beam from its scanner, the shots
+    #: without return included; voxel size ``points_voxel_m`` or 1 m (None: airborne,
+    #: vertical beams)
+    points_scans: Path | None = field(default=None)
 
     def check(self) -> None:
         if self.voxels is not None and self.points is not None:

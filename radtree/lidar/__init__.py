@@ -9,7 +9,10 @@
 * :mod:`~radtree.lidar.evaluate` detected trees against reference trees;
 * :mod:`~radtree.lidar.voxels` plant area density of one tree on voxels (Beer–Lambert), which
   :mod:`radtree.trees.points_crown` fills with slats (``[tree] points``);
-* :mod:`~radtree.lidar.scanner` a synthetic airborne scanner (ray casting) for round trips
+* :mod:`~radtree.lidar.beams` the same inversion along each beam's own path (tilted airborne
+  beams, terrestrial scans);
+* :mod:`~radtree.lidar.scanner` a synthetic airborne scanner (ray casting) and
+  :mod:`~radtree.lidar.tls` a synthetic terrestrial one, for round trips
   (:mod:`radtree.trees.synthetic_scan` scans radtree's own crowns).
 
 Units: metres, x east, y north, z up.

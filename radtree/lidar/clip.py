@@ -37,9 +37,11 @@ def write_subset(tile_path: str | Path, mask: np.ndarray, out: str | Path) -> Pa
 def write_points(out: str | Path, xyz: np.ndarray, classification: np.ndarray,
                  return_number: np.ndarray | None = None,
                  number_of_returns: np.ndarray | None = None, crs: str | None = None,
-                 scale_m: float = 0.001) -> Path:
+                 scale_m: float = 0.001, *, source_id: np.ndarray | None = None,
+                 gps_time: np.ndarray | None = None) -> Path:
     """Write points (m) as LAS 1.4 point format 6 (LAZ when ``out`` ends in ``.laz``), with a
-    CRS (anything pyproj reads) when given; coordinates to ``scale_m``."""
+    CRS (anything pyproj reads) when given; coordinates to ``scale_m``; the point source id
+    (flight line, scan position) and GPS time (s) when given."""
     import laspy
 
     out = Path(out)
@@ -58,6 +60,10 @@ def write_points(out: str | Path, xyz: np.ndarray, classification: np.ndarray,
     las.return_number = ones if return_number is None else np.asarray(return_number, np.uint8)
     las.number_of_returns = (ones if number_of_returns is None
                              else np.asarray(number_of_returns, np.uint8))
+    if source_id is not None and len(source_id):
+        las.point_source_id = np.asarray(source_id, np.int64) % 65536   # LAS: uint16
+    if gps_time is not None and len(gps_time):
+        las.gps_time = np.asarray(gps_time, float)
     return _write(las, out)
 
 

@@ -2,9 +2,20 @@
 
 For round trips (scan radtree's own crowns, rebuild them from the points, compare). Flight
 lines run along ``heading_deg`` (clockwise from north) every ``line_spacing_m``, at
-``altitude_m`` above z = 0; pulses land on a jittered grid of ``pulse_density_m2`` pulses per
-m² (on the ground, per pass; the grid is seeded), each fired from the nearest flight line, so
-its zenith angle is the across-track scan angle (≤ atan(line_spacing / 2 / altitude)).
+``altitude_m`` above z = 0. Each line scans a swath of width ``line_spacing_m / (1 −
+sidelap)`` centred on it, so neighbouring swaths share ``sidelap`` of their width (default 30 %,
+the lateral overlap recommended for ALS: "insufficient overlap between scans, especially in
+combination with significant relief differences, can lead to the formation of an area without
+data", TOPODRONE, *Overlaps between scans and the height of the scanned objects*; with no
+sidelap, beams of the two lines tilt away from each other at the swaths' seam and leave a
+wedge above it that no beam crosses, a crown standing there is seen from one side only). In
+its swath each line lands pulses on its own jittered grid of ``pulse_density_m2`` pulses per m²
+(on the ground, per pass; seeded), fired in the vertical plane across the line, so a pulse's
+zenith angle is its across-track scan angle (≤ atan(swath / 2 / altitude)). Every return
+records its flight line (LAS ``point_source_id``, :attr:`ScanPoints.line`) and its pulse's
+emission time (LAS ``gps_time``, :attr:`ScanPoints.time`: pulse index / ``PULSE_RATE_HZ``):
+with the flight geometry these give each beam's path (:meth:`AlsScan.origins`), which the
+voxel inversion follows (:mod:`radtree.lidar.beams`).
 
 Footprint: a pulse is ``footprint_rays`` parallel sub-rays spread uniformly over a disc of
 diameter ``altitude · beam_divergence_mrad / 1000`` (m) across the beam. Each sub-ray stops at
@@ -40,35 +51,74 @@ class AlsScan(Checked):
     footprint_rays: int = field(default=1, metadata=meta(1, 64))
     range_resolution_m: float = field(default=1.5, metadata=meta(0.0, 100.0))
     max_returns: int = field(default=4, metadata=meta(1, 15))
+    sidelap: float = field(default=0.3, metadata=meta(0.0, 0.9))
     seed: int = 0
+
+    @property
+    def half_swath_m(self) -> float:
+        """Half the swath width of one line (m): line spacing / (1 − sidelap) / 2."""
+        return 0.5 * self.line_spacing_m / (1.0 - self.sidelap)
+
+    def _axes(self) -> tuple[np.ndarray, np.ndarray]:
+        h = math.radians(self.heading_deg)
+        along = np.array([math.sin(h), math.cos(h)])   # the flight direction
+        across = np.array([math.cos(h), -math.sin(h)])  # to its right
+        return along, across
+
+    def origins(self, xyz: np.ndarray, *, line: np.ndarray) -> np.ndarray:
+        """Where the beam of each return (x, y, z m; ``line``: its flight line) was fired:
+        the beam lies in the vertical plane across the line through the return, so the
+        origin is the return's along-track position on line ``line``, at the altitude."""
+        along, across = self._axes()
+        xy = np.asarray(xyz, float)[:, :2]
+        s = xy @ along
+        signed = (np.asarray(line, np.int64) + 32768) % 65536 - 32768   # LAS id: uint16
+        c = signed * self.line_spacing_m
+        return np.column_stack([s[:, None] * along + c[:, None] * across,
+                                np.full(len(xy), self.altitude_m)])
+
+
+#: pulses per second of the synthetic scanners (only orders the LAS ``gps_time`` stamps)
+PULSE_RATE_HZ = 100_000.0
 
 
 @dataclass(frozen=True)
 class ScanPoints:
-    """Returns: positions (n, 3) m, ASPRS classes, return number and number of returns."""
+    """Returns: positions (n, 3) m, ASPRS classes, return number and number of returns, the
+    flight line or scan position (LAS point source id) and the pulse's emission time (s)."""
 
     xyz: np.ndarray
     classification: np.ndarray
     return_number: np.ndarray
     number_of_returns: np.ndarray
+    line: np.ndarray = field(default_factory=lambda: np.zeros(0, np.int64))
+    time: np.ndarray = field(default_factory=lambda: np.zeros(0))
 
 
 def _pulses(lo: np.ndarray, hi: np.ndarray, scan: AlsScan, rng: np.random.Generator
-            ) -> tuple[np.ndarray, np.ndarray]:
-    """Ground aim points (k, 2) and unit directions (k, 3) of the pulses over [lo, hi]."""
+            ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Ground aim points (k, 2), unit directions (k, 3) and flight lines (k,) of the pulses
+    over [lo, hi]: every line whose swath reaches the rectangle fires its own jittered grid."""
     step = 1.0 / math.sqrt(scan.pulse_density_m2)
-    gx = np.arange(lo[0], hi[0], step)
-    gy = np.arange(lo[1], hi[1], step)
+    _, across = scan._axes()
+    corners = np.array([[lo[0], lo[1]], [hi[0], lo[1]], [hi[0], hi[1]], [lo[0], hi[1]]])
+    cc = corners @ across
+    w, sp = scan.half_swath_m, scan.line_spacing_m
+    first, last = math.ceil((cc.min() - w) / sp), math.floor((cc.max() + w) / sp)
+    gx, gy = np.arange(lo[0], hi[0], step), np.arange(lo[1], hi[1], step)
     x, y = (v.ravel() for v in np.meshgrid(gx, gy))
-    aim = np.column_stack([x, y]) + rng.uniform(0.0, step, (len(x), 2))
-    h = math.radians(scan.heading_deg)
-    across = np.array([math.cos(h), -math.sin(h)])   # right of the flight direction
-    c = aim @ across
-    offset = c - np.round(c / scan.line_spacing_m) * scan.line_spacing_m   # from the line
-    d = np.column_stack([offset[:, None] * across[None, :],
-                         np.full(len(aim), -scan.altitude_m)])
-    d /= np.linalg.norm(d, axis=1)[:, None]
-    return aim, d
+    aims, dirs, lines = [], [], []
+    for line in range(first, last + 1):
+        aim = np.column_stack([x, y]) + rng.uniform(0.0, step, (len(x), 2))
+        offset = aim @ across - line * sp                       # from the line, m
+        keep = np.abs(offset) <= w
+        aim, offset = aim[keep], offset[keep]
+        d = np.column_stack([offset[:, None] * across[None, :],
+                             np.full(len(aim), -scan.altitude_m)])
+        aims.append(aim)
+        dirs.append(d / np.linalg.norm(d, axis=1)[:, None])
+        lines.append(np.full(len(aim), line))
+    return np.vstack(aims), np.vstack(dirs), np.concatenate(lines)
 
 
 def scan_als(vertices: np.ndarray, faces: np.ndarray, face_class: np.ndarray,
@@ -80,7 +130,7 @@ def scan_als(vertices: np.ndarray, faces: np.ndarray, face_class: np.ndarray,
     mesh = trimesh.Trimesh(np.asarray(vertices, float), np.asarray(faces, np.int64),
                            process=False)
     rng = np.random.default_rng(scan.seed)
-    aim, d = _pulses(np.asarray(lo, float), np.asarray(hi, float), scan, rng)
+    aim, d, lines = _pulses(np.asarray(lo, float), np.asarray(hi, float), scan, rng)
     k = len(aim)
     m = scan.footprint_rays
     # sub-rays: uniform on the footprint disc, in the plane across the beam
@@ -97,28 +147,38 @@ def scan_als(vertices: np.ndarray, faces: np.ndarray, face_class: np.ndarray,
                + (r * np.sin(phi))[..., None] * e2[:, None, :]).reshape(-1, 3)
     dirs = np.repeat(d, m, axis=0)
     loc, ray, tri = mesh.ray.intersects_location(origins, dirs, multiple_hits=False)
-    rng_dist = np.einsum("ij,ij->i", loc - origins[ray], dirs[ray])
-    pulse = ray // m
-    order = np.lexsort((rng_dist, pulse))
-    pulse, dist, loc, tri = pulse[order], rng_dist[order], loc[order], tri[order]
-    # a new return where the pulse changes or the range jumps by ≥ range_resolution_m
+    xyz, cls, number, total, pulse_of = echoes(loc, pulse=ray // m, dist=np.einsum(
+        "ij,ij->i", loc - origins[ray], dirs[ray]), tri=tri, face_class=face_class,
+        pulses=k, resolution_m=scan.range_resolution_m)
+    keep = number <= scan.max_returns
+    xyz, cls, number, pulse_of = xyz[keep], cls[keep], number[keep], pulse_of[keep]
+    total = np.minimum(total[keep], scan.max_returns)
+    return ScanPoints(xyz, cls, number, total, lines[pulse_of], pulse_of / PULSE_RATE_HZ)
+
+
+def echoes(loc: np.ndarray, *, pulse: np.ndarray, dist: np.ndarray, tri: np.ndarray,
+           face_class: np.ndarray, pulses: int, resolution_m: float
+           ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """Sub-ray hits (``loc`` (h, 3), their pulse, range m, face) grouped into returns: sorted
+    by range within a pulse, a new return where the range jumps by ≥ ``resolution_m``; each
+    at the mean of its hits, with its first hit's class. (xyz, class, return number, number
+    of returns of the pulse, pulse) per return, in pulse order."""
+    order = np.lexsort((dist, pulse))
+    pulse, dist, loc, tri = pulse[order], dist[order], loc[order], tri[order]
     new = np.ones(len(pulse), bool)
-    new[1:] = (pulse[1:] != pulse[:-1]) | (np.diff(dist) >= scan.range_resolution_m)
+    new[1:] = (pulse[1:] != pulse[:-1]) | (np.diff(dist) >= resolution_m)
     ret = np.cumsum(new) - 1
-    n_ret = ret[-1] + 1 if len(ret) else 0
+    n_ret = int(ret[-1] + 1) if len(ret) else 0
     xyz = np.zeros((n_ret, 3))
     np.add.at(xyz, ret, loc)
-    xyz /= np.bincount(ret, minlength=n_ret)[:, None]
-    cls = np.asarray(face_class)[tri[new]]
+    xyz /= np.maximum(np.bincount(ret, minlength=n_ret), 1)[:, None]
+    cls = np.asarray(face_class)[tri[new]].astype(np.uint8)
     pulse_of = pulse[new]
     first = np.ones(n_ret, bool)
     first[1:] = pulse_of[1:] != pulse_of[:-1]
     number = np.arange(n_ret) - np.maximum.accumulate(np.where(first, np.arange(n_ret), 0)) + 1
-    keep = number <= scan.max_returns
-    xyz, cls, number, pulse_of = xyz[keep], cls[keep], number[keep], pulse_of[keep]
-    total = np.bincount(pulse_of, minlength=k)[pulse_of]
-    return ScanPoints(xyz, cls.astype(np.uint8), number.astype(np.uint8),
-                      total.astype(np.uint8))
+    total = np.bincount(pulse_of, minlength=pulses)[pulse_of]
+    return xyz, cls, number.astype(np.uint8), total.astype(np.uint8), pulse_of
 
 
 def ground_plane(lo: tuple[float, float], hi: tuple[float, float], margin: float = 50.0

@@ -28,7 +28,9 @@ NO_ID = 1e300
 @dataclass(frozen=True)
 class Tile:
     """A point cloud: ``xyz`` (n, 3) m, ASPRS ``classification``, ``return_number``,
-    ``number_of_returns``, ``extra`` dimensions by name, ``crs`` (WKT text or None)."""
+    ``number_of_returns``, ``extra`` dimensions by name, ``crs`` (WKT text or None), the
+    LAS ``point_source_id`` (flight line or scan position) and ``gps_time`` (s) of every
+    point (zeros when the file has none)."""
 
     path: Path
     xyz: np.ndarray
@@ -37,6 +39,8 @@ class Tile:
     number_of_returns: np.ndarray
     extra: dict[str, np.ndarray]
     crs: str | None
+    source_id: np.ndarray | None = None
+    gps_time: np.ndarray | None = None
 
     def __len__(self) -> int:
         return len(self.xyz)
@@ -59,7 +63,9 @@ class Tile:
         """The points where ``mask`` is true (same file, CRS)."""
         return Tile(self.path, self.xyz[mask], self.classification[mask],
                     self.return_number[mask], self.number_of_returns[mask],
-                    {k: v[mask] for k, v in self.extra.items()}, self.crs)
+                    {k: v[mask] for k, v in self.extra.items()}, self.crs,
+                    None if self.source_id is None else self.source_id[mask],
+                    None if self.gps_time is None else self.gps_time[mask])
 
 
 def _las(path: Path) -> Any:
@@ -108,7 +114,10 @@ def read_tile(path: str | Path) -> Tile:
     extra = {name: np.asarray(las[name]) for name in las.point_format.extra_dimension_names}
     tile = Tile(path, xyz, np.asarray(las.classification, np.uint8),
                 np.asarray(las.return_number, np.uint8),
-                np.asarray(las.number_of_returns, np.uint8), extra, crs_wkt(las))
+                np.asarray(las.number_of_returns, np.uint8), extra, crs_wkt(las),
+                np.asarray(las.point_source_id, np.int64),
+                np.asarray(las.gps_time, float) if "gps_time" in las.point_format.dimension_names
+                else np.zeros(n))
     check_metric(tile)
     return tile
 

@@ -22,7 +22,8 @@ def input_files(project) -> dict[str, str]:
                    ("epw", project.light.epw),
                    ("ground_reflectance", project.street.ground_reflectance_table),
                    ("photo", project.tree.perforated.photo), ("tree_photo", project.tree.photo),
-                   ("tree_points", project.tree.points), ("tree_voxels", project.tree.voxels)):
+                   ("tree_points", project.tree.points), ("tree_voxels", project.tree.voxels),
+                   ("tree_points_scans", project.tree.points_scans)):
         if p is not None:
             paths[key] = p
     return {k: f"{Path(v).name} sha256:{file_sha256(Path(v))}" for k, v in paths.items()

@@ -121,4 +121,5 @@ def write_scan(points: ScanPoints, out: str | Path, offset: tuple[float, float] 
     """The scan as LAS/LAZ, x, y shifted by ``offset`` (m)."""
     xyz = points.xyz + [offset[0], offset[1], 0.0]
     return write_points(out, xyz, points.classification, points.return_number,
-                        points.number_of_returns, crs=crs)
+                        points.number_of_returns, crs=crs, source_id=points.line,
+                        gps_time=points.time)
