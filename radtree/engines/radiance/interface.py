@@ -82,10 +82,8 @@ class RadianceEngine(Engine):
         plan.prototypes = {prototype_octree(p.stem): str(p.relative_to(folder))
                            for p in sorted((folder / "geometry" / "prototypes").glob("*.rad"))}
         for st in states:
-            files = []
-            ground = folder / "skies" / f"{st.label}_ground.rad"
-            if ground.exists():
-                files.append(str(ground.relative_to(folder)))
+            files = [f"skies/{st.label}_{what}.rad" for what in ("ground", "mist")
+                     if (folder / "skies" / f"{st.label}_{what}.rad").exists()]
             plan.hour_files[st.label] = files + geometry + [f"skies/{st.label}.sky"]
         return plan
 
