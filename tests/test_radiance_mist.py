@@ -52,43 +52,58 @@ def _crown(lad: float = 0.8, planes: np.ndarray | None = None) -> TurbidCrowns:
 
 
 def test_mist_text_is_radiance_mist():
-    assert mist_text("m", extinction=0.44, albedo=0.2909, eccentricity=0.0,
-                     sources=("sun",)) == "void mist m\n1 sun\n0\n7 0.44 0.44 0.44 0.2909 " \
-                                          "0.2909 0.2909 0\n"
+    assert mist_text("m", extinction=0.44, albedo=0.29091, eccentricity=0.0,
+                     sources=("sun",)) == "void mist m\n1 sun\n0\n7 0.44 0.44 0.44 0.29091 " \
+                                          "0.29091 0.29091 0\n"
     assert mist_text("m", extinction=1.23456789, albedo=0.0, eccentricity=0.0) == \
         "void mist m\n0\n0\n7 1.2346 1.2346 1.2346 0 0 0 0\n"
 
 
 def test_hour_mist_text_of_one_crown():
-    """Spherical leaves G = ½, u = 0.8, T_s = 0.45: σ = 0.8·½·0.55 = 0.22 /m at any sun;
-    absorbing by default; with scattering ω = 0.16/0.55 and the sun listed."""
-    media = _crown()
+    """Leaves at 30° (the reference street's slats), u = 1, T_s = 0.45: G(0) = (2/π) sin 30°,
+    G(μ) = μ cos 30° for μ ≥ sin 30° (Ross 1981). Default ("horizontal", "beam"): σ =
+    u·G(0)·0.55 and albedo 1 − G(μ_sun)/G(0) (the sun's shadow rays see σ at the sun), no
+    sources; "scatter": ω = 0.16/0.55 and the sun listed; no sun: albedo 0."""
+    kind = leaf_kind(Louvers(inclination_deg=30.0), "leaf")
+    media = TurbidCrowns.of(np.array([[0.0, 0.0, 5.0]]), 2.0, 2.0, 1.0, 0, [kind])
     mats = {"leaf": LEAF}
-    text = hour_mist_text(media, materials=mats, state=_sun(60.0), extinction="sun",
-                          scattering=False)
-    assert text == ("# turbid crowns as mist at 12:00: extinction 'sun', scattering off\n\n"
-                    "void mist crown_mist.0\n0\n0\n7 0.22 0.22 0.22 0 0 0 0\n")
-    text = hour_mist_text(media, materials=mats, state=_sun(60.0), extinction="mean",
-                          scattering=True)
+    g0, g1 = 2 / math.pi * 0.5, math.cos(math.radians(30.0))
+    sigma, albedo, _ = crown_mist(media, crown=0, leaf=LEAF, sun_mu=1.0,
+                                  extinction="horizontal", sun="beam")
+    assert sigma == pytest.approx(g0 * 0.55, rel=1e-6)
+    assert sigma * (1 - albedo) == pytest.approx(g1 * 0.55, rel=1e-6)
+    text = hour_mist_text(media, materials=mats, state=_sun(90.0), extinction="horizontal",
+                          sun="beam")
+    assert text == ("# turbid crowns as mist at 12:00: extinction 'horizontal', sun 'beam'\n\n"
+                    "void mist crown_mist.0\n0\n0\n7 0.17507 0.17507 0.17507 -1.7207 -1.7207 "
+                    "-1.7207 0\n")
+    text = hour_mist_text(media, materials=mats, state=_sun(90.0), extinction="sun",
+                          sun="scatter")
     assert text.splitlines()[1:] == ["", "void mist crown_mist.0", "1 sun", "0",
-                                     "7 0.22 0.22 0.22 0.2909 0.2909 0.2909 0"]
-    no_sun = hour_mist_text(media, materials=mats, state=_sun(60.0, dni=0.0), extinction="sun",
-                            scattering=True)
-    assert "void mist crown_mist.0\n0\n0\n7 0.22 0.22 0.22 0 0 0 0\n" in no_sun
+                                     "7 0.47631 0.47631 0.47631 0.29091 0.29091 0.29091 0"]
+    no_sun = hour_mist_text(media, materials=mats, state=_sun(60.0, dni=0.0),
+                            extinction="horizontal", sun="beam")
+    assert no_sun.endswith("void mist crown_mist.0\n0\n0\n7 0.17507 0.17507 0.17507 0 0 0 0\n")
 
 
-def test_extinction_at_the_sun_or_the_mean():
-    """Horizontal leaves (inclination 0): G(μ) = μ; σ at a 30° sun uses μ = ½, the mean ½."""
+def test_extinction_choices():
+    """Horizontal leaves (inclination 0): G(μ) = μ — σ at a 30° sun uses μ = ½, the mean ½,
+    the vertical receiver (4/π)∫μ√(1−μ²)dμ = 4/(3π), horizontal 0 (with "beam" floored at
+    10⁻³ of the sun's σ, the sun's own σ kept by the albedo)."""
     flat = leaf_kind(Louvers(inclination_deg=0.0), "leaf")
     media = TurbidCrowns.of(np.array([[0.0, 0.0, 5.0]]), 2.0, 2.0, 1.0, 0, [flat])
     leaf = Trans("leaf", 0.1, 0.1, 0.0)
-    s_sun, _, _ = crown_mist(media, crown=0, leaf=leaf, sun_mu=0.5, extinction="sun",
-                             scattering=False)
-    s_mean, _, _ = crown_mist(media, crown=0, leaf=leaf, sun_mu=0.9, extinction="mean",
-                              scattering=False)
-    assert s_sun == pytest.approx(0.5, abs=1e-3)
-    assert s_mean == pytest.approx(0.5, abs=1e-3) and mean_g(SPHERICAL) == pytest.approx(0.5,
-                                                                                      abs=1e-3)
+    want = {"sun": 0.5, "mean": 0.5, "vertical": 4 / (3 * math.pi), "horizontal": 0.0}
+    for extinction, value in want.items():
+        sigma, albedo, _ = crown_mist(media, crown=0, leaf=leaf, sun_mu=0.5,
+                                      extinction=extinction, sun="mist")
+        assert sigma == pytest.approx(value, abs=1e-3) and albedo == 0.0
+    sigma, albedo, _ = crown_mist(media, crown=0, leaf=leaf, sun_mu=0.5,
+                                  extinction="horizontal", sun="beam")
+    assert sigma == pytest.approx(5e-4, rel=1e-3) and sigma * (1 - albedo) == pytest.approx(0.5)
+    assert mean_g(SPHERICAL) == pytest.approx(0.5, abs=1e-3)
+    with pytest.raises(ValueError, match="mist extinction must be one of"):
+        crown_mist(media, crown=0, leaf=leaf, sun_mu=0.5, extinction="up", sun="beam")
 
 
 def test_leaf_asymmetry_analytic():
@@ -102,10 +117,10 @@ def test_leaf_asymmetry_analytic():
                                                                             rel=5e-3)
     fwd = Trans("leaf", 0.05, 0.45, 0.0)   # transmits more than it reflects: forward, g > 0
     _, albedo, g = crown_mist(_crown(), crown=0, leaf=fwd, sun_mu=1.0, extinction="sun",
-                              scattering=True)
+                              sun="scatter")
     assert albedo == pytest.approx(0.5) and g == pytest.approx(4 / 9 * 0.8, rel=5e-3)
     _, _, g_back = crown_mist(_crown(), crown=0, leaf=LEAF, sun_mu=1.0, extinction="sun",
-                              scattering=True)
+                              sun="scatter")
     assert g_back == 0.0   # backward g is written as 0 (Radiance scatters g ≤ 0 isotropically)
 
 
@@ -151,8 +166,9 @@ def test_write_build_writes_mist_per_hour(tmp_path):
     plan = write_build(_scene(_crown()), [_sun(60.0)], EngineParams(), 1, tmp_path / "b", None)
     assert plan.hour_files["1200"] == ["skies/1200_mist.rad", "geometry/crowns_mist.rad",
                                        "skies/1200.sky"]
+    # spherical leaves: G(μ_sun) = G(0) = ½ up to the tabulation (2·10⁻⁵)
     assert (tmp_path / "b" / "skies" / "1200_mist.rad").read_text().endswith(
-        "void mist crown_mist.0\n0\n0\n7 0.22 0.22 0.22 0 0 0 0\n")
+        "void mist crown_mist.0\n0\n0\n7 0.22 0.22 0.22 -2.2768e-05 -2.2768e-05 -2.2768e-05 0\n")
 
 
 def test_write_build_refuses_other_media(tmp_path):
@@ -187,8 +203,8 @@ def test_scattering_mist_shadow_rays_see_only_absorption():
     from radtree.engines.radiance.engine import trace_hour
     from radtree.engines.radiance.mist import volume_scale
 
-    lux = trace_hour(_scene(_crown()), _sun(90.0), EngineParams(ab=0, mist_scattering=True)
-                     )["s"].lux
+    lux = trace_hour(_scene(_crown()), _sun(90.0),
+                     EngineParams(ab=0, mist_extinction="sun", mist_sun="scatter"))["s"].lux
     omega = 0.16 / 0.55
     path = 4.0 * volume_scale()
     assert lux[0] == pytest.approx(1e5 * math.exp(-0.22 * (1 - omega) * path), rel=1e-4)
@@ -221,3 +237,32 @@ def test_turbid_city_runs_on_radiance(tmp_path):
     assert len(table) > 50 and (table["engine"] == "radiance").all()
     assert (table["lux"] > 0).all()
     assert (root / "build" / "trees" / "skies" / "1230_mist.rad").exists()
+
+
+@needs_radiance
+def test_beam_mist_sun_exact_sky_at_the_mist_sigma():
+    """Real rtrace, horizontal leaves: with sun "beam" the sun's shadow rays see σ_sun
+    (Beer–Lambert at the sun's μ, within 1 %), the sky's ambient rays the mist's σ (here the
+    vertical receiver's) — at the sensor beside the crown, whose sun misses it, the same
+    numbers as sun "mist" (fixed seed, identical rays): the albedo, negative at a high sun
+    (σ_sun > σ), acts on shadow rays only (raytrace.c rayparticipate)."""
+    from radtree.engines.radiance.engine import trace_hour
+    from radtree.engines.radiance.mist import volume_scale
+
+    flat = leaf_kind(Louvers(inclination_deg=0.0), "leaf")
+    media = TurbidCrowns.of(np.array([[0.0, 0.0, 5.0]]), 2.0, 2.0, 1.0, 0, [flat])
+    leaf = Trans("leaf", 0.1, 0.1, 0.5)
+    beam = EngineParams(ab=0, mist_extinction="vertical", mist_sun="beam")
+    sun = trace_hour(_scene(media, leaf), _sun(90.0), beam)["s"].lux
+    assert sun[0] == pytest.approx(1e5 * math.exp(-0.5 * 4.0 * volume_scale()), rel=0.01)
+    sky = SkyState("12:00", NOON, SunPosition(80.0, 0.0), 10000.0, sky_model="uniform",
+                   zenith_luminance=1000.0, ground_glow=False)
+    params = EngineParams(ab=1, ad=512, mist_extinction="vertical", mist_sun="beam")
+    beam_lux = trace_hour(_scene(media, leaf), sky, params)["s"].lux
+    mist_lux = trace_hour(_scene(media, leaf), sky, params.changed(mist_sun="mist"))["s"].lux
+    assert beam_lux[2] == pytest.approx(mist_lux[2], rel=1e-9)
+    assert beam_lux[0] < 0.9 * mist_lux[0]            # σ_sun > σ: the sun darker through it
+    assert " -1.3204 " in hour_mist_text(media, materials={"leaf": leaf}, state=sky,
+                                         extinction="vertical", sun="beam").splitlines()[-1]
+    open_sky = math.pi * 1000.0 + 10000.0 * math.sin(math.radians(80.0))
+    assert beam_lux[2] < 0.998 * open_sky             # the crown shades part of its sky

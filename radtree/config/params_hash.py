@@ -21,7 +21,7 @@ from radtree.fileio import file_sha256_cached
 #: the ``EngineParams`` fields only the Radiance photon map reads
 PMAP_KEYS = ("pmap_photons", "pmap_caustic_photons", "pmap_bandwidth")
 #: the ``EngineParams`` fields only Radiance's mist crowns read (turbid crowns)
-MIST_KEYS = ("mist_extinction", "mist_scattering")
+MIST_KEYS = ("mist_extinction", "mist_sun")
 #: the ``EngineParams`` fields only the forward engine reads
 FORWARD_KEYS = ("photons", "forward_threshold", "forward_splitting", "beam_diameter_m",
                 "patch_m", "forward_batches", "forward_focus_m", "forward_split",

@@ -65,6 +65,6 @@ def mist_text(name: str, *, extinction: float, albedo: float, eccentricity: floa
     significant digits),
     scattering albedo ω, Henyey–Greenstein g; ``sources``: the light sources scattered in the
     volume (:mod:`radtree.engines.radiance.mist`)."""
-    s, a = f"{extinction:.5g}", fmt(albedo)
+    s, a = f"{extinction:.5g}", f"{albedo:.5g}"
     src = " ".join([str(len(sources)), *sources])
     return f"void mist {name}\n{src}\n0\n7 {s} {s} {s} {a} {a} {a} {fmt(eccentricity)}\n"

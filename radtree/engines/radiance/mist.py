@@ -58,7 +58,7 @@ from functools import cache
 import numpy as np
 from scipy.spatial import ConvexHull
 
-from radtree.config.engine import MIST_EXTINCTION
+from radtree.config.engine import MIST_EXTINCTION, MIST_SUN
 from radtree.engines.radiance.materials import mist_text
 from radtree.engines.radiance.meshes import mesh_to_radiance
 from radtree.errors import EngineError
@@ -70,6 +70,8 @@ from radtree.scene import Mesh
 RINGS = 24        # latitude rings of the envelope (pole to pole)
 SEGMENTS = 48     # longitude segments (and points on each cut's ellipse)
 EXTINCTION_CHOICES = MIST_EXTINCTION
+SUN_CHOICES = MIST_SUN
+BEAM_FLOOR = 1e-3   # "beam": σ ≥ 10⁻³ σ_sun (horizontal leaves have G(0) = 0)
 SUN_SOURCE = "sun"   # the source's name in the hour's sky (radtree's and gendaylit's)
 
 
@@ -196,22 +198,44 @@ def mean_g(kind: LeafKind, *, nodes: int = 2000) -> float:
     return float(np.mean(kind.g(mu)))
 
 
-def crown_mist(media: TurbidCrowns, *, crown: int, leaf: Trans, sun_mu: float | None,
-               extinction: str, scattering: bool) -> tuple[float, float, float]:
-    """(σ per metre, albedo ω, HG g) of crown ``crown`` (module text). ``sun_mu``: |Ω_z| of
-    the hour's sun (None: no sun — σ from the mean, no scattering)."""
-    if extinction not in EXTINCTION_CHOICES:
-        raise ValueError(f"mist extinction must be one of {EXTINCTION_CHOICES}, got "
-                         f"{extinction!r}")
-    kind = media.kinds[int(media.kind[crown])]
+def vertical_g(kind: LeafKind, *, nodes: int = 2000) -> float:
+    """(4/π) ∫₀¹ G(μ)·Ω_c √(1 − μ²) dμ: G·Ω_c averaged over the directions a vertical
+    surface receives light from, cosine-weighted (direction at zenith angle θ, azimuth φ from
+    the surface normal: weight sin θ cos φ · sin θ dθ dφ, so μ = |cos θ| has the density
+    (2/π)√(1 − μ²) on [−1, 1]) — the paths that light a façade through a crown."""
+    mu = (np.arange(nodes) + 0.5) / nodes
+    w = np.sqrt(1.0 - mu * mu)
+    return float(np.sum(kind.g(mu) * w) / np.sum(w))
+
+
+def _g_eff(kind: LeafKind, *, extinction: str, sun_mu: float | None) -> float:
+    """G·Ω_c of the mist's one extinction (module text)."""
     if extinction == "sun" and sun_mu is not None:
-        g_eff = float(kind.g(np.array([sun_mu]))[0])
-    else:
-        g_eff = mean_g(kind)
+        return float(kind.g(np.array([sun_mu]))[0])
+    if extinction == "vertical":
+        return vertical_g(kind)
+    if extinction == "horizontal":
+        return float(kind.g(np.array([0.0]))[0])
+    return mean_g(kind)
+
+
+def crown_mist(media: TurbidCrowns, *, crown: int, leaf: Trans, sun_mu: float | None,
+               extinction: str, sun: str) -> tuple[float, float, float]:
+    """(σ per metre, albedo ω, HG g) of crown ``crown`` (module text). ``sun_mu``: |Ω_z| of
+    the hour's sun (None: no sun — no scattering, and ``"sun"`` takes the mean)."""
+    if extinction not in EXTINCTION_CHOICES or sun not in SUN_CHOICES:
+        raise ValueError(f"mist extinction must be one of {EXTINCTION_CHOICES} and sun one of "
+                         f"{SUN_CHOICES}, got {extinction!r}, {sun!r}")
+    kind = media.kinds[int(media.kind[crown])]
     pass_ = 1.0 - leaf.specular_transmittance
-    sigma = float(media.lad[crown]) * g_eff * pass_
-    if not scattering or sun_mu is None or pass_ <= 0:
+    u = float(media.lad[crown])
+    sigma = u * _g_eff(kind, extinction=extinction, sun_mu=sun_mu) * pass_
+    if sun_mu is None or pass_ <= 0 or sun == "mist":
         return sigma, 0.0, 0.0
+    if sun == "beam":     # shadow rays: σ(1 − ω) = σ at the sun's μ
+        at_sun = u * float(kind.g(np.array([sun_mu]))[0]) * pass_
+        sigma = max(sigma, BEAM_FLOOR * at_sun)
+        return sigma, 1.0 - at_sun / sigma, 0.0
     albedo = (leaf.reflectance + leaf.diffuse_transmittance) / pass_
     return sigma, albedo, max(0.0, leaf_asymmetry(kind, leaf=leaf, mu=sun_mu))
 
@@ -229,20 +253,20 @@ def mist_geometry_text(media: TurbidCrowns) -> str:
 
 
 def hour_mist_text(media: TurbidCrowns, *, materials: Mapping[str, Material], state: SkyState,
-                   extinction: str, scattering: bool) -> str:
+                   extinction: str, sun: str) -> str:
     """``skies/<HHMM>_mist.rad``: each crown's mist (:func:`crown_mist`) at this hour."""
-    sun = state.direct_normal_lux > 0 and state.sun.above_horizon
-    sun_mu = abs(float(state.sun.vector[2])) if sun else None
+    lit = state.direct_normal_lux > 0 and state.sun.above_horizon
+    sun_mu = abs(float(state.sun.vector[2])) if lit else None
     out = [f"# turbid crowns as mist at {state.time}: extinction {extinction!r}, "
-           f"scattering {'on' if scattering else 'off'}\n"]
+           f"sun {sun!r}\n"]
     for i in range(len(media)):
         leaf = materials[media.kinds[int(media.kind[i])].material]
         if not isinstance(leaf, Trans):
             raise EngineError(f"turbid crowns: leaf material '{leaf.name}' must be a trans "
                               f"material, got {type(leaf).__name__}")
         sigma, albedo, g = crown_mist(media, crown=i, leaf=leaf, sun_mu=sun_mu,
-                                      extinction=extinction, scattering=scattering)
-        sources = (SUN_SOURCE,) if albedo > 0 else ()
+                                      extinction=extinction, sun=sun)
+        sources = (SUN_SOURCE,) if sun == "scatter" and albedo > 0 else ()
         out.append(mist_text(mist_name(i), extinction=sigma, albedo=albedo, eccentricity=g,
                              sources=sources))
     return "\n".join(out)

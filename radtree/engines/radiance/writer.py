@@ -243,7 +243,7 @@ def _write_hours(scene: Scene, *, states: list[SkyState], folder: Path,
             _write(folder / rel, hour_mist_text(
                 scene.media, materials=scene.materials, state=st,
                 extinction=params.radiance.mist_extinction,
-                scattering=params.radiance.mist_scattering))
+                sun=params.radiance.mist_sun))
             files.append(rel)
         files += geometry_files
         rel_sky = f"skies/{st.label}.sky"

@@ -1,0 +1,181 @@
+"""Radiance ``mist`` crowns against the NumPy engine's turbid crowns (issue 43, item 1).
+
+The same turbid scene (``[tree] representation = "turbid"``, :mod:`radtree.trees.turbid`)
+traced by the NumPy engine — free paths through the medium, every leaf event (bi-Lambertian
+R, T_d about leaf normals drawn from the leaf angle distribution), the reference — and by
+Radiance with the crowns as ``mist`` volumes (:mod:`radtree.engines.radiance.mist`), in the
+variants of ``engine.mist_extinction`` / ``engine.mist_scattering``:
+
+* ``sun/absorb`` (the default): σ = u·G(μ_sun)·Ω_c·(1 − T_s), albedo 0;
+* ``mean/absorb``: σ with the mean G·Ω_c over all directions, albedo 0;
+* ``sun/scatter``: σ at the sun, albedo (R + T_d)/(1 − T_s), the sun scattered (Radiance's
+  shadow rays then see exp(−σ(1 − ω)L)).
+
+Cases: the reference street's free crown row (examples/mendoza-street, scenario F, Perez sky,
+façade circle of 8 sensors) and examples/office-block scenario "with" (façade and work plane),
+every hour of the project. Printed per hour and grid: the NumPy mean ± s.e. (its paths), each
+Radiance variant's mean ± s.e. (``--repeats`` independent ``rtrace -u+`` runs) and the
+difference Radiance − NumPy in % ± the combined s.e.; then the day's mean difference.
+
+Measured 2026-12-07 (see the figures below, with rays, -ab and load).
+
+Run: ``.venv/bin/python benchmarks/turbid_radiance.py [--cases street office] [--rays 2048]
+[--repeats 4] [--ad 1024] [--variants sun/absorb mean/absorb sun/scatter]``.
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+import sys
+import tempfile
+import time
+from dataclasses import replace
+from pathlib import Path
+
+import numpy as np
+
+HERE = Path(__file__).resolve().parent
+ROOT = HERE.parent
+sys.path.insert(0, str(ROOT))
+
+from radtree.config import effective_project, load_project  # noqa: E402
+from radtree.config.engine import MIST_EXTINCTION, MIST_SUN  # noqa: E402
+from radtree.engines.numpy.tracing import trace_states  # noqa: E402
+from radtree.engines.radiance.binaries import find_radiance, run  # noqa: E402
+from radtree.engines.radiance.engine import read_rgb_as_lux, run_hour  # noqa: E402
+from radtree.engines.radiance.writer import write_build  # noqa: E402
+from radtree.light.hours import hour_states  # noqa: E402
+from radtree.optics import Trans  # noqa: E402
+from radtree.pipeline.assemble import make_scene  # noqa: E402
+
+CASES = {"street": (ROOT / "examples" / "mendoza-street", "F"),
+         "office": (ROOT / "examples" / "office-block", "with")}
+VARIANTS = {f"{e}/{s}": (e, s) for e in MIST_EXTINCTION for s in MIST_SUN}
+
+
+def load_case(case: str):
+    """(scene, states, engine params, -ab) of a case with turbid crowns."""
+    project, scenario = CASES[case]
+    proj = load_project(project, overrides={"tree.representation": "turbid",
+                                            "sensors.dense_grid": False})
+    sc = proj.scenario(scenario)
+    built = make_scene(proj, sc, dense_grid=False)
+    return built.scene, hour_states(proj, sc), effective_project(proj, sc).engine, built.ab
+
+
+def uncollided(scene) -> None:
+    """Black leaves of the same σ (R = T_d = 0, T_s kept): the NumPy engine then traces only
+    the light that meets no deflecting leaf — what an absorbing mist can hold."""
+    for kind in scene.media.kinds:
+        leaf = scene.materials[kind.material]
+        scene.materials[kind.material] = Trans(leaf.name, 0.0, 0.0,
+                                               max(leaf.specular_transmittance, 1e-9))
+
+
+def numpy_means(scene, states, engine, ab: int, rays: int) -> dict:
+    """{(hour, grid): (mean lx, s.e.)} of the NumPy engine."""
+    params = replace(engine, rays=rays, max_bounces=ab, workers=2)
+    out = {}
+    for st, res in zip(states, trace_states(scene, states, params, seed=1), strict=True):
+        for g, gr in res.items():
+            se = (float(np.sqrt(np.sum(gr.stderr ** 2)) / len(gr.lux))
+                  if gr.stderr is not None else 0.0)
+            out[(st.time, g)] = (float(gr.lux.mean()), se)
+    return out
+
+
+def _next_second() -> None:
+    """Wait for the next whole second: ``rtrace -u+`` seeds its generator with time(0)
+    (src/rt/rtmain.c), so two runs started within one second draw the same numbers."""
+    global _LAST
+    now = time.time()
+    if int(now) == _LAST:
+        time.sleep(math.ceil(now) - now + 0.01)
+    _LAST = int(time.time())
+
+
+_LAST = -1
+
+
+def radiance_means(scene, states, engine, ab: int, *, variant: str, repeats: int) -> dict:
+    """{(hour, grid): (mean lx, s.e. over ``repeats`` rtrace -u+ runs)} of one mist variant."""
+    extinction, sun = VARIANTS[variant]
+    params = replace(engine, mist_extinction=extinction, mist_sun=sun)
+    out = {}
+    with tempfile.TemporaryDirectory(prefix="radtree-mist-") as tmp:
+        folder = Path(tmp)
+        plan = write_build(scene, states, params, ab, folder, find_radiance())
+        for st in states:
+            run_hour(plan, st.label, grids=[])  # octree
+            for g in plan.grids:
+                pts = (folder / "grids" / f"{g}.pts").read_bytes()
+                opts = ["-u+" if o == "-u-" else o for o in plan.grid_opts.get(g, plan.rtrace_opts)]
+                means = []
+                for _ in range(repeats):
+                    _next_second()
+                    dst = folder / "results" / "bench.rgb"
+                    dst.parent.mkdir(exist_ok=True)
+                    run(["rtrace", *opts, f"octrees/{st.label}.oct"], stdin=pts, cwd=folder,
+                        stdout_path=dst)
+                    means.append(float(read_rgb_as_lux(dst, expected=None).mean()))
+                m = np.array(means)
+                out[(st.time, g)] = (float(m.mean()), float(m.std(ddof=1) / math.sqrt(len(m))))
+    return out
+
+
+def compare(case: str, *, rays: int, repeats: int, ad: int, variants: list[str]) -> None:
+    scene, states, engine, ab = load_case(case)
+    engine = replace(engine, ad=ad)
+    t0 = time.perf_counter()
+    ref = numpy_means(scene, states, engine, ab, rays)
+    t_np = time.perf_counter() - t0
+    print(f"\n== {case}: {CASES[case][0].name} scenario {CASES[case][1]}, {len(scene.media)} "
+          f"turbid crowns, -ab {ab}; numpy {rays} paths/sensor ({t_np:.0f} s); radiance -ad "
+          f"{ad} -as 0 -aa 0 -lw {engine.radiance.lw:g}, {repeats} × rtrace -u+")
+    rad = {}
+    for v in variants:
+        t0 = time.perf_counter()
+        rad[v] = radiance_means(scene, states, engine, ab, variant=v, repeats=repeats)
+        print(f"  radiance {v}: {time.perf_counter() - t0:.0f} s")
+    head = f"  {'hour':6s} {'grid':11s} {'numpy lx':>14s}"
+    for v in variants:
+        head += f" | {v:>11s} lx {'diff %':>14s}"
+    print(head)
+    diffs: dict[tuple[str, str], list[tuple[float, float]]] = {}
+    for key in sorted(ref):
+        m0, s0 = ref[key]
+        line = f"  {key[0]:6s} {key[1]:11s} {m0:8.0f} ±{s0:5.0f}"
+        for v in variants:
+            m1, s1 = rad[v][key]
+            d = 100.0 * (m1 / m0 - 1.0)
+            se = 100.0 * (m1 / m0) * math.hypot(s0 / m0, s1 / m1)
+            diffs.setdefault((v, key[1]), []).append((d, se))
+            line += f" | {m1:8.0f} ±{s1:5.0f} {d:+7.1f} ±{se:4.1f}"
+        print(line)
+    for (v, g), ds in sorted(diffs.items()):
+        d = np.array([x[0] for x in ds])
+        se = math.sqrt(sum(x[1] ** 2 for x in ds)) / len(ds)
+        print(f"  {v:11s} {g:11s}: mean difference {d.mean():+.1f} ± {se:.1f} % "
+              f"(hours {d.min():+.1f} … {d.max():+.1f} %)")
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--cases", nargs="+", default=list(CASES), choices=list(CASES))
+    ap.add_argument("--rays", type=int, default=2048)
+    ap.add_argument("--repeats", type=int, default=4)
+    ap.add_argument("--ad", type=int, default=1024)
+    ap.add_argument("--variants", nargs="+", default=list(VARIANTS), choices=list(VARIANTS))
+    args = ap.parse_args()
+    if find_radiance() is None:
+        raise SystemExit("Radiance not found")
+    for case in args.cases:
+        compare(case, rays=args.rays, repeats=args.repeats, ad=args.ad, variants=args.variants)
+
+
+if __name__ == "__main__":
+    from _common import print_resources_at_exit
+
+    print_resources_at_exit()
+    main()
