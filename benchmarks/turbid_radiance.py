@@ -52,6 +52,8 @@ from radtree.pipeline.assemble import make_scene  # noqa: E402
 CASES = {"street": (ROOT / "examples" / "mendoza-street", "F"),
          "office": (ROOT / "examples" / "office-block", "with")}
 VARIANTS = {f"{e}/{s}": (e, s) for e in MIST_EXTINCTION for s in MIST_SUN}
+DEFAULT_VARIANTS = ["horizontal/beam", "vertical/beam", "mean/beam", "sun/mist", "mean/mist",
+                    "sun/scatter"]
 
 
 def load_case(case: str):
@@ -124,49 +126,65 @@ def radiance_means(scene, states, engine, ab: int, *, variant: str, repeats: int
     return out
 
 
+def _diff(m1: float, s1: float, m0: float, s0: float) -> tuple[float, float]:
+    """(m1/m0 − 1, its s.e.) in %."""
+    return 100.0 * (m1 / m0 - 1.0), 100.0 * (m1 / m0) * math.hypot(s0 / m0, s1 / m1)
+
+
 def compare(case: str, *, rays: int, repeats: int, ad: int, variants: list[str]) -> None:
     scene, states, engine, ab = load_case(case)
     engine = replace(engine, ad=ad)
     t0 = time.perf_counter()
     ref = numpy_means(scene, states, engine, ab, rays)
+    black, _, _, _ = load_case(case)
+    uncollided(black)
+    unc = numpy_means(black, states, engine, ab, rays)
     t_np = time.perf_counter() - t0
     print(f"\n== {case}: {CASES[case][0].name} scenario {CASES[case][1]}, {len(scene.media)} "
-          f"turbid crowns, -ab {ab}; numpy {rays} paths/sensor ({t_np:.0f} s); radiance -ad "
-          f"{ad} -as 0 -aa 0 -lw {engine.radiance.lw:g}, {repeats} × rtrace -u+")
+          f"turbid crowns, -ab {ab}; numpy {rays} paths/sensor (full and uncollided: "
+          f"{t_np:.0f} s); radiance -ad {ad} -as 0 -aa 0 -lw {engine.radiance.lw:g}, "
+          f"{repeats} × rtrace -u+")
     rad = {}
     for v in variants:
         t0 = time.perf_counter()
         rad[v] = radiance_means(scene, states, engine, ab, variant=v, repeats=repeats)
         print(f"  radiance {v}: {time.perf_counter() - t0:.0f} s")
-    head = f"  {'hour':6s} {'grid':11s} {'numpy lx':>14s}"
-    for v in variants:
-        head += f" | {v:>11s} lx {'diff %':>14s}"
-    print(head)
-    diffs: dict[tuple[str, str], list[tuple[float, float]]] = {}
+    print(f"  {'hour':6s} {'grid':10s} {'numpy full':>13s} {'uncollided':>13s}  "
+          + "  ".join(f"{v + ': lx, vs full, vs uncoll. %':>40s}" for v in variants))
+    diffs: dict[tuple[str, str], list[tuple[float, float, float, float]]] = {}
     for key in sorted(ref):
-        m0, s0 = ref[key]
-        line = f"  {key[0]:6s} {key[1]:11s} {m0:8.0f} ±{s0:5.0f}"
+        (m0, s0), (mu, su) = ref[key], unc[key]
+        line = f"  {key[0]:6s} {key[1]:10s} {m0:7.0f} ±{s0:4.0f} {mu:7.0f} ±{su:4.0f} "
         for v in variants:
             m1, s1 = rad[v][key]
-            d = 100.0 * (m1 / m0 - 1.0)
-            se = 100.0 * (m1 / m0) * math.hypot(s0 / m0, s1 / m1)
-            diffs.setdefault((v, key[1]), []).append((d, se))
-            line += f" | {m1:8.0f} ±{s1:5.0f} {d:+7.1f} ±{se:4.1f}"
+            d, se = _diff(m1, s1, m0, s0)
+            du, seu = _diff(m1, s1, mu, su)
+            diffs.setdefault((v, key[1]), []).append((d, se, du, seu))
+            line += f" {m1:7.0f} ±{s1:4.0f} {d:+6.1f} ±{se:3.1f} {du:+6.1f} ±{seu:3.1f}"
         print(line)
+    share = {}
+    for key in ref:
+        share.setdefault(key[1], []).append(100.0 * (1.0 - unc[key][0] / ref[key][0]))
+    for g, sh in sorted(share.items()):
+        print(f"  leaf-scattered share of the NumPy {g} light: {np.mean(sh):.1f} % "
+              f"(hours {min(sh):.1f} … {max(sh):.1f} %)")
     for (v, g), ds in sorted(diffs.items()):
-        d = np.array([x[0] for x in ds])
-        se = math.sqrt(sum(x[1] ** 2 for x in ds)) / len(ds)
-        print(f"  {v:11s} {g:11s}: mean difference {d.mean():+.1f} ± {se:.1f} % "
-              f"(hours {d.min():+.1f} … {d.max():+.1f} %)")
+        a = np.array(ds)
+        se = math.sqrt(float(np.sum(a[:, 1] ** 2))) / len(a)
+        seu = math.sqrt(float(np.sum(a[:, 3] ** 2))) / len(a)
+        print(f"  {v:17s} {g:10s}: vs full {a[:, 0].mean():+.1f} ± {se:.1f} % (hours "
+              f"{a[:, 0].min():+.1f} … {a[:, 0].max():+.1f}); vs uncollided "
+              f"{a[:, 2].mean():+.1f} ± {seu:.1f} % ({a[:, 2].min():+.1f} … "
+              f"{a[:, 2].max():+.1f})")
 
 
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--cases", nargs="+", default=list(CASES), choices=list(CASES))
-    ap.add_argument("--rays", type=int, default=2048)
+    ap.add_argument("--rays", type=int, default=4096)
     ap.add_argument("--repeats", type=int, default=4)
-    ap.add_argument("--ad", type=int, default=1024)
-    ap.add_argument("--variants", nargs="+", default=list(VARIANTS), choices=list(VARIANTS))
+    ap.add_argument("--ad", type=int, default=2048)
+    ap.add_argument("--variants", nargs="+", default=DEFAULT_VARIANTS, choices=list(VARIANTS))
     args = ap.parse_args()
     if find_radiance() is None:
         raise SystemExit("Radiance not found")

@@ -9,6 +9,7 @@ from radtree.engines.base import Engine, GridResult
 from radtree.engines.radiance.binaries import find_radiance, require_radiance
 from radtree.engines.radiance.binaries import version as radiance_version
 from radtree.engines.radiance.engine import hour_commands, run_hour
+from radtree.engines.radiance.mist import mist_params
 from radtree.engines.radiance.pmap import PhotonMap
 from radtree.engines.radiance.writer import (
     BuildPlan,
@@ -70,6 +71,7 @@ class RadianceEngine(Engine):
             raise ValueError("the Radiance engine needs a folder to write its build into")
         if not (folder / "manifest.json").exists():
             return write_build(scene, states, params, ab, folder, require_radiance())
+        params = mist_params(params, scene.media, scene.materials)
         plan = BuildPlan(folder=folder, hours=[s.label for s in states], grids=list(scene.grids),
                          scene_files=["materials.rad"], hour_files={},
                          rtrace_opts=rtrace_options(params, ab),

@@ -34,7 +34,7 @@ from radtree.engines.radiance.meshes import (
     obj2mesh_command,
     write_obj,
 )
-from radtree.engines.radiance.mist import hour_mist_text, mist_geometry_text
+from radtree.engines.radiance.mist import hour_mist_text, mist_geometry_text, mist_params
 from radtree.engines.radiance.pmap import FINAL_GATHER_AB, PhotonMap
 from radtree.engines.radiance.sky import ANALYTIC_SKY_CAL, sky_text
 from radtree.errors import EngineError
@@ -162,6 +162,7 @@ def write_build(scene: Scene, states: list[SkyState], params: EngineParams, ab: 
     ``hour_grids`` maps an hour label (HHMM) to the grids the Makefile traces then (default:
     every grid at every hour)."""
     _check_media(scene)
+    params = mist_params(params, scene.media, scene.materials)
     folder.mkdir(parents=True, exist_ok=True)
     (folder / "geometry").mkdir(exist_ok=True)
     (folder / "grids").mkdir(exist_ok=True)
