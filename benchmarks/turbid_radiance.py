@@ -44,6 +44,7 @@ from radtree.config.engine import MIST_EXTINCTION, MIST_SUN  # noqa: E402
 from radtree.engines.numpy.tracing import trace_states  # noqa: E402
 from radtree.engines.radiance.binaries import find_radiance, run  # noqa: E402
 from radtree.engines.radiance.engine import read_rgb_as_lux, run_hour  # noqa: E402
+from radtree.engines.radiance.mist import mist_params  # noqa: E402
 from radtree.engines.radiance.writer import write_build  # noqa: E402
 from radtree.light.hours import hour_states  # noqa: E402
 from radtree.optics import Trans  # noqa: E402
@@ -142,7 +143,8 @@ def compare(case: str, *, rays: int, repeats: int, ad: int, variants: list[str])
     t_np = time.perf_counter() - t0
     print(f"\n== {case}: {CASES[case][0].name} scenario {CASES[case][1]}, {len(scene.media)} "
           f"turbid crowns, -ab {ab}; numpy {rays} paths/sensor (full and uncollided: "
-          f"{t_np:.0f} s); radiance -ad {ad} -as 0 -aa 0 -lw {engine.radiance.lw:g}, "
+          f"{t_np:.0f} s); radiance -ad {ad} -as 0 -aa 0 -lw {engine.radiance.lw:g} (× "
+          f"exp(−τ_max) = {mist_params(engine, scene.media, scene.materials).radiance.lw:.3g}), "
           f"{repeats} × rtrace -u+")
     rad = {}
     for v in variants:
@@ -162,7 +164,7 @@ def compare(case: str, *, rays: int, repeats: int, ad: int, variants: list[str])
             diffs.setdefault((v, key[1]), []).append((d, se, du, seu))
             line += f" {m1:7.0f} ±{s1:4.0f} {d:+6.1f} ±{se:3.1f} {du:+6.1f} ±{seu:3.1f}"
         print(line)
-    share = {}
+    share: dict[str, list[float]] = {}
     for key in ref:
         share.setdefault(key[1], []).append(100.0 * (1.0 - unc[key][0] / ref[key][0]))
     for g, sh in sorted(share.items()):

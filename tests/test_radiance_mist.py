@@ -273,8 +273,12 @@ def test_mist_params_lower_lw_by_the_thickest_crown():
     from radtree.engines.radiance.mist import max_optical_depth, mist_params
 
     media = _crown()
-    tau = max_optical_depth(media, {"leaf": LEAF})
+    tau = max_optical_depth(media, {"leaf": LEAF}, extinction="horizontal")
     assert tau == pytest.approx(0.88, rel=1e-3)
+    flat = TurbidCrowns.of(np.array([[0.0, 0.0, 5.0]]), 2.0, 2.0, 1.0, 0,
+                           [leaf_kind(Louvers(inclination_deg=0.0), "leaf")])
+    assert max_optical_depth(flat, {"leaf": LEAF}, extinction="sun") == pytest.approx(2.2)
+    assert max_optical_depth(flat, {"leaf": LEAF}, extinction="horizontal") == 0.0
     p = mist_params(EngineParams(lw=0.001, dense_lw=0.01), media, {"leaf": LEAF})
     assert p.radiance.lw == pytest.approx(0.001 * math.exp(-tau))
     assert p.radiance.dense_lw == pytest.approx(0.01 * math.exp(-tau))

@@ -20,6 +20,7 @@ import math
 import numpy as np
 
 from radtree.config import EngineParams, Louvers
+from radtree.engines.radiance.engine import ENGINE_NAME
 from radtree.light.sky import SkyState
 from radtree.light.sun import SunPosition, local_datetime
 from radtree.media import TurbidCrowns
@@ -30,7 +31,7 @@ from radtree.verify.checks import Check
 
 log = logging.getLogger(__name__)
 
-ENGINE = "radiance"
+ENGINE = ENGINE_NAME   # the Radiance engine's registered name
 RADIUS = 2.0
 CENTRE = np.array([0.0, 0.0, 3.0])
 DNI = 100000.0

@@ -286,15 +286,19 @@ def hour_mist_text(media: TurbidCrowns, *, materials: Mapping[str, Material], st
     return "\n".join(out)
 
 
-def max_optical_depth(media: TurbidCrowns, materials: Mapping[str, Material]) -> float:
-    """An upper bound of σ·L across any crown: u · max G·Ω_c · (1 − T_s) · 2·max(a, b)."""
+def max_optical_depth(media: TurbidCrowns, materials: Mapping[str, Material], *,
+                      extinction: str) -> float:
+    """An upper bound of σ·L across one crown for the mists ``extinction`` writes: u · G·Ω_c
+    of that choice (``"sun"``: the largest over μ) · (1 − T_s) · 2·max(a, b)."""
     tau = 0.0
     for i in range(len(media)):
         kind = media.kinds[int(media.kind[i])]
         leaf = materials.get(kind.material)
         ts = leaf.specular_transmittance if isinstance(leaf, Trans) else 0.0
-        tau = max(tau, float(media.lad[i]) * float(np.max(kind.g_eff)) * (1.0 - ts)
-                  * 2.0 * float(max(media.a[i], media.b[i])))
+        g = (float(np.max(kind.g_eff)) if extinction == "sun"
+             else _g_eff(kind, extinction=extinction, sun_mu=None))
+        tau = max(tau, float(media.lad[i]) * g * (1.0 - ts) * 2.0 * float(max(media.a[i],
+                                                                               media.b[i])))
     return tau
 
 
@@ -306,9 +310,11 @@ def mist_params(params: EngineParams, media: TurbidCrowns | None,
     with no Russian roulette (``rayorigin`` with no coefficient, ``m_mist.c``): at ``-lw
     0.001`` an ambient sample of ``-ad 2048`` (weight ≈ 1/800) lost every path that crossed
     more than τ ≈ 0.2 of a crown — the reference street's façade read 95 % low. Scaled, a ray
-    alive before a crown is alive after it; the roulette elsewhere keeps its expectation."""
+    alive before a crown is alive after it (after two crowns in a row it may still be cut);
+    the roulette elsewhere keeps its expectation."""
     if media is None or not len(media):
         return params
-    f = math.exp(-max_optical_depth(media, materials))
+    f = math.exp(-max_optical_depth(media, materials,
+                                    extinction=params.radiance.mist_extinction))
     r = params.radiance
     return params.changed(lw=r.lw * f, dense_lw=None if r.dense_lw is None else r.dense_lw * f)
