@@ -17,7 +17,59 @@ every hour of the project. Printed per hour and grid: the NumPy mean ± s.e. (it
 Radiance variant's mean ± s.e. (``--repeats`` independent ``rtrace -u+`` runs) and the
 difference Radiance − NumPy in % ± the combined s.e.; then the day's mean difference.
 
-Measured 2026-12-07 (see the figures below, with rays, -ab and load).
+Measured 2026-12-07 09:07–09:45 UTC on the 2-core machine shared with other sessions (load
+average 6–10), NumPy 4096 paths/sensor (stratified), Radiance ``-ab 6 -ad 2048 -as 0 -aa 0``
+with ``-lw`` × exp(−τ_max) (street: the bound of the largest G, 1.7·10⁻⁷; later lowered only
+by the written σ — the same expectation), 4 repeats. "Uncollided": the NumPy engine with black
+leaves of the same σ (R = T_d = 0), the light a mist can hold.
+
+Street F (3 crowns, 8 façade sensors), façade, lx and Radiance − NumPy in % (± s.e.):
+
+    hour   NumPy full  uncollided | horizontal/beam (default)   | vertical/beam | sun/mist | sun/scatter
+    10:30  1031 ± 14   659 ± 14   |  869  −15.7 ± 1.2  +31.9     |  487  −52.8   |  238 −76.9 |  583 −43.5
+    11:30  1248 ± 14   820 ± 15   | 1100  −11.8 ± 1.0  +34.1     |  629  −49.6   |  237 −81.0 |  703 −43.7
+    12:30  1304 ± 20   881 ± 19   | 1247   −4.4 ± 1.5  +41.5     |  708  −45.7   |  200 −84.7 |  558 −57.2
+    13:30  1376 ± 19   927 ± 19   | 1321   −4.0 ± 1.4  +42.6     |  748  −45.6   |  190 −86.2 |  509 −63.0
+    14:30  1340 ± 18   919 ± 16   | 1263   −5.8 ± 1.2  +37.4     |  714  −46.7   |  195 −85.4 |  543 −59.5
+    15:30  1233 ± 15   816 ± 15   | 1113   −9.8 ± 1.1  +36.3     |  638  −48.2   |  230 −81.4 |  682 −44.7
+    16:30  1082 ± 13   699 ± 13   |  918  −15.2 ± 1.1  +31.3     |  526  −51.4   |  254 −76.6 |  669 −38.1
+    day mean vs full              |  −9.5 ± 0.5 %               |  −48.6 ± 0.3  |  −81.7    |  −50.0
+    day mean vs uncollided        | +36.5 ± 1.0 %               |  −22.4 ± 0.6  |  −72.3    |  −24.2
+
+(mean/beam −57.5 / −35.9 %, mean/mist −31.5 / +2.9 % but −55 … −19 % by hour.) The leaves
+scatter 33.7 % of the NumPy façade light (31–36 % by hour), which no mist carries; the
+default's horizontal σ lets the sky and the street's reflections through more easily than the
+tilted leaves do (+37 % on the uncollided light) and so lands −4 … −16 % of the full light.
+Radiance 27–30 s per variant (7 hours × 4 repeats, the repeats a second apart: ``-u+``
+seeds from time(0)).
+
+Office "with" (3 crowns; façade 30 sensors, work plane 40), Radiance 170–230 s per variant,
+NumPy full and uncollided 37 s (09:25–09:44, load 5–6):
+
+    hour   façade: full uncoll.| default        | vertical/beam| sun/scatter | work plane: full uncoll.| default
+    10:30  1031 ± 7   518 ± 6  |  657  −36.2 %  |  396  −61.6  |  793  −23.1 |  107 ± 2   44 ± 1  |  60  −44.1 %
+    11:30  1224 ± 8   639 ± 7  |  829  −32.2 %  |  510  −58.4  | 1091  −10.8 |  129 ± 2   56 ± 1  |  77  −40.6 %
+    12:30  1348 ± 9   729 ± 8  |  964  −28.5 %  |  595  −55.8  |  933  −30.8 |  148 ± 2   69 ± 2  |  93  −37.0 %
+    13:30  1456 ± 10  795 ± 9  | 1036  −28.9 %  |  641  −55.9  |  873  −40.0 |  154 ± 3   74 ± 2  | 101  −34.1 %
+    14:30  1387 ± 9   751 ± 7  |  978  −29.5 %  |  604  −56.5  |  914  −34.1 |  140 ± 2   68 ± 2  |  94  −32.6 %
+    15:30  1249 ± 8   658 ± 7  |  849  −32.1 %  |  521  −58.3  | 1075  −14.0 |  128 ± 2   57 ± 2  |  79  −37.9 %
+    16:30  1066 ± 7   541 ± 6  |  682  −36.1 %  |  415  −61.0  |  868  −18.6 |  112 ± 2   46 ± 1  |  62  −45.1 %
+
+Day means, Radiance vs NumPy full / vs uncollided (± s.e. ≤ 0.4 / 1.4 %):
+
+    variant                 façade              work plane
+    horizontal/beam (def.)  −31.9 / +29.2 %     −38.8 / +36.5 %
+    vertical/beam           −58.2 / −20.7 %     −64.1 / −20.1 %
+    mean/mist               −53.3 / −11.7 %     −68.1 / −29.1 %
+    sun/mist                −78.5 / −59.1 %     −83.5 / −62.9 %
+    sun/scatter             −24.5 / +43.9 %     −40.2 / +35.9 %  (hours −58 … −11 %)
+
+The leaves scatter 47 % of the office façade light and 55 % of the work plane's (T_d = 0.25:
+albedo 0.48), which no mist carries: the default reads 4–16 % below the NumPy turbid crown
+on the street and 29–45 % below it at the office, every hour. The scattered sun (``sun/scatter``) is closer on the office day
+mean but swings from −58 to −11 % by hour, because Radiance then lets the sun's shadow rays
+through the scattered share as well (+44 % on the uncollided light) — right for the wrong
+reason; the default holds the sun's beam exactly and errs by the same sign every hour.
 
 Run: ``.venv/bin/python benchmarks/turbid_radiance.py [--cases street office] [--rays 2048]
 [--repeats 4] [--ad 1024] [--variants sun/absorb mean/absorb sun/scatter]``.

@@ -31,9 +31,9 @@ The NumPy and forward engines trace media (:mod:`radtree.engines.common.turbid`)
 scattering included; the Radiance engine writes each crown as a ``mist`` volume
 (:mod:`radtree.engines.radiance.mist`): the same extinction along one direction and the sun's
 exact uncollided beam, but no leaf-scattered light (Radiance's mist scatters only light
-sources and lets their shadow rays through the scattered share) — on the reference street and
-the office example its façade light is the NumPy engine's uncollided light within a few tens
-of % and below the full light by the leaf-scattered share (``benchmarks/turbid_radiance.py``).
+sources and lets their shadow rays through the scattered share) — its façade light is below
+the NumPy engine's by 4–16 % on the reference street and 29–36 % at the office example, most
+of it the leaf-scattered share (``benchmarks/turbid_radiance.py``).
 """
 
 from __future__ import annotations
