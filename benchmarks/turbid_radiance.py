@@ -4,18 +4,19 @@ The same turbid scene (``[tree] representation = "turbid"``, :mod:`radtree.trees
 traced by the NumPy engine — free paths through the medium, every leaf event (bi-Lambertian
 R, T_d about leaf normals drawn from the leaf angle distribution), the reference — and by
 Radiance with the crowns as ``mist`` volumes (:mod:`radtree.engines.radiance.mist`), in the
-variants of ``engine.mist_extinction`` / ``engine.mist_scattering``:
-
-* ``sun/absorb`` (the default): σ = u·G(μ_sun)·Ω_c·(1 − T_s), albedo 0;
-* ``mean/absorb``: σ with the mean G·Ω_c over all directions, albedo 0;
-* ``sun/scatter``: σ at the sun, albedo (R + T_d)/(1 − T_s), the sun scattered (Radiance's
-  shadow rays then see exp(−σ(1 − ω)L)).
+variants ``EXTINCTION/SUN`` of ``engine.mist_extinction`` (σ = u·G(μ)·Ω_c·(1 − T_s) at μ = 0
+"horizontal", the hour's sun "sun", the mean over all directions "mean", the vertical
+receiver's cosine-weighted mean "vertical") and ``engine.mist_sun`` ("beam": the sun's
+shadow rays see σ at the sun's μ through the albedo, no scattering; "scatter": albedo
+(R + T_d)/(1 − T_s), the sun scattered, its shadow rays then see exp(−σ(1 − ω)L); "mist":
+albedo 0). The default is ``horizontal/beam``.
 
 Cases: the reference street's free crown row (examples/mendoza-street, scenario F, Perez sky,
 façade circle of 8 sensors) and examples/office-block scenario "with" (façade and work plane),
 every hour of the project. Printed per hour and grid: the NumPy mean ± s.e. (its paths), each
 Radiance variant's mean ± s.e. (``--repeats`` independent ``rtrace -u+`` runs) and the
-difference Radiance − NumPy in % ± the combined s.e.; then the day's mean difference.
+difference Radiance − NumPy in % ± the combined s.e., against the full NumPy light and against
+its uncollided part; then the leaf-scattered share and the day's mean differences.
 
 Measured 2026-12-07 09:07–09:45 UTC on the 2-core machine shared with other sessions (load
 average 6–10), NumPy 4096 paths/sensor (stratified), Radiance ``-ab 6 -ad 2048 -as 0 -aa 0``
