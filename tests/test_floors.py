@@ -357,7 +357,8 @@ def test_inventory_crown_clip_note_and_refusal(tmp_path, caplog):
             "field 'feature 'N'': the crown of tree 'N' (radius 3 m) reaches the façade: its "
             "trunk stands 1.99 m from the wall's clip plane; [tree] wall_policy = \"refuse\": "
             "move the trunk 1.02 m further from the wall, or reduce the crown radius "
-            "(crown_diameter_m / 2) to 1.98 m")):
+            "(crown_diameter_m / 2, or its crown_outline) to 1.98 m — or set wall_policy = "
+            "\"clip\"")):
         build_project(load_project(refuse), pictures=False)
 
     # against building N1 (south wall at y = 10): the crown keeps y ≤ 10 − 0.015

@@ -1,7 +1,7 @@
 """Turbid-medium crowns ([tree] representation = "turbid", radtree.media, radtree.trees.turbid,
 radtree.engines.common.turbid): Beer–Lambert with the G-function, energy conservation, the
 same façade light as explicit volume slats of equal leaf area density, angles and optics, the
-crowns of the reference street, the engines that refuse media, and the generated city (the
+crowns of the reference street, and the generated city (the
 same table on Dask as in one process)."""
 
 from __future__ import annotations
@@ -18,7 +18,7 @@ from radtree.config import EngineParams, Louvers, load_project
 from radtree.engines.common.turbid import MediumTracer
 from radtree.engines.numpy.scenes import sky_state
 from radtree.engines.numpy.tracing import trace
-from radtree.errors import ConfigError, EngineError
+from radtree.errors import ConfigError
 from radtree.media import TurbidCrowns
 from radtree.optics import Plastic, Trans
 from radtree.scene import Mesh, Scene, SensorGrid, quad
@@ -155,21 +155,6 @@ def test_turbid_needs_the_volume_arrangement():
     with pytest.raises(ConfigError) as err:
         build_crown(p, "louvers", "dome", facade_frame(p), replace(tree, form="dome"))
     assert err.value.field == "tree.representation"
-
-
-def test_radiance_refuses_turbid_crowns(tmp_path):
-    from radtree.engines.radiance.writer import write_build
-
-    media = TurbidCrowns.of(np.array([[0.0, 0.0, 3.0]]), 2.0, 2.0, 1.0, 0,
-                         [leaf_kind(Louvers(), "leaf")])
-    scene = Scene([quad("g", "g", np.array([[-9, -9, 0], [9, -9, 0], [9, 9, 0], [-9, 9, 0]],
-                                           float))],
-                  {"g": Plastic("g", 0.2), "leaf": Trans("leaf", 0.1, 0.05, 0.05)},
-                  {"facade": SensorGrid("facade", [[0, 0, 1.0]], [[0, 0, 1.0]])}, media=media)
-    st = sky_state("uniform", zenith_luminance=1000.0)
-    with pytest.raises(EngineError, match="radiance engine cannot trace turbid"):
-        write_build(scene, [st], EngineParams(), 2, tmp_path / "b", None)
-    assert not (tmp_path / "b").exists()
 
 
 def _make_city():

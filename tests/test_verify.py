@@ -105,6 +105,7 @@ def _fake_suite(monkeypatch, checks):
     monkeypatch.setattr(suite, "agreement_checks", lambda **_k: [])
     monkeypatch.setattr(suite, "turbid_checks", lambda **_k: [])
     monkeypatch.setattr(suite, "voxel_checks", lambda **_k: [])
+    monkeypatch.setattr(suite, "mist_checks", lambda **_k: [])
 
 
 @pytest.mark.parametrize("got, code", [(1.0, 0), (2.0, 1)])

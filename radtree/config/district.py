@@ -27,8 +27,8 @@ Keys of the ``[site]`` table (read here, hooked into :mod:`radtree.config.reader
   1 000 trees explicit 85 s / 1.13 GiB (1.25 M triangles) vs turbid 28 s / 0.24 GiB, the
   façade-chunk means within 0.6 % (250) and 2.4 % (1 000). From ≈ 500 trees the slats cost
   about twice the time and three times the memory for the same façade light; below it they
-  keep the real leaf placement, and Radiance traces slats only (no turbid form), so set 0 to
-  keep slats for Radiance's instanced crowns;
+  keep the real leaf placement, and Radiance's form of turbid crowns (``mist``) carries no
+  leaf-scattered light, so set 0 to keep slats for Radiance's instanced crowns;
 * ``instancing`` — ``"auto"`` (a crown shared by ≥ 2 trees is one Radiance ``instance``
   octree per species × realisation, placed, rotated and scaled per tree; crowns used once
   are built in place), ``"never"`` (every crown in place).

@@ -25,6 +25,8 @@ from typing import Any, ClassVar
 from radtree.config.spec import Checked, meta
 
 SAMPLING_CHOICES = ("sobol", "random")  # NumPy engine's first directions (engines/numpy/qmc)
+MIST_EXTINCTION = ("sun", "mean", "vertical", "horizontal")   # Radiance mist crowns' σ
+MIST_SUN = ("beam", "scatter", "mist")   # the sun through Radiance mist crowns
 
 
 @dataclass(frozen=True)
@@ -49,6 +51,12 @@ class RadianceParams(Checked):
     pmap_photons: int | None = field(default=None, metadata=meta(1))
     pmap_caustic_photons: int | None = field(default=None, metadata=meta(1))
     pmap_bandwidth: int = field(default=50, metadata=meta(1))
+    # turbid crowns as mist (radtree.engines.radiance.mist): σ at the hour's sun direction,
+    # the mean over all directions, the vertical receiver's cosine-weighted mean, or horizontal
+    mist_extinction: str = field(default="horizontal", metadata=meta(choices=MIST_EXTINCTION))
+    # turbid crowns as mist: the sun's shadow rays see σ at the sun (beam, no scattering),
+    # the sun scattered by the leaves (scatter; shadow rays see only absorption), or the mist
+    mist_sun: str = field(default="beam", metadata=meta(choices=MIST_SUN))
 
 
 @dataclass(frozen=True)

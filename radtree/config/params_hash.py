@@ -3,7 +3,7 @@
 Input files count by their path relative to the project folder and their content, so a moved
 project keeps its hashes and an edited input file changes them. Settings at their defaults
 that were added after a hash was first written (species, photo, BSDF, forward and photon-map
-keys) are left out, so older build folders and results keep their hashes.
+keys, Radiance mist keys) are left out, so older build folders and results keep their hashes.
 """
 
 from __future__ import annotations
@@ -20,6 +20,8 @@ from radtree.fileio import file_sha256_cached
 
 #: the ``EngineParams`` fields only the Radiance photon map reads
 PMAP_KEYS = ("pmap_photons", "pmap_caustic_photons", "pmap_bandwidth")
+#: the ``EngineParams`` fields only Radiance's mist crowns read (turbid crowns)
+MIST_KEYS = ("mist_extinction", "mist_sun")
 #: the ``EngineParams`` fields only the forward engine reads
 FORWARD_KEYS = ("photons", "forward_threshold", "forward_splitting", "beam_diameter_m",
                 "patch_m", "forward_batches", "forward_focus_m", "forward_split",
@@ -66,7 +68,7 @@ def _project_payload(project: Any) -> dict[str, Any]:
     payload["engine"] = project.engine.flat()   # the file's flat table: hashes unchanged
     payload["engine"].pop("workers", None)
     defaults = type(project.engine)().flat()
-    for key in FORWARD_KEYS + PMAP_KEYS + ("dense_rays",):  # at defaults: hashes unchanged
+    for key in FORWARD_KEYS + PMAP_KEYS + MIST_KEYS + ("dense_rays",):  # at defaults: unchanged
         if payload["engine"].get(key) == defaults[key]:
             payload["engine"].pop(key, None)
     if project.honeybee is not None:   # absent otherwise: other projects' hashes unchanged

@@ -23,6 +23,7 @@ from radtree.verify.checks import (
     sphere_checks,
     transmission_checks,
 )
+from radtree.verify.mist import mist_checks
 from radtree.verify.turbid import turbid_checks
 from radtree.verify.voxels import voxel_checks
 
@@ -71,6 +72,7 @@ def run_verify(out: Path, *, full: bool = False, backward: list[str] | None = No
         checks += energy_checks(photons=200_000)
         checks += turbid_checks(rays=64_000)
         checks += voxel_checks(rays=64_000)
+        checks += mist_checks()
         for crown in ("louvers dome", "free volume crown"):
             checks += agreement_checks(hours=("10:30", "12:30", "14:30"), scenarios=("A", "B"),
                                        photons=40_000_000, backward=backward, crown=crown,
@@ -87,6 +89,7 @@ def run_verify(out: Path, *, full: bool = False, backward: list[str] | None = No
         checks += energy_checks()
         checks += turbid_checks()
         checks += voxel_checks()
+        checks += mist_checks()
         checks += agreement_checks(backward=backward)
         checks += agreement_checks(backward=backward, crown="free volume crown",
                                    photons=4_000_000)

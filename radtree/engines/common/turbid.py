@@ -48,9 +48,9 @@ MAX_TRIES = 64     # rejection rounds for the leaf normals (then the last draw i
 
 
 def refuse_media(scene: Scene, engine: str) -> None:
-    """EngineError when ``scene`` holds turbid crowns and ``engine`` cannot trace them (the
-    Radiance engine: not implemented — Radiance's ``mist`` carries no leaf scattering, and no
-    crown BSDF is built for media)."""
+    """EngineError when ``scene`` holds turbid crowns and ``engine`` cannot trace them (an
+    engine without a media form; Radiance writes them as ``mist``,
+    :mod:`radtree.engines.radiance.mist`)."""
     if scene.media is not None and len(scene.media):
         raise EngineError(f"the {engine} engine cannot trace turbid-medium crowns ([tree] "
                           "representation = \"turbid\"): use --engine numpy, or "

@@ -9,11 +9,14 @@ from radtree.engines.base import Engine, GridResult
 from radtree.engines.radiance.binaries import find_radiance, require_radiance
 from radtree.engines.radiance.binaries import version as radiance_version
 from radtree.engines.radiance.engine import hour_commands, run_hour
+from radtree.engines.radiance.mist import mist_params
 from radtree.engines.radiance.pmap import PhotonMap
 from radtree.engines.radiance.writer import (
     BuildPlan,
     grid_rtrace_options,
+    mist_media,
     prototype_octree,
+    radiance_scene,
     rtrace_options,
     write_build,
 )
@@ -70,6 +73,7 @@ class RadianceEngine(Engine):
             raise ValueError("the Radiance engine needs a folder to write its build into")
         if not (folder / "manifest.json").exists():
             return write_build(scene, states, params, ab, folder, require_radiance())
+        params = mist_params(params, mist_media(radiance_scene(scene)), scene.materials)
         plan = BuildPlan(folder=folder, hours=[s.label for s in states], grids=list(scene.grids),
                          scene_files=["materials.rad"], hour_files={},
                          rtrace_opts=rtrace_options(params, ab),
@@ -82,10 +86,8 @@ class RadianceEngine(Engine):
         plan.prototypes = {prototype_octree(p.stem): str(p.relative_to(folder))
                            for p in sorted((folder / "geometry" / "prototypes").glob("*.rad"))}
         for st in states:
-            files = []
-            ground = folder / "skies" / f"{st.label}_ground.rad"
-            if ground.exists():
-                files.append(str(ground.relative_to(folder)))
+            files = [f"skies/{st.label}_{what}.rad" for what in ("ground", "mist")
+                     if (folder / "skies" / f"{st.label}_{what}.rad").exists()]
             plan.hour_files[st.label] = files + geometry + [f"skies/{st.label}.sky"]
         return plan
 

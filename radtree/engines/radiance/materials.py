@@ -9,7 +9,8 @@ coefficients via :func:`radtree.optics.fmt`):
 * :class:`~radtree.optics.Glass` → ``void glass NAME 0 0 3 tn tn tn`` (transmissivity);
 * :class:`~radtree.optics.Hole` → nothing (its geometry is not written);
 * :class:`~radtree.optics.Bsdf` → ``void BSDF NAME 6 thickness xml ux uy uz . 0 0`` (the
-  surface normal towards the XML's back side, ``up`` the world direction of its +y).
+  surface normal towards the XML's back side, ``up`` the world direction of its +y);
+* a turbid crown's medium → ``void mist NAME N src… 0 7 σ σ σ ω ω ω g`` (:func:`mist_text`).
 """
 
 from __future__ import annotations
@@ -55,3 +56,15 @@ def _(material: Bsdf) -> str:
     ux, uy, uz = (f"{v:g}" for v in material.up)
     return (f"void BSDF {material.name}\n6 {material.thickness:g} {material.xml} {ux} {uy} {uz} ."
             "\n0\n0\n")
+
+
+def mist_text(name: str, *, extinction: float, albedo: float, eccentricity: float,
+              sources: tuple[str, ...] = ()) -> str:
+    """A grey ``mist`` volume (Radiance reference manual, "Mist"):
+    ``void mist NAME N src… 0 7 σ σ σ ω ω ω g`` — extinction σ per world unit (metres, 5
+    significant digits),
+    scattering albedo ω, Henyey–Greenstein g; ``sources``: the light sources scattered in the
+    volume (:mod:`radtree.engines.radiance.mist`)."""
+    s, a = f"{extinction:.5g}", f"{albedo:.5g}"
+    src = " ".join([str(len(sources)), *sources])
+    return f"void mist {name}\n{src}\n0\n7 {s} {s} {s} {a} {a} {a} {fmt(eccentricity)}\n"

@@ -33,6 +33,16 @@ MESH_MIN_TRIANGLES = 100
 MESH_OBJLIM = 4
 
 
+def mesh_to_radiance(mesh: Mesh) -> str:
+    """Triangles as Radiance polygons: ``MAT polygon NAME.i 0 0 9 x1 y1 z1 x2 y2 z2 x3 y3 z3``."""
+    tri = mesh.triangles
+    out = [f"# {mesh.name}: {len(tri)} triangles, material {mesh.material}\n"]
+    for i, t in enumerate(tri):
+        coords = " ".join(f"{v:.5f}" for v in t.ravel())
+        out.append(f"{mesh.material} polygon {mesh.name}.{i}\n0\n0\n9 {coords}\n")
+    return "\n".join(out)
+
+
 def as_compiled_mesh(mesh: Mesh) -> bool:
     """True when ``mesh`` is written as an ``.rtm`` mesh (large), False for polygon text."""
     return mesh.n_triangles >= MESH_MIN_TRIANGLES

@@ -16,7 +16,7 @@ build/<scenario>/
 from __future__ import annotations
 
 from collections.abc import Mapping
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from functools import cache
 from pathlib import Path
 
@@ -25,34 +25,28 @@ from jinja2 import Template
 
 import radtree
 from radtree.config import EngineParams
-from radtree.engines.common.turbid import refuse_media
 from radtree.engines.common.voxels import refuse_voxels
 from radtree.engines.radiance.binaries import FIXED_SEED, RadianceInstall
 from radtree.engines.radiance.materials import material_text
 from radtree.engines.radiance.meshes import (
     as_compiled_mesh,
     mesh_primitive_text,
+    mesh_to_radiance,
     obj2mesh_command,
     write_obj,
 )
+from radtree.engines.radiance.mist import hour_mist_text, mist_geometry_text, mist_params
 from radtree.engines.radiance.pmap import FINAL_GATHER_AB, PhotonMap
 from radtree.engines.radiance.sky import ANALYTIC_SKY_CAL, sky_text
+from radtree.errors import EngineError
 from radtree.light.sky import SkyState
 from radtree.light.units import PHOTOPIC_RGB, WHITE_EFFICACY
+from radtree.media import TurbidCrowns
+from radtree.media_voxels import media_parts
 from radtree.optics import Hole, Material, Plastic, with_reflectance
 from radtree.resources import template_environment
-from radtree.scene import Mesh, Scene
+from radtree.scene import Scene
 from radtree.sensor_grid import is_dense_grid
-
-
-def mesh_to_radiance(mesh: Mesh) -> str:
-    """Triangles as Radiance polygons: ``MAT polygon NAME.i 0 0 9 x1 y1 z1 x2 y2 z2 x3 y3 z3``."""
-    tri = mesh.triangles
-    out = [f"# {mesh.name}: {len(tri)} triangles, material {mesh.material}\n"]
-    for i, t in enumerate(tri):
-        coords = " ".join(f"{v:.5f}" for v in t.ravel())
-        out.append(f"{mesh.material} polygon {mesh.name}.{i}\n0\n0\n9 {coords}\n")
-    return "\n".join(out)
 
 
 def instances_text(scene: Scene) -> str:
@@ -146,6 +140,33 @@ class BuildPlan:
         return self.photon_map.mkpmap_command(hour) if self.photon_map else None
 
 
+def radiance_scene(scene: Scene) -> Scene:
+    """``scene`` as the Radiance engine takes it: voxel crowns refused (no Radiance form), the
+    spheroid crowns of a :class:`radtree.media_voxels.MediaSet` as plain
+    :class:`~radtree.media.TurbidCrowns` (the ``mist`` volumes), other media refused."""
+    refuse_voxels(scene, engine="radiance")
+    crowns, _ = media_parts(scene.media)
+    if scene.media is not None and crowns is not scene.media:
+        scene = replace(scene, media=crowns)
+    _check_media(scene)
+    return scene
+
+
+def mist_media(scene: Scene) -> TurbidCrowns | None:
+    """The spheroid crowns Radiance writes as ``mist`` (None: none) of a scene
+    :func:`radiance_scene` returned."""
+    media = scene.media
+    return media if isinstance(media, TurbidCrowns) and len(media) else None
+
+
+def _check_media(scene: Scene) -> None:
+    """EngineError for media Radiance has no form of: only turbid spheroid crowns
+    (:class:`radtree.media.TurbidCrowns`) become ``mist`` volumes."""
+    if scene.media is not None and not isinstance(scene.media, TurbidCrowns):
+        raise EngineError(f"the radiance engine traces turbid spheroid crowns as mist, not "
+                          f"{type(scene.media).__name__} media: use --engine numpy")
+
+
 def _write(path: Path, text: str) -> None:
     """Write a build file in place: :func:`write_build` fills a folder that is made whole at
     once (``radtree build``'s temporary folder, renamed when complete) or a scratch folder, and
@@ -161,8 +182,8 @@ def write_build(scene: Scene, states: list[SkyState], params: EngineParams, ab: 
 
     ``hour_grids`` maps an hour label (HHMM) to the grids the Makefile traces then (default:
     every grid at every hour)."""
-    refuse_voxels(scene, engine="radiance")
-    refuse_media(scene, "radiance")
+    scene = radiance_scene(scene)
+    params = mist_params(params, mist_media(scene), scene.materials)
     folder.mkdir(parents=True, exist_ok=True)
     (folder / "geometry").mkdir(exist_ok=True)
     (folder / "grids").mkdir(exist_ok=True)
@@ -176,7 +197,7 @@ def write_build(scene: Scene, states: list[SkyState], params: EngineParams, ab: 
     for name, cal in ANALYTIC_SKY_CAL.items():
         _write(folder / "skies" / f"{name}.cal", f"{{ {name} sky: relative luminance }}\n{cal}")
     hour_files = _write_hours(scene, states=states, folder=folder, install=install,
-                              geometry_files=geometry_files)
+                              geometry_files=geometry_files, params=params)
     # oconv order: materials, hour's ground material, geometry, sky
     plan = BuildPlan(folder=folder, hours=[s.label for s in states], grids=list(scene.grids),
                      scene_files=scene_files, hour_files=hour_files,
@@ -207,6 +228,11 @@ def _write_geometry(scene: Scene, *, folder: Path
         else:
             _write(folder / rel, mesh_to_radiance(mesh))
         geometry_files.append(rel)
+    crowns = mist_media(scene)
+    if crowns is not None:
+        rel = "geometry/crowns_mist.rad"
+        _write(folder / rel, mist_geometry_text(crowns))
+        geometry_files.append(rel)
     prototypes: dict[str, str] = {}
     if scene.instances:
         (folder / "geometry" / "prototypes").mkdir(exist_ok=True)
@@ -220,10 +246,11 @@ def _write_geometry(scene: Scene, *, folder: Path
 
 
 def _write_hours(scene: Scene, *, states: list[SkyState], folder: Path,
-                 install: RadianceInstall | None,
-                 geometry_files: list[str]) -> dict[str, list[str]]:
-    """Write each hour's ground material (a Plastic ground only) and sky; returns each hour's
-    oconv files after materials.rad: ground material, geometry, sky."""
+                 install: RadianceInstall | None, geometry_files: list[str],
+                 params: EngineParams) -> dict[str, list[str]]:
+    """Write each hour's ground material (a Plastic ground only), turbid crowns' mists and
+    sky; returns each hour's oconv files after materials.rad: ground material, mists,
+    geometry, sky."""
     hour_files: dict[str, list[str]] = {}
     ground = scene.materials.get(scene.ground_material)
     for st in states:
@@ -233,6 +260,14 @@ def _write_hours(scene: Scene, *, states: list[SkyState], folder: Path,
             rel = f"skies/{st.label}_ground.rad"
             _write(folder / rel, f"# ground reflectance at {st.time} "
                        f"(sun altitude {st.sun.altitude_deg:.2f}°)\n" + material_text(gm))
+            files.append(rel)
+        crowns = mist_media(scene)
+        if crowns is not None:
+            rel = f"skies/{st.label}_mist.rad"
+            _write(folder / rel, hour_mist_text(
+                crowns, materials=scene.materials, state=st,
+                extinction=params.radiance.mist_extinction,
+                sun=params.radiance.mist_sun))
             files.append(rel)
         files += geometry_files
         rel_sky = f"skies/{st.label}.sky"
