@@ -42,7 +42,7 @@ from radtree.errors import EngineError
 from radtree.light.sky import SkyState
 from radtree.light.units import PHOTOPIC_RGB, WHITE_EFFICACY
 from radtree.media import TurbidCrowns
-from radtree.media_voxels import media_parts
+from radtree.media_voxels import MediaSet, VoxelCrowns, media_parts
 from radtree.optics import Hole, Material, Plastic, with_reflectance
 from radtree.resources import template_environment
 from radtree.scene import Scene
@@ -144,12 +144,13 @@ def radiance_scene(scene: Scene) -> Scene:
     """``scene`` as the Radiance engine takes it: voxel crowns refused (no Radiance form), the
     spheroid crowns of a :class:`radtree.media_voxels.MediaSet` as plain
     :class:`~radtree.media.TurbidCrowns` (the ``mist`` volumes), other media refused."""
+    if scene.media is not None and not isinstance(scene.media, TurbidCrowns | VoxelCrowns
+                                                  | MediaSet):
+        raise EngineError(f"the radiance engine traces turbid spheroid crowns as mist, not "
+                          f"{type(scene.media).__name__} media: use --engine numpy")
     refuse_voxels(scene, engine="radiance")
     crowns, _ = media_parts(scene.media)
-    if scene.media is not None and crowns is not scene.media:
-        scene = replace(scene, media=crowns)
-    _check_media(scene)
-    return scene
+    return scene if crowns is scene.media else replace(scene, media=crowns)
 
 
 def mist_media(scene: Scene) -> TurbidCrowns | None:
@@ -157,14 +158,6 @@ def mist_media(scene: Scene) -> TurbidCrowns | None:
     :func:`radiance_scene` returned."""
     media = scene.media
     return media if isinstance(media, TurbidCrowns) and len(media) else None
-
-
-def _check_media(scene: Scene) -> None:
-    """EngineError for media Radiance has no form of: only turbid spheroid crowns
-    (:class:`radtree.media.TurbidCrowns`) become ``mist`` volumes."""
-    if scene.media is not None and not isinstance(scene.media, TurbidCrowns):
-        raise EngineError(f"the radiance engine traces turbid spheroid crowns as mist, not "
-                          f"{type(scene.media).__name__} media: use --engine numpy")
 
 
 def _write(path: Path, text: str) -> None:
