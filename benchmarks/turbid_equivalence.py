@@ -147,7 +147,12 @@ def collect(case: str, representation: str, seeds: range, paths: int | None) -> 
     grid means (``total``, ``direct``), ``view/<grid>`` (runs,), ``leaf_area`` (runs,), ``g``
     (runs, 3), ``seeds``, ``seconds`` and ``hours``."""
     t0 = time.perf_counter()
-    runs = [one_crown(case, representation, s, paths) for s in seeds]
+    runs = []
+    for i, s in enumerate(seeds):
+        runs.append(one_crown(case, representation, s, paths))
+        if (i + 1) % 100 == 0:
+            print(f"  {case} {representation}: {i + 1}/{len(seeds)} runs, "
+                  f"{time.perf_counter() - t0:.0f} s", flush=True)
     out: dict = {"hours": np.array(runs[0]["hours"]), "seeds": np.array(list(seeds)),
                  "leaf_area": np.array([r["leaf_area"] for r in runs]),
                  "g": np.array([r["g"] for r in runs]),
@@ -232,6 +237,8 @@ def main() -> None:
     ap.add_argument("--paths", type=int, default=64)
     ap.add_argument("--turbid-runs", type=int, default=12)
     ap.add_argument("--first-seed", type=int, default=1, help="seeds first…first + n − 1")
+    ap.add_argument("--only", choices=["explicit", "turbid"],
+                    help="trace one representation and --save it (report with --merge)")
     ap.add_argument("--save", help="write the per-run arrays to this .npz")
     ap.add_argument("--merge", nargs="+", help="report from saved .npz files (no tracing)")
     args = ap.parse_args()
@@ -241,6 +248,13 @@ def main() -> None:
     print(f"load average {os.getloadavg()[0]:.1f} on {os.cpu_count()} CPUs (shared machine)")
     saved: dict[str, np.ndarray] = {}
     for case in args.cases:
+        if args.only:
+            f = args.first_seed
+            rep, n, paths = (("ex", args.realisations, args.paths) if args.only == "explicit"
+                             else ("tu", args.turbid_runs, None))
+            data = collect(case, args.only, range(f, f + n), paths)
+            saved.update({f"{case}|{rep}|{k}": v for k, v in data.items()})
+            continue
         if args.merge:
             ex, tu = _load(args.merge, case)
         else:

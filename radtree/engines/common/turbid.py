@@ -113,6 +113,8 @@ class MediumTracer:
         self.pass_ = 1.0 - ts                      # the share of leaves met that deflect
         self.events = np.stack([r / self.pass_, td / self.pass_], 1)   # (kinds, 2)
         self.scale = max(1.0, float(np.ptp(np.vstack([lo, hi]), axis=0).max()))
+        # the longest box diagonal: a ray leaves every box holding its origin within it
+        self.reach = float(np.linalg.norm(hi - lo, axis=1).max()) if n else 0.0
 
     def corners(self) -> np.ndarray:
         """(8·n, 3) corners of the crowns' proxy boxes (a forward source must enclose them)."""
@@ -127,7 +129,14 @@ class MediumTracer:
     def crossings(self, o: np.ndarray, d: np.ndarray, tmax: np.ndarray, parallel: bool = True
                   ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
         """(ray, crown, t_in, t_out) of every crown whose envelope the rays ``o + t d``
-        (0 ≤ t ≤ ``tmax``) cross, t in metres along the unit ``d``."""
+        (0 ≤ t ≤ ``tmax``) cross, t in metres along the unit ``d``.
+
+        The faces are followed to ``max(tmax, reach)`` (:attr:`reach`: the longest box
+        diagonal), not just to ``tmax``: a ray starting inside boxes (a scattered path, a
+        point on a wall within a crown's box) names those crowns only by their exit faces,
+        which may lie beyond a near surface — stopping at ``tmax`` lost every such crown but
+        the first (up to a third of the in-medium length of paths from a wall between
+        overlapping crowns)."""
         k = len(o)
         idx = np.arange(k)
         cur = np.array(o, float)
@@ -145,7 +154,7 @@ class MediumTracer:
             rays.append(idx[hit])
             crowns.append(self.face_crown[tri[hit]])
             t_all = done[hit] + t[hit]
-            go = t_all < tmax[idx[hit]]
+            go = t_all < np.maximum(tmax[idx[hit]], self.reach)
             keep = hit.nonzero()[0][go]
             idx, dd = idx[keep], dd[keep]
             cur = cur[keep] + (t[keep] + step)[:, None] * dd
