@@ -57,7 +57,7 @@ VIEW_DIRS = 256      # fixed cosine-weighted directions per diagnostic sensor
 VIEW_SENSORS = 8     # diagnostic sensors per grid (evenly spread over the grid)
 
 
-def _setup(case: str, representation: str, seed: int) -> tuple:
+def _setup(case: str, *, representation: str, seed: int) -> tuple:
     """(built scene, hour states, engine params at the example's settings) of one crown."""
     from radtree.config import effective_project, load_project
     from radtree.light.hours import hour_states
@@ -112,7 +112,7 @@ def leaf_g(scene, mus: tuple[float, ...] = (0.0, 0.5, 1.0)) -> tuple[float, list
     return float(a.sum()), gs
 
 
-def one_crown(case: str, representation: str, seed: int, paths: int | None) -> dict:
+def one_crown(case: str, *, representation: str, seed: int, paths: int | None) -> dict:
     """Grid means per hour (total and the sensors' direct sun, lux), the mean uncollided
     transmission over the fixed view rays, and the leaf bookkeeping of one crown (explicit:
     realisation ``seed``; turbid: path seed ``seed``). ``paths``: per sensor (None: the
@@ -120,7 +120,7 @@ def one_crown(case: str, representation: str, seed: int, paths: int | None) -> d
     from radtree.engines.numpy.engine import DEFAULT_OPTIONS
     from radtree.engines.numpy.tracing import _grid_seed, _trace_grid, _tracer
 
-    built, states, params = _setup(case, representation, seed)
+    built, states, params = _setup(case, representation=representation, seed=seed)
     if paths is not None:
         params = params.changed(rays=paths)
     scene = built.scene
@@ -142,14 +142,14 @@ def one_crown(case: str, representation: str, seed: int, paths: int | None) -> d
     return out
 
 
-def collect(case: str, representation: str, seeds: range, paths: int | None) -> dict:
+def collect(case: str, *, representation: str, seeds: range, paths: int | None) -> dict:
     """The runs of one representation stacked: ``<what>/<grid>`` arrays (runs, hours) of the
     grid means (``total``, ``direct``), ``view/<grid>`` (runs,), ``leaf_area`` (runs,), ``g``
     (runs, 3), ``seeds``, ``seconds`` and ``hours``."""
     t0 = time.perf_counter()
     runs = []
     for i, s in enumerate(seeds):
-        runs.append(one_crown(case, representation, s, paths))
+        runs.append(one_crown(case, representation=representation, seed=s, paths=paths))
         if (i + 1) % 100 == 0:
             print(f"  {case} {representation}: {i + 1}/{len(seeds)} runs, "
                   f"{time.perf_counter() - t0:.0f} s", flush=True)
@@ -181,7 +181,7 @@ def _mean_se(x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return x.mean(axis=0), x.std(axis=0, ddof=1) / math.sqrt(len(x))
 
 
-def report(case: str, ex: dict, tu: dict, paths: int) -> list[float]:
+def report(case: str, *, ex: dict, tu: dict, paths: int) -> list[float]:
     """Print the tables of one case; returns the |differences| in % of the totals."""
     hours = [str(h) for h in ex["hours"]]
     print(f"\n== {case}: {CASES[case][0].name} scenario {CASES[case][1]}; explicit "
@@ -219,7 +219,7 @@ def report(case: str, ex: dict, tu: dict, paths: int) -> list[float]:
     return diffs
 
 
-def _load(paths: list[str], case: str) -> tuple[dict, dict]:
+def _load(paths: list[str], *, case: str) -> tuple[dict, dict]:
     parts: dict[str, list[dict]] = {"ex": [], "tu": []}
     for p in paths:
         with np.load(p) as z:
@@ -252,16 +252,18 @@ def main() -> None:
             f = args.first_seed
             rep, n, paths = (("ex", args.realisations, args.paths) if args.only == "explicit"
                              else ("tu", args.turbid_runs, None))
-            data = collect(case, args.only, range(f, f + n), paths)
+            data = collect(case, representation=args.only, seeds=range(f, f + n), paths=paths)
             saved.update({f"{case}|{rep}|{k}": v for k, v in data.items()})
             continue
         if args.merge:
-            ex, tu = _load(args.merge, case)
+            ex, tu = _load(args.merge, case=case)
         else:
             f = args.first_seed
-            ex = collect(case, "explicit", range(f, f + args.realisations), args.paths)
-            tu = collect(case, "turbid", range(f, f + args.turbid_runs), None)
-        diffs = report(case, ex, tu, args.paths)
+            ex = collect(case, representation="explicit", seeds=range(f, f + args.realisations),
+                         paths=args.paths)
+            tu = collect(case, representation="turbid", seeds=range(f, f + args.turbid_runs),
+                         paths=None)
+        diffs = report(case, ex=ex, tu=tu, paths=args.paths)
         print(f"  max |diff| of the totals {max(diffs):.2f} %: "
               f"{'met' if max(diffs) <= 3.0 else 'NOT met'} (|difference| ≤ 3 % every hour)")
         for rep, data in (("ex", ex), ("tu", tu)):

@@ -22,7 +22,7 @@ STREET = Path(__file__).resolve().parents[1] / "examples" / "mendoza-street"
 SEEDS = range(1, 5)
 
 
-def _built(representation: str, seed: int = 1):
+def _built(representation: str, *, seed: int = 1):
     p = load_project(STREET, overrides={"tree.representation": representation,
                                         "sensors.dense_grid": False, "tree.louvers.seed": seed})
     return make_scene(p, p.scenario("F"), dense_grid=False)
@@ -38,10 +38,11 @@ def _leaves(scene) -> tuple[np.ndarray, np.ndarray]:
     return np.vstack(vs), np.vstack(fs)
 
 
-def _crossings(v: np.ndarray, f: np.ndarray, o: np.ndarray, d: np.ndarray) -> np.ndarray:
+def _crossings(v: np.ndarray, *, faces: np.ndarray, o: np.ndarray, d: np.ndarray
+               ) -> np.ndarray:
     """Slat triangles each ray o + t d (t > 0) crosses (repeated first hits, 0.1 mm past each:
     beyond Embree's float32 rounding, which re-hits a slat from 1 µm past it)."""
-    caster = make_caster(v, f, "auto", 1)
+    caster = make_caster(v, faces, "auto", 1)
     n = np.zeros(len(o))
     idx, cur, dd = np.arange(len(o)), o.copy(), d.copy()
     for _ in range(400):
@@ -55,7 +56,7 @@ def _crossings(v: np.ndarray, f: np.ndarray, o: np.ndarray, d: np.ndarray) -> np
     return n
 
 
-def _rays(built, media) -> dict[str, tuple[np.ndarray, np.ndarray]]:
+def _rays(built, *, media) -> dict[str, tuple[np.ndarray, np.ndarray]]:
     """Cosine-weighted rays from the 8 façade sensors, and chords through the crown row from
     random points 30 m away towards random points of the crowns."""
     rng = np.random.default_rng(7)
@@ -81,7 +82,7 @@ def test_slat_leaf_area_matches_the_turbid_crowns():
     want = tu.scene.media.leaf_area(samples=2_000_000)
     got, dropped = [], []
     for seed in SEEDS[:3]:
-        ex = _built("explicit", seed)
+        ex = _built("explicit", seed=seed)
         v, f = _leaves(ex.scene)
         tri = v[f]
         got.append(0.5 * np.linalg.norm(np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0]),
@@ -103,7 +104,7 @@ def test_slats_crossed_follow_the_turbid_optical_depth():
     media = tu.scene.media
     mt = MediumTracer(media, tu.scene.materials)
     ts = tu.scene.materials[LEAF].specular_transmittance
-    rays = _rays(tu, media)
+    rays = _rays(tu, media=media)
     lam = {}
     for key, (o, d) in rays.items():
         r, c, t0, t1 = mt.crossings(o, d, np.full(len(o), np.inf))
@@ -112,9 +113,9 @@ def test_slats_crossed_follow_the_turbid_optical_depth():
     n_sum = {k: np.zeros(len(v[0])) for k, v in rays.items()}
     t_sum = {k: np.zeros(len(v[0])) for k, v in rays.items()}
     for seed in SEEDS:
-        v, f = _leaves(_built("explicit", seed).scene)
+        v, f = _leaves(_built("explicit", seed=seed).scene)
         for key, (o, d) in rays.items():
-            n = _crossings(v, f, o, d)
+            n = _crossings(v, faces=f, o=o, d=d)
             n_sum[key] += n
             t_sum[key] += ts ** n
     for key in rays:
