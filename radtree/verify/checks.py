@@ -317,3 +317,11 @@ def agreement_checks(*, hours: tuple[str, ...] = ("12:30",), scenarios: tuple[st
                 log.info(f"{label}: {e} {bw.lux:.1f} ± {bw.stderr:.1f}, forward "
                          f"{got:.1f} ± {se:.1f}")
     return out
+
+
+def log_checks(checks: list[Check], logger: logging.Logger) -> list[Check]:
+    """Log one line per check (expected, got, ok/FAILED) to ``logger``; return ``checks``."""
+    for c in checks:
+        logger.info(f"{c.check}: expected {c.expected:.4g}, got {c.got:.4g} "
+                    f"({'ok' if c.passed else 'FAILED'})")
+    return checks

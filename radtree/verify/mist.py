@@ -27,7 +27,7 @@ from radtree.media import TurbidCrowns
 from radtree.optics import Trans
 from radtree.scene import Scene, SensorGrid
 from radtree.trees.turbid import leaf_kind
-from radtree.verify.checks import Check
+from radtree.verify.checks import Check, log_checks
 
 log = logging.getLogger(__name__)
 
@@ -73,7 +73,4 @@ def mist_checks() -> list[Check]:
         log.info("mist crown checks skipped: Radiance not found")
         return []
     out = [_sun_row(x, lad, z) for x, lad in CASES for z in ZENITHS]
-    for c in out:
-        log.info(f"{c.check}: expected {c.expected:.4g}, got {c.got:.4g} "
-                 f"({'ok' if c.passed else 'FAILED'})")
-    return out
+    return log_checks(out, log)

@@ -46,7 +46,7 @@ from radtree.media import TurbidCrowns
 from radtree.optics import Plastic, Trans
 from radtree.scene import Scene, SensorGrid, quad
 from radtree.trees.turbid import leaf_kind
-from radtree.verify.checks import Check
+from radtree.verify.checks import Check, log_checks
 
 log = logging.getLogger(__name__)
 
@@ -129,10 +129,7 @@ def turbid_checks(*, rays: int = 8000, seed: int = 7, forward_photons: int = 100
                          f"{white.specular_transmittance:g} = 1)", ENGINE, want,
                          float(res.lux[0]), max(0.01 * want, 3.0 * _se(res))))
     out += forward_checks(forward_photons, seed)
-    for c in out:
-        log.info(f"{c.check}: expected {c.expected:.4g}, got {c.got:.4g} "
-                 f"({'ok' if c.passed else 'FAILED'})")
-    return out
+    return log_checks(out, log)
 
 
 def forward_checks(photons: int, seed: int = 7) -> list[Check]:

@@ -45,7 +45,7 @@ from radtree.media_voxels import MediaSet, VoxelCrowns
 from radtree.optics import Plastic, Trans
 from radtree.scene import Scene, SensorGrid, quad
 from radtree.trees.turbid import leaf_kind
-from radtree.verify.checks import Check
+from radtree.verify.checks import Check, log_checks
 from radtree.verify.turbid import (
     CENTRE,
     DNI,
@@ -182,10 +182,7 @@ def voxel_checks(*, rays: int = 8000, seed: int = 7, forward_photons: int = 100_
                      "0.3 + T_s 0.3 = 1)", ENGINE, want, float(res.lux[0]),
                      max(0.01 * want, 3.0 * _se(res))))
     out += forward_ledger(forward_photons, seed)
-    for c in out:
-        log.info(f"{c.check}: expected {c.expected:.4g}, got {c.got:.4g} "
-                 f"({'ok' if c.passed else 'FAILED'})")
-    return out
+    return log_checks(out, log)
 
 
 def forward_ledger(photons: int, seed: int = 7) -> list[Check]:
