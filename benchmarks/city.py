@@ -69,6 +69,24 @@ Every table equal (0 of 28 252 rows differ). Two workers finish sooner than one 
 the cluster's start and each worker's one-off scene preparation outweigh the 7 hours of
 tracing, so Dask pays off only when a city is larger or spread over more machines.
 
+Measured again 2026-12-07 10:05–10:15 UTC after the turbid tracer's crossings fix (the proxy
+boxes followed past a ray's end when it starts inside them: ≈ 55 % more box-face queries),
+load 6–10 (other sessions running)::
+
+    trees  run              wall s   CPU s   peak GiB (tree sum)  ru_maxrss GiB
+    250    one process        32.6     9.0   0.36                 0.36
+    250    Dask 1 worker      74.0    18.9   0.48                 0.34
+    250    Dask 2 workers     50.7    21.0   0.80                 0.34
+    500    one process        47.4    10.8   0.40                 0.40
+    1000   one process        68.3    18.5   0.44                 0.43
+    1000   Dask 1 worker     112.0    34.0   0.52                 0.38
+    1000   Dask 2 workers     94.1    37.8   0.87                 0.38
+
+Targets met (1 000 trees: 68 s ≤ 600 s, 0.44 GiB ≤ 4 GiB); one process 1 000 / 250 trees: wall
+× 2.09, CPU × 2.06, memory × 1.22 for 4 × the trees (better than linear); every Dask table equal
+to the one-process table (0 of 28 252 rows differ); 2 workers finish sooner than 1 (× 1.46 at
+250 trees, × 1.19 at 1 000). Wall times are inflated by the load; CPU times compare.
+
 Run: ``.venv/bin/python benchmarks/city.py [--trees 250 500 1000] [--workers 1 2] [--keep]``.
 """
 
