@@ -72,11 +72,17 @@ CAVEATS = (
 MIN_ALTITUDE_DEG = 2.0
 """Below this sun altitude an hour takes the zenith transmittance (see the module)."""
 PLANE_GAP_M = 0.01
+OWN_TOLERANCE_M = 0.1
+"""How far outside its envelope's surface a triangle's centroid may lie and still be the
+crown's own (m): a crown shell or leaf on the envelope, whose facets are chords of the
+spheroid the leaves follow (:func:`own_meshes`)."""
 
 
 @dataclass
 class Crown:
-    """One crown's envelope (world metres) as a closed triangle mesh, and its name."""
+    """One crown's envelope (world metres) as a triangle mesh, and its name. The mesh may be
+    open where the crown meets the wall or a neighbour (those faces are left out); the crown's
+    solid is its convex hull (:meth:`solid`)."""
 
     name: str
     vertices: np.ndarray
@@ -84,6 +90,10 @@ class Crown:
 
     def trimesh(self) -> trimesh.Trimesh:
         return trimesh.Trimesh(self.vertices, self.faces, process=False)
+
+    def solid(self) -> trimesh.Trimesh:
+        """The closed convex hull of the envelope's vertices (the envelopes are convex)."""
+        return trimesh.convex.convex_hull(self.vertices)
 
 
 @dataclass
@@ -143,8 +153,9 @@ def sun_vectors(project: Project, hours: list[datetime]) -> tuple[np.ndarray, np
 
 def shadow_areas(crown: Crown, suns: np.ndarray) -> np.ndarray:
     """Area (m²) of the convex crown's shadow on a horizontal plane for each sun (k, 3):
-    its projected area across the beam, ½ Σ_faces A·|n·s| (Cauchy), divided by s_z."""
-    tri = crown.vertices[crown.faces]
+    its projected area across the beam, ½ Σ_faces A·|n·s| over its closed :meth:`Crown.solid`
+    (Cauchy), divided by s_z."""
+    tri = crown.solid().triangles
     cross = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])   # 2·A·n
     return 0.25 * np.abs(suns @ cross.T).sum(axis=1) / suns[:, 2]
 
@@ -171,7 +182,7 @@ def bundle(crown: Crown, sun: np.ndarray, rays: int) -> np.ndarray:
     envelope — the crown's shadow sampled uniformly (equal area across the beam)."""
     o = lattice(crown, sun, rays)
     s = np.asarray(sun, float) / np.linalg.norm(sun)
-    return o[crown.trimesh().ray.intersects_any(o, np.tile(s, (len(o), 1)))]
+    return o[crown.solid().ray.intersects_any(o, np.tile(s, (len(o), 1)))]
 
 
 def transmittances(tracer: DirectTracer, crown: Crown, suns: np.ndarray, rays: int
@@ -184,7 +195,7 @@ def transmittances(tracer: DirectTracer, crown: Crown, suns: np.ndarray, rays: i
     grids = [lattice(crown, s, rays, a) for s, a in zip(suns, areas)]
     who = np.concatenate([np.full(len(g), k) for k, g in enumerate(grids)])
     o, d = np.vstack(grids), suns[who]
-    hit = crown.trimesh().ray.intersects_any(o, d)
+    hit = crown.solid().ray.intersects_any(o, d)
     who, o, d = who[hit], o[hit], d[hit]
     n = np.bincount(who, minlength=len(suns))
     if (n == 0).any():
@@ -217,17 +228,27 @@ def own_tracer(crown: Crown, meshes: list[Mesh], materials: dict[str, Material]
 
 
 def own_meshes(crown: Crown, meshes: list[Mesh]) -> list[Mesh]:
-    """The triangles with a corner in ``crown``'s envelope (all of them for the sensor dome,
-    open on the wall: one crown)."""
+    """The crown's own triangles: those whose centroid lies in its :meth:`Crown.solid`, or
+    within :data:`OWN_TOLERANCE_M` outside a face of its envelope (not outside the faces the
+    envelope leaves open: the plane shared with a neighbouring crown, the wall), so every
+    triangle of a row of touching crowns is one crown's."""
+    solid = crown.solid()
+    n, p0 = solid.face_normals, solid.triangles[:, 0]
     env = crown.trimesh()
-    if not env.is_watertight:
-        return list(meshes)
+    probe = solid.triangles_center + 1e-3 * n        # just outside each face of the solid
+    tri = env.ray.intersects_first(probe, -n)
+    hit = tri >= 0
+    gap = np.full(len(n), np.inf)
+    gap[hit] = np.einsum("ij,ij->i", probe[hit] - env.triangles[tri[hit], 0],
+                         env.face_normals[tri[hit]]) / -np.einsum(
+                             "ij,ij->i", -n[hit], env.face_normals[tri[hit]])
+    tol = np.where(np.abs(gap - 1e-3) < 1e-4, OWN_TOLERANCE_M, 0.0)
     own = []
     for m in meshes:
         if not m.n_triangles:
             continue
-        inside = env.contains(m.vertices)
-        keep = inside[m.faces].any(axis=1)
+        c = m.triangles.mean(axis=1)
+        keep = ((c @ n.T - np.einsum("ij,ij->i", n, p0)) <= tol).all(axis=1)
         if keep.any():
             own.append(Mesh(m.name, m.material, m.triangles[keep].reshape(-1, 3),
                             np.arange(3 * int(keep.sum())).reshape(-1, 3)))
@@ -244,10 +265,11 @@ def scattered_forward(crown: Crown, meshes: list[Mesh], materials: dict[str, Mat
     suns = np.atleast_2d(np.asarray(suns, float))
     suns = suns / np.linalg.norm(suns, axis=1)[:, None]
     top = float(crown.vertices[:, 2].max()) + PLANE_GAP_M
+    solid = crown.solid()
     starts = []
     for s, a in zip(suns, shadow_areas(crown, suns)):
         o = lattice(crown, s, rays, a)
-        o = o[crown.trimesh().ray.intersects_any(o, np.tile(s, (len(o), 1)))]
+        o = o[solid.ray.intersects_any(o, np.tile(s, (len(o), 1)))]
         if len(o) == 0:
             raise RadtreeError(f"{crown.name}: no ray of the bundle meets the crown")
         starts.append(o + s * ((top - o[:, 2]) / s[2])[:, None])
