@@ -24,13 +24,13 @@ R, TD, TS = 0.2, 0.3, 0.1
 
 
 def _sheet() -> tuple[Crown, list[Mesh], dict]:
-    """A horizontal translucent sheet 2.2 m square at z = 1 m in a 2 m square envelope 2 mm
+    """A horizontal translucent sheet 2.1 m square at z = 1 m in a 2 m square envelope 2 mm
     thick: every ray of the bundle crosses the sheet once, and nothing it scatters meets it
     again."""
     box = trimesh.creation.box(extents=(2.0, 2.0, 0.002))
     box.apply_translation((0.0, 0.0, 1.0))
     crown = Crown("sheet", np.asarray(box.vertices, float), np.asarray(box.faces, np.int64))
-    h = 1.1
+    h = 1.05
     v = np.array([[-h, -h, 1.0], [h, -h, 1.0], [h, h, 1.0], [-h, h, 1.0]])
     sheet = Mesh("sheet", "leaf", v, np.array([[0, 1, 2], [0, 2, 3]]))
     return crown, [sheet], {"leaf": Trans("leaf", R, TD, TS)}
@@ -39,10 +39,12 @@ def _sheet() -> tuple[Crown, list[Mesh], dict]:
 @pytest.mark.parametrize("altitude", [90.0, 60.0, 30.0])
 def test_sheet_total_is_its_direct_hemispherical_transmittance(altitude):
     """Sun at zenith angle θ on a Lambertian sheet (R, T_d, T_s): of what it transmits
-    diffusely the share leaving away from the sun is the view factor of a plane tilted by θ to
-    one side of it, (1 + cos θ)/2 (the isotropic sky on a tilted surface, Liu & Jordan 1963);
-    of what it reflects, (1 − cos θ)/2. Beam T_s exactly; total
-    T_s + T_d (1 + cos θ)/2 + R (1 − cos θ)/2 within 1 % (40 000 photons, seeded)."""
+    diffusely the share leaving away from the sun (into the half-space beyond the plane
+    perpendicular to the beam, tilted by θ from the sheet) is (1 + cos θ)/2 — the isotropic
+    sky's share on a plane tilted by θ (pvlib.irradiance.isotropic, Hottel & Woertz 1942) —
+    of what it reflects (1 − cos θ)/2. Beam T_s exactly; total
+    T_s + T_d (1 + cos θ)/2 + R (1 − cos θ)/2 within 1 % (40 000 photons, seeded; 8 seeds
+    scatter by 0.2–0.3 % about it). A horizontal-plane count would read T_s + T_d at every θ."""
     crown, meshes, materials = _sheet()
     a, theta = math.radians(altitude), math.radians(90.0 - altitude)
     sun = np.array([[math.cos(a) * 0.6, math.cos(a) * 0.8, math.sin(a)]])
