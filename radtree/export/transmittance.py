@@ -114,12 +114,12 @@ class Crown:
     vertices: np.ndarray
     faces: np.ndarray
 
-    def trimesh(self) -> trimesh.Trimesh:
-        return trimesh.Trimesh(self.vertices, self.faces, process=False)
-
     def solid(self) -> trimesh.Trimesh:
         """The closed convex hull of the envelope's vertices (the envelopes are convex)."""
         return trimesh.convex.convex_hull(self.vertices)
+
+    def trimesh(self) -> trimesh.Trimesh:
+        return trimesh.Trimesh(self.vertices, self.faces, process=False)
 
 
 @dataclass
@@ -267,10 +267,11 @@ def own_meshes(crown: Crown, meshes: list[Mesh]) -> list[Mesh]:
         if not m.n_triangles:
             continue
         t = m.triangles
-        out = np.einsum("tcj,fj->tcf", t, n) - np.einsum("fj,fj->f", n, p0)   # (tri, corner, face)
-        corner_in = (out[:, :, closed] <= OWN_TOLERANCE_M).all(axis=2).any(axis=1)
-        side_ok = (out.mean(axis=1)[:, ~closed] <= 0.0).all(axis=1)
-        keep = corner_in & side_ok
+        keep = np.zeros(len(t), bool)
+        for c in range(0, len(t), 1024):       # (triangle, corner, face) distances, in chunks
+            out = np.einsum("tcj,fj->tcf", t[c:c + 1024], n) - np.einsum("fj,fj->f", n, p0)
+            corner_in = (out[:, :, closed] <= OWN_TOLERANCE_M).all(axis=2).any(axis=1)
+            keep[c:c + 1024] = corner_in & (out.mean(axis=1)[:, ~closed] <= 0.0).all(axis=1)
         if keep.any():
             own.append(Mesh(m.name, m.material, t[keep].reshape(-1, 3),
                             np.arange(3 * int(keep.sum())).reshape(-1, 3)))
@@ -371,13 +372,14 @@ class _Trace:
     options: ScheduleOptions
 
     def __post_init__(self) -> None:
-        self.tracer = own_tracer(self.crown, self.meshes, self.materials)
+        self.own = own_meshes(self.crown, self.meshes)
+        self.tracer = DirectTracer(self.own, self.materials)
 
     def __call__(self, suns: np.ndarray, seed: int) -> np.ndarray:
         rays = self.options.rays
         values = transmittances(self.tracer, self.crown, suns, rays)
-        if self.options.definition == "total":
-            values = values + scattered_forward(self.crown, self.meshes, self.materials, suns,
+        if self.options.definition == "total":   # own_meshes(own) is own
+            values = values + scattered_forward(self.crown, self.own, self.materials, suns,
                                                 rays, seed=seed)
         return values
 
