@@ -27,7 +27,7 @@ across the beam; with direct normal illuminance E_n the open beam brings Φ₀ =
   bundle (:func:`radtree.engines.forward.passage.beam_passage`: the scattered part is its
   total minus its beam), added to the exact ``beam``; against traced pyranometers on that
   plane within 2 % for each crown model of the reference case at three sun positions
-  (benchmarks/schedule_total.py: −1.6 … +0.4 %).
+  (benchmarks/schedule_total.py: −1.4 … +0.4 %).
 
 *Why total by default:* an EnergyPlus shading surface stops what its schedule does not pass,
 and scattered light passes the crown: with ``beam`` every crown without gaps exports as opaque
