@@ -47,7 +47,7 @@ written sets ``ShadowCalculation`` so (:func:`radtree.export.honeybee.shadow_cal
 hour's value carries that sample's error: at the export's default 128 rays an hour of the
 reference case's crowns scatters by 5–22 % (one standard deviation over photon seeds) and its
 beam, a 128-point lattice over slats about as wide as its step, is off by up to 0.026 (the
-louvers dome at the zenith: 0.002 against 0.028); 65 536 rays bring the scatter to 0.1–0.5 %
+louvers dome at the zenith: 0.002 against 0.028); 65 536 rays bring it under 1 %
 (benchmarks/schedule_total.py). Sums over many hours (a season's energy) average much of it
 out; ``--rays`` buys hourly precision.
 
