@@ -1,23 +1,41 @@
 """Each crown's hourly transmittance along the sun direction for a year (energy shading schedules).
 
-**Definitions.** Two, both relative to the open-sky beam falling on the crown's shadow:
+**Definitions.** Two, both fractions of the open-sky beam falling on the crown's shadow: for a
+sun direction s (unit vector towards the sun), the crown's solid (the convex hull of its
+envelope, :meth:`Crown.solid`) projected along s is the area A⊥ (m²) the crown intercepts
+across the beam; with direct normal illuminance E_n the open beam brings Φ₀ = E_n·A⊥ onto it.
 
-* ``beam`` — the undeviated beam: for a sun direction s (unit vector towards the sun) the mean,
-  over a bundle of parallel rays travelling towards the sun through the crown, of the product
-  of the *specular* (undeviated) transmittances of every crown surface the ray crosses
-  (:class:`radtree.trees.raycast.DirectTracer`: ``trans`` T_s, holes 1, trunk and branches 0).
-  A crown of leaves with no specular transmission (the homogeneous crown, T_s = 0) is opaque.
-* ``total`` (**the default**) — the beam plus the sunlight the crown scatters *forward*
-  (diffuse transmission through leaves, reflections between them), leaving it travelling away
-  from the sun: what a pyranometer facing the sun behind the crown, summed over a plane
-  behind it, receives over what it receives with no crown. Traced by the forward engine's
-  transport from the same bundle (:func:`radtree.engines.forward.passage.beam_passage`: the
-  scattered part is its total minus its beam), added to the exact ``beam``.
+* ``beam`` — the regular (undeviated) transmittance: the mean, over a bundle of parallel rays
+  through the solid towards the sun, of the product of the *specular* transmittances of every
+  surface of the crown the ray crosses (:class:`radtree.trees.raycast.DirectTracer`: ``trans``
+  T_s, holes 1, trunk and branches 0). A crown of leaves without specular transmission (the
+  homogeneous crown, T_s = 0) passes no beam.
+* ``total`` (**the default**) — the crown's direct–hemispherical transmittance: of the flux Φ₀,
+  the share that leaves the crown travelling away from the sun (direction d with d·s < 0):
+  the beam plus what leaves and branches scatter into that hemisphere (diffuse transmission,
+  reflections between leaves) — regular plus diffuse transmittance, τ = τ_r + τ_d (CIE
+  e-ILV 17-24-067), the quantity an integrating sphere measures on a flat sample (Kessel 1986,
+  Applied Optics 25, 2752). Equivalently: sun-facing pyranometers tiling the whole plane
+  perpendicular to s behind the crown, their readings summed over the plane (every such ray
+  crosses it, none other does), less what they sum with no crown, over E_n·A⊥ — at any
+  distance behind the crown, but only on the *whole* plane: leaves scatter into a cosine lobe
+  about their own normal, so the crown's flanks send light nearly at right angles to the beam,
+  and a square 16 crown radii wide just behind it catches only 60–85 % of the scattered light
+  (benchmarks/schedule_total.py). Light scattered back towards the sun (d·s ≥ 0) is not in it
+  (a horizontal pyranometer plane would count the downward half instead: up to +50 % of the
+  scattered part for a sun at 40°). Traced by the forward engine's transport from the same
+  bundle (:func:`radtree.engines.forward.passage.beam_passage`: the scattered part is its
+  total minus its beam), added to the exact ``beam``; against traced pyranometers on that
+  plane within 2 % for each crown model of the reference case at three sun positions
+  (benchmarks/schedule_total.py: −1.4 … +0.4 %).
 
 *Why total by default:* an EnergyPlus shading surface stops what its schedule does not pass,
 and scattered light passes the crown: with ``beam`` every crown without gaps exports as opaque
-(the reference case's homogeneous dome, sun at the zenith, 60° and 40° altitude: beam 0.2–0.6 %, total
-3.9–5.1 %, benchmarks/schedule_total.py) and all scattered light is dropped. Remaining caveats (logged by the export): EnergyPlus applies the
+(the reference case's homogeneous dome, sun at the zenith, 60° and 40° altitude: beam
+0.3 %, total 4.6–5.2 %, benchmarks/schedule_total.py) and all scattered light is dropped. The
+whole plane, not the shadow alone: EnergyPlus lets τ·E_n·A⊥ through the shade (into its
+shadow), and with τ so defined that is the flux that passes the crown.
+Remaining caveats (logged by the export): EnergyPlus applies the
 value to the beam *and* diffuse solar on the shade and passes it on undeviated, as solar and
 visible alike (its issue #992: "the solar and visible transmittance is the same and … the
 surfaces are non-diffusing"); the schedule takes effect only with the ``PolygonClipping``
@@ -25,8 +43,16 @@ shadow calculation (#9059: ``PixelCounting`` treats the shade as opaque) recompu
 (#3073: a transmittance schedule follows the shadow calculation's update frequency) — the IDF
 written sets ``ShadowCalculation`` so (:func:`radtree.export.honeybee.shadow_calculation_idf`).
 
+**Sampling.** Each hour is traced with about ``rays`` bundle rays and as many photons, so an
+hour's value carries that sample's error: at the export's default 128 rays an hour of the
+reference case's crowns scatters by 5–22 % (one standard deviation over photon seeds) and its
+beam, a 128-point lattice over slats about as wide as its step, is off by up to 0.026 (the
+louvers dome at the zenith: 0.002 against 0.028); 65 536 rays bring it under 1 %
+(benchmarks/schedule_total.py). Sums over many hours (a season's energy) average much of it
+out; ``--rays`` buys hourly precision.
+
 The bundle (:func:`bundle`) starts on the horizontal plane 1 cm below the crown's lowest point:
-the points of a square lattice whose ray towards the sun meets the crown envelope, i.e. the
+the points of a square lattice whose ray towards the sun meets the crown's solid, i.e. the
 crown's shadow on that plane sampled uniformly (equal area across the beam), about ``rays``
 points.
 
@@ -72,15 +98,25 @@ CAVEATS = (
 MIN_ALTITUDE_DEG = 2.0
 """Below this sun altitude an hour takes the zenith transmittance (see the module)."""
 PLANE_GAP_M = 0.01
+OWN_TOLERANCE_M = 0.1
+"""How far outside its envelope a triangle's corner may lie and still be the crown's own (m):
+a crown shell on the envelope, whose facets are chords of the spheroid the shell follows
+(:func:`own_meshes`)."""
 
 
 @dataclass
 class Crown:
-    """One crown's envelope (world metres) as a closed triangle mesh, and its name."""
+    """One crown's envelope (world metres) as a triangle mesh, and its name. The mesh may be
+    open where the crown meets the wall or a neighbour (those faces are left out); the crown's
+    solid is its convex hull (:meth:`solid`)."""
 
     name: str
     vertices: np.ndarray
     faces: np.ndarray
+
+    def solid(self) -> trimesh.Trimesh:
+        """The closed convex hull of the envelope's vertices (the envelopes are convex)."""
+        return trimesh.convex.convex_hull(self.vertices)
 
     def trimesh(self) -> trimesh.Trimesh:
         return trimesh.Trimesh(self.vertices, self.faces, process=False)
@@ -143,8 +179,9 @@ def sun_vectors(project: Project, hours: list[datetime]) -> tuple[np.ndarray, np
 
 def shadow_areas(crown: Crown, suns: np.ndarray) -> np.ndarray:
     """Area (m²) of the convex crown's shadow on a horizontal plane for each sun (k, 3):
-    its projected area across the beam, ½ Σ_faces A·|n·s| (Cauchy), divided by s_z."""
-    tri = crown.vertices[crown.faces]
+    its projected area across the beam, ½ Σ_faces A·|n·s| over its closed :meth:`Crown.solid`
+    (Cauchy), divided by s_z."""
+    tri = crown.solid().triangles
     cross = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])   # 2·A·n
     return 0.25 * np.abs(suns @ cross.T).sum(axis=1) / suns[:, 2]
 
@@ -171,7 +208,7 @@ def bundle(crown: Crown, sun: np.ndarray, rays: int) -> np.ndarray:
     envelope — the crown's shadow sampled uniformly (equal area across the beam)."""
     o = lattice(crown, sun, rays)
     s = np.asarray(sun, float) / np.linalg.norm(sun)
-    return o[crown.trimesh().ray.intersects_any(o, np.tile(s, (len(o), 1)))]
+    return o[crown.solid().ray.intersects_any(o, np.tile(s, (len(o), 1)))]
 
 
 def transmittances(tracer: DirectTracer, crown: Crown, suns: np.ndarray, rays: int
@@ -184,7 +221,7 @@ def transmittances(tracer: DirectTracer, crown: Crown, suns: np.ndarray, rays: i
     grids = [lattice(crown, s, rays, a) for s, a in zip(suns, areas)]
     who = np.concatenate([np.full(len(g), k) for k, g in enumerate(grids)])
     o, d = np.vstack(grids), suns[who]
-    hit = crown.trimesh().ray.intersects_any(o, d)
+    hit = crown.solid().ray.intersects_any(o, d)
     who, o, d = who[hit], o[hit], d[hit]
     n = np.bincount(who, minlength=len(suns))
     if (n == 0).any():
@@ -217,21 +254,43 @@ def own_tracer(crown: Crown, meshes: list[Mesh], materials: dict[str, Material]
 
 
 def own_meshes(crown: Crown, meshes: list[Mesh]) -> list[Mesh]:
-    """The triangles with a corner in ``crown``'s envelope (all of them for the sensor dome,
-    open on the wall: one crown)."""
-    env = crown.trimesh()
-    if not env.is_watertight:
-        return list(meshes)
+    """The crown's own triangles: those with a corner in its :meth:`Crown.solid` or within
+    :data:`OWN_TOLERANCE_M` outside a face of its envelope (a leaf poking out, a shell on the
+    envelope), and with the centroid on the crown's side of every face the envelope leaves open
+    (the plane shared with a neighbouring crown, the wall): every triangle of a row of touching
+    crowns is one crown's."""
+    solid = crown.solid()
+    n, p0 = solid.face_normals, solid.triangles[:, 0]
+    closed = _closed_faces(crown, solid)
     own = []
     for m in meshes:
         if not m.n_triangles:
             continue
-        inside = env.contains(m.vertices)
-        keep = inside[m.faces].any(axis=1)
+        t = m.triangles
+        keep = np.zeros(len(t), bool)
+        for c in range(0, len(t), 1024):       # (triangle, corner, face) distances, in chunks
+            out = np.einsum("tcj,fj->tcf", t[c:c + 1024], n) - np.einsum("fj,fj->f", n, p0)
+            corner_in = (out[:, :, closed] <= OWN_TOLERANCE_M).all(axis=2).any(axis=1)
+            keep[c:c + 1024] = corner_in & (out.mean(axis=1)[:, ~closed] <= 0.0).all(axis=1)
         if keep.any():
-            own.append(Mesh(m.name, m.material, m.triangles[keep].reshape(-1, 3),
+            own.append(Mesh(m.name, m.material, t[keep].reshape(-1, 3),
                             np.arange(3 * int(keep.sum())).reshape(-1, 3)))
     return own
+
+
+def _closed_faces(crown: Crown, solid: trimesh.Trimesh) -> np.ndarray:
+    """Per face of ``solid``: True where the envelope has a face there (a probe 1 mm outside
+    the face's centre, cast inwards, meets the envelope 1 mm on)."""
+    n = solid.face_normals
+    env = crown.trimesh()
+    probe = solid.triangles_center + 1e-3 * n
+    tri = env.ray.intersects_first(probe, -n)
+    hit = tri >= 0
+    gap = np.full(len(n), np.inf)
+    en = env.face_normals[tri[hit]]
+    gap[hit] = (np.einsum("ij,ij->i", probe[hit] - env.triangles[tri[hit], 0], en)
+                / np.einsum("ij,ij->i", n[hit], en))
+    return np.abs(gap - 1e-3) < 1e-4
 
 
 def scattered_forward(crown: Crown, meshes: list[Mesh], materials: dict[str, Material],
@@ -243,15 +302,18 @@ def scattered_forward(crown: Crown, meshes: list[Mesh], materials: dict[str, Mat
 
     suns = np.atleast_2d(np.asarray(suns, float))
     suns = suns / np.linalg.norm(suns, axis=1)[:, None]
-    top = float(crown.vertices[:, 2].max()) + PLANE_GAP_M
+    own = own_meshes(crown, meshes)
+    top = max([float(crown.vertices[:, 2].max())]
+              + [float(m.vertices[:, 2].max()) for m in own if m.n_triangles]) + PLANE_GAP_M
+    solid = crown.solid()
     starts = []
     for s, a in zip(suns, shadow_areas(crown, suns)):
         o = lattice(crown, s, rays, a)
-        o = o[crown.trimesh().ray.intersects_any(o, np.tile(s, (len(o), 1)))]
+        o = o[solid.ray.intersects_any(o, np.tile(s, (len(o), 1)))]
         if len(o) == 0:
             raise RadtreeError(f"{crown.name}: no ray of the bundle meets the crown")
         starts.append(o + s * ((top - o[:, 2]) / s[2])[:, None])
-    total, beam = beam_passage(own_meshes(crown, meshes), materials, -suns, starts, seed=seed)
+    total, beam = beam_passage(own, materials, -suns, starts, seed=seed)
     return np.maximum(total - beam, 0.0)
 
 
@@ -310,13 +372,14 @@ class _Trace:
     options: ScheduleOptions
 
     def __post_init__(self) -> None:
-        self.tracer = own_tracer(self.crown, self.meshes, self.materials)
+        self.own = own_meshes(self.crown, self.meshes)
+        self.tracer = DirectTracer(self.own, self.materials)
 
     def __call__(self, suns: np.ndarray, seed: int) -> np.ndarray:
         rays = self.options.rays
         values = transmittances(self.tracer, self.crown, suns, rays)
-        if self.options.definition == "total":
-            values = values + scattered_forward(self.crown, self.meshes, self.materials, suns,
+        if self.options.definition == "total":   # own_meshes(own) is own
+            values = values + scattered_forward(self.crown, self.own, self.materials, suns,
                                                 rays, seed=seed)
         return values
 
