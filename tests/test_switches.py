@@ -50,7 +50,8 @@ def test_every_dataclass_field_is_a_key():
     assert set(table_keys("tree.louvers")) == set(LOUVERS_FIELDS)
     assert PATH_FIELDS == ("project.measured", "project.measured_rows",
                            "street.ground_reflectance", "light.direct_normal", "light.epw",
-                           "tree.photo", "tree.points", "tree.voxels", "tree.perforated.photo",
+                           "tree.photo", "tree.points", "tree.voxels", "tree.points_scans",
+                           "tree.perforated.photo",
                            "tree.bsdf.xml")
 
 
