@@ -25,7 +25,15 @@ from radtree.engines.forward.guide import Guide
 from radtree.engines.forward.precision import Budget, worst_relative_se
 from radtree.engines.forward.settings import ForwardSettings
 from radtree.engines.forward.sources import EnvironmentSource, SunSource, bounding_sphere
-from radtree.engines.forward.strata import PILOT, Stratum, allocate, pilot, ring_edges, trace_strata
+from radtree.engines.forward.strata import (
+    PILOT,
+    Stratum,
+    allocate,
+    pilot,
+    reallocate,
+    ring_edges,
+    trace_strata,
+)
 from radtree.engines.forward.tracer import ForwardTracer, Ledger, Photons, Splitting
 from radtree.errors import ConfigError, EngineError
 from radtree.light.sky import SkyState
@@ -232,6 +240,8 @@ def _rounds(h: _Hour, tracer: ForwardTracer, strata: list[Stratum] | None
     leg = s.photons
     while leg > 0:
         for _ in range(max(1, leg // s.photons)):
+            if strata is not None and rows:   # later rounds: allotted from all photons so far
+                reallocate(strata, s.photons, s.batches)
             n, r = _round(h, tracer, strata, at_points)
             traced += n
             rows.append(r)
