@@ -28,6 +28,25 @@ Issue 40 (the estimator a user can trust by default), each a separate mode:
 
 ``--hours`` and ``--scenarios`` choose the scenario-hours (hour-major order, each line printed
 when done, so a partial run reports what it covered).
+
+Measured 2026-12-07 (2 shared cores, load 5–10 from other sessions), after the strata
+re-allocation between rounds and the sizing round (radtree.engines.forward.strata, .precision):
+
+* Where the tail came from (scenario B at 12:30, per-photon façade contributions by launch
+  ring, one round at the defaults, pre-change allocation): within a ring a hit is at most
+  6.4 × the ring's mean hit (the guided weights are bounded), but rings 4–16 m from the focus
+  reach the patches 1–3 times in 10⁴ photons with ~50 × an inner-ring hit's flux; the pilot
+  saw 0 lux there, the rings ran on the floor share, and a run's few such hits made 17 % of
+  the scattered light (1 round: rings 8–12 m 102 ± 92 lx of 815 lx scattered).
+* ``--radiance --scenarios B A-sky`` (all 7 hours): **14 of 14 within 2 % or 3 s.e.**
+  (before: B 12:30 −9.5 %, z −5.7; A-sky 12:30 −6.1 %, z −3.7). B 12:30 −3.95 % (−1.77 s.e.),
+  10:30 +0.03 %, 16:30 +6.27 % (+1.26), 11:30 −1.13 %, 15:30 +1.38 %, 13:30 +5.80 % (+1.60),
+  14:30 +4.00 % (+1.45); A-sky 12:30 −0.61 %, 10:30 +7.19 % (+1.26), 16:30 −4.10 % (−2.42),
+  11:30 +8.32 % (+1.88), 15:30 −3.06 % (−2.13), 13:30 −5.10 % (−2.90), 14:30 +8.01 % (+0.87).
+  **But the 2 % target is missed in 10 of 14**: they stop at the 16 M cap (15 M counted + the
+  1 M sizing round) with a PrecisionWarning, relative s.e. 2.0–5.3 % (A-sky 14:30: 8.5 %);
+  A-sky 12:30, 13:30, 15:30, 16:30 reach it (1.5–1.9 %, 2–15 M photons). 40–90 s forward per
+  scenario-hour at that load.
 """
 
 from __future__ import annotations
