@@ -5,7 +5,8 @@ area, mean of all photons; standard error = s.d. of the batch estimates / √the
 the hour's :class:`~radtree.engines.forward.tracer.Ledger` and counters. Photons are traced in
 rounds of ``settings.photons`` (``settings.batches`` batches each); with
 ``settings.target_rel_se`` rounds are added until every grid's mean reaches it or
-``settings.max_photons`` (:mod:`radtree.engines.forward.precision`).
+``settings.max_photons`` (:mod:`radtree.engines.forward.precision`; a first round that misses
+the target only sizes the run and is not counted).
 """
 
 from __future__ import annotations
