@@ -54,6 +54,17 @@ def test_leg_from_the_square_root_law():
     assert Budget(1000, None, 1000).next_leg(1000, 0.5) == 0  # no target: one round
 
 
+def test_sizing_round_predicts_the_counted_photons():
+    """A first round of 1 M at 4 % sizes the run: 4 M × 1.1 → 5 rounds traced afresh (within
+    the 16 M cap less the sizing round); further legs count the sizing round towards the cap."""
+    b = Budget(round_photons=1_000_000, target=0.02, cap=16_000_000)
+    assert b.sized_leg(1_000_000, 0.04) == 5_000_000
+    assert b.sized_leg(1_000_000, 0.30) == 15_000_000       # the cap less the sizing round
+    assert b.sized_leg(1_000_000, 0.02) == 0 and b.sized_leg(1_000_000, math.inf) == 0
+    assert b.next_leg(5_000_000, 0.03, spent=1_000_000) == 8_000_000   # 12.4 M: 7.4 M more
+    assert b.next_leg(15_000_000, 0.03, spent=1_000_000) == 0          # cap reached
+
+
 def test_cap_warns_with_the_error_reached():
     b = Budget(1000, 0.02, 2000)
     with pytest.warns(PrecisionWarning, match=r"cap 2,000 reached .* grid 'facade' 10\.0%"):

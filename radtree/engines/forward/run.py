@@ -5,7 +5,8 @@ area, mean of all photons; standard error = s.d. of the batch estimates / √the
 the hour's :class:`~radtree.engines.forward.tracer.Ledger` and counters. Photons are traced in
 rounds of ``settings.photons`` (``settings.batches`` batches each); with
 ``settings.target_rel_se`` rounds are added until every grid's mean reaches it or
-``settings.max_photons`` (:mod:`radtree.engines.forward.precision`).
+``settings.max_photons`` (:mod:`radtree.engines.forward.precision`; a first round that misses
+the target only sizes the run and is not counted).
 """
 
 from __future__ import annotations
@@ -25,7 +26,15 @@ from radtree.engines.forward.guide import Guide
 from radtree.engines.forward.precision import Budget, worst_relative_se
 from radtree.engines.forward.settings import ForwardSettings
 from radtree.engines.forward.sources import EnvironmentSource, SunSource, bounding_sphere
-from radtree.engines.forward.strata import PILOT, Stratum, allocate, pilot, ring_edges, trace_strata
+from radtree.engines.forward.strata import (
+    PILOT,
+    Stratum,
+    allocate,
+    pilot,
+    reallocate,
+    ring_edges,
+    trace_strata,
+)
 from radtree.engines.forward.tracer import ForwardTracer, Ledger, Photons, Splitting
 from radtree.errors import ConfigError, EngineError
 from radtree.light.sky import SkyState
@@ -39,7 +48,7 @@ class ForwardResult:
 
     grids: dict[str, GridResult]
     ledger: Ledger
-    photons: int           # photons traced (every round; the pilot's not counted)
+    photons: int           # photons counted (every counted round; pilot, sizing round not)
     segments: int
     seconds: float
     batches: dict[str, np.ndarray]
@@ -50,6 +59,8 @@ class ForwardResult:
     #: more), and the :class:`PrecisionWarning` text when the photon cap stopped the run
     rounds: int = 1
     warning: str | None = None
+    #: photons of the sizing round (traced, steering the strata, not counted; 0: none)
+    sizing_photons: int = 0
 
     def grid_mean(self, grid: str) -> tuple[float, float]:
         """Mean lux over the grid's sensors and its standard error from the batches (patches
@@ -221,25 +232,37 @@ def _round(h: _Hour, tracer: ForwardTracer, strata: list[Stratum] | None,
 
 
 def _rounds(h: _Hour, tracer: ForwardTracer, strata: list[Stratum] | None
-            ) -> tuple[int, np.ndarray, int, str | None]:
+            ) -> tuple[int, np.ndarray, int, str | None, int]:
     """Rounds of ``photons`` until the precision target or the cap
-    (:class:`~radtree.engines.forward.precision.Budget`): photons traced, (batches,
-    detectors) lux of every batch, rounds, the warning when the cap stopped the run."""
+    (:class:`~radtree.engines.forward.precision.Budget`): photons counted, (batches,
+    detectors) lux of every counted batch, counted rounds, the warning when the cap stopped
+    the run, and the photons of the sizing round (0: the first round met the target, or no
+    target). With a target not met by the first round, that round only *sizes* the run (and
+    steers the strata): the photons it predicts are traced afresh and counted, so whether the
+    run stops early does not depend on the counted photons (precision.py, *Stopping*)."""
     s = h.settings
     at_points = _at_points(h)
     budget = Budget(s.photons, s.target_rel_se, s.max_photons)
-    traced, rows = 0, []
+    traced, sizing, rows = 0, 0, []
     leg = s.photons
     while leg > 0:
         for _ in range(max(1, leg // s.photons)):
+            if strata is not None and traced:   # later rounds: allotted from all so far
+                reallocate(strata, s.photons, s.batches)
             n, r = _round(h, tracer, strata, at_points)
             traced += n
             rows.append(r)
         per_batch = np.vstack(rows)
         grid_batches = {name: per_batch[:, h.det.slices[name]].mean(axis=1)
                         for name in h.names}
-        leg = budget.next_leg(traced, worst_relative_se(grid_batches)[1])
-    return traced, per_batch, len(rows), budget.warn_if_short(traced, grid_batches)
+        rel = worst_relative_se(grid_batches)[1]
+        leg = budget.next_leg(traced - sizing, rel, spent=sizing)
+        if leg and not sizing and len(rows) == 1:
+            fresh = budget.sized_leg(traced, rel)
+            if fresh:   # the first round sized the run: trace the prediction afresh
+                sizing, leg, rows = traced, fresh, []
+    return (traced - sizing, per_batch, len(rows), budget.warn_if_short(traced, grid_batches),
+            sizing)
 
 
 def trace_forward(scene: Scene, state: SkyState, settings: ForwardSettings,
@@ -254,14 +277,15 @@ def trace_forward(scene: Scene, state: SkyState, settings: ForwardSettings,
     h = _plan(scene, state, settings, grids, backend=backend, workers=workers, label=label)
     tracer = _tracer(h, settings.batches)
     strata, n_pilot, pilot_segments = _focus(h)
-    traced, per_batch, rounds, warning = _rounds(h, tracer, strata)
+    counted, per_batch, rounds, warning, sizing = _rounds(h, tracer, strata)
     out, per = {}, {}
     for name in h.names:
         per[name] = per_batch[:, h.det.slices[name]]
         out[name] = GridResult(per[name].mean(axis=0),
                                per[name].std(axis=0, ddof=1) / np.sqrt(len(per[name])))
-    return ForwardResult(out, tracer.ledger, traced, tracer.segments + pilot_segments,
-                         time.perf_counter() - t0, per, strata, n_pilot, rounds, warning)
+    return ForwardResult(out, tracer.ledger, counted, tracer.segments + pilot_segments,
+                         time.perf_counter() - t0, per, strata, n_pilot, rounds, warning,
+                         sizing)
 
 
 def _allot(photons: int, fluxes: list[float], batches: int) -> list[int]:
