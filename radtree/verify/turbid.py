@@ -43,6 +43,7 @@ from radtree.engines.numpy.engine import ENGINE_NAME
 from radtree.engines.numpy.scenes import sky_state
 from radtree.engines.numpy.tracing import trace
 from radtree.media import TurbidCrowns
+from radtree.media_voxels import Media
 from radtree.optics import Plastic, Trans
 from radtree.scene import Scene, SensorGrid, quad
 from radtree.trees.turbid import leaf_kind
@@ -63,20 +64,28 @@ def _lv(x: float) -> Louvers:
     return Louvers(inclination_distribution="ellipsoidal", ellipsoid_x=x)
 
 
-def crown_scene(x: float, lad: float, leaf: Trans, sensors: int = 1, floor_m: float = 500.0
-                ) -> Scene:
-    """The one spherical crown, a black floor of half-width ``floor_m`` 50 m below its centre
-    (the furnace: a 1 cm one, which the sensor sees in 4·10⁻⁸ sr: the engine needs one
-    surface), ``sensors`` sensors at its centre facing up."""
-    kind = leaf_kind(_lv(x), leaf.name)
-    media = TurbidCrowns.of(np.array([CENTRE]), RADIUS, RADIUS, lad, 0, [kind])
+def furnace_scene(media: Media, leaf: Trans, *, sensor: np.ndarray, sensors: int = 1,
+                  floor_m: float = 500.0) -> Scene:
+    """``media`` over a black floor of half-width ``floor_m`` at z = −47 m (the furnace: a
+    1 cm one, which the sensor sees in 4·10⁻⁸ sr: the engine needs one surface), ``sensors``
+    sensors at ``sensor`` facing up."""
     h = floor_m
     floor = quad("floor", "black", np.array([[-h, -h, -47.0], [h, -h, -47.0], [h, h, -47.0],
                                              [-h, h, -47.0]]))
-    grid = SensorGrid("facade", np.tile(CENTRE, (sensors, 1)), np.tile([0.0, 0.0, 1.0],
+    grid = SensorGrid("facade", np.tile(sensor, (sensors, 1)), np.tile([0.0, 0.0, 1.0],
                                                                           (sensors, 1)))
     return Scene([floor], {"black": Plastic("black", 0.0), leaf.name: leaf}, {"facade": grid},
                  media=media)
+
+
+def crown_scene(x: float, lad: float, leaf: Trans, sensors: int = 1, floor_m: float = 500.0
+                ) -> Scene:
+    """The one spherical crown over :func:`furnace_scene`'s floor (50 m below its centre),
+    ``sensors`` sensors at its centre facing up."""
+    kind = leaf_kind(_lv(x), leaf.name)
+    media = TurbidCrowns.of(np.array([CENTRE]), RADIUS, RADIUS, lad, 0, [kind])
+    return furnace_scene(media, leaf, sensor=np.asarray(CENTRE, float), sensors=sensors,
+                         floor_m=floor_m)
 
 
 def beer_lambert(x: float, lad: float, mu: float) -> float:

@@ -42,8 +42,8 @@ from radtree.engines.numpy.scenes import sky_state
 from radtree.engines.numpy.tracing import trace
 from radtree.media import TurbidCrowns
 from radtree.media_voxels import MediaSet, VoxelCrowns
-from radtree.optics import Plastic, Trans
-from radtree.scene import Scene, SensorGrid, quad
+from radtree.optics import Trans
+from radtree.scene import Scene, SensorGrid
 from radtree.trees.turbid import leaf_kind
 from radtree.verify.checks import Check, log_checks
 from radtree.verify.turbid import (
@@ -57,6 +57,7 @@ from radtree.verify.turbid import (
     _params,
     _se,
     crown_scene,
+    furnace_scene,
 )
 
 log = logging.getLogger(__name__)
@@ -106,13 +107,8 @@ def grid_scene(leaf: Trans, *, sensors: int = 1, floor_m: float = 500.0,
     vox = VoxelCrowns.of(ORIGIN[None], size_m=SIZE, pads=[grid_pad()], kinds=[kind])
     media = (MediaSet(TurbidCrowns.of(np.array([CENTRE]), RADIUS, RADIUS, LAD, 0, [kind]), vox)
              if spheroid else vox)
-    h = floor_m
-    floor = quad("floor", "black", np.array([[-h, -h, -47.0], [h, -h, -47.0], [h, h, -47.0],
-                                             [-h, h, -47.0]]))
-    grid = SensorGrid("facade", np.tile(SENSOR, (sensors, 1)), np.tile([0.0, 0.0, 1.0],
-                                                                          (sensors, 1)))
-    return Scene([floor], {"black": Plastic("black", 0.0), leaf.name: leaf}, {"facade": grid},
-                 media=media)
+    return furnace_scene(media, leaf, sensor=np.asarray(SENSOR, float), sensors=sensors,
+                         floor_m=floor_m)
 
 
 def sky_through_grid(nodes: int = 240) -> float:

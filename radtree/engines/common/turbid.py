@@ -39,22 +39,11 @@ from radtree.engines.common.streams import Draws, PathStreams
 from radtree.errors import EngineError
 from radtree.media import LeafKind, TurbidCrowns
 from radtree.optics import Material, Trans
-from radtree.scene import Scene
 
 COLLIDE = 5        # stream site of the free-path draws (the loop's own sites are 0–4)
 NORMALS = 6        # stream site of the leaf-normal draws
 PAIR_SHIFT = 40    # (path, crown) streams: path number + (crown + 1) · 2⁴⁰
 MAX_TRIES = 64     # rejection rounds for the leaf normals (then the last draw is kept)
-
-
-def refuse_media(scene: Scene, engine: str) -> None:
-    """EngineError when ``scene`` holds turbid crowns and ``engine`` cannot trace them (an
-    engine without a media form; Radiance writes them as ``mist``,
-    :mod:`radtree.engines.radiance.mist`)."""
-    if scene.media is not None and len(scene.media):
-        raise EngineError(f"the {engine} engine cannot trace turbid-medium crowns ([tree] "
-                          "representation = \"turbid\"): use --engine numpy, or "
-                          "representation = \"explicit\"")
 
 
 def pair_uniforms(draws: Draws, rows: np.ndarray, crown: np.ndarray) -> np.ndarray:
