@@ -411,3 +411,18 @@ def test_change_stderr_unknown_when_the_engine_gives_none():
                                     rows("open", [400.0, 600.0], [0.0, 0.0])]),
                          [Pair("trees", "open")])
     assert numpy["change_stderr"].tolist() == pytest.approx([2.5, 2.5])
+
+
+@pytest.mark.parametrize(("zone", "date", "hours"), [
+    ("Europe/Paris", "2024-06-21", 2.0), ("Europe/Paris", "2024-12-21", 1.0),
+    ("Australia/Sydney", "2024-12-21", 11.0), ("Australia/Sydney", "2024-06-21", 10.0),
+    ("Asia/Kolkata", "2024-06-21", 5.5), ("UTC-3", "2024-06-21", -3.0)])
+def test_hourly_figure_names_the_civil_offset_of_the_date(zone, date, hours):
+    """The hourly figure's time axis says the clock the hours are in: daylight saving
+    included (Paris in June is UTC+2, not its standard UTC+1)."""
+    from radtree.config.timezone import parse_time_zone
+    from radtree.report.figures import clock_offset_hours
+
+    site = type("S", (), {"date": date, "time_zone": zone, "utc_offset_hours": -99.0,
+                          "tzinfo": parse_time_zone(zone)})()
+    assert clock_offset_hours(site) == hours
