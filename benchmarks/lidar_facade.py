@@ -140,6 +140,8 @@ def main() -> int:
         toml.write_text(head + "".join(scenario(f"orig{k}", args.crossings,
                                                 f', "louvers.seed" = {k}') for k in seeds))
         text, areas = scan_crowns(tmp, args)
+        if args.turbid:
+            text += scenario("turb", args.crossings, ', "tree.representation" = "turbid"')
         toml.write_text(text + '\n[[scenario]]\nname = "open"\nmodel = "none"\n'
                         'reflection = "traced"\nform = "free"\n')
         exe = Path(sys.executable).with_name("radtree")
@@ -173,8 +175,11 @@ def main() -> int:
                   + f"  ({int(np.sum(np.abs(s / o - 1) <= 0.05))}/{len(o)} within 5 %)")
             if args.turbid:
                 v = np.array([mean.loc[hour, f"vox{k}"] for k in seeds])
+                t = mean.loc[hour, "turb"]
                 print(f"{'':7} {'':6} turbid voxels {v.mean():7.0f} lx, vox/orig "
                       f"{v.mean() / o.mean():6.3f}  " + " ".join(f"{x:.3f}" for x in v / o))
+                print(f"{'':7} {'':6} turbid orig {t:7.0f} lx (orig/turb {o.mean() / t:.3f}); "
+                      f"vox/turb {v.mean() / t:.3f} ± {v.std(ddof=1) / t / np.sqrt(len(v)):.3f}")
     print(f"sensors' mean over realisations within 5 %: {'met' if worst <= 0.05 else 'NOT met'}"
           f" (worst {100 * worst:.1f} %)")
     return 0
