@@ -75,10 +75,12 @@ def points_crown_grid(tree: Tree, source: str | None = None) -> tuple[VoxelGrid,
     hull on cells of 1/:data:`~radtree.trees.points_hull.SUB` voxel — what the crowns are
     filled from and placed by —, voxels whose gap the hull could not hold):
     :func:`radtree.trees.points_hull.sharpen`, vertical-beam form for airborne scans."""
-    from radtree.trees.points_hull import sharpen
+    from radtree.trees.points_hull import sharpen, vertical_beams
 
     grid = points_grid(tree, source)
-    fine, unsolved = sharpen(grid, vertical=tree.points_scans is None)
+    assert tree.points is not None
+    beams = vertical_beams(tree.points) if tree.points_scans is None else None
+    fine, unsolved = sharpen(grid, beams=beams)
     return grid, fine, unsolved
 
 

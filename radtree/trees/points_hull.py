@@ -37,6 +37,8 @@ with plant area.
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import numpy as np
 
 from radtree.lidar.voxels import VoxelGrid
@@ -46,55 +48,115 @@ from radtree.lidar.voxels import VoxelGrid
 SUB = 4
 
 
-def hull_inside(grid: VoxelGrid, sub: int) -> np.ndarray | None:
+def vertical_beams(path: str | Path) -> tuple[np.ndarray, np.ndarray]:
+    """(x, y (n, 2) m, heights above ground (n,) m) of every return of the tree in ``path``
+    but buildings and noise — as :func:`radtree.lidar.voxels.tree_voxels` reads them."""
+    from radtree.lidar.ground import NOT_TREES, heights_above_ground
+    from radtree.lidar.tile import read_tile
+
+    tile = read_tile(path)
+    heights, _ = heights_above_ground(tile, "class")
+    keep = ~np.isin(tile.classification, NOT_TREES)
+    return tile.xyz[keep, :2], heights[keep]
+
+
+def hull_inside(grid: VoxelGrid, sub: int, margin_m: float = 0.0) -> np.ndarray | None:
     """(nx·sub, ny·sub, nz·sub) whether each cell's centre lies inside the convex hull of the
-    grid's vegetation returns; None when they span no volume (all in a plane, < 4 points)."""
-    from scipy.spatial import Delaunay, QhullError
+    grid's vegetation returns, its faces moved ``margin_m`` outwards; None when they span no
+    volume (all in a plane, < 4 points)."""
+    from scipy.spatial import ConvexHull, QhullError
 
     r = grid.returns
     if len(r) < 4:
         return None
     try:
-        tri = Delaunay(r)
+        eq = ConvexHull(r).equations          # n·x + c ≤ 0 inside, |n| = 1
     except QhullError:
         return None
     w = grid.size_m / sub
     shape = tuple(int(n) * sub for n in grid.pad.shape)
     x, y = np.meshgrid(grid.x0 + (np.arange(shape[0]) + 0.5) * w,
                        grid.y0 + (np.arange(shape[1]) + 0.5) * w, indexing="ij")
+    xy = np.column_stack([x.ravel(), y.ravel()]) @ eq[:, :2].T + eq[:, 3] - margin_m
     out = np.zeros(shape, bool)
-    for k in range(shape[2]):       # a layer at a time: (nx·sub)·(ny·sub) points
-        pts = np.column_stack([x.ravel(), y.ravel(), np.full(x.size, (k + 0.5) * w)])
-        out[:, :, k] = (tri.find_simplex(pts) >= 0).reshape(shape[0], shape[1])
+    for k in range(shape[2]):       # a layer at a time: (nx·sub)·(ny·sub) × faces
+        far = xy + ((k + 0.5) * w) * eq[:, 2]
+        out[:, :, k] = (far.max(axis=1) <= 0.0).reshape(shape[0], shape[1])
     return out
 
 
-def _solve_u(paths: np.ndarray, gap: np.ndarray, g: float) -> tuple[np.ndarray, np.ndarray]:
-    """(u m²/m³, solved) per voxel: the density with mean_c exp(−u·g·paths[:, c]) = gap
-    (paths (n, sub²) m); solved False where even u → ∞ leaves more gap than ``gap``."""
-    empty = np.mean(paths <= 0, axis=1)
-    solved = empty < gap - 1e-9
+def _solve_u(paths: np.ndarray, *, weights: np.ndarray, gap: np.ndarray, g: float
+             ) -> tuple[np.ndarray, np.ndarray]:
+    """(u m²/m³, solved) per voxel: the density with Σ_c w_c exp(−u·g·ℓ_c) / Σ_c w_c = gap
+    (``paths`` ℓ (n, sub²) m, ``weights`` w the beams reaching each cell column); solved False
+    where even u → ∞ leaves more gap than ``gap``."""
+    wsum = np.maximum(weights.sum(axis=1), 1e-300)
+
+    def mean_gap(uu: np.ndarray) -> np.ndarray:
+        return np.sum(weights * np.exp(-uu[:, None] * g * paths), axis=1) / wsum
+
+    solved = np.sum(weights * (paths <= 0), axis=1) / wsum < gap - 1e-9
     lo = np.zeros(len(gap))
     hi = np.full(len(gap), 1.0)
     for _ in range(60):          # grow the bracket until it holds the root
-        short = solved & (np.mean(np.exp(-hi[:, None] * g * paths), axis=1) > gap)
+        short = solved & (mean_gap(hi) > gap)
         if not short.any():
             break
         hi[short] *= 2.0
     for _ in range(60):          # bisection: the mean gap falls as u grows
         mid = 0.5 * (lo + hi)
-        above = np.mean(np.exp(-mid[:, None] * g * paths), axis=1) > gap
+        above = mean_gap(mid) > gap
         lo = np.where(above, mid, lo)
         hi = np.where(above, hi, mid)
     return 0.5 * (lo + hi), solved
 
 
-def sharpen(grid: VoxelGrid, *, sub: int = SUB, vertical: bool = True) -> tuple[VoxelGrid, int]:
-    """(the grid on cells of side size_m/``sub`` with its plant area inside the returns' hull,
-    voxels whose gap the hull could not hold — kept area-conserving) (module text)."""
-    inside = hull_inside(grid, sub)
+def footprint_density(grid: VoxelGrid, inside: np.ndarray, *, xy: np.ndarray,
+                      heights: np.ndarray, ground_m: float = 0.5
+                      ) -> tuple[np.ndarray, np.ndarray]:
+    """(u m²/m³, counted) per voxel: the column inversion of :mod:`radtree.lidar.voxels` on
+    the beams through the hull's part of each voxel only (module text). ``xy`` (n, 2) m and
+    ``heights`` (n,) m above ground of every return of the tree, ground returns included (one
+    vertical beam each); ``counted``: voxels some beam reached."""
     nx, ny, nz = grid.pad.shape
-    v, w = grid.size_m, grid.size_m / sub
+    sub = inside.shape[0] // nx
+    w, g = grid.size_m / sub, grid.g
+    fi = np.floor((xy[:, 0] - grid.x0) / w).astype(np.int64)
+    fj = np.floor((xy[:, 1] - grid.y0) / w).astype(np.int64)
+    ok = (fi >= 0) & (fi < nx * sub) & (fj >= 0) & (fj < ny * sub)
+    k = np.where(heights >= ground_m, np.floor(heights / grid.size_m), -1).astype(np.int64)
+    k = np.clip(k, -1, nz - 1)
+    counts = np.zeros((nx * sub, ny * sub, nz + 1))      # [..., 0] ground, [..., k + 1] layer k
+    np.add.at(counts, (fi[ok], fj[ok], k[ok] + 1), 1.0)
+    below = np.cumsum(counts, axis=2)
+    top, bottom = below[..., 1:], below[..., :-1]        # N(z_top), N(z_bottom) per cell column
+
+    def per_voxel(a: np.ndarray) -> np.ndarray:           # (nx, ny, nz, sub²)
+        return a.reshape(nx, sub, ny, sub, nz).transpose(0, 2, 4, 1, 3).reshape(
+            nx, ny, nz, sub * sub)
+
+    paths = per_voxel(inside.reshape(nx * sub, ny * sub, nz, sub).sum(axis=-1) * w)
+    lit = paths > 0
+    n_top = per_voxel(top) * lit
+    n_top_sum = n_top.sum(axis=-1)
+    n_bottom = (per_voxel(bottom) * lit).sum(axis=-1)
+    counted = n_top_sum > 0
+    gap = (n_bottom[counted] + 0.5) / (n_top_sum[counted] + 0.5)
+    u = np.zeros((nx, ny, nz))
+    us, _ = _solve_u(paths[counted], weights=n_top[counted], gap=np.minimum(gap, 1.0), g=g)
+    u[counted] = np.where(gap < 1.0, us, 0.0)
+    return u, counted
+
+
+def sharpen(grid: VoxelGrid, *, sub: int = SUB,
+            beams: tuple[np.ndarray, np.ndarray] | None = None, margin_m: float = 0.0
+            ) -> tuple[VoxelGrid, int]:
+    """(the grid on cells of side size_m/``sub`` with its plant area inside the returns' hull
+    (widened by ``margin_m``), voxels whose gap the hull could not hold — kept
+    area-conserving) (module text)."""
+    inside = hull_inside(grid, sub, margin_m)
+    nx, ny, nz = grid.pad.shape
+    w = grid.size_m / sub
     if inside is None:
         inside = np.ones((nx * sub, ny * sub, nz * sub), bool)
     blocks = inside.reshape(nx, sub, ny, sub, nz, sub).transpose(0, 2, 4, 1, 3, 5)
@@ -102,12 +164,10 @@ def sharpen(grid: VoxelGrid, *, sub: int = SUB, vertical: bool = True) -> tuple[
     dense = (grid.pad > 0) & (count > 0)
     u = np.where(dense, grid.pad * sub**3 / np.maximum(count, 1), grid.pad)  # area-conserving
     unsolved = 0
-    if vertical and dense.any():
-        paths = blocks[dense].sum(axis=-1).reshape(-1, sub * sub) * w   # ℓ_c per cell column
-        gap = np.exp(-grid.pad[dense] * grid.g * v)
-        us, ok = _solve_u(paths, gap, grid.g)
-        u[dense] = np.where(ok, np.maximum(us, u[dense]), u[dense])
-        unsolved = int((~ok).sum())
+    if beams is not None and dense.any():
+        uf, counted = footprint_density(grid, inside, xy=beams[0], heights=beams[1])
+        u = np.where(dense & counted, uf, u)
+        unsolved = int((dense & ~counted).sum())
     keep = np.where(dense[..., None, None, None], blocks, True)
     fine = np.where(keep, u[..., None, None, None], 0.0).transpose(0, 3, 1, 4, 2, 5).reshape(
         nx * sub, ny * sub, nz * sub)
