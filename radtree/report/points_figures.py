@@ -4,7 +4,7 @@ like :mod:`radtree.report.figures`).
 
 Coordinates: the crown's own frame — u along the façade, n away from it, both from the trunk
 axis, z up from the street (m). The point cloud is placed as the crown builder places it
-(:mod:`radtree.trees.points_crown`: its plant-area centroid on the trunk axis, its x along u,
+(:mod:`radtree.trees.points_crown`: the centre of its outline on the trunk axis, its x along u,
 its y along n, its ground at z = 0), so both views compare like with like.
 """
 
@@ -136,7 +136,7 @@ def crown_views_plot(views: CrownViews, path: Path, *, file: str) -> str:
     save_png(fig, path, DPI)
     return (f"The crown beside its points: the vegetation returns of {file} (grey dots, "
             f"{len(views.points)} returns 0.5 m or more above ground) placed as the crown "
-            f"builder places them (plant-area centroid on the trunk axis), and the built "
+            f"builder places them (the centre of its outline on the trunk axis), and the built "
             f"slats of one crown (green, {len(views.slats)} triangles), seen from the street "
             "(u–z, top) and along the façade (n–z, bottom); dashed: the points' convex "
             "outline in each view; metres from the trunk axis and the street.")

@@ -19,8 +19,9 @@ near-opaque real leaves, is the consistent one). Before filling, the grid is kep
 convex hull of the crown's returns on cells of a quarter voxel (:func:`points_crown_grid`,
 :mod:`radtree.trees.points_hull`: the rim stays sharp, and each rim voxel's measured gap is
 held by the part of it inside the hull), and the slats fill those cells. The cloud is placed on
-every trunk of the row: the plant-area centroid of that grid on the trunk axis, its ground at
-the street (z = 0), its x along the façade (u) and y away from it (n). Slats are then clipped like the volume arrangement's
+every trunk of the row: the centre of the crown's outline seen from above
+(:func:`radtree.trees.points_hull.crown_centre`) on the trunk axis, its ground at the street
+(z = 0), its x along the façade (u) and y away from it (n). Slats are then clipped like the volume arrangement's
 (:mod:`radtree.trees.crown_clip`: trunk, wall-side plane, planes shared with neighbours).
 """
 
@@ -104,14 +105,17 @@ def _corners(centres: np.ndarray, phi: np.ndarray, tilt: Any, s: float) -> np.nd
 def voxel_slats(grid: VoxelGrid, lv: Louvers, rng: np.random.Generator,
                 origin: np.ndarray) -> tuple[np.ndarray, np.ndarray, Any]:
     """Slat centres (k, 3), azimuths and inclinations of one crown: PAD·v³/s² per voxel
-    (module text); ``origin`` is where the grid's plant-area centroid stands (u, n, 0)."""
+    (module text); ``origin`` is where the crown's centre
+    (:func:`radtree.trees.points_hull.crown_centre`) stands (u, n, 0)."""
+    from radtree.trees.points_hull import crown_centre
+
     s, v = lv.slat_size_m, grid.size_m
     expected = grid.pad * v**3 / (s * s)
     n = np.floor(expected).astype(np.int64)
     n += rng.random(expected.shape) < (expected - n)
     idx = np.repeat(np.arange(n.size), n.ravel())
     i, j, k = np.unravel_index(idx, n.shape)
-    cxy = grid.centroid_xy()
+    cxy = crown_centre(grid)
     corner = np.column_stack([grid.x0 + i * v - cxy[0], grid.y0 + j * v - cxy[1], k * v])
     centres = origin + corner + rng.random((len(idx), 3)) * v
     # horizontally, slats go where the voxel's returns are (± half a point spacing), so the

@@ -13,7 +13,7 @@ whose sensors see a steep sun through its wall-side rim, is where this shows
 So each voxel is cut into ``sub``³ cells of side w = v/``sub``, and only the cells whose centre
 lies inside the convex hull of the crown's vegetation returns keep plant area (the hull by
 Qhull, Barber, Dobkin & Huhdanpaa 1996, ACM Trans. Math. Softw. 22:469–483, through SciPy's
-``Delaunay``): the returns are where the beams met leaves, and no leaf stands outside the
+``ConvexHull``): the returns are where the beams met leaves, and no leaf stands outside the
 smallest convex body that holds them all (a concave crown keeps its concavities at voxel
 scale: only voxels the hull crosses change). The density in a voxel's inside cells:
 
@@ -60,6 +60,30 @@ def vertical_beams(path: str | Path) -> tuple[np.ndarray, np.ndarray]:
     return tile.xyz[keep, :2], heights[keep]
 
 
+def crown_centre(grid: VoxelGrid) -> np.ndarray:
+    """Where a crown from points stands on its trunk: the area centroid (x, y m) of the
+    convex outline of its vegetation returns seen from above — the crown projection's centre,
+    which the outermost returns fix (the plant-area centroid also carries the inversion's
+    noise voxel by voxel: on the synthetic crowns of ``benchmarks/lidar_facade.py`` 0.07 m
+    r.m.s. from the trunk against 0.13 m, 16 scans); the plant-area centroid where the
+    returns span no area."""
+    from scipy.spatial import ConvexHull, QhullError
+
+    xy = grid.returns[:, :2]
+    ref = xy.mean(axis=0) if len(xy) else np.zeros(2)   # map coordinates: keep the digits
+    try:
+        p = xy[ConvexHull(xy).vertices] - ref
+    except (QhullError, ValueError):
+        return grid.centroid_xy()
+    x, y = p[:, 0], p[:, 1]
+    x1, y1 = np.roll(x, -1), np.roll(y, -1)
+    cross = x * y1 - x1 * y
+    area = cross.sum() / 2.0
+    if abs(area) < 1e-12:
+        return grid.centroid_xy()
+    return ref + np.array([((x + x1) * cross).sum(), ((y + y1) * cross).sum()]) / (6.0 * area)
+
+
 def hull_inside(grid: VoxelGrid, sub: int, margin_m: float = 0.0) -> np.ndarray | None:
     """(nx·sub, ny·sub, nz·sub) whether each cell's centre lies inside the convex hull of the
     grid's vegetation returns, its faces moved ``margin_m`` outwards; None when they span no
@@ -69,14 +93,16 @@ def hull_inside(grid: VoxelGrid, sub: int, margin_m: float = 0.0) -> np.ndarray 
     r = grid.returns
     if len(r) < 4:
         return None
+    ref = r.mean(axis=0)                      # map coordinates: keep the digits
     try:
-        eq = ConvexHull(r).equations          # n·x + c ≤ 0 inside, |n| = 1
+        eq = ConvexHull(r - ref).equations    # n·(x − ref) + c ≤ 0 inside, |n| = 1
     except QhullError:
         return None
+    eq[:, 3] -= eq[:, 2] * ref[2]             # heights: n·x − n_z·ref_z …
     w = grid.size_m / sub
     shape = tuple(int(n) * sub for n in grid.pad.shape)
-    x, y = np.meshgrid(grid.x0 + (np.arange(shape[0]) + 0.5) * w,
-                       grid.y0 + (np.arange(shape[1]) + 0.5) * w, indexing="ij")
+    x, y = np.meshgrid(grid.x0 - ref[0] + (np.arange(shape[0]) + 0.5) * w,
+                       grid.y0 - ref[1] + (np.arange(shape[1]) + 0.5) * w, indexing="ij")
     xy = np.column_stack([x.ravel(), y.ravel()]) @ eq[:, :2].T + eq[:, 3] - margin_m
     out = np.zeros(shape, bool)
     for k in range(shape[2]):       # a layer at a time: (nx·sub)·(ny·sub) × faces

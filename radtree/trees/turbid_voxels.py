@@ -5,8 +5,8 @@
   :func:`radtree.trees.points_crown.points_crown_grid` (Beer–Lambert inversion along vertical
   beams, G of the louvers' leaf angles, wood counted as leaf area; kept inside the returns'
   convex hull on quarter-voxel cells, :mod:`radtree.trees.points_hull`) placed on every trunk
-  of the free row exactly as the louvers-from-points crown places its slats: the grid's
-  plant-area centroid on the trunk axis, its ground at the street, its x along the façade (u) and y away
+  of the free row exactly as the louvers-from-points crown places its slats: the centre of
+  the crown's outline (:func:`radtree.trees.points_hull.crown_centre`) on the trunk axis, its ground at the street, its x along the façade (u) and y away
   from it (n).
 * ``voxels`` (a CSV file, :mod:`radtree.trees.voxel_file`): the grid as written, its
   coordinates relative to each trunk base (x along the façade, y away from it, z up).
@@ -56,9 +56,10 @@ def _grid(tree: Tree, source: str | None) -> tuple[np.ndarray, float, np.ndarray
     base in the façade frame (u, n, z) m, info, what it is for the notes)."""
     if tree.points is not None:
         from radtree.trees.points_crown import points_crown_grid
+        from radtree.trees.points_hull import crown_centre
 
         inv, g, unsolved = points_crown_grid(tree, source)
-        cxy = g.centroid_xy()
+        cxy = crown_centre(g)
         corner = np.array([g.x0 - cxy[0], g.y0 - cxy[1], 0.0])
         info = {"points_voxel_m": inv.size_m, "points_spacing_m": g.spacing_m,
                 "points_g_vertical": g.g, "points_leaf_area_m2": g.leaf_area_m2,
@@ -69,7 +70,7 @@ def _grid(tree: Tree, source: str | None) -> tuple[np.ndarray, float, np.ndarray
                 f"beams on {inv.size_m:g} m voxels (mean point spacing {g.spacing_m:.2f} m, "
                 f"G = {g.g:.3f} of the leaf angles; wood counted as leaf area; "
                 f"{inv.leaf_area_m2:.1f} m²), kept inside the returns' convex hull on "
-                f"{g.size_m:g} m cells, its plant-area centroid on each trunk")
+                f"{g.size_m:g} m cells, the centre of its outline on each trunk")
         return g.pad, g.size_m, corner, info, what
     from radtree.trees.voxel_file import read_voxel_file
 

@@ -44,10 +44,11 @@ def crown_views(project: Project, sc: Scenario) -> CrownViews:
     from radtree.pipeline.build import built_scene
     from radtree.trees.model import LEAF, TRUNK
     from radtree.trees.points_crown import points_crown_grid
+    from radtree.trees.points_hull import crown_centre
 
     tree = effective_project(project, sc).tree
     grid, crown, _ = points_crown_grid(tree, str(project.source))
-    cxy = crown.centroid_xy()          # where the crown was placed on its trunk
+    cxy = crown_centre(crown)          # where the crown was placed on its trunk
     points = grid.returns - [cxy[0], cxy[1], 0.0]
     model = built_scene(project, sc).tree
     frame = model.frame
