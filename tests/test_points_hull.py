@@ -99,8 +99,8 @@ def test_facade_direct_sun_of_crowns_rebuilt_from_scans(tmp_path: Path) -> None:
     from radtree.config import load_project
     from radtree.engines.common.turbid import MediumTracer
     from radtree.engines.common.voxels import VoxelTracer
-    from radtree.light.sun import local_datetime, sun_position
     from radtree.lidar.scanner import AlsScan, ground_plane, scan_als
+    from radtree.light.sun import local_datetime, sun_position
     from radtree.media_voxels import media_parts
     from radtree.sensor_grid import facade_circle, facade_dense_grid
     from radtree.site.frame import FacadeFrame
