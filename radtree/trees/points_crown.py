@@ -81,8 +81,8 @@ def points_crown_grid(tree: Tree, source: str | None = None) -> tuple[VoxelGrid,
     grid = points_grid(tree, source)
     assert tree.points is not None
     beams = vertical_beams(tree.points) if tree.points_scans is None else None
-    fine, unsolved = sharpen(grid, beams=beams)
-    return grid, fine, unsolved
+    fine, unreached = sharpen(grid, beams=beams)
+    return grid, fine, unreached
 
 
 def layer_profile(inv: VoxelGrid, fine: VoxelGrid) -> tuple[np.ndarray, np.ndarray]:
@@ -137,7 +137,7 @@ def build_points_louvers(spec: CrownRowSpec, tree: Tree, source: str | None = No
     """Slat polygons (local coordinates) of the row's crowns from ``tree.points``, geometry
     info (voxel size, leaf area, its vertical profile) and the grid."""
     lv = tree.louvers
-    inv, grid, unsolved = points_crown_grid(tree, source)
+    inv, grid, unreached = points_crown_grid(tree, source)
     per = grid.leaf_area_m2 / lv.slat_size_m**2
     if per * spec.count > MAX_VOLUME_SLATS:
         raise ConfigError(f"the crowns from {tree.points} would need {per * spec.count:.0f} "
@@ -163,7 +163,7 @@ def build_points_louvers(spec: CrownRowSpec, tree: Tree, source: str | None = No
     info = {"points_voxel_m": inv.size_m, "points_spacing_m": grid.spacing_m,
             "points_g_vertical": grid.g, "points_leaf_area_m2": grid.leaf_area_m2,
             "points_inverted_leaf_area_m2": inv.leaf_area_m2, "points_cell_m": grid.size_m,
-            "points_hull_unsolved": float(unsolved),
+            "points_hull_unreached": float(unreached),
             "points_scan_positions": float(scan_positions(tree)),
             "points_height_m": float(len(z) * inv.size_m), "slats_cut": float(cut),
             "slats_dropped": float(dropped), "slat_mean_area_m2": lv.slat_size_m**2}

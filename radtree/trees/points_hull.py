@@ -17,16 +17,20 @@ Qhull, Barber, Dobkin & Huhdanpaa 1996, ACM Trans. Math. Softw. 22:469–483, th
 smallest convex body that holds them all (a concave crown keeps its concavities at voxel
 scale: only voxels the hull crosses change). The density in a voxel's inside cells:
 
-* vertical-beam inversion (airborne scans): the voxel's measured gap P = exp(−PAD·G·v) is the
-  mean over its beams, and a beam through the hull part of the voxel crosses a path ℓ_c in it
-  (its cell column's inside cells × w; 0 outside the hull's footprint), so the density u of
-  the inside cells solves (1/sub²) Σ_c exp(−u·G·ℓ_c) = P — the sub-voxel heterogeneity that
-  biases a voxel's Beer–Lambert estimate low (Soma et al. 2018, Remote Sens. 10:1580;
-  Pimont, Soma & Dupuy 2019, Remote Sens. 11:1580, "sub-grid clumping"), taken out with
-  the one thing known about it: where the crown is. u ≥ the area-conserving PAD·v³ /
-  (inside cells × w³) (Jensen's inequality); where no u reaches P (the hull's footprint
-  smaller than the voxel's interception: a hull short of the true rim), that area-conserving
-  value is kept;
+* vertical-beam inversion (airborne scans, ``beams`` given): the column inversion of
+  :mod:`radtree.lidar.voxels` again, on the beams through the voxel's hull part only. Of the
+  beams of the voxel's cell columns c that the hull crosses (ℓ_c > 0: the column's inside
+  cells in the voxel × w), N_c reach the voxel's top and N(z_bottom) = Σ its bottom; the
+  density u of the inside cells solves Σ_c N_c exp(−u·G·ℓ_c) / Σ_c N_c = (N(z_bottom) + ½) /
+  (Σ_c N_c + ½) (the same ½ correction). Counting every beam of the voxel, as the voxel
+  inversion does, mixes beams that miss the crown with beams through it, and reads a rim
+  voxel low — the sub-voxel heterogeneity that biases a voxel's Beer–Lambert estimate
+  (Soma et al. 2018, Remote Sens. 10:1580; Pimont, Soma & Dupuy 2019, Remote Sens. 11:1580,
+  "sub-grid clumping"), taken out with the one thing known about it: where the crown is.
+  (Solving instead for the voxel's own gap over its hull part amplifies the counts' noise
+  where the hull covers a sliver of the voxel; benchmarks/lidar_facade.py.) A voxel no beam
+  through its hull part reached (occluded, filled from its layer) keeps its leaf area,
+  spread over its inside cells;
 * beams along their own paths (terrestrial scans, :mod:`radtree.lidar.beams`): the voxel's
   plant area PAD·v³ spread over its inside cells (area-conserving).
 
@@ -64,8 +68,8 @@ def crown_centre(grid: VoxelGrid) -> np.ndarray:
     """Where a crown from points stands on its trunk: the area centroid (x, y m) of the
     convex outline of its vegetation returns seen from above — the crown projection's centre,
     which the outermost returns fix (the plant-area centroid also carries the inversion's
-    noise voxel by voxel: on the synthetic crowns of ``benchmarks/lidar_facade.py`` 0.07 m
-    r.m.s. from the trunk against 0.13 m, 16 scans); the plant-area centroid where the
+    noise voxel by voxel: on the synthetic crowns of ``benchmarks/lidar_facade.py`` 0.03 m
+    r.m.s. from the trunk against 0.11 m, 16 scans); the plant-area centroid where the
     returns span no area."""
     from scipy.spatial import ConvexHull, QhullError
 
@@ -114,8 +118,8 @@ def hull_inside(grid: VoxelGrid, sub: int, margin_m: float = 0.0) -> np.ndarray 
 def _solve_u(paths: np.ndarray, *, weights: np.ndarray, gap: np.ndarray, g: float
              ) -> tuple[np.ndarray, np.ndarray]:
     """(u m²/m³, solved) per voxel: the density with Σ_c w_c exp(−u·g·ℓ_c) / Σ_c w_c = gap
-    (``paths`` ℓ (n, sub²) m, ``weights`` w the beams reaching each cell column); solved False
-    where even u → ∞ leaves more gap than ``gap``."""
+    (``paths`` ℓ (n, sub²) m, ``weights`` w the beams reaching each cell column) by
+    bisection; solved False where even u → ∞ leaves more gap than ``gap``."""
     wsum = np.maximum(weights.sum(axis=1), 1e-300)
 
     def mean_gap(uu: np.ndarray) -> np.ndarray:
@@ -178,8 +182,10 @@ def sharpen(grid: VoxelGrid, *, sub: int = SUB,
             beams: tuple[np.ndarray, np.ndarray] | None = None, margin_m: float = 0.0
             ) -> tuple[VoxelGrid, int]:
     """(the grid on cells of side size_m/``sub`` with its plant area inside the returns' hull
-    (widened by ``margin_m``), voxels whose gap the hull could not hold — kept
-    area-conserving) (module text)."""
+    (widened by ``margin_m``), voxels with plant area that no beam through their hull part
+    reached — their leaf area kept, spread over their inside cells) (module text). ``beams``:
+    (x, y, heights) of :func:`vertical_beams` for the vertical-beam inversion; None spreads
+    every voxel's leaf area over its inside cells."""
     inside = hull_inside(grid, sub, margin_m)
     nx, ny, nz = grid.pad.shape
     w = grid.size_m / sub
@@ -189,11 +195,11 @@ def sharpen(grid: VoxelGrid, *, sub: int = SUB,
     count = blocks.sum(axis=(3, 4, 5))                       # inside cells per voxel
     dense = (grid.pad > 0) & (count > 0)
     u = np.where(dense, grid.pad * sub**3 / np.maximum(count, 1), grid.pad)  # area-conserving
-    unsolved = 0
+    unreached = 0
     if beams is not None and dense.any():
         uf, counted = footprint_density(grid, inside, xy=beams[0], heights=beams[1])
         u = np.where(dense & counted, uf, u)
-        unsolved = int((dense & ~counted).sum())
+        unreached = int((dense & ~counted).sum())
     keep = np.where(dense[..., None, None, None], blocks, True)
     fine = np.where(keep, u[..., None, None, None], 0.0).transpose(0, 3, 1, 4, 2, 5).reshape(
         nx * sub, ny * sub, nz * sub)
@@ -202,4 +208,4 @@ def sharpen(grid: VoxelGrid, *, sub: int = SUB,
         return VoxelGrid(grid.x0, grid.y0, w, fine, grid.g, grid.spacing_m, grid.returns), 0
     i0, i1, j0, j1 = cols[0].min(), cols[0].max() + 1, cols[1].min(), cols[1].max() + 1
     return VoxelGrid(grid.x0 + i0 * w, grid.y0 + j0 * w, w, fine[i0:i1, j0:j1].copy(), grid.g,
-                     grid.spacing_m, grid.returns), unsolved
+                     grid.spacing_m, grid.returns), unreached

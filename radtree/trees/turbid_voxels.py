@@ -58,13 +58,13 @@ def _grid(tree: Tree, source: str | None) -> tuple[np.ndarray, float, np.ndarray
         from radtree.trees.points_crown import points_crown_grid
         from radtree.trees.points_hull import crown_centre
 
-        inv, g, unsolved = points_crown_grid(tree, source)
+        inv, g, unreached = points_crown_grid(tree, source)
         cxy = crown_centre(g)
         corner = np.array([g.x0 - cxy[0], g.y0 - cxy[1], 0.0])
         info = {"points_voxel_m": inv.size_m, "points_spacing_m": g.spacing_m,
                 "points_g_vertical": g.g, "points_leaf_area_m2": g.leaf_area_m2,
                 "points_inverted_leaf_area_m2": inv.leaf_area_m2, "points_cell_m": g.size_m,
-                "points_hull_unsolved": float(unsolved),
+                "points_hull_unreached": float(unreached),
                 "points_height_m": float(inv.pad.shape[2] * inv.size_m)}
         what = (f"the point cloud {tree.points.name}: Beer–Lambert inversion along vertical "
                 f"beams on {inv.size_m:g} m voxels (mean point spacing {g.spacing_m:.2f} m, "
