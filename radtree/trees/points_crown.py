@@ -74,7 +74,7 @@ def points_grid(tree: Tree, source: str | None = None) -> VoxelGrid:
 def points_crown_grid(tree: Tree, source: str | None = None) -> tuple[VoxelGrid, VoxelGrid, int]:
     """(the inversion grid of :func:`points_grid`, the crown's grid kept inside the returns'
     hull on cells of 1/:data:`~radtree.trees.points_hull.SUB` voxel — what the crowns are
-    filled from and placed by —, voxels whose gap the hull could not hold):
+    filled from and placed by —, voxels with leaves no beam through their hull part reached):
     :func:`radtree.trees.points_hull.sharpen`, vertical-beam form for airborne scans."""
     from radtree.trees.points_hull import sharpen, vertical_beams
 
