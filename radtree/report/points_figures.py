@@ -58,7 +58,7 @@ def profile_plot(record: dict[str, Any], views: CrownViews | None, path: Path) -
     fig = new_figure(5.6, 4.8, DPI)
     ax = fig.add_subplot()
     ax.stairs(per_m, np.append(lo, lo[-1] + v) if len(lo) else [0.0], orientation="horizontal",
-              color=SCAN_COLOUR, linewidth=1.8, label="scan (Beer–Lambert inversion)")
+              color=SCAN_COLOUR, linewidth=1.8, label="scan (Beer–Lambert inversion in its hull)")
     built = ""
     if views is not None and len(lo):
         area = slat_profile(views.slats, layer_m=v, layers=len(lo))
@@ -78,8 +78,9 @@ def profile_plot(record: dict[str, Any], views: CrownViews | None, path: Path) -
     save_png(fig, path, DPI)
     return (f"Vertical profile of the crown's leaf (plant) area from {record['file']}: m² per "
             f"metre of height in layers of one voxel ({v:g} m), from the Beer–Lambert "
-            f"inversion along vertical beams (G = {record['g_vertical']:.3f}; solid grey), "
-            f"total {record['leaf_area_m2']:.1f} m² per crown." + built)
+            f"inversion along vertical beams (G = {record['g_vertical']:.3f}) kept inside the "
+            f"convex hull of the returns (solid grey), total {record['leaf_area_m2']:.1f} m² "
+            "per crown." + built)
 
 
 def _hull(xy: np.ndarray) -> np.ndarray | None:
