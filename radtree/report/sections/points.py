@@ -49,11 +49,12 @@ def crown_views(project: Project, sc: Scenario) -> CrownViews:
     (u, n from the trunk axis, z from the street; :mod:`radtree.report.points_figures`)."""
     from radtree.pipeline.build import built_scene
     from radtree.trees.model import LEAF, TRUNK
-    from radtree.trees.points_crown import points_grid
+    from radtree.trees.points_crown import points_crown_grid
+    from radtree.trees.points_hull import crown_centre
 
     tree = effective_project(project, sc).tree
-    grid = points_grid(tree, str(project.source))
-    cxy = grid.centroid_xy()
+    grid, crown, _ = points_crown_grid(tree, str(project.source))
+    cxy = crown_centre(crown)          # where the crown was placed on its trunk
     points = grid.returns - [cxy[0], cxy[1], 0.0]
     model = built_scene(project, sc).tree
     frame = model.frame
