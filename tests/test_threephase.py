@@ -177,6 +177,27 @@ def test_facet_groups_face_the_sensors():
     for g in tiles:
         cells = np.floor(g.triangles.mean(axis=1) / 1.5)
         assert len(np.unique(cells, axis=0)) == 1
+    # one group per facet plane (the annual default for free crowns): every facet of a
+    # group in its plane, each group's share of its level-0 group's area; the shares of a
+    # level-0 group sum to 1, and level 0 keeps every group whole
+    from radtree.annual.facets import FACETS
+    from radtree.annual.threephase import D_MIN_SAMPLES, daylight_samples
+
+    planes = facet_groups(model, sensors_inside=False, level=FACETS)
+    assert len(planes) == len(f)               # an icosphere: no two facets coplanar
+    share: dict[int, float] = {}
+    for g in planes:
+        t = g.triangles
+        n = np.cross(t[:, 1] - t[:, 0], t[:, 2] - t[:, 0])
+        n /= np.linalg.norm(n, axis=1)[:, None]
+        assert np.all(n @ g.normal > 1 - 1e-6)
+        share[g.coarse] = share.get(g.coarse, 0.0) + g.weight
+    assert sorted(share) == list(range(14))
+    np.testing.assert_allclose(list(share.values()), 1.0)
+    np.testing.assert_allclose([g.weight for g in groups], 1.0)
+    assert daylight_samples(400, groups[0]) == 400
+    assert sum(daylight_samples(400, g) for g in planes if g.coarse == 0) >= 400
+    assert min(daylight_samples(10, g) for g in planes) == D_MIN_SAMPLES
 
 
 @needs_radiance

@@ -87,7 +87,7 @@ def closure_checks(folder: Path | None = None, *, ad: int = 1024, samples: int =
     a temporary one). Each check is logged (INFO) as it is made."""
     from radtree.annual.closure import ClosureSettings, closure_table
     from radtree.annual.coefficients import TraceParams
-    from radtree.annual.threephase import GROUP_LEVEL, GROUP_MATERIAL_UP, crown_models
+    from radtree.annual.threephase import GROUP_MATERIAL_UP, crown_models
     from radtree.config import load_project
     from radtree.pipeline.assemble import make_scene
     from radtree.pipeline.crown_bsdf import scenario_xmls
@@ -101,7 +101,7 @@ def closure_checks(folder: Path | None = None, *, ad: int = 1024, samples: int =
         on = scenario_xmls(project, sc)
         models, form = crown_models(project, sc, {"leaf_on": on, "leaf_off": on})
         bare = make_scene(project, replace(sc, model="none"), dense_grid=False).scene
-        settings = ClosureSettings(TraceParams(ab=6, ad=ad, lw=1e-3), samples, GROUP_LEVEL,
+        settings = ClosureSettings(TraceParams(ab=6, ad=ad, lw=1e-3), samples, None,
                                    GROUP_MATERIAL_UP)
         table = closure_table(bare, models=models, form=form, grids=["facade"],
                               rho=project.street.ground_reflectance, folder=root / "closure",
