@@ -70,13 +70,32 @@ a uniform ground hemisphere. Measured:
   through Klems patches turned by 180° when the matrices used +Z.
 
 Hence :data:`GROUP_MATERIAL_UP` (each group's Klems frame is its material's: the XML is
-applied in that frame by rtrace); level 0 kept (level 2 doubles the daylight matrices for no
-gain here). What remains: the two lowest façade rows still read 1.08–1.11 (5 mm from the
-cap's lower edge, next to the curved lower band: a daylight matrix is a mean over its
-sender's area and a curved group has one frame), and the small single crown of
-``radtree verify`` (12 segments, facets ≈ 1.5 m across) reads 0.94–0.96 on its façade
-(0.955 at level 0, 0.941 at level 2 with the material's up; rcontrib's own noise at
-``-ad 512`` moved its reference by 1.8 % between two runs).
+applied in that frame by rtrace). The two lowest façade rows still read 1.08–1.11 at level 0
+(5 mm from the cap's lower edge, next to the curved lower band).
+
+**One group per facet plane (issue 40, the small crown).** The small single crown of
+``radtree verify`` (12 segments, facets ≈ 1.5 m across, sensors 0.5 m from it) read 0.936 at
+level 0 (chain 0.807 against rcontrib 0.862). Measured there (uniform sky, leaf-on, façade
+mean; rtrace of the same scene at ``-ab 8 -ad 16384 -lw 1e-5``, six seeds: 0.8604 ± 0.0005,
+the shell black 0.3851): the by-pass was right (V_sky 0.385–0.393) and the reflection is 1 %;
+the light through the crown read 0.88 of the trace. A crown XML without its reflection read
+0.944, a Lambertian-diffuse T 1.00, a purely straight-through T 0.955; the grouping moved it
+(level 0: 0.936, level 2: 0.929, level 3: 1.09, level 4 and one group per facet: 1.02–1.03).
+The crown XML depends on the incidence angle relative to the facet (``crossing = "chord"``:
+the depth R cos θ), and a curved group applies it at the group's mean normal; near the
+vertical the groups' facets' up vectors turn round the normal. So free crowns now group only
+coplanar facets (:data:`GROUP_LEVEL` = :data:`~radtree.annual.facets.FACETS`, the wall cap
+by tile as before); the daylight matrices are given to the facets the sensors see
+(:data:`TILE_SHARE`), the rest merged per level-0 direction, and a group's daylight matrix
+traces its share of its level-0 group's rays (:func:`daylight_samples`), so the total stays
+about as before. Measured with it (``radtree verify --full``'s row, ``-ad 65536 -lw 1e-6``):
+chain 0.874 against rcontrib 0.855 (1.022; against the six-seed rtrace 1.016): by-pass
+0.385, through the crown 0.480 + 0.009 reflected against 0.475 traced. The office example
+(``benchmarks/threephase_closure.py --xml … --states leaf_on``, ``-ad 1024``, ``-c 100``)
+reads façade 1.029, work plane 1.013 with it (88 daylight matrices, 423 s of them at load
+≈ 28) — within the claim as at level 0 (1.024 / 0.9996, 22 daylight matrices). The uniform
+*ground* hemisphere through the crown stays high (verify crown 1.16, office 1.28): light
+from below the horizon is 10–20 % of the sky's here, not resolved.
 
 A second weather file reruns ``gendaymtx`` and the products only (the sun coefficients
 are reused when the sun positions are the same, i.e. the same site); a second leaf state
