@@ -92,8 +92,9 @@ about as before. Measured with it (``radtree verify --full``'s row, ``-ad 65536 
 chain 0.874 against rcontrib 0.855 (1.022; against the six-seed rtrace 1.016): by-pass
 0.385, through the crown 0.480 + 0.009 reflected against 0.475 traced. The office example
 (``benchmarks/threephase_closure.py --xml … --states leaf_on``, ``-ad 1024``, ``-c 100``)
-reads façade 1.029, work plane 1.013 with it (88 daylight matrices, 423 s of them at load
-≈ 28) — within the claim as at level 0 (1.024 / 0.9996, 22 daylight matrices). The uniform
+reads façade 1.029, work plane 1.013 with it — within the claim as level 0 in the same run
+(1.036 / 1.009); cost: 1 278 groups in V (4 rfluxmtx runs), 88 daylight matrices against
+22, the closure's matrices 470 s against 291 s (load 26–28 on 2 cores). The uniform
 *ground* hemisphere through the crown stays high (verify crown 1.16, office 1.28): light
 from below the horizon is 10–20 % of the sky's here, not resolved.
 
