@@ -54,10 +54,12 @@ def runs(project_dir):
 def test_three_phase_sky_matches_rcontrib_on_the_same_bsdf_crown(runs):
     """Σ_g V_g·T_g·D_g + V_sky against rcontrib's sky coefficients of the BSDF-crown scene,
     weighted by the year's sky (the same gendaymtx matrix): façade means within 12 % (measured
-    0.97–1.00 leaf-on, 1.02–1.09 bare over five runs; both are Monte Carlo and not repeatable
-    run to run — rfluxmtx/rcontrib on several processes, no -u- —: 192 ambient rays per sensor,
-    24 rays per Klems patch in D; on the office example the two agree within 0.8 pp of UDI,
-    benchmarks/threephase.py --same-crown)."""
+    0.97–1.00 leaf-on, 1.02–1.09 bare over five runs at level 0; with one group per facet
+    plane, the default since issue 40, 1.085 leaf-on and 1.098 bare in one run: 192 ambient
+    rays per sensor, 24 rays per Klems patch of a level-0 group in D; the year's sky holds the
+    ground column, whose light through the crown the chain reads 1.55 × a trace on the verify
+    crown — radtree/annual/threephase.py; on the office example the two agree within 0.8 pp
+    of UDI, benchmarks/threephase.py --same-crown)."""
     from radtree.annual.coefficients import CoefficientRunner, TraceParams
     from radtree.annual.run import LUX
     from radtree.annual.skymatrix import sky_matrix

@@ -95,8 +95,13 @@ chain 0.874 against rcontrib 0.855 (1.022; against the six-seed rtrace 1.016): b
 reads façade 1.029, work plane 1.013 with it — within the claim as level 0 in the same run
 (1.036 / 1.009); cost: 1 278 groups in V (4 rfluxmtx runs), 88 daylight matrices against
 22, the closure's matrices 470 s against 291 s (load 26–28 on 2 cores). The uniform
-*ground* hemisphere through the crown stays high (verify crown 1.16, office 1.28): light
-from below the horizon is 10–20 % of the sky's here, not resolved.
+*ground* hemisphere (the ``h=u`` column: radiance 1 below the horizon, seen past the street's
+edge, so within a few degrees of the horizon) through the crown stays high: verify crown
+0.168 against rcontrib 0.144 (1.16), office 1.28; against rtrace (three seeds, 0.1365, the
+shell black 0.0792) the chain's by-pass is right (0.0793) and its light through the crown
+reads 0.089 against 0.057 (1.55 ×). Not resolved; a lead: that light arrives within a few
+degrees of the horizon, and the Klems patches that hold it straddle the horizon (a daylight
+matrix averages over its patch, the sensors see only part of it).
 
 A second weather file reruns ``gendaymtx`` and the products only (the sun coefficients
 are reused when the sun positions are the same, i.e. the same site); a second leaf state
