@@ -101,7 +101,14 @@ edge, so within a few degrees of the horizon) through the crown stays high: veri
 shell black 0.0792) the chain's by-pass is right (0.0793) and its light through the crown
 reads 0.089 against 0.057 (1.55 ×). Not resolved; a lead: that light arrives within a few
 degrees of the horizon, and the Klems patches that hold it straddle the horizon (a daylight
-matrix averages over its patch, the sensors see only part of it).
+matrix averages over its patch, the sensors see only part of it). The same on the sky: with
+facet planes a Lambertian T closes (crown part 0.99, total 0.9995) and a purely
+straight-through T reads 1.06 on the crown part (total 1.0185; rtrace of the same XMLs,
+``-ad 8192 -lw 1e-5``; V at ``-ad 16384 -lw 1e-5``); the daylight matrices at 4 × the rays
+moved the chain by 0.1 %. So the chain's remaining +2 % is the Klems patches' angular
+resolution on the crown XML's straight-through part, not its sampling — a finer basis for
+that part (a tensor tree, or the sun-like treatment of the five-phase method) is the next
+step.
 
 A second weather file reruns ``gendaymtx`` and the products only (the sun coefficients
 are reused when the sun positions are the same, i.e. the same site); a second leaf state
