@@ -89,8 +89,9 @@ by tile as before); the daylight matrices are given to the facets the sensors se
 (:data:`TILE_SHARE`), the rest merged per level-0 direction, and a group's daylight matrix
 traces its share of its level-0 group's rays (:func:`daylight_samples`), so the total stays
 about as before. Measured with it (``radtree verify --full``'s row, ``-ad 65536 -lw 1e-6``):
-chain 0.874 against rcontrib 0.855 (1.022; against the six-seed rtrace 1.016): by-pass
-0.385, through the crown 0.480 + 0.009 reflected against 0.475 traced. The office example
+chain 0.874–0.876 against rcontrib 0.855 (1.022–1.025 in two runs, per sensor row
+1.018–1.034; against the six-seed rtrace 1.016–1.019): by-pass 0.385, through the crown
+0.480 + 0.009 reflected against 0.475 traced. The office example
 (``benchmarks/threephase_closure.py --xml … --states leaf_on``, ``-ad 1024``, ``-c 100``)
 reads façade 1.029, work plane 1.013 with it — within the claim as level 0 in the same run
 (1.036 / 1.009); cost: 1 278 groups in V (4 rfluxmtx runs), 88 daylight matrices against
@@ -113,8 +114,8 @@ step.
 A second weather file reruns ``gendaymtx`` and the products only (the sun coefficients
 are reused when the sun positions are the same, i.e. the same site); a second leaf state
 reuses ``V`` (and the dome's ``D``). Not ray traced: light crossing the shell is turned
-by the Klems BSDF of its group, whose frame is the group's mean normal (facets within 55°
-of it); the BSDF of a planar periodic sample holds no lateral displacement.
+by the Klems BSDF of its group, whose frame is its facets' plane (free crowns) or the group's
+mean normal (the dome: facets within 55° of it); the BSDF of a planar periodic sample holds no lateral displacement.
 """
 
 from __future__ import annotations
