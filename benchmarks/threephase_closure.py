@@ -18,7 +18,8 @@ the XML is applied in by rtrace) prints
     transmitted, reflected (each a mean over the grid's sensors, irradiance per unit radiance)
 
 Run: ``nice .venv/bin/python benchmarks/threephase_closure.py [--work DIR] [--samples 50]
-[--daylight-samples 100] [--levels facets,0] [--up default,material] [--ad 1024] [--xml X]
+[--daylight-samples 100] [--levels facets,0] [--up default,material] [--ad 1024] [--lw 1e-3]
+[--xml X]
 [-j 2]``.
 """
 
@@ -61,6 +62,9 @@ def main() -> None:
     ap.add_argument("--up", default="default,material")
     ap.add_argument("--ab", type=int, default=6)
     ap.add_argument("--ad", type=int, default=1024)
+    ap.add_argument("--lw", type=float, default=1e-3,
+                    help="-lw of V and the reference: at -aa 0 Radiance traces at most "
+                         "≈ 0.8 / lw rays per hemisphere whatever -ad says (ambcomp.c)")
     ap.add_argument("--states", default="leaf_on,leaf_off")
     ap.add_argument("--xml", type=Path, default=None,
                     help="tree.bsdf.xml: one given crown XML for every band (no crown BSDF "
@@ -106,7 +110,7 @@ def main() -> None:
     bare = make_scene(project, replace(sc, model="none"), dense_grid=False).scene
     grids = [g for g in bare.grids if g != "facade_map"]
     rho = annual_ground_reflectance(project)
-    trace = TraceParams(ab=args.ab, ad=args.ad, lw=1e-3, nproc=args.processes)
+    trace = TraceParams(ab=args.ab, ad=args.ad, lw=args.lw, nproc=args.processes)
     pd.set_option("display.width", 200)
     from radtree.annual.facets import FACETS
 
