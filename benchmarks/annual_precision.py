@@ -72,7 +72,7 @@ def main() -> int:
                 rows = [r[start:start + n] for r in reps]
                 start += n
                 single = {k: np.array([grid_metrics(r, occ)[k] for r in rows]) for k in SHOWN}
-                est, se = jackknife(rows, lambda e: grid_metrics(e, occ))
+                est, se = jackknife(rows, lambda e, o=occ: grid_metrics(e, o))
                 cells = "; ".join(
                     f"{k} {v.mean():.1f} sd {v.std(ddof=1):.2f} [{v.min():.1f}–{v.max():.1f}]"
                     for k, v in single.items())
