@@ -9,7 +9,7 @@ from radtree.annual.coefficients import CoefficientRunner, TraceParams
 from radtree.annual.uncertainty import grid_metrics, jackknife
 
 from .conftest import needs_radiance
-from .test_annual import _tiny_scene
+from .test_annual import _tiny_scene, tiny_project  # noqa: F401
 
 
 @needs_radiance
@@ -58,3 +58,28 @@ def test_grid_metrics_count_the_stated_bands():
     assert got["UDI100-3000"] == pytest.approx(100 * 4 / 8)   # 100 and 3000 included
     assert got["UDI>3000"] == pytest.approx(100 * 1 / 8)
     assert got["mean_lux"] == pytest.approx(lux[:, :4].mean())
+
+
+@needs_radiance
+def test_annual_with_replicates_reports_the_metrics_standard_errors(tiny_project):  # noqa: F811
+    from radtree.annual.run import AnnualOptions, compute_annual
+    from radtree.config import load_project
+
+    project = load_project(tiny_project)
+    plain = compute_annual(project, options=AnnualOptions(nproc=1))
+    assert plain.uncertainty is None
+    res = compute_annual(project, options=AnnualOptions(nproc=1, replicates=3))
+    assert res.trace.replicates == res.sun_trace.replicates == 3
+    u = res.uncertainty
+    assert u is not None and len(u) == 2 * 6          # facade × with/without × metrics
+    assert set(u.tree) == {"with", "without"} and set(u.grid) == {"facade"}
+    assert (u.se >= 0).all() and u.se.notna().all()
+    mean_lux = u[(u.tree == "without") & (u.metric == "mean_lux")].iloc[0]
+    assert mean_lux.se > 0                               # the sky coefficients vary
+    occ = res.occupied
+    e = res.total["without"]["facade"][:, occ]
+    assert mean_lux.value == pytest.approx(e.mean(), rel=1e-5)
+    # the mean of 3 replicates is a different (better) estimate than the plain run
+    assert not np.allclose(res.total["without"]["facade"], plain.total["without"]["facade"])
+    with pytest.raises(Exception, match="replicates"):
+        AnnualOptions(replicates=2, method="3phase")

@@ -23,6 +23,7 @@ from __future__ import annotations
 from collections.abc import Callable, Sequence
 
 import numpy as np
+import pandas as pd
 
 from radtree.annual import metrics as m
 from radtree.annual.coefficients import CoefficientRunner, TraceParams
@@ -90,3 +91,19 @@ def year_replicates(runner: CoefficientRunner, year: YearInputs, mf: int, sun_mf
         c_ind[:, need] = c_n[k] - c_0
         out.append(combine(c_sky[k], sky, c_dir, suns, c_ind, verts, weights, wea.n_hours))
     return out
+
+
+def table(replicas: Sequence[dict[str, dict[str, np.ndarray]]], grids: Sequence[str],
+          occupied: np.ndarray) -> pd.DataFrame:
+    """Grid metrics of the replicates' mean year and their jackknife standard errors: one row
+    per grid, tree ("with" — the seasonal crown —, "without") and metric of :data:`METRICS`
+    (columns grid, tree, metric, value, se; percent, mean_lux in lux). ``replicas``: R dicts
+    tree → grid → (sensors, hours) lux, one per replicate."""
+    rows = []
+    for g in grids:
+        for tree in ("with", "without"):
+            est, se = jackknife([r[tree][g] for r in replicas],
+                                lambda e: grid_metrics(e, occupied))
+            rows += [{"grid": g, "tree": tree, "metric": k, "value": est[k], "se": se[k]}
+                     for k in METRICS]
+    return pd.DataFrame(rows)
