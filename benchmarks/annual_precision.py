@@ -30,9 +30,16 @@ SHOWN = ("DA300", "sDA", "UDI<100", "UDI100-3000", "UDI>3000")
 
 def main() -> int:
     from radtree.annual.coefficients import CoefficientRunner
+    from radtree.annual.metrics import daylight_autonomy
     from radtree.annual.run import AnnualOptions, plan_annual, plan_year, with_season
     from radtree.annual.schedule import occupied
-    from radtree.annual.uncertainty import grid_metrics, jackknife, year_replicates
+    from radtree.annual.uncertainty import (
+        grid_metrics,
+        jackknife,
+        metrics_se,
+        sda_se,
+        year_replicates,
+    )
     from radtree.config import load_project
 
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
@@ -72,7 +79,11 @@ def main() -> int:
                 rows = [r[start:start + n] for r in reps]
                 start += n
                 single = {k: np.array([grid_metrics(r, occ)[k] for r in rows]) for k in SHOWN}
-                est, se = jackknife(rows, lambda e, o=occ: grid_metrics(e, o))
+                est, se = metrics_se(rows, occ)
+                # one run's sDA SE predicted from the sensors: its DA SE is √R × the mean's
+                _, da_se = jackknife(rows, lambda e, o=occ: {"da": daylight_autonomy(e, o)})
+                da_mean = daylight_autonomy(np.mean(rows, axis=0), occ)
+                one_sda = sda_se(da_mean, np.sqrt(len(rows)) * da_se["da"])
                 cells = "; ".join(
                     f"{k} {v.mean():.1f} sd {v.std(ddof=1):.2f} [{v.min():.1f}–{v.max():.1f}]"
                     for k, v in single.items())
@@ -80,7 +91,8 @@ def main() -> int:
                 cells = "; ".join(f"{k} {est[k]:.1f} ± {se[k]:.2f} (sd/√R "
                                   f"{single[k].std(ddof=1) / np.sqrt(len(rows)):.2f})"
                                   for k in SHOWN)
-                print(f"  {'':<8} {g:<9} mean of {len(rows)}: {cells}")
+                print(f"  {'':<8} {g:<9} mean of {len(rows)}: {cells}; one run's sDA SE "
+                      f"predicted {one_sda:.2f} (observed sd {single['sDA'].std(ddof=1):.2f})")
             print(f"  {variant}: {wall:.0f} s wall for {args.replicates} replicates "
                   f"({wall / args.replicates:.0f} s per run)")
     print(f"(work folder {work})")

@@ -13,9 +13,14 @@ and the metrics' standard errors are the jackknife's over the replicates (Efron 
     SE = √((R − 1)/R · Σₖ (θ̂₍₋ₖ₎ − mean θ̂₍₋·₎)²)
 
 Illuminance is linear in the coefficients, so the leave-one-out years are
-``(R·Ē − E_k)/(R − 1)``. The metrics are step functions of the illuminance (a sensor counts
-or not), for which the jackknife is a rough guide — :mod:`benchmarks.annual_precision`
-checks it against the spread of repeated runs.
+``(R·Ē − E_k)/(R − 1)``. DA and the UDI bands count thousands of sensor-hours and move
+smoothly with the coefficients; sDA counts sensors (DA ≥ 50 %) and moves in steps of one
+sensor, for which the jackknife fails (it reads 0 when no leave-one-out year flips a
+sensor). Its SE is from the sensors instead (:func:`sda_se`): each sensor is in sDA with
+probability p = Φ((DA − 50)/SE_DA), SE_DA its DA's jackknife SE, independently of the
+others (each sensor has its own samples), so the count of sensors in sDA has variance
+Σ p(1 − p). ``benchmarks/annual_precision.py`` checks both against the spread of repeated
+runs.
 """
 
 from __future__ import annotations
@@ -46,12 +51,24 @@ def grid_metrics(lux: np.ndarray, occupied: np.ndarray) -> dict[str, float]:
             "UDI>3000": float(bands["udi_above_3000"]), "mean_lux": float(e.mean())}
 
 
-def jackknife(replicates: Sequence[np.ndarray],
-              statistic: Callable[[np.ndarray], dict[str, float]]
-              ) -> tuple[dict[str, float], dict[str, float]]:
-    """(estimate, standard error) per key of ``statistic`` applied to the mean of the
-    ``replicates`` (R arrays of the same shape, each an independent estimate of one quantity
-    that is linear in the traced coefficients). One replicate: SE NaN."""
+def sda_se(da: np.ndarray, da_se: np.ndarray, fraction: float = m.SDA_FRACTION) -> float:
+    """Standard error (percentage points) of sDA over sensors whose DA (%) has standard error
+    ``da_se``, the sensors independent: 100/N · √Σ p(1 − p), p = Φ((DA − fraction)/SE_DA)
+    (p is 0 or 1 where SE_DA is 0)."""
+    from scipy.special import ndtr
+
+    da, da_se = np.asarray(da, float), np.asarray(da_se, float)
+    z = np.where(da_se > 0, (da - fraction) / np.where(da_se > 0, da_se, 1.0),
+                 np.where(da >= fraction, np.inf, -np.inf))
+    p = ndtr(z)
+    return float(100.0 / max(len(da), 1) * np.sqrt(np.sum(p * (1 - p))))
+
+
+def jackknife(replicates: Sequence[np.ndarray], statistic: Callable[[np.ndarray], dict]
+              ) -> tuple[dict, dict]:
+    """(estimate, standard error) per key of ``statistic`` (floats or arrays) applied to the
+    mean of the ``replicates`` (R arrays of the same shape, each an independent estimate of
+    one quantity that is linear in the traced coefficients). One replicate: SE NaN."""
     reps = [np.asarray(r, np.float64) for r in replicates]
     n = len(reps)
     if n == 0:
@@ -59,13 +76,27 @@ def jackknife(replicates: Sequence[np.ndarray],
     total = np.sum(reps, axis=0)
     estimate = statistic(total / n)
     if n == 1:
-        return estimate, {k: float("nan") for k in estimate}
+        return estimate, {k: np.full(np.shape(v), np.nan) if np.ndim(v) else float("nan")
+                          for k, v in estimate.items()}
     leave = [statistic((total - r) / (n - 1)) for r in reps]
     se = {}
-    for k in estimate:
+    for k, v0 in estimate.items():
         v = np.array([d[k] for d in leave])
-        se[k] = float(np.sqrt((n - 1) / n * np.sum((v - v.mean()) ** 2)))
+        s = np.sqrt((n - 1) / n * np.sum((v - v.mean(axis=0)) ** 2, axis=0))
+        se[k] = s if np.ndim(v0) else float(s)
     return estimate, se
+
+
+def metrics_se(replicates: Sequence[np.ndarray], occupied: np.ndarray
+               ) -> tuple[dict[str, float], dict[str, float]]:
+    """(metrics, standard errors) of :func:`grid_metrics` for the mean of one grid's
+    ``replicates`` ((sensors, hours) lux each): the jackknife's, sDA's by :func:`sda_se`."""
+    def stat(e: np.ndarray) -> dict:
+        return {**grid_metrics(e, occupied), "da": m.daylight_autonomy(e, occupied)}
+
+    est, se = jackknife(replicates, stat)
+    se["sDA"] = sda_se(est.pop("da"), se.pop("da"))
+    return est, se
 
 
 def year_replicates(runner: CoefficientRunner, year: YearInputs, mf: int, sun_mf: int,
@@ -102,8 +133,7 @@ def table(replicas: Sequence[dict[str, dict[str, np.ndarray]]], grids: Sequence[
     rows = []
     for g in grids:
         for tree in ("with", "without"):
-            est, se = jackknife([r[tree][g] for r in replicas],
-                                lambda e: grid_metrics(e, occupied))
+            est, se = metrics_se([r[tree][g] for r in replicas], occupied)
             rows += [{"grid": g, "tree": tree, "metric": k, "value": est[k], "se": se[k]}
                      for k in METRICS]
     return pd.DataFrame(rows)
