@@ -83,3 +83,15 @@ def test_annual_with_replicates_reports_the_metrics_standard_errors(tiny_project
     assert not np.allclose(res.total["without"]["facade"], plain.total["without"]["facade"])
     with pytest.raises(Exception, match="replicates"):
         AnnualOptions(replicates=2, method="3phase")
+
+
+def test_sda_se_counts_the_sensors_that_may_flip():
+    from radtree.annual.uncertainty import sda_se
+
+    # one sensor on the threshold (p = ½), two far from it: 100/3 · √¼
+    assert sda_se(np.array([50.0, 100.0, 0.0]), np.array([10.0, 0.0, 0.0])) == \
+        pytest.approx(100 / 3 * 0.5)
+    # a sensor 1 SE above: p = Φ(1)
+    p = 0.841344746
+    assert sda_se(np.array([60.0]), np.array([10.0])) == pytest.approx(100 * np.sqrt(p * (1 - p)))
+    assert sda_se(np.array([60.0, 40.0]), np.zeros(2)) == 0.0
