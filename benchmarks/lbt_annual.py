@@ -81,6 +81,7 @@ import tempfile
 from pathlib import Path
 
 import numpy as np
+import pandas as pd
 
 ROOT = Path(__file__).resolve().parents[1]
 EXAMPLE = ROOT / "examples" / "honeybee-office"
@@ -110,83 +111,139 @@ def radtree(*args: str, cwd: Path) -> None:
     subprocess.run([sys.executable, "-m", "radtree", "-q", *args], cwd=cwd, check=True)
 
 
-def metrics(lux: np.ndarray, occupied: np.ndarray) -> dict[str, float]:
-    """DA300, sDA300/50, UDI bands and mean lux of (sensors, 8760) ``lux`` over the occupied
-    hours (percent of occupied hours, sDA percent of sensors)."""
-    e = lux[:, occupied]
-    da = 100 * (e >= 300).mean(axis=1)
-    return {"DA300": da.mean(), "sDA": 100 * (da >= 50).mean(), "UDI<100": 100 * (e < 100).mean(),
-            "UDI100-3000": 100 * ((e >= 100) & (e <= 3000)).mean(),
-            "UDI>3000": 100 * (e > 3000).mean(), "mean_lux": e.mean()}
+def metrics(lux: np.ndarray, direct: np.ndarray, occupied: np.ndarray) -> dict[str, float]:
+    """DA300, sDA300/50, UDI bands, ASE1000,250 (LM-83: % of sensors with more than 250
+    occupied hours of direct sun above 1000 lx) and mean lux of (sensors, 8760) ``lux`` and
+    direct-sun ``direct`` over the occupied hours (:mod:`radtree.annual.uncertainty`)."""
+    from radtree.annual import metrics as m
+    from radtree.annual.uncertainty import grid_metrics
+
+    out = grid_metrics(lux, occupied)
+    out["ASE"] = m.annual_sunlight_exposure(m.sunlight_hours(direct, occupied))
+    return out
 
 
 def run_recipe(python: str, *, recipe: str, model: Path, epw: Path, params: str,
                folder: Path) -> Path:
-    """Run one lbt recipe; the folder holding its ``results``."""
-    env = dict(os.environ, PATH=f"{Path(python).parent}{os.pathsep}{os.environ['PATH']}")
-    subprocess.run([python, "-c", RECIPE, recipe, str(model), str(epw), params, str(folder)],
-                   check=True, env=env, capture_output=True)
-    found = sorted(folder.rglob("results/sun-up-hours.txt"))
+    """Run one lbt recipe (unless ``folder`` holds its results already); the folder holding
+    its ``results``."""
+    found = sorted(folder.rglob("results/__static_apertures__/default/total/Office_2.npy"))
+    if not found:
+        env = dict(os.environ, PATH=f"{Path(python).parent}{os.pathsep}{os.environ['PATH']}")
+        subprocess.run([python, "-c", RECIPE, recipe, str(model), str(epw), params,
+                        str(folder)], check=True, env=env, capture_output=True)
+        found = sorted(folder.rglob("results/__static_apertures__/default/total/Office_2.npy"))
     if not found:
         raise SystemExit(f"{recipe}: no results under {folder}")
-    return found[0].parent
+    return found[0].parents[3]
 
 
-def recipe_hourly(results: Path, grid: str) -> np.ndarray:
-    """(sensors, 8760) lux of a recipe's ``total`` results (zero outside its sun-up hours)."""
+def recipe_hourly(results: Path, grid: str, kind: str = "total") -> np.ndarray:
+    """(sensors, 8760) lux of a recipe's ``total`` (or ``direct``: the exact sun at ``-ab 0``)
+    results, zero outside its sun-up hours."""
     hours = np.floor(np.loadtxt(results / "sun-up-hours.txt")).astype(int)
-    values = np.load(results / "__static_apertures__" / "default" / "total" / f"{grid}.npy")
+    values = np.load(results / "__static_apertures__" / "default" / kind / f"{grid}.npy")
     out = np.zeros((values.shape[0], 8760))
     out[:, hours] = values
     return out
 
 
-def compare(hourly: dict, results: Path, *, scene: str, recipe: str) -> None:
+def compare(hourly: dict, results: Path, spread: pd.DataFrame | None, *, scene: str,
+            recipe: str) -> None:
+    """One row per grid: radtree/lbt per metric, lbt − radtree, radtree's Monte Carlo SE."""
     occupied = hourly["occupied"].astype(bool)
+    tree = SCENES[scene]
     for grid in ("Office_1", "Office_2"):
-        ours = metrics(hourly[f"total__{SCENES[scene]}__{grid}"], occupied)
-        theirs = metrics(recipe_hourly(results, grid), occupied)
-        seasonal = metrics(hourly[f"total__with__{grid}"], occupied) if scene == "crown" else None
-        cells = ", ".join(f"{k} {ours[k]:.1f}/{theirs[k]:.1f} ({theirs[k] - ours[k]:+.1f})"
-                          for k in ours if k != "mean_lux")
+        ours = metrics(hourly[f"total__{tree}__{grid}"], hourly[f"direct__{tree}__{grid}"],
+                       occupied)
+        theirs = metrics(recipe_hourly(results, grid), recipe_hourly(results, grid, "direct"),
+                         occupied)
+        se = {} if spread is None else dict(
+            spread[(spread.grid == grid) & (spread.tree == tree)][["metric", "se"]].values)
+        cells = ", ".join(
+            f"{k} {ours[k]:.1f}/{theirs[k]:.1f} ({theirs[k] - ours[k]:+.1f}"
+            + (f" ± {se[k]:.1f})" if k in se else ")") for k in ours if k != "mean_lux")
         print(f"  {recipe:<25} {scene:<5} {grid}: {cells}; mean lux ratio lbt/radtree "
-              f"{theirs['mean_lux'] / ours['mean_lux']:.3f}"
-              + (f"; radtree with seasons sDA {seasonal['sDA']:.1f}" if seasonal else ""))
+              f"{theirs['mean_lux'] / ours['mean_lux']:.3f}")
+        if scene == "crown":
+            seasonal = metrics(hourly[f"total__with__{grid}"], hourly[f"direct__with__{grid}"],
+                               occupied)
+            print(f"    radtree with its leaf season (the recipes have none): "
+                  f"sDA {seasonal['sDA']:.1f}, DA {seasonal['DA300']:.1f}")
 
 
-def reference(project: Path, *, hourly: dict, epw: Path, results: Path, hours: int) -> None:
-    """Exact hourly rtrace (gendaylit with the EPW's DNI/DHI) of the model at ``hours``
-    diffuse-dominated occupied hours (radtree 200–400 lx on office 1, no direct sun), against
-    radtree's and the recipe's annual values of those hours."""
-    from radtree.engines.radiance.binaries import require_radiance
+def radtree_sky_part(project: Path, replicates: int, hours: np.ndarray) -> np.ndarray:
+    """Office 1's mean lux of radtree's sky term alone (no sun) at ``hours``, from the annual
+    run's cached sky coefficients (no tracing)."""
+    from radtree.annual.coefficients import CoefficientRunner
+    from radtree.annual.run import LUX, AnnualOptions, plan_annual, plan_year, with_season
+    from radtree.config import load_project
+
+    proj = load_project(project)
+    plan = plan_annual(proj, with_season(proj, AnnualOptions(replicates=replicates)))
+    sky = plan_year(proj, plan)[2][:, hours]
+    scene = plan.scenes["without"]
+    runner = CoefficientRunner(scene, plan.grids, project / "results" / "annual" /
+                               "coefficients" / "without", plan.rho)
+    first = sum(len(scene.grids[g]) for g in plan.grids[:plan.grids.index("Office_1")])
+    c = runner.sky(plan.options.mf, plan.trace)[first:first + len(scene.grids["Office_1"])]
+    return sum(LUX[ch] * (c[:, :, ch].astype(float) @ sky[:, :, ch].astype(float))
+               for ch in range(3)).mean(axis=0)
+
+
+def exact_hour(build: Path, row: list[str], site: tuple[float, float, float], *,
+               sun: bool, env: dict) -> float:
+    """Office 1's mean lux by ``rtrace -ab 4 -ad 8192 -lw 1e-5`` under ``gendaylit`` with the
+    EPW ``row``'s DNI/DHI at the hour's middle (``sun`` False: its sky alone, ``-s``)."""
     from radtree.engines.radiance.writer import rgb_to_lux
 
+    lat, lon, tz = site
+    geometry = sorted(str(p.relative_to(build)) for p in (build / "geometry").glob("*.rad"))
+    sky = subprocess.run(["gendaylit", row[1], row[2], str(int(row[3]) - 0.5), "-a", str(lat),
+                          "-o", str(-lon), "-m", str(-15 * tz), "-W", row[14], row[15], "-O",
+                          "0", "-g", "0.15", *([] if sun else ["-s"])],
+                         capture_output=True, text=True, env=env, check=True).stdout
+    (build / "ref.sky").write_text(sky + SKY_GLOWS)
+    with (build / "ref.oct").open("wb") as fh:
+        subprocess.run(["oconv", "ref.sky", "materials.rad", "skies/1330_ground.rad",
+                        *geometry], cwd=build, stdout=fh, check=True, env=env)
+    out = subprocess.run(["rtrace", "-h", "-I", "-ab", "4", "-ad", "8192", "-lw", "1e-5",
+                          "-aa", "0", "ref.oct"], cwd=build,
+                         input=(build / "grids" / "Office_1.pts").read_text(), text=True,
+                         capture_output=True, check=True, env=env).stdout
+    return float(rgb_to_lux(np.loadtxt(out.splitlines()).reshape(-1, 3)).mean())
+
+
+def reference(project: Path, *, hourly: dict, epw: Path, results: Path, hours: int,
+              replicates: int) -> None:
+    """Exact hourly rtrace of the model at ``hours`` diffuse-dominated occupied hours (radtree
+    200–400 lx on office 1, no direct sun), its sky and sun parts against radtree's and the
+    recipe's annual values of those hours (the recipe's sky part: its daylight coefficients'
+    sky is radtree's within 1 %, see the docstring)."""
+    from radtree.engines.radiance.binaries import require_radiance
+
     env = require_radiance().env()
-    site = next(r for r in epw.read_text().splitlines() if r.startswith("LOCATION")).split(",")
-    lat, lon, tz = float(site[6]), float(site[7]), float(site[8])
+    loc = next(r for r in epw.read_text().splitlines() if r.startswith("LOCATION")).split(",")
+    site = (float(loc[6]), float(loc[7]), float(loc[8]))
     rows = [r.split(",") for r in epw.read_text().splitlines()[8:]]
     ours, theirs = hourly["total__without__Office_1"], recipe_hourly(results, "Office_1")
     mean, direct = ours.mean(axis=0), hourly["direct__without__Office_1"].mean(axis=0)
     pick = np.flatnonzero((mean > 200) & (mean < 400) & (direct == 0) & hourly["occupied"])
+    print(f"  {len(pick)} diffuse-dominated hours: lbt/radtree median "
+          f"{np.median(theirs[:, pick].mean(axis=0) / mean[pick]):.3f}")
+    chosen = np.sort(np.random.default_rng(1).choice(pick, min(hours, len(pick)),
+                                                     replace=False))
+    sky_part = radtree_sky_part(project, replicates, chosen)
     build = project / "build" / "model"
-    geometry = sorted(str(p.relative_to(build)) for p in (build / "geometry").glob("*.rad"))
-    pts = (build / "grids" / "Office_1.pts").read_text()
-    for h in sorted(np.random.default_rng(1).choice(pick, min(hours, len(pick)), replace=False)):
+    for h, r_sky in zip(chosen, sky_part):
         r = rows[h]
-        sky = subprocess.run(["gendaylit", r[1], r[2], str(int(r[3]) - 0.5), "-a", str(lat),
-                              "-o", str(-lon), "-m", str(-15 * tz), "-W", r[14], r[15], "-O",
-                              "0", "-g", "0.15"], capture_output=True, text=True, env=env,
-                             check=True).stdout
-        (build / "ref.sky").write_text(sky + SKY_GLOWS)
-        with (build / "ref.oct").open("wb") as fh:
-            subprocess.run(["oconv", "ref.sky", "materials.rad", "skies/1330_ground.rad",
-                            *geometry], cwd=build, stdout=fh, check=True, env=env)
-        out = subprocess.run(["rtrace", "-h", "-I", "-ab", "4", "-ad", "8192", "-lw", "1e-5",
-                              "-aa", "0", "ref.oct"], cwd=build, input=pts, text=True,
-                             capture_output=True, check=True, env=env).stdout
-        ref = rgb_to_lux(np.loadtxt(out.splitlines()).reshape(-1, 3)).mean()
-        print(f"  reference hour {h} ({r[1]}/{r[2]} {int(r[3]) - 1}:30): rtrace {ref:.1f} lx; "
-              f"radtree {ours[:, h].mean() / ref:.3f}, lbt {theirs[:, h].mean() / ref:.3f}")
+        ref_sky = exact_hour(build, r, site, sun=False, env=env)
+        ref = exact_hour(build, r, site, sun=True, env=env)
+        r_all, l_all = ours[:, h].mean(), theirs[:, h].mean()
+        print(f"  reference hour {h} ({r[1]}/{r[2]} {int(r[3]) - 1}:30): rtrace {ref:.1f} lx "
+              f"(sky {ref_sky:.1f}, sun {ref - ref_sky:.1f}); radtree {r_all / ref:.3f} (sky "
+              f"{r_sky / ref_sky:.3f}, sun {(r_all - r_sky) / (ref - ref_sky):.3f}), lbt "
+              f"{l_all / ref:.3f}")
 
 
 def main() -> int:
@@ -195,31 +252,46 @@ def main() -> int:
                     help="interpreter with lbt-recipes and queenbee-local")
     ap.add_argument("--lbt-params", default="-ab 4 -ad 8192 -lw 1e-5 -dr 0")
     ap.add_argument("--reference-hours", type=int, default=8)
+    ap.add_argument("--replicates", type=int, help="radtree annual --replicates (default: "
+                    "radtree's)")
     ap.add_argument("--recipes", nargs="+",
                     default=["annual-daylight-enhanced", "annual-daylight"])
+    ap.add_argument("--work", type=Path, help="work folder; runs whose results it holds "
+                    "already are not repeated (default: a new temporary folder)")
     args = ap.parse_args()
-    work = Path(tempfile.mkdtemp(prefix="lbt_annual_"))
+    work = args.work or Path(tempfile.mkdtemp(prefix="lbt_annual_"))
     project = work / "honeybee-office"
-    shutil.copytree(EXAMPLE, project)
-    shutil.copytree(ROOT / "examples" / "office-block" / "data", work / "office-block" / "data")
-    radtree("annual", str(project), "--no-figures", cwd=work)
+    if not project.exists():
+        shutil.copytree(EXAMPLE, project)
+        shutil.copytree(ROOT / "examples" / "office-block" / "data",
+                        work / "office-block" / "data")
+    if not (project / "results" / "annual" / "hourly.npz").exists():
+        radtree("annual", str(project), "--no-figures",
+                *(["--replicates", str(args.replicates)] if args.replicates else []), cwd=work)
     meta = json.loads((project / "results" / "annual" / "annual_meta.json").read_text())
     epw = Path(meta["weather"]["path"])
     hourly = dict(np.load(project / "results" / "annual" / "hourly.npz"))
-    print(f"radtree annual: {meta['rcontrib']}, weather {epw.name}; lbt params {args.lbt_params}")
+    unc = project / "results" / "annual" / "uncertainty.csv"
+    spread = pd.read_csv(unc) if unc.exists() else None
+    replicates = int(meta.get("replicates", 1))
+    print(f"radtree annual: {meta['rcontrib']}, {replicates} replicate(s), weather {epw.name}; "
+          f"lbt params {args.lbt_params}")
     for scene in SCENES:
-        radtree("export", str(project), "--format", "honeybee-scene", "-s", scene, "--out",
-                str(work / f"export_{scene}"), cwd=work)
         model = work / f"export_{scene}" / "radtree_scene.hbjson"
+        if not model.exists():
+            radtree("export", str(project), "--format", "honeybee-scene", "-s", scene, "--out",
+                    str(model.parent), cwd=work)
         for recipe in args.recipes:
             results = run_recipe(args.lbt_python, recipe=recipe, model=model, epw=epw,
                                  params=args.lbt_params, folder=work / f"{recipe}_{scene}")
-            compare(hourly, results, scene=scene, recipe=recipe)
+            compare(hourly, results, spread, scene=scene, recipe=recipe)
             if scene == "model" and recipe == args.recipes[0] and args.reference_hours:
-                radtree("build", str(project), cwd=work)
+                if not (project / "build" / "model").exists():
+                    radtree("build", str(project), cwd=work)
                 reference(project, hourly=hourly, epw=epw, results=results,
-                          hours=args.reference_hours)
-    print(f"(radtree/lbt per metric, lbt − radtree in brackets; work folder {work})")
+                          hours=args.reference_hours, replicates=replicates)
+    print(f"(radtree/lbt per metric, lbt − radtree ± radtree's SE in brackets; work folder "
+          f"{work})")
     return 0
 
 

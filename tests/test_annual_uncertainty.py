@@ -71,8 +71,9 @@ def test_annual_with_replicates_reports_the_metrics_standard_errors(tiny_project
     res = compute_annual(project, options=AnnualOptions(nproc=1, replicates=3))
     assert res.trace.replicates == res.sun_trace.replicates == 3
     u = res.uncertainty
-    assert u is not None and len(u) == 2 * 6          # facade × with/without × metrics
-    assert set(u.tree) == {"with", "without"} and set(u.grid) == {"facade"}
+    assert u is not None and len(u) == 4 * 6          # facade × 4 trees × metrics
+    assert set(u.tree) == {"with", "without", "leaf_on", "leaf_off"}
+    assert set(u.grid) == {"facade"}
     assert (u.se >= 0).all() and u.se.notna().all()
     mean_lux = u[(u.tree == "without") & (u.metric == "mean_lux")].iloc[0]
     assert mean_lux.se > 0                               # the sky coefficients vary

@@ -126,13 +126,14 @@ def year_replicates(runner: CoefficientRunner, year: YearInputs, mf: int, sun_mf
 
 def table(replicas: Sequence[dict[str, dict[str, np.ndarray]]], grids: Sequence[str],
           occupied: np.ndarray) -> pd.DataFrame:
-    """Grid metrics of the replicates' mean year and their jackknife standard errors: one row
-    per grid, tree ("with" — the seasonal crown —, "without") and metric of :data:`METRICS`
-    (columns grid, tree, metric, value, se; percent, mean_lux in lux). ``replicas``: R dicts
-    tree → grid → (sensors, hours) lux, one per replicate."""
+    """Grid metrics of the replicates' mean year and their standard errors (:func:`metrics_se`):
+    one row per grid, tree ("with" — the seasonal crown —, "without", "leaf_on", "leaf_off")
+    and metric of :data:`METRICS` (columns grid, tree, metric, value, se; percent, mean_lux
+    in lux). ``replicas``: R dicts tree → grid → (sensors, hours) lux, one per replicate."""
     rows = []
+    trees = [t for t in ("with", "without", "leaf_on", "leaf_off") if t in replicas[0]]
     for g in grids:
-        for tree in ("with", "without"):
+        for tree in trees:
             est, se = metrics_se([r[tree][g] for r in replicas], occupied)
             rows += [{"grid": g, "tree": tree, "metric": k, "value": est[k], "se": se[k]}
                      for k in METRICS]

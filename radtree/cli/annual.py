@@ -102,7 +102,8 @@ def annual_command(*, project: Path, leaf_on: str | None, leaf_off: str | None, 
     spread = out.result.uncertainty
     if spread is not None:
         click.echo(f"  Monte Carlo standard errors ({options.replicates} replicates, jackknife):")
-        for (grid, tree), rows in spread.groupby(["grid", "tree"], sort=False):
+        shown = spread[spread.tree.isin(["with", "without"])]
+        for (grid, tree), rows in shown.groupby(["grid", "tree"], sort=False):
             se = dict(zip(rows.metric, rows.se))
             click.echo(f"  {grid:>10} {tree:>7} tree: sDA ± {se['sDA']:.1f}, DA ± "
                        f"{se['DA300']:.1f}, UDI <100 ± {se['UDI<100']:.1f}, 100–3000 ± "
