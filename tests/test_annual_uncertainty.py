@@ -28,6 +28,9 @@ def test_replicates_are_independent_passes_and_the_first_is_the_plain_run(tmp_pa
     assert not np.array_equal(reps[1], reps[0])
     open_field = total[:, :5]                                # the 5 sensors outside the box
     assert np.all(np.abs(open_field[1:] / open_field[0] - 1) < 0.1)
+    # more replicates extend fewer: passes 0 and 1 of R = 3 are those of R = 2
+    two = runner.sky_replicates(1, TraceParams(ab=2, ad=64, lw=1e-3, nproc=2, replicates=2))
+    assert np.array_equal(two, reps[:2])
     # sky() is their mean, and the cache returns the same array
     assert np.allclose(runner.sky(1, params), reps.mean(axis=0))
     assert np.array_equal(runner.sky_replicates(1, params), reps)
@@ -66,7 +69,7 @@ def test_annual_with_replicates_reports_the_metrics_standard_errors(tiny_project
     from radtree.config import load_project
 
     project = load_project(tiny_project)
-    plain = compute_annual(project, options=AnnualOptions(nproc=1))
+    plain = compute_annual(project, options=AnnualOptions(nproc=1, replicates=1))
     assert plain.uncertainty is None
     res = compute_annual(project, options=AnnualOptions(nproc=1, replicates=3))
     assert res.trace.replicates == res.sun_trace.replicates == 3
@@ -96,3 +99,13 @@ def test_sda_se_counts_the_sensors_that_may_flip():
     p = 0.841344746
     assert sda_se(np.array([60.0]), np.array([10.0])) == pytest.approx(100 * np.sqrt(p * (1 - p)))
     assert sda_se(np.array([60.0, 40.0]), np.zeros(2)) == 0.0
+
+
+def test_default_replicates_by_method():
+    from radtree.annual.run import DEFAULT_REPLICATES, AnnualOptions
+
+    assert DEFAULT_REPLICATES == 4
+    assert AnnualOptions().replicates is None                # resolved by plan_annual
+    assert AnnualOptions(method="3phase").replicates is None
+    with pytest.raises(Exception, match="replicates"):
+        AnnualOptions(replicates=0)
