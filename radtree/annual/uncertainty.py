@@ -36,6 +36,8 @@ from radtree.annual.weather_year import YearInputs
 
 #: grid metrics of :func:`grid_metrics` (percent; ``mean_lux`` in lux)
 METRICS = ("DA300", "sDA", "UDI<100", "UDI100-3000", "UDI>3000", "mean_lux")
+#: columns of ``results/annual/uncertainty.csv`` (:func:`table`)
+COLUMNS = ("grid", "tree", "metric", "value", "se")
 
 
 def grid_metrics(lux: np.ndarray, occupied: np.ndarray) -> dict[str, float]:
@@ -137,4 +139,4 @@ def table(replicas: Sequence[dict[str, dict[str, np.ndarray]]], grids: Sequence[
             est, se = metrics_se([r[tree][g] for r in replicas], occupied)
             rows += [{"grid": g, "tree": tree, "metric": k, "value": est[k], "se": se[k]}
                      for k in METRICS]
-    return pd.DataFrame(rows)
+    return pd.DataFrame(rows, columns=list(COLUMNS))
