@@ -9,6 +9,36 @@ spread of a metric over the replicates is the run-to-run spread a user sees. The
 R replicates is a run at ≈ R × ``-ad``, and its jackknife SE is printed beside the SD / √R
 the replicates imply.
 
+Measured 2026-12-07 11:50–12:30 UTC, load 11–28 (≈ 6 sessions on 2 cores), ``--ad 1024
+--replicates 6`` (the defaults: reflected sun ``-ad 256 -lw 1e-3``); per grid, one run's
+mean ± SD over the 6 passes [range], and the 6 passes' mean ± its SE:
+
+    scene     grid      one run: DA300     sDA                UDI<100           UDI100-3000
+    no crown  Office_1  74.7 ± 0.46   78.8 ± 1.82 [77.1–82.3]   4.6 ± 0.06   85.7 ± 0.06
+              Office_2  74.6 ± 0.56   78.5 ± 1.57 [76.0–80.2]   4.6 ± 0.09   85.6 ± 0.09
+    leafed    Office_1  53.8 ± 0.38   56.1 ± 1.79 [53.1–58.3]  15.2 ± 0.36   79.0 ± 0.36
+              Office_2  37.5 ± 0.62   39.6 ± 1.61 [37.5–41.7]  15.5 ± 1.04   81.3 ± 1.04
+    mean of 6 (SE): DA 74.8 ± 0.25, 74.7 ± 0.30, 54.1 ± 0.16, 37.8 ± 0.32; sDA 79.2 ± 0.8,
+    77.1 ± 1.2, 56.2 ± 1.2, 40.6 ± 0.8 (sensors); UDI<100 4.5, 4.5, 14.7 ± 0.2, 13.3 ± 0.3.
+
+* UDI above 3000 lx moves ≤ 0.01 pp (the direct sun is exact); UDI below 100 lx of a single
+  run is biased high where it is noisy (office 2 with the crown: 15.5 for one pass, 13.3 for
+  the mean of 6 — noise spreads the low values below 100 lx).
+* sDA: one pass at -ad 1024 has an SD of 1.6–1.8 pp (5 pp range over 6 runs), more than
+  DA's 0.4–0.6: it counts 96 sensors, each 1.04 pp. The sensors' estimate
+  (:func:`radtree.annual.uncertainty.sda_se`, from the 6 passes' DA SEs × √6) predicts
+  1.55–1.57 pp for one pass (observed 1.57–1.82); the jackknife of sDA itself reads 0.00 on
+  two of the four grids (no leave-one-out flipped a sensor), hence the sensors' estimate.
+  sDA's SE falls as R^-¼, not R^-½ (sensors within ~1 SE of DA 50 % flip): 4 passes ≈ 1.1 pp,
+  16 ≈ 0.8 pp — a default that reports it rather than one that hides it: ``radtree annual``
+  now runs 4 passes and prints every metric's SE.
+* Per sensor, one pass's mean lux over the hours without direct sun moves 7 % (SD/mean, sky
+  part 9 %, reflected sun 11 %): a sensor deep in the room sees the window in a small solid
+  angle, so few of its 1024 ambient samples reach the sky.
+* Cost: 1 pass of both scenes 60 s CPU (362 s CPU for 6 passes of the two scenes, 100 s and
+  288 s wall per pass at load ≈ 25); ``radtree annual`` at its defaults before (1 pass, three
+  scenes) 84 s CPU, 354 s wall at load ≈ 11; 4 passes ≈ 4 × the sky and reflected-sun traces.
+
 Run: ``.venv/bin/python benchmarks/annual_precision.py [--ad 1024 4096] [--replicates 8]``.
 """
 

@@ -1,72 +1,94 @@
 """Ladybug Tools' own annual-daylight recipes against ``radtree annual`` on the same Honeybee
 model, crowns and weather (issue 40, item 3b).
 
-Steps (in a temporary copy of ``examples/honeybee-office``):
+Steps (in ``--work`` or a temporary copy of ``examples/honeybee-office``; runs whose results
+the folder holds already are not repeated):
 
-1. ``radtree annual`` (its defaults: ``-ab 4 -ad 1024 -lw 1e-4``, daylight coefficients, the
-   generated clear-sky year of the site, occupancy 8–18) → ``results/annual/hourly.npz``:
-   every grid's hourly lux for the leafed crown (``leaf_on``), the bare crown and no crown.
+1. ``radtree annual`` (its defaults: ``-ab 4 -ad 1024 -lw 1e-4``, 4 replicates, daylight
+   coefficients, the generated clear-sky year of the site, occupancy 8–18; ``--replicates``)
+   → ``results/annual/hourly.npz`` and ``uncertainty.csv`` (each metric's Monte Carlo SE).
 2. ``radtree export --format honeybee-scene`` of the scenarios ``model`` (no crown: radtree's
    ground plane only) and ``crown`` (every leaf, trunk and the ground as ShadeMesh with their
    Radiance modifiers, :mod:`radtree.export.honeybee_scene`) → two HBJSON models.
-3. lbt-recipes' ``annual-daylight`` (one daylight-coefficient run, the sun smeared over the 145
-   Reinhart patches of its ``sky_type total`` matrix) and ``annual-daylight-enhanced`` (2-phase:
-   total sky − direct sky + the exact direct sun) on each model, with queenbee-local, Radiance
-   from the ``pyradiance`` wheel, the same EPW and the same radiance parameters
-   (``--lbt-params``), run by ``--lbt-python`` (an interpreter with ``pip install
-   'radtree[lbt]'``, or a separate venv with ``lbt-recipes queenbee-local pyradiance``: they
-   pull ~750 MB, cupy among them, so they are not part of ``make install``).
-4. The same metrics from both hourly arrays and radtree's occupied hours (the recipe's own DA
-   file equals this recomputation: its schedule is the same 8–18): DA300, sDA300/50, UDI
-   below 100 / 100–3000 / above 3000 lx, mean lux; a static leafed crown all year in both (the
-   recipe knows no seasons; radtree's seasonal result is printed beside).
-5. An exact reference at ``--reference-hours`` diffuse-dominated hours (radtree total 200–400
-   lx, no direct sun): ``gendaylit`` with the EPW's DNI/DHI at the hour's middle, ``rtrace -ab 4
-   -ad 8192 -lw 1e-5`` on radtree's build of the model, the office 1 grid.
+3. lbt-recipes' ``annual-daylight`` (the sun smeared over the sky patches) and
+   ``annual-daylight-enhanced`` (2-phase: total sky − direct sky + the exact direct sun) on
+   each model, queenbee-local, Radiance from the ``pyradiance`` wheel, the same EPW and
+   ``--lbt-params``, run by ``--lbt-python`` (a separate venv with ``lbt-recipes
+   queenbee-local pyradiance``: ~750 MB, cupy among them, not part of ``make install``).
+4. The same metrics from both hourly arrays over radtree's occupied hours: DA300, sDA300/50,
+   UDI below 100 / 100–3000 / above 3000 lx, ASE1000,250 (the recipe's ``direct`` results are
+   its exact suns at ``-ab 0``, radtree's ``direct`` the same), mean lux; a static leafed
+   crown all year in both (the recipe knows no seasons; radtree's seasonal sDA beside).
+5. An exact reference at ``--reference-hours`` diffuse-dominated hours (radtree 200–400 lx, no
+   direct sun, office 1, no crown): ``gendaylit`` with the EPW's DNI/DHI at the hour's middle,
+   ``rtrace -ab 4 -ad 8192 -lw 1e-5``, with and without its sun (``-s``): sky and sun parts.
 
-Measured 2026-12-07 09:06–09:24 UTC (load 6–9: helper sessions running; 1 039 s wall),
-lbt-recipes 0.29.1, queenbee-local 1.0.3, honeybee-radiance 1.66.299, ``--lbt-params "-ab 4
--ad 8192 -lw 1e-5 -dr 0"``; radtree/lbt per metric, lbt − radtree in pp:
+Measured 2026-12-07 11:44–12:45 UTC, load 11–28 (≈ 6 sessions on 2 cores); lbt-recipes 0.29.1,
+queenbee-local 1.0.3, honeybee-radiance 1.66.299, pyradiance 1.3.1 (Radiance 6.0a); enhanced
+recipe, ``--lbt-params "-ab 4 -ad 8192 -lw 1e-5 -dr 0"`` (crown also ``-ad 32768``). radtree's
+1, 4 and 6 passes are the first passes of one 6-replicate run (bit for bit those runs:
+``tests/test_annual_uncertainty.py``). lbt − radtree in pp, ± radtree's Monte Carlo SE:
 
-    recipe    scene  grid      DA300          sDA            UDI<100       UDI100-3000    UDI>3000     lux ratio
-    enhanced  model  Office_1  74.1/69.8 −4.3  77.1/71.9 −5.2  4.6/5.7 +1.1  85.7/84.5 −1.2  9.7/9.9 +0.2  0.988
-    enhanced  model  Office_2  74.6/69.1 −5.5  78.1/72.9 −5.2  4.6/5.4 +0.8  85.6/84.7 −0.9  9.8/9.9 +0.1  0.988
-    enhanced  crown  Office_1  54.3/48.6 −5.7  58.3/50.0 −8.3  15.0/17.2 +2.2 79.2/76.9 −2.3  5.8/5.9 +0.1  0.984
-    enhanced  crown  Office_2  37.0/34.3 −2.7  38.5/37.5 −1.0  15.4/22.5 +7.1 81.4/74.4 −7.0  3.2/3.2 −0.0  0.971
-    plain     model  Office_1  74.1/69.9 −4.1  77.1/72.9 −4.2  4.6/5.5 +0.9  85.7/79.4 −6.4  9.7/15.1 +5.5 0.929
-    plain     model  Office_2  74.6/69.9 −4.7  78.1/70.8 −7.3  4.6/5.3 +0.7  85.6/79.6 −6.1  9.8/15.1 +5.3 0.925
-    plain     crown  Office_1  54.3/50.4 −3.9  58.3/54.2 −4.2  15.0/17.3 +2.3 79.2/73.2 −6.0  5.8/9.5 +3.6  0.912
-    plain     crown  Office_2  37.0/35.9 −1.2  38.5/36.5 −2.1  15.4/22.2 +6.8 81.4/72.8 −8.7  3.2/5.0 +1.8  0.897
+    scene grid      radtree   DA300        sDA          UDI<100      UDI100-3000  UDI>3000  ASE
+    model Office_1  1 pass    −6.2 ± 0.6   −10.4 ± 1.5  +0.9         −1.0         +0.1      0.0
+                    4 (dflt)  −5.8 ± 0.3    −7.3 ± 1.1  +0.9         −1.0         +0.1      0.0
+                    6         −5.7 ± 0.3    −7.3 ± 0.8  +0.9         −1.0         +0.1      0.0
+    model Office_2  1 pass    −5.3 ± 0.7    −8.3 ± 1.6  +0.8 ± 0.1   −0.9 ± 0.1   +0.1      0.0
+                    4 (dflt)  −4.9 ± 0.3    −7.3 ± 1.4  +0.8         −0.9         +0.1      0.0
+                    6         −5.1 ± 0.3    −5.2 ± 1.2  +0.8         −0.9         +0.1      0.0
+    crown Office_1  1 pass    −4.6 ± 0.4    −7.3 ± 1.9  +2.4 ± 0.4   −2.5 ± 0.4   +0.2      0.0
+                    4 (dflt)  −5.0 ± 0.2    −7.3 ± 1.4  +2.8 ± 0.1   −3.0 ± 0.1   +0.2      0.0
+                    6         −5.2 ± 0.2    −7.3 ± 1.3  +2.9 ± 0.2   −3.0 ± 0.2   +0.2      0.0
+      lbt -ad 32768, 6        −4.5 ± 0.2    −7.3 ± 1.3  +2.1 ± 0.2   −2.2 ± 0.2   +0.0      0.0
+    crown Office_2  1 pass    −4.5 ± 0.8    −7.3 ± 1.5  +8.2 ± 0.8   −8.2 ± 0.8   −0.0      0.0
+                    4 (dflt)  −4.1 ± 0.4    −6.2 ± 0.9  +9.0 ± 0.6   −9.0 ± 0.6   −0.0      0.0
+                    6         −4.1 ± 0.3    −6.2 ± 0.8  +9.4 ± 0.3   −9.4 ± 0.3   −0.0      0.0
+      lbt -ad 32768, 6        −3.2 ± 0.3    −5.2 ± 0.8  +8.8 ± 0.3   −8.7 ± 0.3   −0.0      0.0
 
-  (radtree with its leaf season, which the recipes cannot model: sDA 65.6 and 44.8.)
+  Values (radtree 6 passes / lbt): model DA 74.8/69.1 and 74.7/69.7, sDA 79.2/71.9 and
+  77.1/71.9, ASE 35.4/35.4; crown DA 54.1/48.8 and 37.8/33.7, sDA 56.2/49.0 and 40.6/34.4,
+  UDI<100 14.7/17.5 and 13.3/22.7, ASE 27.1 and 19.8 both; mean lux lbt/radtree 0.974–0.989.
+  radtree with its leaf season: sDA 63.5 and 46.9 (one pass).
 
-* Scene check first (independent of the annual methods): a uniform sky traced by ``rtrace
-  -ab 4 -ad 8192`` on radtree's build of the model and on the recipe's translation of the
-  exported HBJSON: 0.09658 vs 0.09665 (0.08 %).
-* Exact reference, 8 diffuse-dominated hours (office 1, no crown): radtree 1.008–1.023 of the
-  hourly rtrace at 6 hours, the enhanced recipe 0.966–1.000; at the other 2 (October mornings,
-  the sun just behind the opposite building) radtree 1.126–1.156 and lbt 1.113–1.154: both
-  annual methods take reflected sun from sky patches that straddle the building's edge.
-* radtree annual moved between fresh runs when this was measured (an earlier run of the same
-  command read sDA 81.2 / 82.3 without and 59.4 / 36.5 with the crown, and 0.997–1.007 of the
-  reference at those 6 hours): ``rcontrib -n 2`` let its two children take rays as they came
-  free. Since then the points are split into fixed chunks, one single-process rcontrib each
-  (:mod:`radtree.annual.coefficients`): two fresh ``-j 2`` runs are bit-identical
-  (``tests/test_annual_determinism.py``); a fresh run now differs from the table's radtree
-  column by that same Monte Carlo spread (≈ 4 pp of sDA), itself larger than the 3 pp target.
-* Where they differ: in diffuse-dominated hours (radtree 200–400 lx) the enhanced recipe reads
-  a median 0.89–0.91 of radtree; DA and sDA count hours and sensors across 300 lx, so a few
-  per cent near 300 lx move them by 5–10 pp. The plain recipe smears the sun over the sky
-  patches: UDI above 3 000 lx +1.8 … +5.5 pp, mean lux 0.90–0.93. At the recipe's ``-ad 1024``
-  (with its fixed ``-aa 0``) each sensor's hourly value is noisy enough to move UDI below
-  100 lx by 6–19 pp.
-* Target (issue 40, 3b: sDA, ASE, UDI within 3 pp): **not met** — sDA up to 8.3 pp (enhanced)
-  and UDI 100–3000 up to 7.0 pp (Office_2 with the crown); met on UDI above 3 000 lx with the
-  enhanced recipe (≤ 0.2 pp) and on the UDI bands without the crown (≤ 1.2 pp). ASE is not in
-  these recipes' outputs (radtree's is in ``standards.csv``).
+* Same scene and skies: daylight coefficients of the recipe's octree (its ``rfluxmtx``, sky
+  dome and points, re-run) over radtree's on a uniform sky: 1.004 (office 1, no crown), 0.988
+  (office 2, crown; per sensor 0.90–1.05, both tools' noise); the recipe's sky matrix over
+  radtree's on radtree's coefficients 1.005 (the recipe leaves ``gendaymtx -g`` at 0.2,
+  radtree uses the project's 0.15). ASE equal to 0.0 pp: both trace each hour's sun exactly.
+* Where they differ — the reflected sun. At the 195 diffuse-dominated hours lbt reads a median
+  0.976 of radtree; split against the exact reference (4 hours, -ad 4096):
+  sky part radtree 1.055–1.070, lbt 1.068–1.083 of exact (both take gendaymtx's Perez patches;
+  ``--mf 4`` does not change it, 141.5 vs 138.6 lx at hour 632: it is the patch sky against
+  gendaylit's perezlum.cal near the horizon, not the patch size); sun part (half the light
+  in these hours: sun on the street and the opposite façade) radtree 0.96–1.00, lbt 0.875–0.935
+  at -ad 8192 and 0.91–0.96 at -ad 32768 (the recipe's total sky re-traced). Totals: radtree
+  1.013–1.029, lbt 0.968–1.004. The recipe carries the sun as sky patches — ``gendaymtx``
+  spreads each hour's sun over its 4 nearest Reinhart patches, weights 1/(1.002 − cos)
+  (Radiance ``src/gen/gendaymtx.c``, ``AddDirect``) — which rays reach only by ambient
+  sampling (a glow, not a light source), so the reflected sun comes in low and converges
+  slowly; radtree's unit suns are light sources tested from every ambient hit. Per sensor the
+  deep ones differ most (lbt's sun part 0.70–0.79 of radtree's for the lowest tenth), and DA300
+  is decided there: 7 % of sensor-hours are ≥ 300 lx in radtree and < 300 in lbt (median
+  0.71 of radtree), 1 % the other way. DA moves 69.0 → 69.3 with the recipe's total sky at
+  -ad 32768 instead of 8192: not the recipe's noise.
+* Office 2 with the crown, UDI < 100 +8.8 pp: 11 % of its sensor-hours read < 100 lx in lbt
+  and ≥ 100 in radtree (median 80 vs 127 lx), all day, all year; the sky parts agree there
+  (19.8 vs 20.9 lx), the sun part (scattered by the leaves) is 60 vs 107 lx; unchanged at
+  -ad 32768 (22.7 → 22.1 %). Exact reference at two such hours: see below.
+* No input of ``annual-daylight-enhanced`` changes the sun's treatment or the sky density (its
+  inputs: model, wea, north, radiance-parameters, thresholds, schedule, grid filter, CPU and
+  sensor counts); ``-ad`` is the only lever and moves its diffuse-hour median only 0.976 →
+  0.988 of radtree (-ad 32768).
+* Target (issue 40, 3b: sDA, ASE, UDI within 3 pp; radtree annual as a user runs it, now 4
+  passes): **not met** — DA300 −4.1 … −5.8 pp, sDA −6.2 … −7.3 pp (SE 0.9–1.4), UDI 100–3000
+  −9.0 pp on office 2 with the crown. Met: ASE (0.0 pp), UDI above 3000 lx (≤ 0.2 pp), UDI
+  bands without the crown (≤ 1.0 pp) and on office 1 with it (≤ 3.0 pp). At converged
+  settings (radtree 6 passes, lbt -ad 32768 on the crown): the same verdict. radtree's own
+  precision no longer decides it (``benchmarks/annual_precision.py``).
 
 Run: ``.venv/bin/python benchmarks/lbt_annual.py --lbt-python /path/to/venv/bin/python
-[--lbt-params "-ab 4 -ad 8192 -lw 1e-5 -dr 0"] [--recipes annual-daylight-enhanced]``.
+[--work DIR] [--replicates R] [--lbt-params "-ab 4 -ad 8192 -lw 1e-5 -dr 0"]
+[--recipes annual-daylight-enhanced]``.
 """
 
 from __future__ import annotations
