@@ -74,7 +74,13 @@ recipe, ``--lbt-params "-ab 4 -ad 8192 -lw 1e-5 -dr 0"`` (crown also ``-ad 32768
 * Office 2 with the crown, UDI < 100 +8.8 pp: 11 % of its sensor-hours read < 100 lx in lbt
   and ≥ 100 in radtree (median 80 vs 127 lx), all day, all year; the sky parts agree there
   (19.8 vs 20.9 lx), the sun part (scattered by the leaves) is 60 vs 107 lx; unchanged at
-  -ad 32768 (22.7 → 22.1 %). Exact reference at two such hours: see below.
+  -ad 32768 (22.7 → 22.1 %). Exact hourly rtrace (``-ad 4096``, radtree's leafed scene) at the
+  two hours where most of its sensors flip (30 Aug and 4 May, 11:30; the sun in front, through
+  the crown): the truth lies between the tools. Grid mean radtree (6 passes) 1.090 / 1.062 of
+  exact (sky part 1.180 / 1.172, sun part 1.059 / 1.039), lbt 1.027 / 0.988 (-ad 32768);
+  sensors below 100 lx: exact 21 / 24, radtree 12 / 19, lbt 28 / 36. radtree's UDI < 100 is
+  low there and lbt's high; radtree's sky term through the crown reads 17–18 % above
+  gendaylit's sky (6–8 % without the crown) — the two Perez skies of Radiance, left as found.
 * No input of ``annual-daylight-enhanced`` changes the sun's treatment or the sky density (its
   inputs: model, wea, north, radiance-parameters, thresholds, schedule, grid filter, CPU and
   sensor counts); ``-ad`` is the only lever and moves its diffuse-hour median only 0.976 →
