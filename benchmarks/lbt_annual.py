@@ -67,9 +67,11 @@ recipe, ``--lbt-params "-ab 4 -ad 8192 -lw 1e-5 -dr 0"`` (crown also ``-ad 32768
   (Radiance ``src/gen/gendaymtx.c``, ``AddDirect``) — which rays reach only by ambient
   sampling (a glow, not a light source), so the reflected sun comes in low and converges
   slowly; radtree's unit suns are light sources tested from every ambient hit. Per sensor the
-  deep ones differ most (lbt's sun part 0.70–0.79 of radtree's for the lowest tenth), and DA300
-  is decided there: 7 % of sensor-hours are ≥ 300 lx in radtree and < 300 in lbt (median
-  0.71 of radtree), 1 % the other way. DA moves 69.0 → 69.3 with the recipe's total sky at
+  deep ones differ most (the recipe's sun part, its total sky at -ad 32768, 0.70–0.79 of
+  radtree's 6 passes for the lowest tenth of office 1's sensors), and DA300 is decided there:
+  7 % of sensor-hours are ≥ 300 lx in radtree (one pass) and < 300 in the recipe (median
+  0.71 of radtree), 1 % the other way. The direct-sky subtraction is not it: at the 16 of
+  the 195 hours where it subtracts nothing the recipe reads 0.948 of radtree. DA moves 69.0 → 69.3 with the recipe's total sky at
   -ad 32768 instead of 8192: not the recipe's noise.
 * Office 2 with the crown, UDI < 100 +8.8 pp: 11 % of its sensor-hours read < 100 lx in lbt
   and ≥ 100 in radtree (median 80 vs 127 lx), all day, all year; the sky parts agree there
