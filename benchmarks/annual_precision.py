@@ -36,8 +36,9 @@ mean ± SD over the 6 passes [range], and the 6 passes' mean ± its SE:
   part 9 %, reflected sun 11 %): a sensor deep in the room sees the window in a small solid
   angle, so few of its 1024 ambient samples reach the sky.
 * Cost: 1 pass of both scenes 60 s CPU (362 s CPU for 6 passes of the two scenes, 100 s and
-  288 s wall per pass at load ≈ 25); ``radtree annual`` at its defaults before (1 pass, three
-  scenes) 84 s CPU, 354 s wall at load ≈ 11; 4 passes ≈ 4 × the sky and reflected-sun traces.
+  288 s wall per pass at load ≈ 25); ``radtree annual`` on the example, three scenes: one
+  pass (the old default) 84 s CPU, 354 s wall at load ≈ 11; four (the new default) 304 s
+  CPU, 604 s wall at load 15–20 — 3.6 × (the direct sun at ``-ab 0`` is traced once).
 
 Run: ``.venv/bin/python benchmarks/annual_precision.py [--ad 1024 4096] [--replicates 8]``.
 """

@@ -27,7 +27,8 @@ Measured 2026-12-07 11:44–12:45 UTC, load 11–28 (≈ 6 sessions on 2 cores);
 queenbee-local 1.0.3, honeybee-radiance 1.66.299, pyradiance 1.3.1 (Radiance 6.0a); enhanced
 recipe, ``--lbt-params "-ab 4 -ad 8192 -lw 1e-5 -dr 0"`` (crown also ``-ad 32768``). radtree's
 1, 4 and 6 passes are the first passes of one 6-replicate run (bit for bit those runs:
-``tests/test_annual_uncertainty.py``). lbt − radtree in pp, ± radtree's Monte Carlo SE:
+``tests/test_annual_uncertainty.py``; the 4-pass rows also from ``radtree annual`` at its new
+default, ``--work`` with the recipes' results: the same figures). lbt − radtree in pp, ± radtree's Monte Carlo SE:
 
     scene grid      radtree   DA300        sDA          UDI<100      UDI100-3000  UDI>3000  ASE
     model Office_1  1 pass    −6.2 ± 0.6   −10.4 ± 1.5  +0.9         −1.0         +0.1      0.0
