@@ -197,7 +197,7 @@ def main() -> None:
             print(f"  sun runs: {share_sun_runs(dirs['dc'], dirs[m])} files of the default "
                   "method's copy", flush=True)
         opts = AnnualOptions(nproc=args.processes, method=m, sun_crown=sun_crowns[0],
-                             daylight_samples=args.daylight_samples)
+                             daylight_samples=args.daylight_samples, replicates=1)
         runs[m] = timed(dirs[m], opts, over)
     variants: dict[str, tuple[AnnualResult, float, float]] = {}
     if "3phase" in runs:
@@ -215,7 +215,7 @@ def main() -> None:
             print(f"\n== {m}, second weather file", flush=True)
             opts = AnnualOptions(nproc=args.processes, method=m, epw=epw2,
                                  sun_crown=sun_crowns[0],
-                                 daylight_samples=args.daylight_samples)
+                                 daylight_samples=args.daylight_samples, replicates=1)
             again[m] = timed(dirs[m], opts, over)
 
     pd.set_option("display.width", 250)

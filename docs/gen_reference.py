@@ -253,6 +253,10 @@ RESULT_TABLES: list[tuple[str, list[str], str, str]] = [
     ("results/annual/standards.csv", ["radtree.annual.standards:COLUMNS"], "radtree annual",
      "one scenario × grid (or room) × metric: EN 17037 daylight provision and sunlight "
      "exposure, LEED v4.1 sDA and ASE, with its definition"),
+    ("results/annual/uncertainty.csv", ["radtree.annual.uncertainty:COLUMNS"],
+     "radtree annual (replicates above 1, the default)", "one grid × tree state × metric: "
+     "the metric of the replicates' mean year and its Monte Carlo standard error (pp; lux "
+     "for mean_lux)"),
     ("results/direct_sun.csv", ["radtree.pipeline.sunreach:DIRECT_SUN_COLUMNS"],
      "radtree simulate (perforated crowns)", "one hour × sensor: does the sun reach it"),
     ("results/photo_check.csv", ["radtree.photo.check:CHECK_COLUMNS"], "radtree hemi check",

@@ -403,7 +403,11 @@ def test_annual_command_writes_the_interface(tiny_project):
                                               "--mf", "1", "-j", "1"])
     assert res.exit_code == 0, res.output
     assert "GENERATED" in res.output
+    assert "Monte Carlo standard errors (4 replicates)" in res.output   # the default
     results = tiny_project / "results"
+    u = pd.read_csv(results / "annual" / "uncertainty.csv")
+    assert list(u.columns) == ["grid", "tree", "metric", "value", "se"]
+    assert (u.se >= 0).all() and set(u.tree) >= {"with", "without"}
     a = pd.read_csv(results / "annual.csv")
     assert list(a.columns) == ["grid", "sensor", "tree", "udi_below_100", "udi_100_300",
                                "udi_300_3000", "udi_above_3000", "da_300", "ase_hours"]

@@ -251,7 +251,8 @@ def test_unknown_sun_crown_is_refused():
 def test_default_method_reuses_the_three_phase_sun_runs(runs):
     """One project, both methods: with ``sun_crown = "explicit"`` the 3-phase year's direct
     and reflected sun are the default method's rcontrib runs, so a ``--method dc`` run after
-    it traces no sun again (the same files, untouched) and the two years differ only by the
+    it (one pass, ``replicates=1``: the 3-phase run's) traces no sun again (the same files,
+    untouched) and the two years differ only by the
     sky (``benchmarks/threephase.py --sun-runs shared`` relies on it: two traces of the same
     reflected sun differ by 34 % per point on the office example)."""
     from radtree.annual.methods import compute as compute_annual
@@ -262,7 +263,8 @@ def test_default_method_reuses_the_three_phase_sun_runs(runs):
     before = {f: f.stat().st_mtime_ns for s in ("leaf_on", "leaf_off")
               for f in (coeffs / s).glob("sun_*.npy")}
     assert len(before) == 6                  # direct, patch -ab 0, patch -ab N per state
-    dc = compute_annual(project, options=AnnualOptions(nproc=1, method="dc", sun_ad=32))
+    dc = compute_annual(project, options=AnnualOptions(nproc=1, method="dc", sun_ad=32,
+                                                       replicates=1))
     after = {f: f.stat().st_mtime_ns for s in ("leaf_on", "leaf_off")
              for f in (coeffs / s).glob("sun_*.npy")}
     assert after == before

@@ -56,19 +56,28 @@ class TraceParams:
 
     The runs sample with :data:`~radtree.engines.radiance.binaries.FIXED_SEED`, and the
     points are split into ``nproc`` fixed chunks (one single-process ``rcontrib`` each), so the
-    same ``nproc`` gives the same coefficients every time."""
+    same ``nproc`` gives the same coefficients every time.
+
+    ``replicates`` R > 1: every chunk's points are traced R times in a row. Under the fixed
+    seed each ray of a run gets its own sample sequence (Radiance indexes its correlated
+    samples by the ray's number), so the R passes are R independent estimates of every
+    coefficient at ``-ad``; their mean has the noise of one run at about R × ``-ad`` and
+    their spread measures it (:mod:`radtree.annual.uncertainty`). ``-ab 0`` runs (no Monte
+    Carlo part with ``-dj 0``) are traced once whatever R."""
 
     ab: int
     ad: int
     lw: float
     nproc: int = 1
+    replicates: int = 1
 
     def ambient(self, ab: int | None = None) -> list[str]:
         use_ab = self.ab if ab is None else ab
         return [FIXED_SEED, "-ab", str(use_ab), "-ad", str(self.ad), "-lw", f"{self.lw:g}", "-aa", "0"]
 
     def key(self) -> str:
-        return f"u-_ab{self.ab}_ad{self.ad}_lw{self.lw:g}"
+        rep = f"_r{self.replicates}" if self.replicates > 1 else ""
+        return f"u-_ab{self.ab}_ad{self.ad}_lw{self.lw:g}{rep}"
 
 
 def scene_text(scene: Scene, ground_reflectance: float | None) -> str:
@@ -143,29 +152,35 @@ class CoefficientRunner:
         return octree
 
     def _rcontrib(self, argv: list[str], octree: Path, ncols: int, scale: float = 1.0, *,
-                  nproc: int = 1) -> np.ndarray:
-        """``rcontrib`` over the sensor points, in ``nproc`` contiguous chunks of points, one
-        single-process ``rcontrib`` each, run side by side: unlike ``rcontrib -n`` (whose
-        children take rays as they come free, so each draws a different sample sequence from
-        run to run) the same ``nproc`` gives the same coefficients every time."""
+                  nproc: int = 1, replicates: int = 1) -> np.ndarray:
+        """(replicates, sensors, ncols, 3): ``rcontrib`` over the sensor points, in ``nproc``
+        contiguous chunks of points, one single-process ``rcontrib`` each, run side by side:
+        unlike ``rcontrib -n`` (whose children take rays as they come free, so each draws a
+        different sample sequence from run to run) the same ``nproc`` gives the same
+        coefficients every time. Each chunk's points are sent ``replicates`` times in a row
+        (:class:`TraceParams`)."""
         cmd = ["rcontrib", "-I+", "-h-", "-faf", "-V+", "-dj", "0", "-dc", "1", "-dt", "0",
                *argv, str(octree)]
         lines = self.pts_text.splitlines(keepends=True)
         bounds = np.linspace(0, len(lines), max(1, min(nproc, len(lines))) + 1).astype(int)
-        chunks = ["".join(lines[a:b]).encode() for a, b in zip(bounds[:-1], bounds[1:])]
+        chunks = ["".join(lines[a:b]).encode() * replicates
+                  for a, b in zip(bounds[:-1], bounds[1:])]
         with ThreadPoolExecutor(max_workers=len(chunks)) as pool:
             parts = list(pool.map(lambda text: run(cmd, stdin=text, cwd=self.folder), chunks))
-        a = np.frombuffer(b"".join(parts), dtype=np.float32)
-        expected = self.n_sensors * ncols * 3
-        if a.size != expected:
-            raise EngineError(f"rcontrib gave {a.size} values, expected {expected}",
-                              command=cmd)
-        return (a.reshape(self.n_sensors, ncols, 3) / np.float32(scale)).astype(np.float32)
+        expected = self.n_sensors * ncols * 3 * replicates
+        got = sum(len(p) for p in parts) // 4
+        if got != expected:
+            raise EngineError(f"rcontrib gave {got} values, expected {expected}", command=cmd)
+        per_chunk = [np.frombuffer(p, dtype=np.float32).reshape(replicates, -1, ncols, 3)
+                     for p in parts]
+        a = np.concatenate(per_chunk, axis=1)
+        return (a / np.float32(scale)).astype(np.float32)
 
     def _cached(self, kind: str, key: str, compute) -> np.ndarray:
         path = self.folder / f"{kind}_{_digest(self.scene_key, key)}.npy"
         if path.exists():
-            return np.load(path)
+            value = np.load(path)
+            return value[None] if value.ndim == 3 else value  # cached before replicates
         value = compute()
         with atomic_path(path) as tmp:
             with open(tmp, "wb") as fh:
@@ -174,7 +189,12 @@ class CoefficientRunner:
 
     # -------------------------------------------------------------- coefficients
     def sky(self, mf: int, params: TraceParams) -> np.ndarray:
-        """(sensors, patches, 3) sky coefficients at ``-ab N``."""
+        """(sensors, patches, 3) sky coefficients at ``-ab N`` (the replicates' mean)."""
+        return self.sky_replicates(mf, params).mean(axis=0)
+
+    def sky_replicates(self, mf: int, params: TraceParams) -> np.ndarray:
+        """(replicates, sensors, patches, 3) sky coefficients at ``-ab N``, one estimate per
+        replicate of ``params``."""
         n = patch_count(mf)
 
         def compute() -> np.ndarray:
@@ -182,16 +202,25 @@ class CoefficientRunner:
             octree = self._octree("sky", SKY_TEXT)
             argv = [*params.ambient(), "-f", "reinhartb.cal", "-e", f"MF:{mf}", "-b",
                     "rbin+1", "-bn", "Nrbins+1", "-m", "skyglow"]
-            return self._rcontrib(argv, octree, n, nproc=params.nproc)
+            return self._rcontrib(argv, octree, n, nproc=params.nproc,
+                                  replicates=params.replicates)
 
         return self._cached("sky", f"mf{mf}_{params.key()}", compute)
 
     def suns(self, name: str, directions: np.ndarray, ab: int, params: TraceParams
              ) -> np.ndarray:
-        """(sensors, suns, 3) coefficients of unit suns at ``directions`` at ``-ab ab``."""
+        """(sensors, suns, 3) coefficients of unit suns at ``directions`` at ``-ab ab`` (the
+        replicates' mean)."""
+        return self.suns_replicates(name, directions, ab, params).mean(axis=0)
+
+    def suns_replicates(self, name: str, directions: np.ndarray, ab: int,
+                        params: TraceParams) -> np.ndarray:
+        """(replicates, sensors, suns, 3) coefficients of unit suns at ``directions`` at
+        ``-ab ab``; one replicate at ``-ab 0`` (deterministic)."""
         directions = np.asarray(directions, float).reshape(-1, 3)
+        reps = params.replicates if ab else 1
         if len(directions) == 0:
-            return np.zeros((self.n_sensors, 0, 3), np.float32)
+            return np.zeros((reps, self.n_sensors, 0, 3), np.float32)
         text, mods = sun_sources_text(directions)
         key = f"{name}_ab{ab}_{params.key() if ab else 'direct'}_" + _digest(text)
 
@@ -201,6 +230,7 @@ class CoefficientRunner:
             modfile = self.folder / f"suns_{name}.mod"
             write_text(modfile, "\n".join(mods) + "\n")
             argv = [*params.ambient(ab), "-M", str(modfile)]
-            return self._rcontrib(argv, octree, len(mods), SUN_UNIT, nproc=params.nproc)
+            return self._rcontrib(argv, octree, len(mods), SUN_UNIT, nproc=params.nproc,
+                                  replicates=reps)
 
         return self._cached(f"sun_{name}", key, compute)

@@ -86,6 +86,9 @@ def write_annual(result: AnnualResult, figures: bool = True) -> AnnualOutcome:
     standards.write_standards(project, standards.standards_table(
         result.scenarios, list(result.grids), result.total, result.direct, result.wea.dhi,
         result.occupied, result.sunlight, result.options.sunlight_date))
+    if result.uncertainty is not None:
+        meta["replicates"] = result.trace.replicates
+        _write_csv(result.uncertainty, res / "annual" / "uncertainty.csv")
     mp = write_text(res / "annual" / "annual_meta.json", json.dumps(meta, indent=2,
                                                                      default=str))
     figs: list[Path] = []

@@ -47,6 +47,7 @@ from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 import numpy as np
+import pandas as pd
 
 import radtree.annual.standards as standards
 from radtree.annual.branches import BranchParams, build_leaf_off
@@ -82,6 +83,11 @@ METHOD_NOTES = [
     "the direct sun (ASE) is exact for every hour.",
 ]
 METHODS = ("dc", "3phase")
+#: replicates of a dc run (``radtree annual --replicates``): 4 passes of every Monte Carlo
+#: trace, 4 × the time of one, report the metrics' standard errors and halve those of DA
+#: and UDI; one pass at -ad 1024 moves sDA by ≈ 1.6 pp SE on the office's 96-sensor grids,
+#: four by ≈ 1.1 pp (sDA's SE falls as R^-¼: benchmarks/annual_precision.py)
+DEFAULT_REPLICATES = 4
 #: ``AnnualOptions.sun_crown`` values (3phase)
 SUN_CROWNS = ("explicit", "bsdf")
 @dataclass(frozen=True)
@@ -99,6 +105,10 @@ class AnnualOptions:
     sun_ad: int | None = None
     sun_lw: float | None = None
     nproc: int = 2
+    #: independent passes of every Monte Carlo trace (:class:`TraceParams`); above 1 the
+    #: metrics' Monte Carlo standard errors are reported (:mod:`radtree.annual.uncertainty`).
+    #: None: :data:`DEFAULT_REPLICATES` with the dc method, 1 with 3phase
+    replicates: int | None = None
     with_scenario: str | None = None
     without_scenario: str | None = None
     epw: Path | None = None
@@ -131,6 +141,10 @@ class AnnualOptions:
         standards.check_sunlight_date(self.sunlight_date)
         if self.nproc < 1:
             raise ConfigError("processes must be ≥ 1")
+        if self.replicates is not None and (
+                self.replicates < 1 or (self.replicates > 1 and self.method != "dc")):
+            raise ConfigError(f"replicates must be ≥ 1 (above 1 with --method dc only), got "
+                              f"{self.replicates}")
         for name, value in (("--lw", self.lw), ("--sun-lw", self.sun_lw)):
             if value is not None and not 0 < value < 1:
                 raise ConfigError(f"{name} must be between 0 and 1 (a ray weight), got {value:g}")
@@ -168,6 +182,8 @@ class AnnualResult:
     phenology: Phenology | None = None
     #: EN 17037 sunlight: "with"/"without" → grid → hours of sun per sensor (standards.py)
     sunlight: dict[str, dict[str, np.ndarray]] | None = None
+    #: with replicates: grid, tree, metric, value, se (:func:`radtree.annual.uncertainty.table`)
+    uncertainty: pd.DataFrame | None = None
 
 
 # ---------------------------------------------------------------- scene choice
@@ -335,11 +351,14 @@ def plan_annual(project: Project, options: AnnualOptions, *,
     scenes, grids, rec_ab, more = annual_scenes(project, with_sc, without_sc,
                                                 options.branches, options.grids)
     eng = effective_project(project, with_sc).engine
+    reps = options.replicates or (DEFAULT_REPLICATES if options.method == "dc" else 1)
     ab = options.ab if options.ab is not None else (eng.ab if eng.ab is not None else rec_ab)
     trace = TraceParams(ab=ab, ad=options.ad or eng.radiance.ad,
-                        lw=options.lw or eng.radiance.lw, nproc=options.nproc)
+                        lw=options.lw or eng.radiance.lw, nproc=options.nproc,
+                        replicates=reps)
     sun_trace = TraceParams(ab=ab, ad=options.sun_ad or max(128, trace.ad // 4),
-                            lw=options.sun_lw or max(trace.lw, SUN_LW_MIN), nproc=options.nproc)
+                            lw=options.sun_lw or max(trace.lw, SUN_LW_MIN), nproc=options.nproc,
+                            replicates=reps)
     return AnnualPlan(options, with_sc, without_sc, scenes, grids, trace, sun_trace,
                       annual_ground_reflectance(project),
                       tuple(notes + (more if crown_notes else [])))
@@ -365,32 +384,45 @@ def by_grid(values: tuple[np.ndarray, np.ndarray], grids: list[str], scene: Scen
 
 
 def _trace_variants(plan: AnnualPlan, year: YearInputs, folder: Path,
-                    timing: dict[str, float]) -> tuple[dict, dict]:
+                    timing: dict[str, float], replicas: list | None = None) -> tuple[dict, dict]:
     """(total, direct) lux ``{variant: {grid: (sensors, hours)}}`` of the plan's scenes, their
-    coefficients cached in ``folder/<variant>``; a progress bar over the variants."""
+    coefficients cached in ``folder/<variant>``; a progress bar over the variants. With
+    replicates the year of each replicate is appended to ``replicas`` as (total, direct) of
+    the same form, and the result is their mean."""
+    from radtree.annual.uncertainty import year_replicates
+
     total: dict[str, dict[str, np.ndarray]] = {}
     direct: dict[str, dict[str, np.ndarray]] = {}
     o = plan.options
+    reps = plan.trace.replicates
+    if replicas is not None and reps > 1:
+        replicas.extend(({}, {}) for _ in range(reps))
     for variant in progress(VARIANTS, desc="annual", unit="scene"):
         tv = time.perf_counter()
         scene = plan.scenes[variant]
         log.info(f"  {variant}: {scene.n_triangles} triangles, "
                  f"{sum(len(scene.grids[g]) for g in plan.grids)} sensors")
         runner = CoefficientRunner(scene, plan.grids, folder / variant, plan.rho)
-        total[variant], direct[variant] = by_grid(
-            scene_year_lux(runner, year, o.mf, o.sun_mf, plan.trace, plan.sun_trace),
-            plan.grids, scene)
+        if replicas is not None and reps > 1:
+            years = year_replicates(runner, year, o.mf, o.sun_mf, plan.trace, plan.sun_trace)
+            for (tot_k, dir_k), year_k in zip(replicas, years):
+                tot_k[variant], dir_k[variant] = by_grid(year_k, plan.grids, scene)
+            values = (np.mean([y[0] for y in years], axis=0), years[0][1])
+        else:
+            values = scene_year_lux(runner, year, o.mf, o.sun_mf, plan.trace, plan.sun_trace)
+        total[variant], direct[variant] = by_grid(values, plan.grids, scene)
         timing[f"{variant}_s"] = time.perf_counter() - tv
     return total, direct
 
 
 def finish_annual(project: Project, plan: AnnualPlan, year: YearInputs,
                   lux: tuple[dict, dict], *, grid_scene: Scene, timing: dict[str, float],
-                  t0: float, method_note: str | None = None, sunlight: bool = True
-                  ) -> AnnualResult:
+                  t0: float, method_note: str | None = None, sunlight: bool = True,
+                  replicas: list | None = None) -> AnnualResult:
     """The :class:`AnnualResult` of the variants' (total, direct) ``lux``: the crown of each
     hour (leaf season or phenology), occupancy, the sensors of ``grid_scene``, the notes
-    (``method_note`` before :data:`METHOD_NOTES`), EN 17037 sunlight when ``sunlight``."""
+    (``method_note`` before :data:`METHOD_NOTES`), EN 17037 sunlight when ``sunlight``; the
+    metrics' Monte Carlo standard errors from ``replicas`` (of :func:`_trace_variants`)."""
     weather, wea = year[0], year[1]
     total, direct = lux
     o = plan.options
@@ -402,15 +434,22 @@ def finish_annual(project: Project, plan: AnnualPlan, year: YearInputs,
              *([method_note] if method_note else []), *METHOD_NOTES]
     sun = (standards.annual_sunlight(project, plan.scenes, plan.grids, o.sunlight_date,
                                      in_leaf, wea) if sunlight else None)
+    occ = occupied(wea.hour, o.occupancy)
+    spread = None
+    if replicas:
+        from radtree.annual.uncertainty import table
+
+        for tot_k, dir_k in replicas:
+            crown_year(tot_k, dir_k, plan.grids, wea, o.season, phen)
+        spread = table([r[0] for r in replicas], plan.grids, occ)
     timing["total_s"] = time.perf_counter() - t0
     return AnnualResult(project=project, options=o, weather=weather, wea=wea, grids=grid_geo,
-                        total=total, direct=direct, in_leaf=in_leaf,
-                        occupied=occupied(wea.hour, o.occupancy),
+                        total=total, direct=direct, in_leaf=in_leaf, occupied=occ,
                         scenarios={"with": plan.with_sc.name, "without": plan.without_sc.name},
                         trace=plan.trace, sun_trace=plan.sun_trace,
                         ground_reflectance=plan.rho, notes=notes, timing=timing,
                         leaf_fraction=fraction, leaf_weight=weight, phenology=phen,
-                        sunlight=sun)
+                        sunlight=sun, uncertainty=spread)
 
 
 def compute_annual(project: Project, *, options: AnnualOptions | None = None
@@ -436,7 +475,10 @@ def compute_annual(project: Project, *, options: AnnualOptions | None = None
              f"(MF {options.sun_mf})")
     log.info(f"  rcontrib: -ab {trace.ab} -ad {trace.ad} -lw {trace.lw:g} (sky, MF "
              f"{options.mf}); -ad {sun_trace.ad} -lw {sun_trace.lw:g} (reflected sun); "
-             f"{trace.nproc} process(es); ground ρ {plan.rho:.3f}")
-    lux = _trace_variants(plan, year, project.results_dir / "annual" / "coefficients", timing)
+             f"{trace.nproc} process(es); ground ρ {plan.rho:.3f}"
+             + (f"; {trace.replicates} replicates" if trace.replicates > 1 else ""))
+    replicas: list = []
+    lux = _trace_variants(plan, year, project.results_dir / "annual" / "coefficients", timing,
+                          replicas)
     return finish_annual(project, plan, year, lux, grid_scene=plan.scenes["leaf_on"],
-                         timing=timing, t0=t0)
+                         timing=timing, t0=t0, replicas=replicas)
