@@ -7,19 +7,20 @@ voxel's plant area comes out low (the sub-voxel heterogeneity bias of voxel inve
 Pimont, Durrieu & Dupuy 2018, "Enhanced measurements of leaf area density with T-LiDAR:
 evaluating and calibrating the effects of vegetation heterogeneity and scanner properties",
 Remote Sens. 10:1580). Measured on the synthetic street of ``benchmarks/lidar_roundtrip.py``
-at 150 pulses/m² (scan noise small), 1.2 m voxels: voxels less than ¾ inside the true crown
-spheroid held 28 % of the leaf area and came out 9–15 % low; voxels more than ¾ inside, within
-1 %: the trees' leaf area −2.8 % on average.
+at 150 pulses/m² (scan noise small), 1.15 m voxels: voxels less than ¾ inside the true crown
+spheroid held 28 % of the leaf area and came out 8–14 % low; voxels more than ¾ inside, within
+1.5 %: the trees' leaf area −2.2 % on average.
 
 What: the envelope is the convex hull of the tree's vegetation returns (scipy ``ConvexHull``,
-Qhull: Barber, Dobkin & Huhdanpaa 1996, ACM TOMS 22:469–483), pushed out by ``margin_m`` on
-every face. The returns are the first surfaces the beams met, so the hull's faces pass through
+Qhull: Barber, Dobkin & Huhdanpaa 1996, ACM TOMS 22:469–483, cited from memory), pushed out by
+``margin_m`` on every face. The returns are the first surfaces the beams met, so the hull's faces pass through
 returns and a beam that stopped on one would have no path inside it; the margin (default: the
 scan's mean point spacing, the resolution at which the returns trace the envelope) gives those
 beams the path they crossed. The beams are clipped to the envelope before the voxel walk
 (each beam's line meets a convex body in one interval: Cyrus & Beck 1978, Computers &
-Graphics 3:23–28), so a voxel's density is that of its part inside the envelope, and the
-voxel's plant area is that density times the volume of that part (:meth:`Envelope.fractions`).
+Graphics 3:23–28, cited from memory), so a voxel's density is that of its part inside the
+envelope, and the voxel's plant area is that density times the volume of that part
+(:meth:`Envelope.fractions`).
 A concave crown is overstated by its hull; the inversion then tends to the one without an
 envelope. Units: metres; the grid's frame (heights above ground).
 """
