@@ -44,9 +44,10 @@ mean inside the envelope):
   likelihood over free paths (AMAPVox's ``attenuation_FPL_unbiasedMLE``: mean −0.8 %, noise
   6.1 %), the potential-path MLE of AMAPVox (blows up where every beam is
   intercepted), voxels of 1.2 / 1.6 / 2 m without an envelope (−4.0 / −7.5 / −10 %: more rim).
-  Left: a per-tree scatter of 3.5–4 % even at 150 pulses/m² (seed 0, envelope, 0.85–1.2 m
-  voxels; mean +4 … +7 %, the 0.3 m slats' own −ln bias in small voxels) — likely which slats
-  lie hidden under others in one random crown, which first returns cannot see.
+  Left: a per-tree scatter of 3–4 % even at 150 pulses/m² (seed 0, 0.85 / 1.2 m voxels: mean
+  +5.6 / +2.7 %, s.d. over trees 2.9 / 3.9 %; the mean's rise in small voxels is the 0.3 m
+  slats' own −ln bias) — likely which slats lie hidden under others in one random crown, which
+  first returns cannot see.
 * ``--vertical`` (columns on the same scan): leaf area 7/20 (max 47 %): the beams of two
   overlapping lines cross each other tilted up to 20°, a column mixes them.
 * ``--sidelap 0 --vertical`` (the former scanner and inversion): heights 19/20 (max 1.13 m),

@@ -33,6 +33,8 @@ import numpy as np
 
 #: sub-points per voxel edge for the volume fraction inside the envelope (4³ = 64 a voxel)
 FRACTION_POINTS = 4
+#: segments × faces handled at once by :meth:`Envelope.clip` (~8 bytes × 4 arrays each)
+CLIP_BLOCK = 2_000_000
 
 
 @dataclass(frozen=True)
@@ -61,11 +63,21 @@ class Envelope:
 
     def clip(self, start: np.ndarray, end: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """(t_in, t_out): the part of each segment start + t·(end − start) inside the
-        envelope, t_in ≥ 0; t_in ≥ t_out where the line misses it (t_out may exceed 1)."""
-        d = np.asarray(end, float) - np.asarray(start, float)
+        envelope, t_in ≥ 0; t_in ≥ t_out where the line misses it (t_out may exceed 1).
+        In blocks of CLIP_BLOCK entries (segments × faces) to bound the memory."""
+        start, end = np.asarray(start, float), np.asarray(end, float)
+        t_in, t_out = np.zeros(len(start)), np.zeros(len(start))
+        step = max(1, CLIP_BLOCK // max(len(self.equations), 1))
+        for b0 in range(0, len(start), step):
+            t_in[b0:b0 + step], t_out[b0:b0 + step] = self._clip(start[b0:b0 + step],
+                                                                  end[b0:b0 + step])
+        return t_in, t_out
+
+    def _clip(self, start: np.ndarray, end: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        d = end - start
         n, c = self.equations[:, :3], self.equations[:, 3]
         nd = d @ n.T
-        no = np.asarray(start, float) @ n.T + c
+        no = start @ n.T + c
         with np.errstate(divide="ignore", invalid="ignore"):
             t = -no / nd
         t_in = np.max(np.where(nd < 0, t, -np.inf), axis=1, initial=0.0)
