@@ -8,7 +8,9 @@ Copies the project (default ``examples/office-block``) into ``--work`` once (kep
 BSDFs and every matrix are cached there, so a rerun only traces what a changed setting
 needs), computes the crown BSDFs with ``tree.bsdf.samples = --samples``, and for each facet
 grouping in ``--levels`` (:func:`radtree.annual.facets.group_directions`: 0 = the 14
-cube directions; k ≥ 1 an icosphere of k − 1 subdivisions) and each ``--up`` choice
+cube directions; k ≥ 1 an icosphere of k − 1 subdivisions; ``facets`` one group per facet
+plane, :data:`radtree.annual.facets.FACETS`, the annual default for free crowns) and each
+``--up`` choice
 (``default``: rfluxmtx's default up; ``material``: the ``BSDF`` material's up vector, the frame
 the XML is applied in by rtrace) prints
 
@@ -16,7 +18,8 @@ the XML is applied in by rtrace) prints
     transmitted, reflected (each a mean over the grid's sensors, irradiance per unit radiance)
 
 Run: ``nice .venv/bin/python benchmarks/threephase_closure.py [--work DIR] [--samples 50]
-[--daylight-samples 100] [--levels 0,2,3] [--up default,material] [--ad 1024] [--xml X]
+[--daylight-samples 100] [--levels facets,0] [--up default,material] [--ad 1024] [--lw 1e-3]
+[--xml X]
 [-j 2]``.
 """
 
@@ -54,10 +57,14 @@ def main() -> None:
     ap.add_argument("--work", type=Path, default=Path("/tmp/threephase_closure"))
     ap.add_argument("--samples", type=int, default=50, help="tree.bsdf.samples")
     ap.add_argument("--daylight-samples", type=int, default=100, help="rfluxmtx -c of D")
-    ap.add_argument("--levels", default="0,2,3")
+    ap.add_argument("--levels", default="facets,0",
+                    help="comma-separated: facets (one group per facet plane) or 0, 1, 2 …")
     ap.add_argument("--up", default="default,material")
     ap.add_argument("--ab", type=int, default=6)
     ap.add_argument("--ad", type=int, default=1024)
+    ap.add_argument("--lw", type=float, default=1e-3,
+                    help="-lw of V and the reference: at -aa 0 Radiance traces at most "
+                         "≈ 0.8 / lw rays per hemisphere whatever -ad says (ambcomp.c)")
     ap.add_argument("--states", default="leaf_on,leaf_off")
     ap.add_argument("--xml", type=Path, default=None,
                     help="tree.bsdf.xml: one given crown XML for every band (no crown BSDF "
@@ -103,9 +110,12 @@ def main() -> None:
     bare = make_scene(project, replace(sc, model="none"), dense_grid=False).scene
     grids = [g for g in bare.grids if g != "facade_map"]
     rho = annual_ground_reflectance(project)
-    trace = TraceParams(ab=args.ab, ad=args.ad, lw=1e-3, nproc=args.processes)
+    trace = TraceParams(ab=args.ab, ad=args.ad, lw=args.lw, nproc=args.processes)
     pd.set_option("display.width", 200)
-    for level in [int(x) for x in args.levels.split(",")]:
+    from radtree.annual.facets import FACETS
+
+    levels = [FACETS if x == "facets" else int(x) for x in args.levels.split(",")]
+    for level in levels:
         for up in args.up.split(","):
             t1 = time.perf_counter()
             table = closure_table(bare, models=models, form=form, grids=grids, rho=rho,

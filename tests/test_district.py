@@ -368,3 +368,16 @@ def test_csv_inventory_in_lonlat_matches_geojson(tmp_path):
     b, _ = read_trees(gj, "EPSG:4326", LAT, LON)
     assert [(t.id, t.x, t.y) for t in a] == [(t.id, t.x, t.y) for t in b]
     assert a[0].x == pytest.approx(10.0, abs=0.01) and abs(a[0].y) < 0.01
+
+
+@pytest.mark.parametrize("key", ["voxels", "points"])
+def test_one_crown_inputs_are_refused_with_an_inventory(key: str) -> None:
+    """[tree] voxels / points describe one crown; an inventory's crowns come from its rows:
+    refused with the field, the value as written and the fix, not silently ignored."""
+    root = Path(__file__).resolve().parents[1] / "examples" / "district"
+    with pytest.raises(ConfigError) as err:
+        load_project(root, {f"tree.{key}": "data/trees.geojson"} | (
+            {"tree.representation": "turbid"} if key == "voxels" else {}))
+    msg = str(err.value)
+    assert f"tree.{key}" in msg and "'data/trees.geojson'" in msg
+    assert "remove [tree] " + key in msg and "[site] trees" in msg

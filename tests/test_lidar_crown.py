@@ -121,6 +121,7 @@ def test_points_crown_filled_voxel_by_voxel(one_tree, frame) -> None:
     assert sum(profile.values()) == pytest.approx(info["points_leaf_area_m2"])
     text = " ".join(tm.notes)
     assert "Crowns from the point cloud tree.laz" in text and "wood counted as leaf" in text
+    assert "1 crown(s) from tree.laz" in text and "1 spheroid(s)" not in text
     local = frame.to_local(tm.meshes[0].vertices)
     assert local[:, 2].max() < 10.5 and local[:, 2].min() > 3.0
     assert input_files(project)["tree_points"].startswith("tree.laz sha256:")

@@ -22,6 +22,13 @@ name = "P"
 model = "louvers"
 reflection = "traced"
 form = "free"
+
+[[scenario]]
+name = "Q"
+model = "louvers"
+reflection = "traced"
+form = "free"
+switches = { "louvers.realisations" = 2 }
 """
 
 
@@ -38,7 +45,7 @@ def built(tmp_path_factory: pytest.TempPathFactory):
     clip_tree(TILE, "L001", p / "tree.laz")
     (p / "radtree.toml").write_text((p / "radtree.toml").read_text() + SCENARIO)
     project = load_project(p)
-    build_project(project, ["P"], pictures=False)
+    build_project(project, ["P", "Q"], pictures=False)
     return project
 
 
@@ -114,3 +121,12 @@ def test_no_points_no_record() -> None:
 
     assert points_record(None, {"points_leaf_area_m2": 1.0}) is None
     assert points_record("tree.laz", {"slat_count": 3.0}) is None
+
+
+def test_section_finds_the_first_crown_realisation(built) -> None:
+    """A points crown traced as several random crowns (Q@1, Q@2) is shown by Q@1's build."""
+    from radtree.report.sections.points import points_scenario
+
+    sc, record = points_scenario(built, ["Q"])
+    assert sc.name == "Q@1" and record["file"] == "tree.laz"
+    assert (built.build_dir / "Q@2" / "manifest.json").is_file()

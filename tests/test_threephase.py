@@ -54,10 +54,12 @@ def runs(project_dir):
 def test_three_phase_sky_matches_rcontrib_on_the_same_bsdf_crown(runs):
     """Σ_g V_g·T_g·D_g + V_sky against rcontrib's sky coefficients of the BSDF-crown scene,
     weighted by the year's sky (the same gendaymtx matrix): façade means within 12 % (measured
-    0.97–1.00 leaf-on, 1.02–1.09 bare over five runs; both are Monte Carlo and not repeatable
-    run to run — rfluxmtx/rcontrib on several processes, no -u- —: 192 ambient rays per sensor,
-    24 rays per Klems patch in D; on the office example the two agree within 0.8 pp of UDI,
-    benchmarks/threephase.py --same-crown)."""
+    0.97–1.00 leaf-on, 1.02–1.09 bare over five runs at level 0; with one group per facet
+    plane, the default since issue 40, 1.085 leaf-on and 1.098 bare in one run: 192 ambient
+    rays per sensor, 24 rays per Klems patch of a level-0 group in D; the year's sky holds the
+    ground column, whose light through the crown the chain reads 1.55 × a trace on the verify
+    crown — radtree/annual/threephase.py; on the office example the two agree within 0.8 pp
+    of UDI, benchmarks/threephase.py --same-crown)."""
     from radtree.annual.coefficients import CoefficientRunner, TraceParams
     from radtree.annual.run import LUX
     from radtree.annual.skymatrix import sky_matrix
@@ -177,6 +179,27 @@ def test_facet_groups_face_the_sensors():
     for g in tiles:
         cells = np.floor(g.triangles.mean(axis=1) / 1.5)
         assert len(np.unique(cells, axis=0)) == 1
+    # one group per facet plane (the annual default for free crowns): every facet of a
+    # group in its plane, each group's share of its level-0 group's area; the shares of a
+    # level-0 group sum to 1, and level 0 keeps every group whole
+    from radtree.annual.facets import FACETS
+    from radtree.annual.threephase import D_MIN_SAMPLES, daylight_samples
+
+    planes = facet_groups(model, sensors_inside=False, level=FACETS)
+    assert len(planes) == len(f)               # an icosphere: no two facets coplanar
+    share: dict[int, float] = {}
+    for g in planes:
+        t = g.triangles
+        n = np.cross(t[:, 1] - t[:, 0], t[:, 2] - t[:, 0])
+        n /= np.linalg.norm(n, axis=1)[:, None]
+        assert np.all(n @ g.normal > 1 - 1e-6)
+        share[g.coarse] = share.get(g.coarse, 0.0) + g.weight
+    assert sorted(share) == list(range(14))
+    np.testing.assert_allclose(list(share.values()), 1.0)
+    np.testing.assert_allclose([g.weight for g in groups], 1.0)
+    assert daylight_samples(400, groups[0]) == 400
+    assert sum(daylight_samples(400, g) for g in planes if g.coarse == 0) >= 400
+    assert min(daylight_samples(10, g) for g in planes) == D_MIN_SAMPLES
 
 
 @needs_radiance

@@ -19,6 +19,7 @@ import numpy as np
 import pandas as pd
 
 from radtree.annual.coefficients import CoefficientRunner, TraceParams
+from radtree.annual.facets import FACETS
 from radtree.annual.threephase import ThreePhase, _scene_with
 from radtree.engines.radiance import threephase as rad3
 from radtree.scene import Scene
@@ -32,20 +33,22 @@ COLUMNS = ["grid", "state", "light", "reference", "chain", "ratio", "bypass", "t
 @dataclass(frozen=True)
 class ClosureSettings:
     """``trace``: the view matrix's and the reference's rcontrib settings; ``samples``: rays per
-    Klems patch of the daylight matrices (``-c``); ``level``, ``material_up``: the facet
-    grouping of :func:`radtree.annual.facets.facet_groups`; ``tile_m`` the wall cap's
-    tile size (0: :data:`radtree.annual.threephase.GROUP_TILE_M`)."""
+    Klems patch of a level-0 group's daylight matrix (``-c``); ``level``, ``material_up``:
+    the facet grouping of :func:`radtree.annual.facets.facet_groups` (level None: the annual
+    method's, :class:`radtree.annual.threephase.ThreePhase`; :data:`~radtree.annual.facets.FACETS`
+    one group per facet plane); ``tile_m`` the wall cap's tile size (0:
+    :data:`radtree.annual.threephase.GROUP_TILE_M`)."""
 
     trace: TraceParams
     samples: int = 100
-    level: int = 0
+    level: int | None = None
     material_up: bool = False
     tile_m: float = 0.0
 
     def __post_init__(self) -> None:
-        if self.samples < 1 or self.level < 0:
-            raise ValueError(f"closure: samples ≥ 1 and level ≥ 0, got {self.samples}, "
-                             f"{self.level}")
+        if self.samples < 1 or (self.level is not None and self.level < FACETS):
+            raise ValueError(f"closure: samples ≥ 1 and level ≥ {FACETS} or None, got "
+                             f"{self.samples}, {self.level}")
 
 
 def chain_parts(tp: ThreePhase, state: str) -> tuple[dict[str, np.ndarray], int]:
@@ -71,7 +74,8 @@ def closure_sensors(bare: Scene, *, models: dict[str, TreeModel], form: str,
     """(sensors, patches) grey coefficients of the reference (rcontrib on the BSDF-crown
     scene, MF 1) and of the chain's parts (:func:`chain_parts`), the number of groups.
     Matrices are cached in ``folder`` by their inputs."""
-    tag = (f"l{settings.level}_{'material' if settings.material_up else 'default'}"
+    level = "default" if settings.level is None else settings.level
+    tag = (f"l{level}_{'material' if settings.material_up else 'default'}"
            + (f"_t{settings.tile_m:g}" if settings.tile_m else ""))
     tp = ThreePhase(folder / f"chain_{tag}", bare=bare, models=models, form=form, grids=grids,
                     rho=rho, mf=1, trace=settings.trace, samples=settings.samples,

@@ -1,7 +1,14 @@
 """The BSDF shell's facets grouped for the three-phase method (:mod:`radtree.annual.threephase`):
 one Klems hemisphere per group of one material and orientation (and, for the wall cap, one
 tile of a world grid). A group's Klems frame is its facets' mean normal and either rfluxmtx's
-default up or its ``BSDF`` material's up vector (the frame rtrace applies the XML in)."""
+default up or its ``BSDF`` material's up vector (the frame rtrace applies the XML in).
+
+:data:`FACETS` groups only facets of one plane orientation (normals within
+:data:`PLANE_TOLERANCE`): every group's Klems frame is then each of its facets' own, the frame
+rtrace applies the XML in — on a curved crown the coarser levels apply the XML at the group's
+mean normal instead of each facet's (measured, issue 40: radtree verify's small crown,
+uniform sky, chain / rcontrib 0.936 at level 0, 0.929 at level 2, 1.09 at level 3, 1.02
+with one frame per facet)."""
 
 from __future__ import annotations
 
@@ -18,12 +25,17 @@ from radtree.trees.model import TreeModel
 _DIRS = np.array([(i, j, k) for i in (-1, 0, 1) for j in (-1, 0, 1) for k in (-1, 0, 1)
                   if abs(i) + abs(j) + abs(k) in (1, 3)], float)
 _DIRS /= np.linalg.norm(_DIRS, axis=1)[:, None]
+#: the grouping level of one group per facet plane orientation (and wall-cap tile)
+FACETS = -1
+#: facets whose unit normals differ by less than this (≈ 0.06°) share a plane orientation
+PLANE_TOLERANCE = 1e-3
 
 
 def group_directions(level: int) -> np.ndarray:
     """Unit directions facets are grouped by: level 0 the 14 of :data:`_DIRS`; level k ≥ 1
     the vertices of an icosphere of k − 1 subdivisions (12, 42, 162, 642 directions: a
-    facet's normal within ≈ 37°, 19°, 10°, 5° of its group's direction)."""
+    facet's normal within ≈ 37°, 19°, 10°, 5° of its group's direction). :data:`FACETS` has
+    no fixed directions (:func:`facet_groups`)."""
     if level <= 0:
         return _DIRS
     import trimesh
@@ -35,13 +47,19 @@ def group_directions(level: int) -> np.ndarray:
 @dataclass
 class FacetGroup:
     """Shell facets of one material and orientation; ``triangles`` wound to the sensors;
-    ``up`` the world up vector of the group's Klems frame (None: rfluxmtx's default)."""
+    ``up`` the world up vector of the group's Klems frame (None: rfluxmtx's default);
+    ``coarse`` the index of the nearest of the 14 level-0 directions (groups merged for the
+    daylight matrices share it) and ``weight`` the group's share (0–1) of the area of its
+    level-0 group (material, coarse direction, tile): the daylight matrix of a group takes
+    that share of the rays per Klems patch (:class:`radtree.annual.threephase.ThreePhase`)."""
 
     material: str
     triangles: np.ndarray  # (k, 3, 3)
     normal: np.ndarray     # unit mean normal, towards the sensors
     direction: int = -1    # index of the nearest grouping direction
     up: tuple[float, float, float] | None = None
+    coarse: int = -1
+    weight: float = 1.0
 
     @property
     def area(self) -> float:
@@ -57,13 +75,13 @@ class FacetGroup:
 def facet_groups(model: TreeModel, sensors_inside: bool, tile_m: float = 0.0,
                  tiled: tuple[str, ...] | None = None, level: int = 0,
                  material_up: bool = False) -> list[FacetGroup]:
-    """The shell's facets grouped by BSDF material, by the nearest of 14 directions and
-    (``tile_m`` > 0, for the materials in ``tiled`` or all when None) by the cell of a world
-    grid of ``tile_m`` holding their centroid; each triangle wound so that its normal points
-    to the sensors (the shell's own normals point inwards: to the sensors inside a dome,
-    away from them for free crowns)."""
+    """The shell's facets grouped by BSDF material, by the nearest of the grouping directions
+    (:func:`group_directions`; :data:`FACETS`: by plane orientation) and (``tile_m`` > 0, for
+    the materials in ``tiled`` or all when None) by the cell of a world grid of ``tile_m``
+    holding their centroid; each triangle wound so that its normal points to the sensors (the
+    shell's own normals point inwards: to the sensors inside a dome, away from them for free
+    crowns)."""
     groups = []
-    dirs = group_directions(level)
     for mesh in model.meshes:
         if not mesh.material.startswith(BSDF_SHELL):
             continue
@@ -74,15 +92,26 @@ def facet_groups(model: TreeModel, sensors_inside: bool, tile_m: float = 0.0,
         n = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
         area = np.linalg.norm(n, axis=1)
         keep = area > 1e-12
-        tri, n = tri[keep], n[keep] / area[keep][:, None]
-        which = direction = np.argmax(n @ dirs.T, axis=1)
+        tri, n, area = tri[keep], n[keep] / area[keep][:, None], 0.5 * area[keep]
+        coarse = np.argmax(n @ _DIRS.T, axis=1)
+        if level == FACETS:
+            _, direction = np.unique(np.round(n / PLANE_TOLERANCE).astype(np.int64), axis=0,
+                                     return_inverse=True)
+            direction = direction.ravel()
+        else:
+            direction = np.argmax(n @ group_directions(level).T, axis=1)
+        cell = np.zeros((len(tri), 3), np.int64)
         if tile_m > 0 and (tiled is None or mesh.material in tiled):
             cell = np.floor(tri.mean(axis=1) / tile_m).astype(np.int64)
-            _, which = np.unique(np.column_stack([which, cell]), axis=0, return_inverse=True)
-            which = which.ravel()
+        _, which = np.unique(np.column_stack([direction, cell]), axis=0, return_inverse=True)
+        _, parent = np.unique(np.column_stack([coarse, cell]), axis=0, return_inverse=True)
+        which, parent = which.ravel(), parent.ravel()
+        parent_area = np.bincount(parent, weights=area)
         for d in np.unique(which):
             pick = which == d
-            mean = (n[pick] * area[keep][pick][:, None]).sum(axis=0)
+            mean = (n[pick] * area[pick][:, None]).sum(axis=0)
+            weight = float(area[pick].sum() / parent_area[parent[pick][0]])
             groups.append(FacetGroup(mesh.material, tri[pick], mean / np.linalg.norm(mean),
-                                     int(direction[pick][0]), up))
+                                     int(direction[pick][0]), up, int(coarse[pick][0]),
+                                     min(1.0, weight)))
     return groups

@@ -70,19 +70,52 @@ a uniform ground hemisphere. Measured:
   through Klems patches turned by 180° when the matrices used +Z.
 
 Hence :data:`GROUP_MATERIAL_UP` (each group's Klems frame is its material's: the XML is
-applied in that frame by rtrace); level 0 kept (level 2 doubles the daylight matrices for no
-gain here). What remains: the two lowest façade rows still read 1.08–1.11 (5 mm from the
-cap's lower edge, next to the curved lower band: a daylight matrix is a mean over its
-sender's area and a curved group has one frame), and the small single crown of
-``radtree verify`` (12 segments, facets ≈ 1.5 m across) reads 0.94–0.96 on its façade
-(0.955 at level 0, 0.941 at level 2 with the material's up; rcontrib's own noise at
-``-ad 512`` moved its reference by 1.8 % between two runs).
+applied in that frame by rtrace). The two lowest façade rows still read 1.08–1.11 at level 0
+(5 mm from the cap's lower edge, next to the curved lower band).
+
+**One group per facet plane (issue 40, the small crown).** The small single crown of
+``radtree verify`` (12 segments, facets ≈ 1.5 m across, sensors 0.5 m from it) read 0.936 at
+level 0 (chain 0.807 against rcontrib 0.862). Measured there (uniform sky, leaf-on, façade
+mean; rtrace of the same scene at ``-ab 8 -ad 16384 -lw 1e-5``, six seeds: 0.8604 ± 0.0005,
+the shell black 0.3851): the by-pass was right (V_sky 0.385–0.393) and the reflection is 1 %;
+the light through the crown read 0.88 of the trace. A crown XML without its reflection read
+0.944, a Lambertian-diffuse T 1.00, a purely straight-through T 0.955; the grouping moved it
+(level 0: 0.936, level 2: 0.929, level 3: 1.09, level 4 and one group per facet: 1.02–1.03).
+The crown XML depends on the incidence angle relative to the facet (``crossing = "chord"``:
+the depth R cos θ), and a curved group applies it at the group's mean normal; near the
+vertical the groups' facets' up vectors turn round the normal. So free crowns now group only
+coplanar facets (:data:`GROUP_LEVEL` = :data:`~radtree.annual.facets.FACETS`, the wall cap
+by tile as before); the daylight matrices are given to the facets the sensors see
+(:data:`TILE_SHARE`), the rest merged per level-0 direction, and a group's daylight matrix
+traces its share of its level-0 group's rays (:func:`daylight_samples`), so the total stays
+about as before. Measured with it (``radtree verify --full``'s row, ``-ad 65536 -lw 1e-6``):
+chain 0.874–0.876 against rcontrib 0.855 (1.022–1.025 in two runs, per sensor row
+1.018–1.034; against the six-seed rtrace 1.016–1.019): by-pass 0.385, through the crown
+0.480 + 0.009 reflected against 0.475 traced. The office example
+(``benchmarks/threephase_closure.py --xml … --states leaf_on``, ``-ad 1024``, ``-c 100``)
+reads façade 1.029, work plane 1.013 with it — within the claim as level 0 in the same run
+(1.036 / 1.009); cost: 1 278 groups in V (4 rfluxmtx runs), 88 daylight matrices against
+22, the closure's matrices 470 s against 291 s (load 26–28 on 2 cores). The uniform
+*ground* hemisphere (the ``h=u`` column: radiance 1 below the horizon, seen past the street's
+edge, so within a few degrees of the horizon) through the crown stays high: verify crown
+0.168 against rcontrib 0.144 (1.16), office 1.28; against rtrace (three seeds, 0.1365, the
+shell black 0.0792) the chain's by-pass is right (0.0793) and its light through the crown
+reads 0.089 against 0.057 (1.55 ×). Not resolved; a lead: that light arrives within a few
+degrees of the horizon, and the Klems patches that hold it straddle the horizon (a daylight
+matrix averages over its patch, the sensors see only part of it). The same on the sky: with
+facet planes a Lambertian T closes (crown part 0.99, total 0.9995) and a purely
+straight-through T reads 1.06 on the crown part (total 1.0185; rtrace of the same XMLs,
+``-ad 8192 -lw 1e-5``; V at ``-ad 16384 -lw 1e-5``); the daylight matrices at 4 × the rays
+moved the chain by 0.1 %. So the chain's remaining +2 % is the Klems patches' angular
+resolution on the crown XML's straight-through part, not its sampling — a finer basis for
+that part (a tensor tree, or the sun-like treatment of the five-phase method) is the next
+step.
 
 A second weather file reruns ``gendaymtx`` and the products only (the sun coefficients
 are reused when the sun positions are the same, i.e. the same site); a second leaf state
 reuses ``V`` (and the dome's ``D``). Not ray traced: light crossing the shell is turned
-by the Klems BSDF of its group, whose frame is the group's mean normal (facets within 55°
-of it); the BSDF of a planar periodic sample holds no lateral displacement.
+by the Klems BSDF of its group, whose frame is its facets' plane (free crowns) or the group's
+mean normal (the dome: facets within 55° of it); the BSDF of a planar periodic sample holds no lateral displacement.
 """
 
 from __future__ import annotations
@@ -97,7 +130,7 @@ from pathlib import Path
 import numpy as np
 
 from radtree.annual.coefficients import TraceParams, points_text, scene_text
-from radtree.annual.facets import FacetGroup, facet_groups
+from radtree.annual.facets import FACETS, FacetGroup, facet_groups
 from radtree.annual.run import LUX
 from radtree.annual.skymatrix import (
     patch_count,
@@ -128,10 +161,23 @@ GROUP_TILE_M = 1.5
 #: dropped when its share stays below VISIBLE_SHARE for every sensor
 TILE_SHARE = 2e-3
 VISIBLE_SHARE = 1e-4
-#: facet grouping of the annual runs (:func:`radtree.annual.facets.group_directions` level) and whether each
-#: group's Klems frame takes its ``BSDF`` material's up vector (module text)
-GROUP_LEVEL = 0
+#: facet grouping of the annual runs for free crowns (:data:`radtree.annual.facets.FACETS`:
+#: one group per facet plane orientation, each group in its facets' own Klems frame) and for
+#: the sensor dome (:func:`radtree.annual.facets.group_directions` level 0: not re-measured),
+#: and whether each group's Klems frame takes its ``BSDF`` material's up vector (module text)
+GROUP_LEVEL = FACETS
+DOME_GROUP_LEVEL = 0
 GROUP_MATERIAL_UP = True
+#: a group's daylight matrix traces ``samples`` × its share of its level-0 group's area rays
+#: per Klems patch (:attr:`radtree.annual.facets.FacetGroup.weight`), at least this many
+D_MIN_SAMPLES = 8
+
+
+def daylight_samples(samples: int, group: FacetGroup) -> int:
+    """``rfluxmtx -c`` of ``group``'s daylight matrix: ``samples`` rays per Klems patch of a
+    level-0 group, shared among its finer groups by area (at least :data:`D_MIN_SAMPLES`),
+    so that a finer grouping traces about as many rays in all."""
+    return max(D_MIN_SAMPLES, int(np.ceil(samples * group.weight)))
 
 
 def _without_shell(scene: Scene) -> Scene:
@@ -194,19 +240,23 @@ class ThreePhase:
     ``bare``: the scene without a crown; ``models``: the BSDF crown of each leaf state
     (:data:`STATES`); ``form``: ``dome`` or ``free``; ``grids`` the sensor grids traced;
     ``rho`` the ground reflectance (0–1); ``mf`` the Reinhart sky subdivision; ``trace`` the
-    rfluxmtx settings; ``samples`` rays per Klems patch of the daylight matrices (``-c``);
-    ``level``, ``material_up``, ``tile_m``: the facet grouping (:func:`facet_groups`; 0:
-    :data:`GROUP_TILE_M`)."""
+    rfluxmtx settings; ``samples`` rays per Klems patch of a level-0 group's daylight
+    matrix (``-c``, :func:`daylight_samples`); ``level``, ``material_up``, ``tile_m``: the
+    facet grouping (:func:`facet_groups`; None: :data:`GROUP_LEVEL`, the dome
+    :data:`DOME_GROUP_LEVEL`; tile 0: :data:`GROUP_TILE_M`)."""
 
     def __init__(self, folder: Path, *, bare: Scene, models: dict[str, TreeModel], form: str,
                  grids: list[str], rho: float, mf: int, trace: TraceParams,
-                 samples: int = 400, level: int = GROUP_LEVEL,
+                 samples: int = 400, level: int | None = None,
                  material_up: bool = GROUP_MATERIAL_UP, tile_m: float = 0.0):
         self.folder, self.samples = folder, samples
         folder.mkdir(parents=True, exist_ok=True)
         self.bare, self.models, self.grids, self.rho, self.mf = bare, models, grids, rho, mf
         self.inside = form == "dome"
         self.trace = trace
+        if level is None:
+            level = DOME_GROUP_LEVEL if self.inside else GROUP_LEVEL
+        self.level = level
         self.groups = facet_groups(models["leaf_on"], self.inside, tile_m or GROUP_TILE_M,
                                    (WALL_CAP,), level, material_up)
         self.points = points_text(bare, grids)
@@ -224,7 +274,9 @@ class ThreePhase:
     def view(self, groups: list[FacetGroup] | None = None, tag: str = "g"
              ) -> tuple[list[Path], np.ndarray]:
         """The view matrix of each of ``groups`` (default: every tile; files
-        ``view_<tag><k>.vmx``) and V_sky (sensors, patches, 3)."""
+        ``view_<tag><k>.vmx``) and V_sky (sensors, patches, 3). More groups than
+        :data:`~radtree.engines.radiance.threephase.VIEW_CHUNK` are traced in several
+        rfluxmtx runs, each with the other groups' facets as absorbers."""
         groups = self.groups if groups is None else groups
         receivers = (rad3.group_receivers_text([(g.triangles, g.normal) for g in groups],
                                                [g.up for g in groups])
@@ -238,9 +290,7 @@ class ThreePhase:
             t0 = time.perf_counter()
             log.info(f"    rfluxmtx view matrix: {self.n} sensors → {len(groups)} shell "
                      f"groups × {KLEMS} + {patch_count(self.mf)} sky patches")
-            octree = _octree(self.folder, "view", scene, self.rho)
-            m = rad3.view_matrix(self.folder, octree, self.points, self.n, receivers, ambient,
-                                 self.trace.nproc)
+            m = self._view_runs(groups, octree_text, ambient)
             self.timing[f"view_{tag}_s"] = time.perf_counter() - t0
             return rad3.write_matrix(self.folder / "view.vmx.tmp", m)
 
@@ -253,11 +303,35 @@ class ThreePhase:
             files.append(f)
         return files, m[:, len(groups) * KLEMS:]
 
+    def _view_runs(self, groups: list[FacetGroup], octree_text: str, ambient: list[str]
+                   ) -> np.ndarray:
+        """(sensors, groups × 145 + sky patches, 3): one rfluxmtx run per
+        :data:`~radtree.engines.radiance.threephase.VIEW_CHUNK` groups (the sky in the first)."""
+        chunks = [list(range(i, min(i + rad3.VIEW_CHUNK, len(groups))))
+                  for i in range(0, len(groups), rad3.VIEW_CHUNK)] or [[]]
+        parts, sky = [], None
+        for c, ks in enumerate(chunks):
+            inside = set(ks)
+            others = [g.triangles for k, g in enumerate(groups) if k not in inside]
+            text = octree_text + ("\n" + rad3.blocker_text(others) if others else "")
+            octree = rad3.octree(self.folder, f"view{c}", text)
+            receivers = rad3.group_receivers_text([(groups[k].triangles, groups[k].normal)
+                                                   for k in ks], [groups[k].up for k in ks])
+            if c == 0:
+                receivers += "\n" + rad3.sky_receivers_text(self.mf)
+            m = rad3.view_matrix(self.folder, octree, self.points, self.n, receivers, ambient,
+                                 self.trace.nproc)
+            parts.append(m[:, :len(ks) * KLEMS])
+            if c == 0:
+                sky = m[:, len(ks) * KLEMS:]
+        assert sky is not None
+        return np.concatenate([*parts, sky], axis=1)
+
     def d_groups(self, views: list[Path], v_sky: np.ndarray) -> list[FacetGroup]:
         """The groups given daylight matrices: every tile whose view share (its columns'
         sum over all of a sensor's, sky included; ``views`` of :meth:`view`) reaches
         :data:`TILE_SHARE` for some sensor on its own; the other tiles of each material and
-        direction merged, unless even merged they stay below :data:`VISIBLE_SHARE`."""
+        level-0 direction merged, unless even merged they stay below :data:`VISIBLE_SHARE`."""
         sums = np.stack([rad3.read_matrix(v.read_bytes(), str(v)).sum(axis=(1, 2))
                          for v in views])
         total = sums.sum(axis=0) + v_sky.sum(axis=(1, 2))
@@ -266,15 +340,16 @@ class ThreePhase:
         rest: dict[tuple[str, int], list[int]] = {}
         for k, g in enumerate(self.groups):
             if share[k].max() < TILE_SHARE:
-                rest.setdefault((g.material, g.direction), []).append(k)
-        for (material, direction), ks in sorted(rest.items()):
+                rest.setdefault((g.material, g.coarse), []).append(k)
+        for (material, coarse), ks in sorted(rest.items()):
             if share[ks].sum(axis=0).max() < VISIBLE_SHARE:
                 continue
             mean = np.sum([self.groups[k].normal * self.groups[k].area for k in ks], axis=0)
+            weight = min(1.0, sum(self.groups[k].weight for k in ks))
             groups.append(FacetGroup(material, np.concatenate([self.groups[k].triangles
                                                                for k in ks]),
-                                     mean / np.linalg.norm(mean), direction,
-                                     self.groups[ks[0]].up))
+                                     mean / np.linalg.norm(mean), self.groups[ks[0]].direction,
+                                     self.groups[ks[0]].up, coarse, weight))
         return groups
 
     def daylight(self, state: str, groups: list[FacetGroup], room_side: bool = False
@@ -297,13 +372,14 @@ class ThreePhase:
         out: list[Path] = []
         for k, g in enumerate(groups):
             sender = rad3.sender_text(g.triangles, g.normal, room_side, g.up)
-            key = "|".join([sender, text, " ".join(ambient), str(self.samples), str(self.mf)])
+            c = daylight_samples(self.samples, g)
+            key = "|".join([sender, text, " ".join(ambient), str(c), str(self.mf)])
 
-            def compute(k: int = k, sender: str = sender) -> Path:
+            def compute(k: int = k, sender: str = sender, c: int = c) -> Path:
                 if not octree:
                     octree.append(_octree(self.folder, f"daylight_{state}", scene, self.rho))
                 return rad3.daylight_matrix(self.folder, octree[0], f"{tag}{k}", sender,
-                                            self.mf, self.samples, ambient, self.trace.nproc)
+                                            self.mf, c, ambient, self.trace.nproc)
 
             out.append(self._cached(f"daylight_{tag}{k}", key, compute))
         name = f"daylight_{'room_' if room_side else ''}{state}_s"
@@ -311,7 +387,7 @@ class ThreePhase:
         if octree:
             log.info(f"    rfluxmtx daylight matrices ({state}"
                      f"{', room side' if room_side else ''}): {len(groups)} groups (tiles seen "
-                     f"from the sensors, the rest merged), -c {self.samples}, "
+                     f"from the sensors, the rest merged), -c {self.samples} per level-0 group, "
                      f"{self.timing[name]:.0f} s")
         return out
 

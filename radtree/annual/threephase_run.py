@@ -31,7 +31,6 @@ from radtree.annual.run import (
     with_season,
 )
 from radtree.annual.threephase import (
-    GROUP_LEVEL,
     GROUP_MATERIAL_UP,
     STATES,
     ThreePhase,
@@ -128,8 +127,7 @@ def compute_annual_3phase(project: Project, *, options: AnnualOptions) -> Annual
     log.info(f"  3-phase: {form} crown, BSDFs {', '.join(names)}")
     tp = ThreePhase(work / "threephase", bare=bare, models=models, form=form, grids=plan.grids,
                     rho=plan.rho, mf=options.mf, trace=plan.trace,
-                    samples=options.daylight_samples, level=GROUP_LEVEL,
-                    material_up=GROUP_MATERIAL_UP)
+                    samples=options.daylight_samples, material_up=GROUP_MATERIAL_UP)
     t1 = time.perf_counter()
     views = tp.view()
     timing["view_s"] = time.perf_counter() - t1

@@ -175,6 +175,7 @@ def parse_project(data: dict, path: Path) -> Project:
     street = _street(top.sub("street"), base)
     light = _table(top.sub("light"), "light", base)
     tree = _tree(top.sub("tree"), base)
+    _one_crown_inputs(top.sub("tree"), tree, district)
     sensors = _sensors(top.sub("sensors"), base, site.hours)
     engine = _table(top.sub("engine"), "engine", base)
     office = _table(top.sub("office"), "office", base) if top.has("office") else None
@@ -237,6 +238,19 @@ def _tree(tr: _Reader, base: Path) -> Any:
                                                    if not r.has(k)})
               for t, r in ((t, tr.sub(t)) for t in TREE_TABLES)}
     return _table(tr, "tree", base, **crowns)
+
+
+def _one_crown_inputs(tr: _Reader, tree: Any, district: Any) -> None:
+    """``[tree] points``, ``points_scans`` and ``voxels`` describe one crown (repeated along a
+    row); an inventory's crowns come from its rows, so they are refused there, not ignored."""
+    if district is None or getattr(district, "trees", None) is None:
+        return
+    for key in ("points", "points_scans", "voxels"):
+        if getattr(tree, key) is not None:
+            raise tr.error(key, f"got {tr.raw(key)!r}, but the project's crowns come from the "
+                           "tree inventory ([site] trees: one crown per row, from its species, "
+                           "height, crown diameter and outline); remove [tree] " + key + " or "
+                           "study that one crown in a project without [site] trees")
 
 
 def _sensors(se: _Reader, base: Path, hours: tuple[str, ...]) -> Any:

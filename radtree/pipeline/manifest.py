@@ -79,8 +79,9 @@ def weather_record(project: Any, states: dict[str, list[Any]]) -> dict[str, list
         out[name] = []
         for st in sts:
             dni, dhi = _light_sources(light, st.sky_model)
-            out[name].append({"time": st.time, "source": f"direct normal: {dni}; diffuse "
-                              f"horizontal: {dhi}", "direct_normal_lux": round(
+            source = (f"direct normal and diffuse horizontal: {dni}" if dni == dhi else
+                      f"direct normal: {dni}; diffuse horizontal: {dhi}")
+            out[name].append({"time": st.time, "source": source, "direct_normal_lux": round(
                                   float(st.direct_normal_lux), 1),
                               "diffuse_horizontal_lux": round(float(st.diffuse_horizontal_lux), 1),
                               "sky": st.sky_model})

@@ -249,15 +249,21 @@ def light_data(data: ReportData) -> dict[str, Any]:
                                 for key, names in groups.items()) + "."
     table = None
     if shown:
-        table = Table("light", "The light of each hour traced, as recorded by `radtree "
-                      "simulate` in results/manifest.json: direct normal and diffuse horizontal "
-                      "illuminance (lx), sky model and source.",
-                      ["scenarios", "hour", "direct normal (lx)", "diffuse horizontal (lx)",
-                       "sky", "source"], [False, False, True, True, False, False])
+        sources = {str(r["source"]) for recs in shown.values() for r in recs}
+        one = next(iter(sources)) if len(sources) == 1 else None
+        caption = ("The light of each hour traced, as recorded by `radtree simulate` in "
+                   "results/manifest.json: direct normal and diffuse horizontal illuminance "
+                   "(lx), sky model" + (f"; every hour's source: {one}." if one else
+                                        " and source."))
+        table = Table("light", caption, ["scenarios", "hour", "direct normal (lx)",
+                                         "diffuse horizontal (lx)", "sky"]
+                      + ([] if one else ["source"]),
+                      [False, False, True, True, False] + ([] if one else [False]))
         for key, names in groups.items():
             for r in json.loads(key):
                 table.add(", ".join(names), r["time"], f"{float(r['direct_normal_lux']):,.0f}",
-                          f"{float(r['diffuse_horizontal_lux']):,.0f}", r["sky"], r["source"])
+                          f"{float(r['diffuse_horizontal_lux']):,.0f}", r["sky"],
+                          *([] if one else [r["source"]]))
     return {"description": description, "table": table, "first": light_description(first)
             if len(groups) <= 1 else "per scenario (see 'The light traced')"}
 

@@ -65,11 +65,24 @@ def _utc_label(offset: float) -> str:
     return f"UTC{sign}{text}"
 
 
-def _time_axis(ax: Axes, times: list[str], offset: float) -> None:
+def clock_offset_hours(site: Any) -> float:
+    """The site's civil UTC offset (h) at noon on its date: daylight saving included (an IANA
+    ``time_zone``), unlike ``utc_offset_hours`` (standard time, the EPW time base)."""
+    from datetime import datetime
+
+    noon = datetime.fromisoformat(f"{site.date}T12:00").replace(tzinfo=site.tzinfo)
+    delta = noon.utcoffset()
+    return site.utc_offset_hours if delta is None else delta.total_seconds() / 3600.0
+
+
+def _time_axis(ax: Axes, times: list[str], site: Any) -> None:
     ticks = [decimal_hour(t) for t in times]
     ax.xaxis.set_major_locator(FixedLocator(ticks))
-    ax.set_xticklabels(times)
-    ax.set_xlabel(f"local clock time ({_utc_label(offset)})")
+    ax.set_xticklabels(times, rotation=45 if len(times) > 8 else 0,
+                       ha="right" if len(times) > 8 else "center")
+    zone = site.time_zone if "/" in str(site.time_zone) else ""
+    label = _utc_label(clock_offset_hours(site))
+    ax.set_xlabel(f"local clock time ({zone + ', ' if zone else ''}{label})")
 
 
 def _plain_log_axis(axis) -> None:
@@ -120,7 +133,7 @@ def hourly_plot(data: ReportData, path: Path) -> str:
         ax.plot([decimal_hour(t) for t in m["time"]], m["measured_lux"], label="measured",
                 **MEASURED_STYLE)
         scale.extend(m["measured_lux"].to_numpy(dtype=float))
-    _time_axis(ax, times, data.project.site.utc_offset_hours)
+    _time_axis(ax, times, data.project.site)
     ax.set_ylabel(LUX_LABEL)
     finite = [v for v in scale if np.isfinite(v)]
     stand_ins = [s.name for s in data.scenarios if s.stand_in]

@@ -104,7 +104,9 @@ def target_rows(results: pd.DataFrame) -> pd.DataFrame:
 def _means(rows: pd.DataFrame) -> pd.DataFrame:
     se2 = rows["lux_stderr"].astype(float) ** 2
     g = rows.assign(_se2=se2).groupby(["level", "target", "time"], sort=False)
-    out = g.agg(lux=("lux", "mean"), n=("lux", "size"), se2=("_se2", "sum"))
+    # an engine that estimates no standard error (Radiance) leaves it unknown, not zero
+    out = g.agg(lux=("lux", "mean"), n=("lux", "size"),
+                se2=("_se2", lambda v: v.sum() if v.notna().all() else np.nan))
     out["se"] = np.sqrt(out["se2"]) / out["n"]
     return out.drop(columns="se2")
 

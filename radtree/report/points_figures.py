@@ -4,7 +4,7 @@ like :mod:`radtree.report.figures`).
 
 Coordinates: the crown's own frame — u along the façade, n away from it, both from the trunk
 axis, z up from the street (m). The point cloud is placed as the crown builder places it
-(:mod:`radtree.trees.points_crown`: its plant-area centroid on the trunk axis, its x along u,
+(:mod:`radtree.trees.points_crown`: the centre of its outline on the trunk axis, its x along u,
 its y along n, its ground at z = 0), so both views compare like with like.
 """
 
@@ -58,7 +58,7 @@ def profile_plot(record: dict[str, Any], views: CrownViews | None, path: Path) -
     fig = new_figure(5.6, 4.8, DPI)
     ax = fig.add_subplot()
     ax.stairs(per_m, np.append(lo, lo[-1] + v) if len(lo) else [0.0], orientation="horizontal",
-              color=SCAN_COLOUR, linewidth=1.8, label="scan (Beer–Lambert inversion)")
+              color=SCAN_COLOUR, linewidth=1.8, label="scan (Beer–Lambert inversion in its hull)")
     built = ""
     if views is not None and len(lo):
         area = slat_profile(views.slats, layer_m=v, layers=len(lo))
@@ -78,8 +78,9 @@ def profile_plot(record: dict[str, Any], views: CrownViews | None, path: Path) -
     save_png(fig, path, DPI)
     return (f"Vertical profile of the crown's leaf (plant) area from {record['file']}: m² per "
             f"metre of height in layers of one voxel ({v:g} m), from the Beer–Lambert "
-            f"inversion along vertical beams (G = {record['g_vertical']:.3f}; solid grey), "
-            f"total {record['leaf_area_m2']:.1f} m² per crown." + built)
+            f"inversion along vertical beams (G = {record['g_vertical']:.3f}) kept inside the "
+            f"convex hull of the returns (solid grey), total {record['leaf_area_m2']:.1f} m² "
+            "per crown." + built)
 
 
 def _hull(xy: np.ndarray) -> np.ndarray | None:
@@ -136,7 +137,7 @@ def crown_views_plot(views: CrownViews, path: Path, *, file: str) -> str:
     save_png(fig, path, DPI)
     return (f"The crown beside its points: the vegetation returns of {file} (grey dots, "
             f"{len(views.points)} returns 0.5 m or more above ground) placed as the crown "
-            f"builder places them (plant-area centroid on the trunk axis), and the built "
+            f"builder places them (the centre of its outline on the trunk axis), and the built "
             f"slats of one crown (green, {len(views.slats)} triangles), seen from the street "
             "(u–z, top) and along the façade (n–z, bottom); dashed: the points' convex "
             "outline in each view; metres from the trunk axis and the street.")

@@ -27,6 +27,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from pathlib import Path
 
 import numpy as np
 
@@ -311,11 +312,16 @@ def icosphere_level(angular_step_deg: float) -> int:
 
 def row_notes(spec: CrownRowSpec, tree: Tree, sensors: Sensors) -> list[str]:
     cr = tree.crown
+    shape = (f"spheroid(s) of horizontal radius {spec.a:g} m and vertical semi-axis {spec.b:g} m"
+             f", base {cr.base_height_m:g} m above the street")
+    measured = tree.points or tree.voxels
+    if measured is not None:   # the crown is the measured one; the spheroid only shares it out
+        shape = (f"crown(s) from {Path(measured).name} (the row's shares between neighbours "
+                 f"and the wall are cut along {shape})")
     notes = [
-        f"Free-standing crowns: {spec.count} spheroid(s) of horizontal radius {spec.a:g} m and "
-        f"vertical semi-axis {spec.b:g} m, base {cr.base_height_m:g} m above the street, on "
-        f"trunks ({cr.trunk_diameter_m:g} m) {cr.trunk_distance_m:g} m from the façade, every "
-        f"{cr.spacing_m:g} m, centred on the sensors (u = {sensors.x_m:g} m).",
+        f"Free-standing crowns: {spec.count} {shape}, on trunks ({cr.trunk_diameter_m:g} m) "
+        f"{cr.trunk_distance_m:g} m from the façade, every {cr.spacing_m:g} m, centred on the "
+        f"sensors (u = {sensors.x_m:g} m).",
     ]
     gap = spec.centres[0, 1] - spec.a
     if gap > spec.n_clip:

@@ -15,9 +15,13 @@ returns drawn at random ± half a point spacing (kept in the voxel; uniform wher
 holds no return), so the crown keeps its shape inside a voxel; normals at random azimuths and the louvers' inclination
 (fixed or drawn from the ellipsoidal distribution). So the crown's leaf area is the scan's,
 voxel by voxel; ``cover_fraction`` plays no part (the slats' optics do: the gap reading, with
-near-opaque real leaves, is the consistent one). The cloud is placed on every trunk of the
-row: its plant-area centroid on the trunk axis, its ground at the street (z = 0), its x along
-the façade (u) and y away from it (n). Slats are then clipped like the volume arrangement's
+near-opaque real leaves, is the consistent one). Before filling, the grid is kept inside the
+convex hull of the crown's returns on cells of a quarter voxel (:func:`points_crown_grid`,
+:mod:`radtree.trees.points_hull`: the rim stays sharp, and each rim voxel's measured gap is
+held by the part of it inside the hull), and the slats fill those cells. The cloud is placed on
+every trunk of the row: the centre of the crown's outline seen from above
+(:func:`radtree.trees.points_hull.crown_centre`) on the trunk axis, its ground at the street
+(z = 0), its x along the façade (u) and y away from it (n). Slats are then clipped like the volume arrangement's
 (:mod:`radtree.trees.crown_clip`: trunk, wall-side plane, planes shared with neighbours).
 """
 
@@ -67,6 +71,29 @@ def points_grid(tree: Tree, source: str | None = None) -> VoxelGrid:
     return tree_voxels(tree.points, g, tree.points_voxel_m)
 
 
+def points_crown_grid(tree: Tree, source: str | None = None) -> tuple[VoxelGrid, VoxelGrid, int]:
+    """(the inversion grid of :func:`points_grid`, the crown's grid kept inside the returns'
+    hull on cells of 1/:data:`~radtree.trees.points_hull.SUB` voxel — what the crowns are
+    filled from and placed by —, voxels with leaves no beam through their hull part reached):
+    :func:`radtree.trees.points_hull.sharpen`, vertical-beam form for airborne scans."""
+    from radtree.trees.points_hull import sharpen, vertical_beams
+
+    grid = points_grid(tree, source)
+    assert tree.points is not None
+    beams = vertical_beams(tree.points) if tree.points_scans is None else None
+    fine, unreached = sharpen(grid, beams=beams)
+    return grid, fine, unreached
+
+
+def layer_profile(inv: VoxelGrid, fine: VoxelGrid) -> tuple[np.ndarray, np.ndarray]:
+    """(layer bottoms m, plant area m²) of the crown grid ``fine`` on the layers of the
+    inversion grid ``inv`` (the manifest's profile)."""
+    z, area = fine.profile()
+    k = np.floor(z / inv.size_m + 1e-6).astype(np.int64)
+    per = np.bincount(k, weights=area, minlength=inv.pad.shape[2])
+    return np.arange(len(per)) * inv.size_m, per
+
+
 def _corners(centres: np.ndarray, phi: np.ndarray, tilt: Any, s: float) -> np.ndarray:
     e1, e2 = slat_edges(phi, tilt)
     h1 = np.array([-0.5, 0.5, 0.5, -0.5]) * s
@@ -78,14 +105,17 @@ def _corners(centres: np.ndarray, phi: np.ndarray, tilt: Any, s: float) -> np.nd
 def voxel_slats(grid: VoxelGrid, lv: Louvers, rng: np.random.Generator,
                 origin: np.ndarray) -> tuple[np.ndarray, np.ndarray, Any]:
     """Slat centres (k, 3), azimuths and inclinations of one crown: PAD·v³/s² per voxel
-    (module text); ``origin`` is where the grid's plant-area centroid stands (u, n, 0)."""
+    (module text); ``origin`` is where the crown's centre
+    (:func:`radtree.trees.points_hull.crown_centre`) stands (u, n, 0)."""
+    from radtree.trees.points_hull import crown_centre
+
     s, v = lv.slat_size_m, grid.size_m
     expected = grid.pad * v**3 / (s * s)
     n = np.floor(expected).astype(np.int64)
     n += rng.random(expected.shape) < (expected - n)
     idx = np.repeat(np.arange(n.size), n.ravel())
     i, j, k = np.unravel_index(idx, n.shape)
-    cxy = grid.centroid_xy()
+    cxy = crown_centre(grid)
     corner = np.column_stack([grid.x0 + i * v - cxy[0], grid.y0 + j * v - cxy[1], k * v])
     centres = origin + corner + rng.random((len(idx), 3)) * v
     # horizontally, slats go where the voxel's returns are (± half a point spacing), so the
@@ -107,7 +137,7 @@ def build_points_louvers(spec: CrownRowSpec, tree: Tree, source: str | None = No
     """Slat polygons (local coordinates) of the row's crowns from ``tree.points``, geometry
     info (voxel size, leaf area, its vertical profile) and the grid."""
     lv = tree.louvers
-    grid = points_grid(tree, source)
+    inv, grid, unreached = points_crown_grid(tree, source)
     per = grid.leaf_area_m2 / lv.slat_size_m**2
     if per * spec.count > MAX_VOLUME_SLATS:
         raise ConfigError(f"the crowns from {tree.points} would need {per * spec.count:.0f} "
@@ -129,14 +159,16 @@ def build_points_louvers(spec: CrownRowSpec, tree: Tree, source: str | None = No
         kept, n_cut = cut_to_share(corners[ok], spec, lo, hi)
         polys.extend(kept)
         cut += n_cut
-    z, area = grid.profile()
-    info = {"points_voxel_m": grid.size_m, "points_spacing_m": grid.spacing_m,
+    z, area = layer_profile(inv, grid)
+    info = {"points_voxel_m": inv.size_m, "points_spacing_m": grid.spacing_m,
             "points_g_vertical": grid.g, "points_leaf_area_m2": grid.leaf_area_m2,
+            "points_inverted_leaf_area_m2": inv.leaf_area_m2, "points_cell_m": grid.size_m,
+            "points_hull_unreached": float(unreached),
             "points_scan_positions": float(scan_positions(tree)),
-            "points_height_m": float(len(z) * grid.size_m), "slats_cut": float(cut),
+            "points_height_m": float(len(z) * inv.size_m), "slats_cut": float(cut),
             "slats_dropped": float(dropped), "slat_mean_area_m2": lv.slat_size_m**2}
     for zk, ak in zip(z, area):
-        info[f"points_leaf_area_m2_z{zk:.2f}_{zk + grid.size_m:.2f}"] = float(ak)
+        info[f"points_leaf_area_m2_z{zk:.2f}_{zk + inv.size_m:.2f}"] = float(ak)
     return polys, info, grid
 
 
@@ -159,9 +191,12 @@ def points_note(tree: Tree, info: dict[str, float], slats: int) -> str:
             f"{info['points_spacing_m']:.2f} m) by Beer–Lambert inversion along "
             f"{_beams_text(info)} "
             f"(G = {info['points_g_vertical']:.3f} of the slats' leaf angles; wood counted as "
-            f"leaf area): {info['points_leaf_area_m2']:.1f} m² per crown, "
+            f"leaf area), kept inside the returns' convex hull on "
+            f"{info.get('points_cell_m', info['points_voxel_m']):g} m cells (inverted "
+            f"{info.get('points_inverted_leaf_area_m2', info['points_leaf_area_m2']):.1f} m²): "
+            f"{info['points_leaf_area_m2']:.1f} m² per crown, "
             f"{info['points_height_m']:.1f} m high; densest layers {peak}. {slats} slats of "
-            f"{tree.louvers.slat_size_m:g} m fill it voxel by voxel "
+            f"{tree.louvers.slat_size_m:g} m fill it cell by cell "
             f"({int(info['slats_cut'])} cut at the wall-side or shared planes, "
             f"{int(info['slats_dropped'])} dropped at the trunks).")
 

@@ -2,10 +2,11 @@
 ``[tree] voxels``), the louvers model's turbid builder.
 
 * ``points`` (one tree's LAS/LAZ): the plant area density grid of
-  :func:`radtree.trees.points_crown.points_grid` (Beer–Lambert inversion along vertical beams,
-  G of the louvers' leaf angles, wood counted as leaf area) placed on every trunk of the free
-  row exactly as the louvers-from-points crown places its slats: the grid's plant-area
-  centroid on the trunk axis, its ground at the street, its x along the façade (u) and y away
+  :func:`radtree.trees.points_crown.points_crown_grid` (Beer–Lambert inversion along vertical
+  beams, G of the louvers' leaf angles, wood counted as leaf area; kept inside the returns'
+  convex hull on quarter-voxel cells, :mod:`radtree.trees.points_hull`) placed on every trunk
+  of the free row exactly as the louvers-from-points crown places its slats: the centre of
+  the crown's outline (:func:`radtree.trees.points_hull.crown_centre`) on the trunk axis, its ground at the street, its x along the façade (u) and y away
   from it (n).
 * ``voxels`` (a CSV file, :mod:`radtree.trees.voxel_file`): the grid as written, its
   coordinates relative to each trunk base (x along the façade, y away from it, z up).
@@ -54,17 +55,22 @@ def _grid(tree: Tree, source: str | None) -> tuple[np.ndarray, float, np.ndarray
     """(density grid, voxel side m, lower corner of voxel (0, 0, 0) relative to the trunk
     base in the façade frame (u, n, z) m, info, what it is for the notes)."""
     if tree.points is not None:
-        from radtree.trees.points_crown import points_grid
+        from radtree.trees.points_crown import points_crown_grid
+        from radtree.trees.points_hull import crown_centre
 
-        g = points_grid(tree, source)
-        cxy = g.centroid_xy()
+        inv, g, unreached = points_crown_grid(tree, source)
+        cxy = crown_centre(g)
         corner = np.array([g.x0 - cxy[0], g.y0 - cxy[1], 0.0])
-        info = {"points_voxel_m": g.size_m, "points_spacing_m": g.spacing_m,
+        info = {"points_voxel_m": inv.size_m, "points_spacing_m": g.spacing_m,
                 "points_g_vertical": g.g, "points_leaf_area_m2": g.leaf_area_m2,
-                "points_height_m": float(g.pad.shape[2] * g.size_m)}
+                "points_inverted_leaf_area_m2": inv.leaf_area_m2, "points_cell_m": g.size_m,
+                "points_hull_unreached": float(unreached),
+                "points_height_m": float(inv.pad.shape[2] * inv.size_m)}
         what = (f"the point cloud {tree.points.name}: Beer–Lambert inversion along vertical "
-                f"beams (mean point spacing {g.spacing_m:.2f} m, G = {g.g:.3f} of the leaf "
-                "angles; wood counted as leaf area), its plant-area centroid on each trunk")
+                f"beams on {inv.size_m:g} m voxels (mean point spacing {g.spacing_m:.2f} m, "
+                f"G = {g.g:.3f} of the leaf angles; wood counted as leaf area; "
+                f"{inv.leaf_area_m2:.1f} m²), kept inside the returns' convex hull on "
+                f"{g.size_m:g} m cells, the centre of its outline on each trunk")
         return g.pad, g.size_m, corner, info, what
     from radtree.trees.voxel_file import read_voxel_file
 

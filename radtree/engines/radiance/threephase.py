@@ -36,6 +36,9 @@ from radtree.fileio import write_text
 
 #: a daylight-matrix sender sits this far behind its facets (on the shell's far side)
 SENDER_OFFSET_M = 0.002
+#: Klems receivers per rfluxmtx run of a view matrix: rfluxmtx stops at "too many
+#: arguments" (it passes rcontrib some 8 per receiver; 1 172 groups failed, 320 ran)
+VIEW_CHUNK = 400
 _REFLECT = {"Reflection Back": "Transmission Front", "Reflection Front": "Transmission Back",
             "Transmission Front": "Reflection Back", "Transmission Back": "Reflection Front"}
 _SWAP = {"Transmission Front": "Transmission Back", "Transmission Back": "Transmission Front",
@@ -88,6 +91,13 @@ def group_receivers_text(groups: list[tuple[np.ndarray, np.ndarray]],
         out.append(f"#@rfluxmtx h=kf u={up_text(normal, up)}\nvoid glow tp_win{g}\n0\n0\n"
                    f"4 1 1 1 0\n\n" + _polygons(f"tp_win{g}", f"tp_win{g}", tri))
     return "\n".join(out)
+
+
+def blocker_text(triangles: list[np.ndarray]) -> str:
+    """Facets that absorb every ray (a ``glow`` of radiance 0): the groups of a view matrix
+    traced in another rfluxmtx run (:data:`VIEW_CHUNK`)."""
+    return "void glow tp_block\n0\n0\n4 0 0 0 0\n\n" + "\n".join(
+        _polygons("tp_block", f"tp_block{k}", t) for k, t in enumerate(triangles))
 
 
 def sender_text(triangles: np.ndarray, normal: np.ndarray, room_side: bool = False,

@@ -24,10 +24,16 @@ log = logging.getLogger(__name__)
 def points_scenario(project: Project, names: list[str]
                     ) -> tuple[Scenario, dict[str, Any]] | None:
     """The first of the simulated scenarios ``names`` whose build manifest records a crown
-    from points, with that record (None: none has)."""
-    for sc in project.scenarios:
+    from points, with that record (None: none has). A scenario with crown realisations is
+    shown by its first (``<name>@1``, the build the report pictures)."""
+    from radtree.pipeline.realisations import realisations_of
+
+    for parent in project.scenarios:
+        if parent.name not in names:
+            continue
+        sc = realisations_of(project, parent)[0]
         path = project.build_dir / sc.name / "manifest.json"
-        if sc.name not in names or not path.is_file():
+        if not path.is_file():
             continue
         try:
             record = json.loads(path.read_text(encoding="utf-8"))["build"].get("points_crown")
@@ -43,11 +49,12 @@ def crown_views(project: Project, sc: Scenario) -> CrownViews:
     (u, n from the trunk axis, z from the street; :mod:`radtree.report.points_figures`)."""
     from radtree.pipeline.build import built_scene
     from radtree.trees.model import LEAF, TRUNK
-    from radtree.trees.points_crown import points_grid
+    from radtree.trees.points_crown import points_crown_grid
+    from radtree.trees.points_hull import crown_centre
 
     tree = effective_project(project, sc).tree
-    grid = points_grid(tree, str(project.source))
-    cxy = grid.centroid_xy()
+    grid, crown, _ = points_crown_grid(tree, str(project.source))
+    cxy = crown_centre(crown)          # where the crown was placed on its trunk
     points = grid.returns - [cxy[0], cxy[1], 0.0]
     model = built_scene(project, sc).tree
     frame = model.frame
