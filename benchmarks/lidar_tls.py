@@ -11,6 +11,11 @@ back, and inverted to plant area along every beam's path, the sky shots (no retu
 (:mod:`radtree.lidar.beams`; G(μ) of the slats; voxels of ``--voxel`` m). Target: leaf area
 within 10 % of the crown's.
 
+Measured 2026-12-07 with the crown envelope and the 5-beam minimum of :mod:`radtree.lidar.voxels`
+(load 18–20, 140 s, peak 355 MiB): 4 positions, 0.2° step, thin beams: 45.1 / 43.9 / 43.4 m² at
+voxels 0.5 / 0.75 / 1.0 m (+5.0 / +2.1 / +0.9 %); through ``[tree] points`` + ``points_scans``
+(Mendoza example, 1 m voxels): +0.9 %, 497 slats — met. The figures below are from before it.
+
 Measured 2026-12-07 (load 9–10; 10–35 s): leaf area 43.0 m² (478 slats); 4 positions, 0.2°
 step, thin beams: 127 528 returns, from the scan 44.5 / 43.0 / 41.8 m² at voxels 0.5 / 0.75 /
 1.0 m (+3.4 / −0.1 / −2.8 % with the inversion's ½ added to both counts; +3.5 / −0.1 / −2.7 %

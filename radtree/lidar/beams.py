@@ -109,10 +109,13 @@ def _chord_beyond(end: np.ndarray, *, d: np.ndarray, lo: np.ndarray, size: float
 
 
 def beam_density(beams: Beams, *, lo: np.ndarray, size: float, shape: tuple[int, int, int],
-                 g_of_mu: Callable[[np.ndarray], np.ndarray]
+                 g_of_mu: Callable[[np.ndarray], np.ndarray],
+                 beyond_max: np.ndarray | None = None
                  ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """(pad, entering beams, intercepted beams) on the grid, each of ``shape`` (module
-    text); ``g_of_mu`` gives G for |cos zenith| of the beams."""
+    text); ``g_of_mu`` gives G for |cos zenith| of the beams. ``beyond_max`` (m, one per
+    beam): how far an intercepted beam's chord may run on past its return (the crown
+    envelope's exit, :mod:`radtree.lidar.envelope`); unbounded when None."""
     d = beams.end - beams.origin
     d /= np.maximum(np.linalg.norm(d, axis=1), 1e-12)[:, None]
     w = beams.weight
@@ -126,6 +129,8 @@ def beam_density(beams: Beams, *, lo: np.ndarray, size: float, shape: tuple[int,
     hits = np.bincount(hit_cell, weights=w[ok], minlength=n)
     # an intercepted beam was exposed to its whole chord through the voxel
     beyond = _chord_beyond(beams.end[ok], d=d[ok], lo=lo, size=size)
+    if beyond_max is not None:
+        beyond = np.minimum(beyond, np.asarray(beyond_max, float)[ok])
     optical += np.bincount(hit_cell, weights=g[ok] * beyond, minlength=n)
     # entering: every beam with a piece in the voxel (an intercepted one has, up to its return)
     first = np.ones(len(seg), bool)
