@@ -341,15 +341,26 @@ def agreement_forward(project: Project, ab: int, photons: int, rel_se: float | N
                    max_photons=max(max_photons, photons))
 
 
+def forward_target(backward_rel_se: list[float], claim: float = 0.02, share: float = 0.9,
+                   floor: float = 0.002) -> float:
+    """The forward run's relative standard error that brings 3 combined standard errors to
+    ``share`` × ``claim`` against the noisiest backward estimate (relative SEs), at least
+    ``floor``."""
+    room = (share * claim / 3.0) ** 2 - max(backward_rel_se, default=0.0) ** 2
+    return max(math.sqrt(room) if room > 0 else 0.0, floor)
+
+
 def agreement_checks(*, hours: tuple[str, ...] = ("12:30",), scenarios: tuple[str, ...] = ("A",),
                      photons: int = 4_000_000, backward: list[str] | None = None,
                      crown: str = "louvers dome", plans: dict[str, BackwardPlan] | None = None,
                      rel_se: float | None = None, max_photons: int = 0) -> list[Check]:
     """Forward vs backward engines on the reduced Mendoza louvers dome (or another ``crown``
     of :data:`radtree.verify.compare.REDUCED`): the 8 sensors' 0.5 m
-    patch mean per scenario and hour (expected = the backward engine's value). The forward
-    engine: :func:`agreement_forward`; each backward engine is sampled by its entry of
-    ``plans`` (default :class:`BackwardPlan`)."""
+    patch mean per scenario and hour (expected = the backward engine's value). Each backward
+    engine is sampled by its entry of ``plans`` (default :class:`BackwardPlan`) first; the
+    forward engine (:func:`agreement_forward`) then runs ``photons`` once (``rel_se`` None) or
+    in rounds to :func:`forward_target` of the backward errors (at least ``rel_se``, at most
+    ``max_photons``)."""
     from radtree.engines.registry import available_engines
     from radtree.light.hours import hour_states
     from radtree.pipeline.assemble import make_scene
@@ -367,23 +378,23 @@ def agreement_checks(*, hours: tuple[str, ...] = ("12:30",), scenarios: tuple[st
             sc = proj.scenario(name)
             built = make_scene(proj, sc, dense_grid=False)
             st = hour_states(proj, sc, [hour])[0]
+            bws = {e: backward_patch_mean(
+                e, built.scene, st, "facade", 0.5, ab=built.ab, points=plan_of[e].points,
+                rays=plan_of[e].rays, stratified=True, params=(
+                    proj.engine if plan_of[e].ad is None
+                    else proj.engine.changed(ad=int(plan_of[e].ad)))) for e in active}
+            target = None if rel_se is None else max(rel_se, forward_target(
+                [b.stderr / max(b.lux, 1e-9) for b in bws.values()]))
             fw = trace_forward(built.scene, st, agreement_forward(
-                proj, built.ab, photons, rel_se, max_photons), ["facade"])
+                proj, built.ab, photons, target, max_photons), ["facade"])
             got, se = fw.grid_mean("facade")
-            for e in active:
-                plan = plan_of[e]
-                params = (proj.engine if plan.ad is None
-                          else proj.engine.changed(ad=int(plan.ad)))
-                bw = backward_patch_mean(e, built.scene, st, "facade", 0.5, ab=built.ab,
-                                         points=plan.points, rays=plan.rays, params=params,
-                                         stratified=True)
-                comb = math.hypot(se, bw.stderr)
+            for e, bw in bws.items():
                 label = (f"agreement: reduced Mendoza {crown} {name} {hour}, façade patch "
                          f"mean, forward vs {e}")
-                out.append(_checked(label, FORWARD, bw.lux, got, comb, 0.02,
-                                    f"{e} backward engine, same scene"))
+                out.append(_checked(label, FORWARD, bw.lux, got, math.hypot(se, bw.stderr),
+                                    0.02, f"{e} backward engine, same scene"))
                 log.info(f"{label}: {e} {bw.lux:.1f} ± {bw.stderr:.1f}, forward "
-                         f"{got:.1f} ± {se:.1f}")
+                         f"{got:.1f} ± {se:.1f} ({fw.photons} photons)")
     return out
 
 

@@ -57,7 +57,8 @@ SAMPLING = (
     "3 SE is within 80 % of its claim; backward engines at stratified points (two in each cell "
     "of an m × m grid per patch, standard error from the pairs); the forward agreement runs "
     "with the project's focused, guided estimator and the sun tallied on the patches, in "
-    "rounds to a 0.3 % standard error of the façade mean.")
+    "rounds until 3 combined SE (with the backward estimate, traced first) reach 90 % of the "
+    "claim or the photon cap.")
 
 
 def page_text(checks: Iterable[Check], command: str, seconds: float, note: str = "") -> str:
