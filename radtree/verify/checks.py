@@ -21,7 +21,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from radtree.config import Project
+from radtree.config import EngineParams, Project
 from radtree.engines.forward import ForwardSettings, trace_forward
 from radtree.engines.forward.interface import ForwardEngine
 from radtree.engines.numpy.scenes import sky_state
@@ -341,6 +341,11 @@ def agreement_forward(project: Project, ab: int, photons: int, rel_se: float | N
                    max_photons=max(max_photons, photons))
 
 
+def _plan_params(project: Project, plan: BackwardPlan) -> EngineParams:
+    ad = plan.ad
+    return project.engine if ad is None else project.engine.changed(ad=int(ad))
+
+
 def forward_target(backward_rel_se: list[float], claim: float = 0.02, share: float = 0.9,
                    floor: float = 0.002) -> float:
     """The forward run's relative standard error that brings 3 combined standard errors to
@@ -380,9 +385,8 @@ def agreement_checks(*, hours: tuple[str, ...] = ("12:30",), scenarios: tuple[st
             st = hour_states(proj, sc, [hour])[0]
             bws = {e: backward_patch_mean(
                 e, built.scene, st, "facade", 0.5, ab=built.ab, points=plan_of[e].points,
-                rays=plan_of[e].rays, stratified=True, params=(
-                    proj.engine if plan_of[e].ad is None
-                    else proj.engine.changed(ad=int(plan_of[e].ad)))) for e in active}
+                rays=plan_of[e].rays, stratified=True,
+                params=_plan_params(proj, plan_of[e])) for e in active}
             target = None if rel_se is None else max(rel_se, forward_target(
                 [b.stderr / max(b.lux, 1e-9) for b in bws.values()]))
             fw = trace_forward(built.scene, st, agreement_forward(
