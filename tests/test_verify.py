@@ -229,3 +229,12 @@ def test_the_quick_leaf_layer_plan_is_the_old_scene():
     quick, full = LayerPlan(), LayerPlan(detectors=14)
     assert (quick.extent, quick.beam) == (10.0, 9.0)     # 6 × 6 detectors, as before
     assert (full.extent, full.beam) == (18.0, 20.0)      # the beam holds every 1 m patch
+
+
+def test_forward_target_leaves_the_backward_error_room_within_the_claim():
+    from radtree.verify.checks import forward_target
+
+    # 3 combined SE = 90 % of the 2 % claim: combined 0.6 %; NumPy at 0.2 % leaves √(0.6² − 0.2²)
+    assert forward_target([0.002]) == pytest.approx(math.sqrt(0.006 ** 2 - 0.002 ** 2))
+    assert forward_target([0.002, 0.0051]) == pytest.approx(math.sqrt(0.006 ** 2 - 0.0051 ** 2))
+    assert forward_target([0.01]) == 0.002                 # no room: the floor
