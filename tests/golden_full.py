@@ -18,6 +18,11 @@ platform's or Radiance version's sampling moves rows by ~1 SE, a change of physi
 
 ``python -m tests.golden_full`` (from the repository root; long: both runs of both examples)
 rewrites ``tests/golden/*_full.csv`` — only in a commit of its own that says why.
+
+``office_radiance_ci`` is the CI-sized slice of the office table: the office block at the
+example's own settings (``-ad 2048``, ``-ab 6``, ``-aa 0``), both scenarios and both grids, one
+hour (13:30), small enough for every test run (``python -m tests.golden_full
+office_radiance_ci`` rewrites it).
 """
 
 from __future__ import annotations
@@ -38,7 +43,12 @@ GOLDEN = ROOT / "tests" / "golden"
 KEYS = ["scenario", "time", "grid", "sensor"]
 #: largest |z| a row may reach: ~700 rows, P(|z| > 5) ≈ 6e-7 per row for Gaussian noise
 Z_MAX = 5.0
-EXAMPLES = {"mendoza_radiance_full": "mendoza-street", "office_radiance_full": "office-block"}
+EXAMPLES = {"mendoza_radiance_full": "mendoza-street", "office_radiance_full": "office-block",
+            "office_radiance_ci": "office-block"}
+#: overrides of a table beyond the example's own settings (every table: no dense façade map)
+OVERRIDES: dict[str, dict] = {"office_radiance_ci": {"site.hours": ["13:30"]}}
+#: the tables the default generator run writes (office_radiance_ci only when named)
+DEFAULT = ("mendoza_radiance_full", "office_radiance_full")
 
 
 def _copy(example: str, dst: Path) -> Path:
@@ -57,7 +67,7 @@ def run_table(name: str, workdir: Path, seed_flag: str = "-u-") -> pd.DataFrame:
     from radtree.pipeline.simulate import simulate_project
 
     proj = load_project(_copy(EXAMPLES[name], workdir / f"{name}{seed_flag}"),
-                        overrides={"sensors.dense_grid": False})
+                        overrides={"sensors.dense_grid": False, **OVERRIDES.get(name, {})})
     saved = writer.FIXED_SEED
     writer.FIXED_SEED = seed_flag          # the golden runs: -u-; the SE run: -u+
     try:
@@ -99,7 +109,7 @@ def read_golden(name: str) -> pd.DataFrame:
 
 
 def main() -> None:
-    names = sys.argv[1:] or list(EXAMPLES)
+    names = sys.argv[1:] or list(DEFAULT)
     GOLDEN.mkdir(parents=True, exist_ok=True)
     with tempfile.TemporaryDirectory(prefix="radtree-golden-full-") as tmp:
         for name in names:

@@ -36,13 +36,9 @@ def test_radiance_tables_unchanged(name, tmp_path):
     assert_table_unchanged(name, tmp_path)
 
 
-@needs_radiance
-@pytest.mark.radiance
-@pytest.mark.slow
-@pytest.mark.parametrize("name", ["office_radiance_full", "mendoza_radiance_full"])
-def test_radiance_tables_at_the_examples_settings_within_standard_errors(name, tmp_path):
-    """Every hour of the examples at their own settings (tests/golden_full.py): each row
-    within Z_MAX combined standard errors of the golden table (the same platform: equal)."""
+def assert_within_standard_errors(name: str, tmp_path: Path) -> None:
+    """Every row of the rerun table within Z_MAX combined standard errors of the golden one
+    (tests/golden_full.py; the same platform: equal)."""
     import time
 
     import numpy as np
@@ -57,3 +53,20 @@ def test_radiance_tables_at_the_examples_settings_within_standard_errors(name, t
     print(f"{name}: {len(z)} rows, max |z| {np.abs(z).max():.2f} at {worst}, "
           f"{time.perf_counter() - t0:.0f} s")
     assert np.abs(z).max() <= Z_MAX, z[np.abs(z) > Z_MAX].head(20)
+
+
+@needs_radiance
+@pytest.mark.radiance
+@pytest.mark.slow
+@pytest.mark.parametrize("name", ["office_radiance_full", "mendoza_radiance_full"])
+def test_radiance_tables_at_the_examples_settings_within_standard_errors(name, tmp_path):
+    """Every hour of the examples at their own settings (tests/golden_full.py)."""
+    assert_within_standard_errors(name, tmp_path)
+
+
+@needs_radiance
+@pytest.mark.radiance
+def test_office_radiance_one_hour_at_the_examples_settings_within_standard_errors(tmp_path):
+    """The office block as shipped (-ad 2048, -ab 6; both scenarios, façade and work plane)
+    at 13:30: every sensor within Z_MAX standard errors of tests/golden/office_radiance_ci.csv."""
+    assert_within_standard_errors("office_radiance_ci", tmp_path)

@@ -119,7 +119,7 @@ def test_verify_command_writes_the_table_and_fails_on_a_failure(monkeypatch, tmp
     assert res.exit_code == code, res.output
     t = pd.read_csv(out)
     assert list(t.columns) == ["check", "engine", "expected", "got", "tolerance", "claim",
-                               "status", "passed", "reference"]
+                               "status", "passed", "reference", "seconds"]
     assert bool(t["passed"][0]) is (code == 0)
     assert ("FAIL" in res.output) is (code == 1)
 
@@ -181,3 +181,60 @@ def test_agreement_plan_hours_skip_the_engine_and_the_forward_trace():
 
     plans = {"numpy": BackwardPlan(points=2, rays=4, hours=("10:30",))}
     assert agreement_checks(hours=("12:30",), photons=0, backward=["numpy"], plans=plans) == []
+
+
+def test_group_runs_merge_into_one_page(monkeypatch, tmp_path):
+    from radtree.cli import main
+
+    _fake_suite(monkeypatch, [Check("a check", "forward", 1.0, 1.01, 0.02, 0.02, "ref")])
+    a, b = tmp_path / "a.csv", tmp_path / "b.csv"
+    assert CliRunner().invoke(main, ["verify", "--group", "layers", "-o", str(a)]).exit_code == 0
+    monkeypatch.setattr("radtree.verify.suite.transmission_checks", lambda **_k: [
+        Check("another", "numpy", 2.0, 2.5, 0.1, 0.1, "")])
+    assert CliRunner().invoke(main, ["verify", "--group", "layers", "-o", str(b)]).exit_code == 1
+    page = tmp_path / "validation.md"
+    res = CliRunner().invoke(main, ["verify", "--merge", str(a), "--merge", str(b), "--page",
+                                    str(page)])
+    assert res.exit_code == 1, res.output       # the merged table holds a failure
+    text = page.read_text()
+    assert "2 row groups run side by side" in text
+    assert "1 pass, 1 fail, 0 unresolved of 2 checks." in text
+    assert "| a check | ref |" in text and "| another | — |" in text
+
+
+def test_cli_groups_are_the_suites_groups():
+    from radtree.cli.verify import GROUP_NAMES
+    from radtree.verify.suite import GROUPS
+
+    assert GROUP_NAMES == tuple(GROUPS)
+
+
+def test_stratified_patch_points_put_two_points_in_every_cell():
+    from radtree.scene import SensorGrid
+    from radtree.verify.compare import patch_points, stratified_cells
+
+    assert stratified_cells(128) == 8
+    with pytest.raises(ValueError):
+        stratified_cells(64)
+    g = SensorGrid("g", np.array([[0.0, 0.0, 0.0]]), np.array([[0.0, 0.0, 1.0]]))
+    p = patch_points(g, 0.5, 32, np.random.default_rng(3), stratified=True).points
+    cell = np.floor((p[:, :2] + 0.25) / 0.125).astype(int)          # 4 × 4 cells of 0.125 m
+    assert (cell[0::2] == cell[1::2]).all()                          # pairs share their cell
+    assert len({tuple(c) for c in cell}) == 16                       # every cell is sampled
+
+
+def test_the_quick_leaf_layer_plan_is_the_old_scene():
+    from radtree.verify.checks import LayerPlan
+
+    quick, full = LayerPlan(), LayerPlan(detectors=14)
+    assert (quick.extent, quick.beam) == (10.0, 9.0)     # 6 × 6 detectors, as before
+    assert (full.extent, full.beam) == (18.0, 20.0)      # the beam holds every 1 m patch
+
+
+def test_forward_target_leaves_the_backward_error_room_within_the_claim():
+    from radtree.verify.checks import forward_target
+
+    # 3 combined SE = 90 % of the 2 % claim: combined 0.6 %; NumPy at 0.2 % leaves √(0.6² − 0.2²)
+    assert forward_target([0.002]) == pytest.approx(math.sqrt(0.006 ** 2 - 0.002 ** 2))
+    assert forward_target([0.002, 0.0051]) == pytest.approx(math.sqrt(0.006 ** 2 - 0.0051 ** 2))
+    assert forward_target([0.01]) == 0.002                 # no room: the floor

@@ -1,12 +1,19 @@
 """Run the physics suite and write ``verify.csv`` (``check, engine, expected, got, tolerance,
-passed``). Quick mode (default) fits in ≈ 2 minutes on 2 cores; ``full`` traces more photons,
-more leaf layers, the floating spheres by NumPy too, scenarios A and B of the reduced dome and of
-the free volume crown at three hours against NumPy and at noon against Radiance."""
+claim, status, passed, reference, seconds``). Quick mode (default) fits in ≈ 2 minutes on 2
+cores; ``full`` samples every row until its 3 standard errors fit inside its claim (more leaf
+area with smaller leaves, stratified backward points, the forward engine to a precision target),
+adds the floating spheres by NumPy, scenarios A and B of the reduced dome and of the free volume
+crown at three hours against NumPy and at noon against Radiance, and the three-phase closure.
+
+The suite is cut into row groups (:data:`GROUPS`) that can run as separate processes
+(``radtree verify --full --group G -o G.csv``) and be merged into one page
+(``radtree verify --merge a.csv --merge b.csv --page docs/validation.md``)."""
 
 from __future__ import annotations
 
 import logging
 import time
+from collections.abc import Callable, Iterable
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -18,6 +25,7 @@ from radtree.verify.checks import (
     FORWARD,
     BackwardPlan,
     Check,
+    LayerPlan,
     agreement_checks,
     energy_checks,
     sphere_checks,
@@ -29,14 +37,61 @@ from radtree.verify.voxels import voxel_checks
 
 log = logging.getLogger(__name__)
 
-# Radiance at -ad 2048 over 64 points per patch took 206 s per scenario and hour on the reduced
-# dome (2 cores); at -ad 1024 over 32 points ≈ 75 s, so it is compared at noon only, while NumPy
-# (≈ 1 s a case) is compared at every hour.
-FULL_PLANS = {"numpy": BackwardPlan(points=64, rays=128),
-              "radiance": BackwardPlan(points=32, ad=1024, hours=("12:30",))}
+# --full backward plans: stratified points (2 per cell) carry most of the spatial noise away, so
+# many cheap points beat few expensive ones. Free crown A 12:30 (load ≈ 12 on 2 cores): NumPy
+# 64 uniform points × 128 rays 1.96 % SE, 128 stratified × 128 0.50 %, 512 stratified × 128
+# 0.20 %; Radiance 32 stratified points at -ad 1024 1.58 % (113 s), 128 at -ad 256 0.51 %.
+FULL_PLANS = {"numpy": BackwardPlan(points=512, rays=64),
+              "radiance": BackwardPlan(points=128, ad=256, hours=("12:30",))}
+#: --full forward runs of the agreement rows: rounds of 2 M photons until 3 combined standard
+#: errors (with the noisiest backward estimate, traced first) reach 90 % of the 2 % claim
+#: (:func:`radtree.verify.checks.forward_target`; never below 0.2 %, at most 128 M photons: the
+#: dome B 10:30 needs ≈ 110 M)
+FULL_PHOTONS, FULL_REL_SE, FULL_MAX_PHOTONS = 2_000_000, 0.002, 128_000_000
+#: --full leaf layers: 14 × 14 detectors under a 18 m layer of 3.5 cm leaves, layers added until
+#: every zenith's 3 SE is within 80 % of its 1 % claim (at most 16)
+FULL_LAYERS = LayerPlan(detectors=14, leaf=0.035, realisations=16, min_realisations=3,
+                        resolve=0.8)
+HOURS = ("10:30", "12:30", "14:30")
 
 COLUMNS = ["check", "engine", "expected", "got", "tolerance", "claim", "status", "passed",
-           "reference"]
+           "reference", "seconds"]
+
+
+def _agreement(full: bool, backward: list[str] | None, crown: str) -> list[Check]:
+    if full:
+        return agreement_checks(hours=HOURS, scenarios=("A", "B"), backward=backward,
+                                crown=crown, plans=FULL_PLANS, photons=FULL_PHOTONS,
+                                rel_se=FULL_REL_SE, max_photons=FULL_MAX_PHOTONS)
+    return agreement_checks(backward=backward, crown=crown,
+                            photons=4_000_000 if crown == "louvers dome" else 2_000_000)
+
+
+def _threephase(full: bool, backward: list[str] | None) -> list[Check]:
+    from radtree.engines.radiance.binaries import find_radiance
+
+    if not full or find_radiance() is None:
+        return []
+    from radtree.verify.threephase import closure_checks
+
+    return closure_checks()
+
+
+#: the row groups in page order: name → (full?, backward engines) → checks
+GROUPS: dict[str, Callable[[bool, list[str] | None], list[Check]]] = {
+    "layers": lambda full, _b: (transmission_checks(photons=100_000, plan=FULL_LAYERS) if full
+                                else transmission_checks()),
+    "spheres": lambda full, _b: (sphere_checks(
+        realisations=8, photons=400_000, points=512, engines=(FORWARD, seeded_engine().name))
+        if full else sphere_checks()),
+    "energy": lambda full, _b: energy_checks(photons=200_000) if full else energy_checks(),
+    "media": lambda full, _b: (turbid_checks(rays=64_000) + voxel_checks(rays=64_000)
+                               + mist_checks() if full else
+                               turbid_checks() + voxel_checks() + mist_checks()),
+    "agreement-dome": lambda full, b: _agreement(full, b, "louvers dome"),
+    "agreement-free": lambda full, b: _agreement(full, b, "free volume crown"),
+    "threephase": _threephase,
+}
 
 
 @dataclass
@@ -55,46 +110,39 @@ class VerifyOutcome:
 
     @property
     def table(self) -> pd.DataFrame:
-        return pd.DataFrame([c.row() for c in self.checks], columns=COLUMNS)
+        t = pd.DataFrame([c.row() for c in self.checks], columns=COLUMNS)
+        t["seconds"] = round(self.seconds, 1)
+        return t
 
 
-def run_verify(out: Path, *, full: bool = False, backward: list[str] | None = None
-               ) -> VerifyOutcome:
-    """Every check; ``out`` is the CSV written. ``backward``: the backward engines compared
-    with the forward one (default every available one). Each check is logged (INFO) as it is
-    made."""
+def run_verify(out: Path, *, full: bool = False, backward: list[str] | None = None,
+               groups: Iterable[str] | None = None) -> VerifyOutcome:
+    """The checks of ``groups`` (default every one of :data:`GROUPS`); ``out`` is the CSV
+    written. ``backward``: the backward engines compared with the forward one (default every
+    available one). Each check is logged (INFO) as it is made."""
+    chosen = list(groups) if groups else list(GROUPS)
+    unknown = [g for g in chosen if g not in GROUPS]
+    if unknown:
+        raise ValueError(f"unknown verify group(s) {unknown}: choose from {list(GROUPS)}")
     t0 = time.perf_counter()
     checks: list[Check] = []
-    if full:
-        checks += transmission_checks(realisations=16, photons=200_000, points=64)
-        checks += sphere_checks(realisations=8, photons=400_000, points=64,
-                                engines=(FORWARD, seeded_engine().name))
-        checks += energy_checks(photons=200_000)
-        checks += turbid_checks(rays=64_000)
-        checks += voxel_checks(rays=64_000)
-        checks += mist_checks()
-        for crown in ("louvers dome", "free volume crown"):
-            checks += agreement_checks(hours=("10:30", "12:30", "14:30"), scenarios=("A", "B"),
-                                       photons=40_000_000, backward=backward, crown=crown,
-                                       plans=FULL_PLANS)
-        from radtree.engines.radiance.binaries import find_radiance
-
-        if find_radiance() is not None:
-            from radtree.verify.threephase import closure_checks
-
-            checks += closure_checks()
-    else:
-        checks += transmission_checks()
-        checks += sphere_checks()
-        checks += energy_checks()
-        checks += turbid_checks()
-        checks += voxel_checks()
-        checks += mist_checks()
-        checks += agreement_checks(backward=backward)
-        checks += agreement_checks(backward=backward, crown="free volume crown",
-                                   photons=4_000_000)
+    for g in GROUPS:
+        if g in chosen:
+            t = time.perf_counter()
+            checks += GROUPS[g](full, backward)
+            log.info(f"verify group {g}: {time.perf_counter() - t:.0f} s")
     outcome = VerifyOutcome(checks, Path(out), time.perf_counter() - t0)
     outcome.path.parent.mkdir(parents=True, exist_ok=True)
     with atomic_path(outcome.path) as tmp:
         outcome.table.to_csv(tmp, index=False, float_format="%.6g")
     return outcome
+
+
+def read_checks(path: Path) -> tuple[list[Check], float]:
+    """The checks of a ``verify.csv`` and the seconds its run took."""
+    t = pd.read_csv(path, keep_default_na=False, na_values={"expected": [""], "got": [""]})
+    checks = [Check(str(r.check), str(r.engine), float(r.expected), float(r.got),
+                    float(r.tolerance), float(r.claim), str(r.reference))
+              for r in t.itertuples(index=False)]
+    seconds = float(t["seconds"].max()) if "seconds" in t.columns and len(t) else 0.0
+    return checks, seconds
