@@ -141,30 +141,66 @@ def _cases(hours: list[str], scenarios: list[str]):
             yield proj, name, hour, built, hour_states(proj, sc, [hour])[0]
 
 
-def zscores(hours: list[str], scenarios: list[str], repeats: int, target: float,
-            round_photons: int) -> None:
-    print(f"z-scores: {repeats} seeds per scenario-hour, target {target:.1%}, rounds of "
-          f"{round_photons} photons (project forward settings otherwise)")
-    pooled = []
+def zscores(hours: list[str], scenarios: list[str], seeds: range, target: float,
+            round_photons: int, out: Path | None) -> None:
+    """Seeded repeats per scenario-hour (``seeds``), one line per run (appended to ``out`` as
+    CSV when given, so several processes can share the seeds), then :func:`z_summary`."""
+    print(f"z-scores: seeds {seeds.start}–{seeds.stop - 1} per scenario-hour, target "
+          f"{target:.1%}, rounds of {round_photons} photons (project forward settings "
+          f"otherwise)", flush=True)
+    rows = []
     for proj, name, hour, built, st in _cases(hours, scenarios):
         s = replace(ForwardSettings.from_params(proj.engine, built.ab), photons=round_photons,
                     target_rel_se=target)
-        t0 = time.perf_counter()
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore")
-            runs = [trace_forward(built.scene, st, replace(s, seed=k), ["facade"],
-                                  workers=1).grid_mean("facade") for k in range(1, repeats + 1)]
-        m = np.array([r[0] for r in runs])
-        se = np.array([r[1] for r in runs])
+        for k in seeds:
+            t0 = time.perf_counter()
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore")
+                r = trace_forward(built.scene, st, replace(s, seed=k), ["facade"], workers=1)
+            m, se = r.grid_mean("facade")
+            rows.append((name, hour, k, m, se, r.photons))
+            print(f"  {name:6s} {hour} seed {k:3d}: {m:8.1f} ± {se:6.1f} lx ({se / m:5.2%}), "
+                  f"{r.photons / 1e6:5.1f} M photons, {time.perf_counter() - t0:4.0f} s",
+                  flush=True)
+            if out is not None:
+                with open(out, "a") as f:
+                    f.write(f"{name},{hour},{k},{m!r},{se!r},{r.photons}\n")
+    z_summary(rows)
+
+
+def z_summary(rows: list[tuple]) -> None:
+    """Per scenario-hour and pooled: z of each run against the mean of the others (combined
+    standard error), its s.d., max |z| and share |z| > 3. ``rows``: (scenario, hour, seed,
+    mean lux, s.e. lux, photons)."""
+    pooled = []
+    for key in dict.fromkeys((r[0], r[1]) for r in rows):
+        m = np.array([r[3] for r in rows if (r[0], r[1]) == key])
+        se = np.array([r[4] for r in rows if (r[0], r[1]) == key])
+        n = np.array([r[5] for r in rows if (r[0], r[1]) == key])
+        if len(m) < 3:
+            continue
         others = (m.sum() - m) / (len(m) - 1)
         z = (m - others) / np.sqrt(se ** 2 + np.mean(se ** 2) / (len(m) - 1))
         pooled += list(z)
-        print(f"  {name:6s} {hour}: mean {m.mean():8.1f} lx, mean rel. s.e. {np.mean(se / m):6.2%}"
+        print(f"  {key[0]:6s} {key[1]}: {len(m)} runs, mean {m.mean():8.1f} lx, mean rel. s.e. "
+              f"{np.mean(se / m):6.2%}, spread/rms s.e. {m.std(ddof=1) / np.sqrt(np.mean(se ** 2)):.2f}"
               f", z s.d. {z.std(ddof=1):5.3f}, max |z| {np.abs(z).max():4.2f}, |z| > 3: "
-              f"{np.mean(np.abs(z) > 3):5.1%}  ({time.perf_counter() - t0:.0f} s)", flush=True)
+              f"{np.mean(np.abs(z) > 3):5.1%}, photons median {np.median(n) / 1e6:.1f} M "
+              f"(at the cap {np.mean(n >= n.max()):.0%})", flush=True)
     zp = np.array(pooled)
-    print(f" pooled over {len(zp)} runs: z s.d. {zp.std(ddof=1):.3f}, |z| > 3: "
-          f"{np.mean(np.abs(zp) > 3):.2%}", flush=True)
+    if len(zp):
+        print(f" pooled over {len(zp)} runs: z s.d. {zp.std(ddof=1):.3f}, |z| > 3: "
+              f"{np.mean(np.abs(zp) > 3):.2%}", flush=True)
+
+
+def z_from_files(paths: list[Path]) -> None:
+    """:func:`z_summary` of the runs written by ``--z-out`` (duplicated seeds counted once)."""
+    seen = {}
+    for path in paths:
+        for line in path.read_text().splitlines():
+            name, hour, k, m, se, n = line.split(",")
+            seen[(name, hour, int(k))] = (name, hour, int(k), float(m), float(se), int(n))
+    z_summary(sorted(seen.values(), key=lambda r: (r[0], r[1], r[2])))
 
 
 def against_radiance(hours: list[str], scenarios: list[str]) -> None:
@@ -194,6 +230,60 @@ def against_radiance(hours: list[str], scenarios: list[str]) -> None:
     print(f" within 2 % or 3 s.e.: {ok} of {n}", flush=True)
 
 
+def against_golden(hours: list[str], scenarios: list[str], realisations: int | None) -> None:
+    """The forward engine at the project's defaults against the Radiance golden table
+    (tests/golden/mendoza_radiance_full.csv: Radiance at the example's settings, rtrace's
+    fixed seed, per-row s.e. from a clock-seeded rerun), façade mean per scenario-hour: the
+    calculated ground terms added to the forward mean as ``simulate`` adds them; a scenario
+    with crown realisations (F) traced as each of them (their own crowns and engine seeds) and
+    averaged, as the golden's rows are (``realisations`` < all: only the first ones, stated).
+    Combined s.e. = √(forward s.e.² + golden s.e.²), the golden's from its 8 rows (independent
+    sensor paths): √Σ lux_se² / 8."""
+    import pandas as pd
+
+    from radtree.config import effective_project
+    from radtree.light.ground import ground_terms
+    from radtree.pipeline.realisations import realisations_of
+
+    gold = pd.read_csv(ROOT / "tests" / "golden" / "mendoza_radiance_full.csv",
+                       dtype={"time": str, "scenario": str})
+    gold = gold[gold["grid"] == "facade"]
+    proj = load_project(MENDOZA, overrides={"site.hours": hours, "sensors.dense_grid": False})
+    print("forward (project defaults, weight window factor "
+          f"{proj.engine.forward.forward_window:g}) vs the Radiance golden, façade mean", flush=True)
+    ok = n = 0
+    for hour in hours:
+        for name in scenarios:
+            subs = realisations_of(proj, proj.scenario(name))[:realisations or None]
+            t0 = time.perf_counter()
+            ms, ses, photons = [], [], 0
+            for sc in subs:
+                built = make_scene(proj, sc, dense_grid=False)
+                st = hour_states(proj, sc, [hour])[0]
+                eff = effective_project(proj, sc).engine
+                with warnings.catch_warnings():
+                    warnings.simplefilter("ignore")
+                    fw = trace_forward(built.scene, st, ForwardSettings.from_params(eff, built.ab),
+                                       ["facade"], workers=1, label=st.label)
+                m, se = fw.grid_mean("facade")
+                extra = float(ground_terms(proj, sc, st, built.scene.grids["facade"]).mean())
+                ms.append(m + extra)
+                ses.append(se)
+                photons += fw.photons
+            m, se = float(np.mean(ms)), float(np.sqrt(np.sum(np.square(ses))) / len(ses))
+            g = gold[(gold["scenario"] == name) & (gold["time"] == hour)]
+            gm, gse = float(g["lux"].mean()), float(np.sqrt((g["lux_se"] ** 2).sum()) / len(g))
+            d, c = m - gm, math.hypot(se, gse)
+            good = abs(d) <= max(0.02 * gm, 3 * c)
+            ok += good
+            n += 1
+            print(f"  {name:6s} {hour}: golden {gm:8.1f} ± {gse:5.1f}  forward {m:8.1f} ± {se:6.1f}"
+                  f" ({se / m:5.2%}, {photons / 1e6:5.1f} M photons, {len(subs)} crown(s))  diff "
+                  f"{d / gm:+6.2%} = {d / c:+5.2f} s.e.  {'ok' if good else 'MISS'}  "
+                  f"({time.perf_counter() - t0:.0f} s)", flush=True)
+    print(f" within 2 % or 3 combined s.e.: {ok} of {n}", flush=True)
+
+
 def patch_bias(hours: list[str], scenarios: list[str], side: float) -> None:
     from radtree.verify.compare import backward_patch_mean
 
@@ -215,15 +305,27 @@ def main() -> None:
     ap.add_argument("--hours", nargs="+", default=["12:30", "10:30", "16:30", "11:30",
                                                       "15:30", "13:30", "14:30"])
     ap.add_argument("--zscores", type=int, default=0, metavar="N")
-    ap.add_argument("--z-target", type=float, default=0.05)
-    ap.add_argument("--z-round", type=int, default=100_000)
+    ap.add_argument("--z-first", type=int, default=1, help="first seed of --zscores")
+    ap.add_argument("--z-target", type=float, default=0.02)
+    ap.add_argument("--z-round", type=int, default=1_000_000)
+    ap.add_argument("--z-out", type=Path, default=None, help="append the runs to this CSV")
+    ap.add_argument("--z-from", type=Path, nargs="+", default=None,
+                    help="no tracing: z of the runs in these --z-out files")
     ap.add_argument("--radiance", action="store_true")
+    ap.add_argument("--golden", action="store_true")
+    ap.add_argument("--realisations", type=int, default=None,
+                    help="--golden: crowns of F traced (default all)")
     ap.add_argument("--patch-bias", action="store_true")
     ap.add_argument("--patch", type=float, default=0.5)
     a = ap.parse_args()
     every = ["A", "B", "C", "D", "E", "A-sky", "F"]
-    if a.zscores:
-        zscores(a.hours, a.scenarios or every, a.zscores, a.z_target, a.z_round)
+    if a.z_from:
+        z_from_files(a.z_from)
+    elif a.zscores:
+        zscores(a.hours, a.scenarios or every, range(a.z_first, a.z_first + a.zscores),
+                a.z_target, a.z_round, a.z_out)
+    elif a.golden:
+        against_golden(a.hours, a.scenarios or every, a.realisations)
     elif a.radiance:
         against_radiance(a.hours, a.scenarios or every)
     elif a.patch_bias:
