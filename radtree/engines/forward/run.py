@@ -62,6 +62,9 @@ class ForwardResult:
     warning: str | None = None
     #: photons of the sizing round (traced, steering the strata, not counted; 0: none)
     sizing_photons: int = 0
+    #: the weight window's level (lm; None: no window opened) and the copies it added
+    window_level: float | None = None
+    window_splits: int = 0
 
     def grid_mean(self, grid: str) -> tuple[float, float]:
         """Mean lux over the grid's sensors and its standard error from the batches (patches
@@ -298,7 +301,8 @@ def trace_forward(scene: Scene, state: SkyState, settings: ForwardSettings,
                                per[name].std(axis=0, ddof=1) / np.sqrt(len(per[name])))
     return ForwardResult(out, tracer.ledger, counted, tracer.segments + pilot_segments,
                          time.perf_counter() - t0, per, strata, n_pilot, rounds, warning,
-                         sizing)
+                         sizing, None if tracer.window is None else tracer.window.level,
+                         tracer.window_splits)
 
 
 def _allot(photons: int, fluxes: list[float], batches: int) -> list[int]:
