@@ -133,7 +133,8 @@ def run(label: str, overrides: dict, scenarios: list[str], photons: int, rays: i
 
 def _cases(hours: list[str], scenarios: list[str]):
     """(project, scenario name, hour, built scene, hour state), hour-major."""
-    proj = load_project(MENDOZA, overrides={"site.hours": hours, "sensors.dense_grid": False})
+    proj = load_project(MENDOZA, overrides={"site.hours": hours, "sensors.dense_grid": False,
+                                            "sensors.dense_hours": hours[:1]})
     for hour in hours:
         for name in scenarios:
             sc = proj.scenario(name)
@@ -248,7 +249,8 @@ def against_golden(hours: list[str], scenarios: list[str], realisations: int | N
     gold = pd.read_csv(ROOT / "tests" / "golden" / "mendoza_radiance_full.csv",
                        dtype={"time": str, "scenario": str})
     gold = gold[gold["grid"] == "facade"]
-    proj = load_project(MENDOZA, overrides={"site.hours": hours, "sensors.dense_grid": False})
+    proj = load_project(MENDOZA, overrides={"site.hours": hours, "sensors.dense_grid": False,
+                                            "sensors.dense_hours": hours[:1]})
     print("forward (project defaults, weight window factor "
           f"{proj.engine.forward.forward_window:g}) vs the Radiance golden, façade mean", flush=True)
     ok = n = 0
