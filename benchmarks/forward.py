@@ -286,6 +286,65 @@ def against_golden(hours: list[str], scenarios: list[str], realisations: int | N
     print(f" within 2 % or 3 combined s.e.: {ok} of {n}", flush=True)
 
 
+def crossings(hours: list[str], scenarios: list[str], seeds: list[int], window: float) -> None:
+    """Every patch crossing of runs at the project's defaults (``window``: the weight-window
+    factor; with a window only the rounds it applies to, without one every main round),
+    recorded with the crossing photon's flux, launched flux (its ring: the focused
+    launch gives each ring's photons an equal share of the ring's flux) and events: where the
+    heavy tail of the façade estimate comes from. The tracer is subclassed here (each segment
+    tallied once more into a row per photon), so the runs are slower than plain ones."""
+    from radtree.engines.forward import run as forward_run
+    from radtree.engines.forward.tracer import ForwardTracer
+
+    rec: list[np.ndarray] = []
+    phase = {"counted": False}
+
+    class Recording(ForwardTracer):
+        def _advance(self, ph):  # type: ignore[no-untyped-def]
+            seen = ph if not ph.direct.any() else ph.take(~ph.direct)
+            tri, t = self.geo.caster.first_hit(seen.o, seen.d)
+            t = np.where(tri < 0, np.inf, t)
+            rows = np.zeros((len(seen), self.det.count))
+            self.det.tally(seen.o, seen.d, t, seen.w, np.arange(len(seen)), rows)
+            c = rows.sum(axis=1)
+            hit = np.flatnonzero(c > 0)
+            if len(hit) and phase["counted"] and (window <= 0 or self.window is not None):
+                rec.append(np.column_stack([c[hit], seen.w[hit], seen.w0[hit],
+                                            seen.ndiff[hit], seen.nspec[hit]]))
+            return super()._advance(ph)
+
+    def tracer(h, batches):  # type: ignore[no-untyped-def]
+        s = h.settings
+        phase["counted"] = batches > 1   # the pilot's scout traces one batch: not recorded
+        return Recording(h.geo, h.optics, h.det, batches, threshold=s.threshold,
+                         splitting=s.splitting, max_bounces=s.max_bounces,
+                         max_specular=s.max_specular, chunk=s.chunk, rng=h.rng,
+                         splitting_near=h.near, guide=h.guide)
+
+    forward_run._tracer = tracer  # type: ignore[assignment]
+    for proj, name, hour, built, st in _cases(hours, scenarios):
+        s = replace(ForwardSettings.from_params(proj.engine, built.ab), window=window)
+        for k in seeds:
+            rec.clear()
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore")
+                r = trace_forward(built.scene, st, replace(s, seed=k), ["facade"], workers=1)
+            m, se = r.grid_mean("facade")
+            a = np.vstack(rec)
+            c, w, w0 = a[:, 0], a[:, 1], a[:, 2]
+            mc = c.mean()
+            print(f"  {name} {hour} seed {k} window {window:g}: {m:.1f} ± {se:.1f} lx, "
+                  f"{(r.photons + r.sizing_photons) / 1e6:.1f} M photons (sizing round "
+                  f"included), {len(c)} crossings, effective {c.sum() ** 2 / (c ** 2).sum():.0f}"
+                  f"; largest {c.max() / c.sum():.2%} of the total", flush=True)
+            for f in (10, 30, 100):
+                big = c > f * mc
+                print(f"    crossings > {f:3d} × mean: {big.sum():5d} carry {c[big].sum() / c.sum():6.1%}"
+                      f"; their launched flux median {np.median(w0[big]) if big.any() else 0:7.1f}"
+                      f" lm (all: {np.median(w0):.1f}), flux / launched max "
+                      f"{(w / w0)[big].max() if big.any() else 0:.2f}", flush=True)
+
+
 def patch_bias(hours: list[str], scenarios: list[str], side: float) -> None:
     from radtree.verify.compare import backward_patch_mean
 
@@ -318,6 +377,9 @@ def main() -> None:
     ap.add_argument("--realisations", type=int, default=None,
                     help="--golden: crowns of F traced (default all)")
     ap.add_argument("--patch-bias", action="store_true")
+    ap.add_argument("--crossings", type=int, nargs="+", default=None, metavar="SEED",
+                    help="record every patch crossing of these seeds' runs")
+    ap.add_argument("--window", type=float, default=2.0, help="--crossings: window factor")
     ap.add_argument("--patch", type=float, default=0.5)
     a = ap.parse_args()
     every = ["A", "B", "C", "D", "E", "A-sky", "F"]
@@ -326,6 +388,8 @@ def main() -> None:
     elif a.zscores:
         zscores(a.hours, a.scenarios or every, range(a.z_first, a.z_first + a.zscores),
                 a.z_target, a.z_round, a.z_out)
+    elif a.crossings:
+        crossings(a.hours, a.scenarios or ["B"], a.crossings, a.window)
     elif a.golden:
         against_golden(a.hours, a.scenarios or every, a.realisations)
     elif a.radiance:
