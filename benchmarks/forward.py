@@ -345,6 +345,30 @@ def crossings(hours: list[str], scenarios: list[str], seeds: list[int], window: 
                       f"{(w / w0)[big].max() if big.any() else 0:.2f}", flush=True)
 
 
+def radiance_repeats(hours: list[str], scenarios: list[str], repeats: int) -> None:
+    """Radiance at the scenario's own settings (its switches applied), the traced façade mean
+    of ``repeats`` clock-seeded runs (rtrace ``-u+``) on the build the forward z-scores trace
+    (a scenario with crown realisations: its first crown): mean ± s.e. over the runs."""
+    from radtree.config import effective_project
+    from radtree.engines.radiance import writer
+    from radtree.engines.registry import get_engine
+
+    rad = get_engine("radiance")
+    saved = writer.FIXED_SEED
+    writer.FIXED_SEED = "-u+"
+    try:
+        for proj, name, hour, built, st in _cases(hours, scenarios):
+            eff = effective_project(proj, proj.scenario(name)).engine
+            t0 = time.perf_counter()
+            v = np.array([float(rad.trace_once(built.scene, st, eff, built.ab, ["facade"])
+                                ["facade"].lux.mean()) for _ in range(repeats)])
+            print(f"  {name:6s} {hour}: radiance {v.mean():8.1f} ± {v.std(ddof=1) / np.sqrt(len(v)):5.1f}"
+                  f" lx over {len(v)} clock-seeded runs ({time.perf_counter() - t0:.0f} s)",
+                  flush=True)
+    finally:
+        writer.FIXED_SEED = saved
+
+
 def patch_bias(hours: list[str], scenarios: list[str], side: float) -> None:
     from radtree.verify.compare import backward_patch_mean
 
@@ -374,6 +398,8 @@ def main() -> None:
                     help="no tracing: z of the runs in these --z-out files")
     ap.add_argument("--radiance", action="store_true")
     ap.add_argument("--golden", action="store_true")
+    ap.add_argument("--radiance-repeats", type=int, default=0, metavar="N",
+                    help="Radiance alone: N clock-seeded runs per scenario-hour")
     ap.add_argument("--realisations", type=int, default=None,
                     help="--golden: crowns of F traced (default all)")
     ap.add_argument("--patch-bias", action="store_true")
@@ -390,6 +416,8 @@ def main() -> None:
                 a.z_target, a.z_round, a.z_out)
     elif a.crossings:
         crossings(a.hours, a.scenarios or ["B"], a.crossings, a.window)
+    elif a.radiance_repeats:
+        radiance_repeats(a.hours, a.scenarios or every, a.radiance_repeats)
     elif a.golden:
         against_golden(a.hours, a.scenarios or every, a.realisations)
     elif a.radiance:
