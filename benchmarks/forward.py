@@ -15,22 +15,31 @@ Run: ``.venv/bin/python benchmarks/forward.py [--photons N] [--rays N]``. No ass
 
 Issue 40 (the estimator a user can trust by default), each a separate mode:
 
-* ``--zscores N``: N seeded repeats of every chosen scenario-hour with the project's forward
-  settings (precision loop on; ``--z-target`` and ``--z-round`` make it affordable: the
-  stopping logic is the one of the 2 % default): z of each run against the mean of the others
-  (combined standard error), per scenario-hour and pooled: s.d., share |z| > 3.
-* ``--radiance``: the forward engine at the project's defaults (2 % target) against the
-  Radiance engine at the project's settings (point sensors, fixed seed) on the same build,
-  traced façade mean per scenario-hour (the calculated ground term, the same for both, left
-  out): difference, forward standard error, within 2 % or 3 s.e.
+* ``--zscores N``: N seeded repeats (from ``--z-first``) of every chosen scenario-hour with the
+  project's forward settings (``--z-target`` 2 % and ``--z-round`` 1 M: the defaults), one
+  line per run, appended to ``--z-out`` as CSV; ``--z-from FILES`` pools such files (several
+  processes share the seeds): z of each run against the mean of the others (combined standard
+  error), per scenario-hour and pooled: s.d., share |z| > 3.
+* ``--golden``: the forward engine at the project's defaults against the Radiance golden
+  table (tests/golden/mendoza_radiance_full.csv, the example's settings, per-row s.e.), façade
+  mean per scenario-hour, calculated ground terms added, F as its 8 crowns: within 2 % or 3
+  combined s.e.
+* ``--radiance``: forward at its defaults against the Radiance engine on the same build
+  (fixed seed, traced façade mean); ``--radiance-repeats N``: Radiance alone, N clock-seeded
+  runs on the build ``--zscores`` traces (F: its first crown), mean ± s.e.
+* ``--crossings SEED …``: every patch crossing of those runs recorded (``--window`` factor):
+  how much of the façade light the heavy crossings carry and where they started.
 * ``--patch-bias``: the NumPy engine at the 8 sensor points vs averaged over their squares of
   ``--patch`` m (why a patch tally of the direct sun cannot stand for point sensors).
 
 ``--hours`` and ``--scenarios`` choose the scenario-hours (hour-major order, each line printed
 when done, so a partial run reports what it covered).
 
-Measured 2026-12-07 (2 shared cores, load 5–10 from other sessions), after the strata
-re-allocation between rounds and the sizing round (radtree.engines.forward.strata, .precision):
+WEIGHT_WINDOW_FIGURES
+
+Before the weight window — measured 2026-12-07 (2 shared cores, load 5–10 from other
+sessions), after the strata re-allocation between rounds and the sizing round
+(radtree.engines.forward.strata, .precision):
 
 * Where the tail came from (scenario B at 12:30, per-photon façade contributions by launch
   ring, one round at the defaults, pre-change allocation): within a ring a hit is at most
@@ -297,9 +306,10 @@ def crossings(hours: list[str], scenarios: list[str], seeds: list[int], window: 
     from radtree.engines.forward.tracer import ForwardTracer
 
     rec: list[np.ndarray] = []
-    phase = {"counted": False}
 
     class Recording(ForwardTracer):
+        counted = False
+
         def _advance(self, ph):  # type: ignore[no-untyped-def]
             seen = ph if not ph.direct.any() else ph.take(~ph.direct)
             tri, t = self.geo.caster.first_hit(seen.o, seen.d)
@@ -308,18 +318,19 @@ def crossings(hours: list[str], scenarios: list[str], seeds: list[int], window: 
             self.det.tally(seen.o, seen.d, t, seen.w, np.arange(len(seen)), rows)
             c = rows.sum(axis=1)
             hit = np.flatnonzero(c > 0)
-            if len(hit) and phase["counted"] and (window <= 0 or self.window is not None):
+            if len(hit) and self.counted and (window <= 0 or self.window is not None):
                 rec.append(np.column_stack([c[hit], seen.w[hit], seen.w0[hit],
                                             seen.ndiff[hit], seen.nspec[hit]]))
             return super()._advance(ph)
 
     def tracer(h, batches):  # type: ignore[no-untyped-def]
         s = h.settings
-        phase["counted"] = batches > 1   # the pilot's scout traces one batch: not recorded
-        return Recording(h.geo, h.optics, h.det, batches, threshold=s.threshold,
-                         splitting=s.splitting, max_bounces=s.max_bounces,
-                         max_specular=s.max_specular, chunk=s.chunk, rng=h.rng,
-                         splitting_near=h.near, guide=h.guide)
+        tr = Recording(h.geo, h.optics, h.det, batches, threshold=s.threshold,
+                       splitting=s.splitting, max_bounces=s.max_bounces,
+                       max_specular=s.max_specular, chunk=s.chunk, rng=h.rng,
+                       splitting_near=h.near, guide=h.guide)
+        tr.counted = batches > 1   # the pilot's scout traces one batch: not recorded
+        return tr
 
     forward_run._tracer = tracer  # type: ignore[assignment]
     for proj, name, hour, built, st in _cases(hours, scenarios):
