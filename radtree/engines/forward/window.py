@@ -1,16 +1,19 @@
 """The weight window: photons too heavy for where they are split into lighter copies.
 
-**Why** (reference street, scenario B at 12:30, defaults, 4 seeded runs of 16 M photons, every
-patch crossing recorded: benchmarks/forward.py ``--crossings``): the focused launch gives the
-outer rings (16–48 m from the focus) few photons for their area, so each starts with
-100–3 000 lm against 4–30 lm in the inner rings. The weight a photon brings to the façade
-patches is therefore spread over five decades: crossings carrying more than 10 × the mean
-crossing (~1 % of them) made 25–30 % of the scattered façade light, those above 30 × the mean
-(~30 crossings in 15 000) 11–14 %, and the largest single crossing 0.5–1.1 % of the run's
-total. The weights were *not* grown by the guide (a heavy crossing's flux was at most 2.6 × its
-launched flux, most at the roulette floor 0.05 ×): they came with the launch. A mean of a
-few such crossings is the skewed estimate whose batch error is low exactly when they are
-missing (z s.d. 1.26, |z| > 3 in 2 % over 50 seeds before this module).
+**Why** (reference street, scenario B at 12:30, defaults, seed 1, every patch crossing of the
+counted rounds recorded: benchmarks/forward.py ``--crossings``): the focused launch gives the
+outer rings (16–48 m from the focus) few photons for their area, so each starts with hundreds
+of lumens against ~26 lm for the median crossing photon. The flux photons bring to the façade
+patches is therefore spread over five decades: the 1 % of crossings carrying more than 10 ×
+the mean crossing made 23 % of the scattered façade light (their launched flux: median 222 lm),
+those above 30 × (27 of 14 981) 10 %, the largest single crossing 1 %: 14 981 crossings worth
+1 316 equal ones. The weights were *not* grown by the guide (a heavy crossing's flux was at
+most 1.6 × its launched flux, most at the roulette floor 0.05 ×); they came with the launch
+and reached the façade through the five slat layers (4–7 specular events after 1–3 diffuse
+ones). A mean of a few such crossings is the skewed estimate whose batch error is low exactly
+when they are missing (z s.d. 1.26, |z| > 3 in 2 % over 50 seeds before this module). With the
+window (same seed): 31 740 crossings worth 12 442 equal ones, none above 10 × the mean, the
+largest 0.03 % of the total.
 
 **What** (the weight-window method of MCNP: Booth 1982, "Automatic importance estimation in
 forward Monte Carlo calculations", Trans. Am. Nucl. Soc. 41, 308, and Booth & Hendricks 1984,
