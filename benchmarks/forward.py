@@ -196,7 +196,7 @@ def z_summary(rows: list[tuple]) -> None:
               f"{np.mean(se / m):6.2%}, spread/rms s.e. {m.std(ddof=1) / np.sqrt(np.mean(se ** 2)):.2f}"
               f", z s.d. {z.std(ddof=1):5.3f}, max |z| {np.abs(z).max():4.2f}, |z| > 3: "
               f"{np.mean(np.abs(z) > 3):5.1%}, photons median {np.median(n) / 1e6:.1f} M "
-              f"(at the cap {np.mean(n >= n.max()):.0%})", flush=True)
+              f"(max {n.max() / 1e6:.1f} M)", flush=True)
     zp = np.array(pooled)
     if len(zp):
         print(f" pooled over {len(zp)} runs: z s.d. {zp.std(ddof=1):.3f}, |z| > 3: "
