@@ -35,7 +35,36 @@ Issue 40 (the estimator a user can trust by default), each a separate mode:
 ``--hours`` and ``--scenarios`` choose the scenario-hours (hour-major order, each line printed
 when done, so a partial run reports what it covered).
 
-WEIGHT_WINDOW_FIGURES
+With the weight window (radtree.engines.forward.window, ``engine.forward_window`` = 2) —
+measured 2026-12-07, 2 shared cores at load 3–27 from other sessions (runs of 1–30 min each):
+
+* ``--crossings 1 --window 0`` / ``--window 2`` (B 12:30, seed 1, counted rounds): without the
+  window 14 981 crossings worth 1 316 equal ones (Σc)²/Σc²; the 154 above 10 × the mean
+  crossing carried 23.4 % of the façade's scattered light (launched flux median 222 lm, all
+  crossings 26 lm; flux / launched flux at most 1.59: the launch, not the guide), the 27 above
+  30 × 9.9 %, the largest 0.96 %. With it: 31 740 crossings worth 12 442, none above 10 × the
+  mean, the largest 0.03 %; 1 280.6 ± 11.8 lx (0.92 %) from 8 M counted photons (without:
+  1 212.6 ± 28.1, 2.3 %, at the 15 M cap).
+* ``--zscores 50 --hours 12:30 --scenarios B`` (defaults: 2 %, rounds of 1 M, cap 16 M; seeds
+  1–50 over several processes, ``--z-from``): **z s.d. 0.850, |z| > 3 in 0 %, max |z| 1.77:
+  met** (0.8–1.25, ≤ 1 %). Mean 1 270.8 ± 1.7 lx (golden 1 262.5 ± 3.2; Radiance, 4
+  clock-seeded runs, ``--radiance-repeats 4``: 1 270.3 ± 5.8); relative s.e. 0.69–1.90 %
+  (median 1.26 %), median 8.5 M photons, 20 of 50 at 15 M: the sizing round (no window yet)
+  over-predicts. Spread of the means / r.m.s. s.e. 0.79: the errors are now on the cautious
+  side (before: 0.98 with z s.d. 1.26, |z| > 3 in 2 %).
+* ``--zscores N --hours 12:30 --scenarios F`` (the free crowns, first crown, clear sky; same
+  defaults; 32 seeds — 1–11, 16–19, 26–37, 42–46 — when the deadline came): **z s.d. 1.28,
+  |z| > 3 in 3.1 % (1 run: z +3.26), not met**; 31 of 32 runs stop at the 15 M cap with
+  relative s.e. 1.83–2.99 % (the 2 % target reached in 10). Mean 1 415.5 ± 6.8 lx against
+  Radiance on the same crown, 4 clock-seeded runs at the scenario's settings
+  (``--radiance-repeats 4``): 1 442.7 ± 4.1 lx, −1.9 % (−3.4 combined s.e.): within 2 %, but
+  low. Not diagnosed (``--crossings`` on F: not run).
+* ``--golden --scenarios A B C D E A-sky`` (all 7 hours, in four processes): **42 of 42 within
+  2 % or 3 combined s.e.**; differences −2.23 … +3.34 % (39 within 2 %; B 14:30 +3.34 % =
+  +1.85 s.e., B 16:30 +2.46 % = +1.63, C 15:30 −2.23 % = −1.34), −1.64 … +2.10 combined s.e.
+  (mean +0.35, s.d. 0.99); forward relative s.e. 0.15–1.93 %: the 2 % target reached in all
+  42 (0.9–15 M counted photons). F against the golden (its 8 crowns each traced, 1–30 min a
+  crown-hour depending on the load) was **not run** (one process started at the end did not finish).
 
 Before the weight window — measured 2026-12-07 (2 shared cores, load 5–10 from other
 sessions), after the strata re-allocation between rounds and the sizing round
