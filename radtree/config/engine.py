@@ -113,6 +113,10 @@ class ForwardParams(Checked):
     # the sun's direct beam computed at the sensor points (as the backward engines see it), sun
     # photons tallied on the patches only once scattered: radtree.engines.forward.direct
     forward_direct_sun: bool = True
+    # weight window: after an hour's first round, photons heavier than this many mean patch
+    # crossings (× (d / r)², d from the target grid's centre) split into copies (0 = none):
+    # radtree.engines.forward.window
+    forward_window: float = field(default=2.0, metadata=meta(0.0))
 
 
 #: the parameter groups of :class:`EngineParams`: attribute → class

@@ -26,7 +26,8 @@ MIST_KEYS = ("mist_extinction", "mist_sun")
 FORWARD_KEYS = ("photons", "forward_threshold", "forward_splitting", "beam_diameter_m",
                 "patch_m", "forward_batches", "forward_focus_m", "forward_split",
                 "forward_split_radius_m", "forward_guide", "forward_guide_radius_m",
-                "target_rel_se", "max_photons", "forward_direct_sun")
+                "target_rel_se", "max_photons", "forward_direct_sun",
+                "forward_window")
 
 
 def plain(obj: Any, path: Callable[[Path], Any] = str) -> Any:

@@ -83,10 +83,12 @@ class PatchDetectors:
         return out
 
     def tally(self, origins: np.ndarray, dirs: np.ndarray, lengths: np.ndarray,
-              flux: np.ndarray, batch: np.ndarray, out: np.ndarray) -> None:
+              flux: np.ndarray, batch: np.ndarray, out: np.ndarray) -> tuple[int, float]:
         """Add the flux of segments ``origins + s·dirs`` (0 < s < ``lengths``) crossing a
-        detector from its front into ``out[batch, detector]`` (lm)."""
+        detector from its front into ``out[batch, detector]`` (lm); the crossings and their
+        flux (lm)."""
         n_det = out.shape[1]
+        crossings, crossed = 0, 0.0
         h = self.side / 2.0
         for g in self.groups:
             denom = dirs @ g.normal
@@ -113,3 +115,6 @@ class PatchDetectors:
                 r = sel[part][ray]
                 flat = batch[r] * n_det + g.index[det]
                 out += np.bincount(flat, flux[r], minlength=out.size).reshape(out.shape)
+                crossings += len(r)
+                crossed += float(flux[r].sum())
+        return crossings, crossed

@@ -36,6 +36,7 @@ from radtree.engines.forward.strata import (
     trace_strata,
 )
 from radtree.engines.forward.tracer import ForwardTracer, Ledger, Photons, Splitting
+from radtree.engines.forward.window import WeightWindow, window_level
 from radtree.errors import ConfigError, EngineError
 from radtree.light.sky import SkyState
 from radtree.scene import Scene
@@ -61,6 +62,9 @@ class ForwardResult:
     warning: str | None = None
     #: photons of the sizing round (traced, steering the strata, not counted; 0: none)
     sizing_photons: int = 0
+    #: the weight window's level (lm; None: no window opened) and the copies it added
+    window_level: float | None = None
+    window_splits: int = 0
 
     def grid_mean(self, grid: str) -> tuple[float, float]:
         """Mean lux over the grid's sensors and its standard error from the batches (patches
@@ -128,6 +132,7 @@ class _Hour:
     target: np.ndarray
     near: Splitting | None
     guide: Guide | None
+    reach: float   # radius (m) of the sphere around ``target`` the guide and window aim at
 
 
 def _plan(scene: Scene, state: SkyState, settings: ForwardSettings, grids: list[str] | None,
@@ -166,7 +171,7 @@ def _plan(scene: Scene, state: SkyState, settings: ForwardSettings, grids: list[
         radius = float(np.linalg.norm(corners - target, axis=1).max())
     guide = Guide(target, radius, settings.guide) if settings.guide > 0 else None
     return _Hour(scene, state, settings, names, geo, optics, det, sphere, sources, direct, rng,
-                 target, near, guide)
+                 target, near, guide, radius)
 
 
 def _tracer(h: _Hour, batches: int) -> ForwardTracer:
@@ -231,6 +236,16 @@ def _round(h: _Hour, tracer: ForwardTracer, strata: list[Stratum] | None,
     return n, rows
 
 
+def _open_window(h: _Hour, tracer: ForwardTracer) -> None:
+    """After the hour's first round: the weight window for every later round, its level
+    from that round's patch crossings (:mod:`radtree.engines.forward.window`)."""
+    if tracer.window is not None or h.settings.window <= 0:
+        return
+    level = window_level(h.settings.window, tracer.crossed_flux, tracer.crossings)
+    if level is not None:
+        tracer.window = WeightWindow(h.target, h.reach, level)
+
+
 def _rounds(h: _Hour, tracer: ForwardTracer, strata: list[Stratum] | None
             ) -> tuple[int, np.ndarray, int, str | None, int]:
     """Rounds of ``photons`` until the precision target or the cap
@@ -252,6 +267,7 @@ def _rounds(h: _Hour, tracer: ForwardTracer, strata: list[Stratum] | None
             n, r = _round(h, tracer, strata, at_points)
             traced += n
             rows.append(r)
+            _open_window(h, tracer)
         per_batch = np.vstack(rows)
         grid_batches = {name: per_batch[:, h.det.slices[name]].mean(axis=1)
                         for name in h.names}
@@ -285,7 +301,8 @@ def trace_forward(scene: Scene, state: SkyState, settings: ForwardSettings,
                                per[name].std(axis=0, ddof=1) / np.sqrt(len(per[name])))
     return ForwardResult(out, tracer.ledger, counted, tracer.segments + pilot_segments,
                          time.perf_counter() - t0, per, strata, n_pilot, rounds, warning,
-                         sizing)
+                         sizing, None if tracer.window is None else tracer.window.level,
+                         tracer.window_splits)
 
 
 def _allot(photons: int, fluxes: list[float], batches: int) -> list[int]:

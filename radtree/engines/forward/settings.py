@@ -84,6 +84,7 @@ class ForwardSettings:
     target_rel_se: float | None = None
     max_photons: int = 64_000_000
     direct_sun: bool = False
+    window: float = 0.0
 
     def __post_init__(self) -> None:
         if isinstance(self.photons, bool) or not isinstance(self.photons, int) or self.photons < 1:
@@ -136,6 +137,10 @@ class ForwardSettings:
                        f"({self.photons}), got {m!r}")
         if not isinstance(self.direct_sun, bool):
             raise _bad("forward_direct_sun", f"must be true or false, got {self.direct_sun!r}")
+        ww = self.window
+        if isinstance(ww, bool) or not isinstance(ww, int | float) or not math.isfinite(ww) \
+                or ww < 0:
+            raise _bad("forward_window", f"must be ≥ 0 (0: no weight window), got {ww!r}")
         if self.max_bounces < 0 or self.max_specular < 0 or self.chunk < 1:
             raise _bad("max_bounces", "bounce caps must be ≥ 0 and the chunk ≥ 1")
 
@@ -153,7 +158,7 @@ class ForwardSettings:
                    split=f.forward_split, split_radius_m=f.forward_split_radius_m,
                    guide=f.forward_guide, guide_radius_m=f.forward_guide_radius_m,
                    target_rel_se=f.target_rel_se, max_photons=f.max_photons,
-                   direct_sun=f.forward_direct_sun)
+                   direct_sun=f.forward_direct_sun, window=f.forward_window)
 
     def describe(self) -> str:
         source = ("sun over the whole scene" if self.beam_diameter_m is None

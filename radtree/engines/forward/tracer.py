@@ -40,6 +40,7 @@ from radtree.engines.common.streams import GeneratorDraws
 from radtree.engines.forward.detectors import PatchDetectors
 from radtree.engines.forward.guide import Guide
 from radtree.engines.forward.sources import Launch
+from radtree.engines.forward.window import WeightWindow
 
 
 @dataclass
@@ -140,6 +141,12 @@ class ForwardTracer:
         self.tally = np.zeros((batches, detectors.count))
         self.ledger = Ledger(list(geo.material_names))
         self.segments = 0
+        #: patch crossings tallied and their flux (lm): the weight window's level (window.py)
+        self.crossings = 0
+        self.crossed_flux = 0.0
+        #: the weight window (None: none), set by the run after its first round
+        self.window: WeightWindow | None = None
+        self.window_splits = 0   # copies the window added
         #: with ``escape_axes`` (batches, 3) unit vectors: per batch, the flux escaping the scene
         #: along its axis (d · axis > 0, lm), and the part still the direct beam
         self.axes = escape_axes
@@ -187,10 +194,12 @@ class ForwardTracer:
         self.segments += len(ph)
         if ph.direct.any():
             seen = ~ph.direct
-            self.det.tally(ph.o[seen], ph.d[seen], t[seen], ph.w[seen], ph.batch[seen],
-                           self.tally)
+            n, f = self.det.tally(ph.o[seen], ph.d[seen], t[seen], ph.w[seen], ph.batch[seen],
+                                  self.tally)
         else:
-            self.det.tally(ph.o, ph.d, t, ph.w, ph.batch, self.tally)
+            n, f = self.det.tally(ph.o, ph.d, t, ph.w, ph.batch, self.tally)
+        self.crossings += n
+        self.crossed_flux += f
         miss = tri < 0
         if miss.any() and self.axes is not None:
             gone = ph.take(miss)
@@ -284,6 +293,8 @@ class ForwardTracer:
         w0, nsplit = ph.w0[src], ph.nsplit[src]
         if self.near is not None:
             src, ev, cw, w0, nsplit = self._split(p, src, ev, cw, w0, nsplit)
+        if self.window is not None:
+            src, ev, cw, w0, nsplit = self._windowed(p, src, ev, cw, w0, nsplit)
         d, n = ph.d[src], nf[src]
         new_d = d.copy()
         diff_r, diff_t, spec_t, mir = ev == 0, ev == 1, ev == 2, ev == 3
@@ -306,7 +317,35 @@ class ForwardTracer:
         out = Photons(p[src] + n * (self.eps * side)[:, None], new_d, cw, w0,
                       ph.ndiff[src] + diffuse, ph.nspec[src] + (spec_t | mir), ph.batch[src],
                       nsplit, ph.direct[src] & spec_t)
-        return out if self.guide is None else out.take(out.w > 0)
+        if self.guide is not None:
+            out = out.take(out.w > 0)
+        return out if self.window is None else self._aimed(out)
+
+    def _aimed(self, out: Photons) -> Photons:
+        """Photons heading at the target sphere above the window's level split into
+        identical copies (flux and reference flux divided); they part at their next event."""
+        assert self.window is not None
+        reps = self.window.aimed_copies(out.o, out.d, out.w)
+        if not (reps > 1).any():
+            return out
+        self.window_splits += int((reps - 1).sum())
+        idx = np.repeat(np.arange(len(out)), reps)
+        f = np.repeat(1.0 / reps, reps)
+        split = out.take(idx)
+        split.w, split.w0 = split.w * f, split.w0 * f
+        return split
+
+    def _windowed(self, p: np.ndarray, src: np.ndarray, ev: np.ndarray, cw: np.ndarray,
+                  w0: np.ndarray, nsplit: np.ndarray) -> tuple[np.ndarray, ...]:
+        """Children above the weight window split into copies (flux and reference flux
+        divided: the expected tally is unchanged), each to draw its own direction."""
+        assert self.window is not None
+        reps = self.window.copies(p[src], cw)
+        if not (reps > 1).any():
+            return src, ev, cw, w0, nsplit
+        self.window_splits += int((reps - 1).sum())
+        return (np.repeat(src, reps), np.repeat(ev, reps), np.repeat(cw / reps, reps),
+                np.repeat(w0 / reps, reps), np.repeat(nsplit, reps))
 
     def _split(self, p: np.ndarray, src: np.ndarray, ev: np.ndarray, cw: np.ndarray,
                w0: np.ndarray, nsplit: np.ndarray) -> tuple[np.ndarray, ...]:
