@@ -122,15 +122,14 @@ def scan_crowns(tmp: Path, args: argparse.Namespace) -> tuple[str, list[tuple[fl
     """Build and scan each original crown; the project text with the scan scenarios added,
     and (built, inverted from the scan, the crown kept in the returns' hull) leaf areas m² per
     realisation."""
-    import numpy as np
 
     from radtree.config import load_project
-    from radtree.lidar.scanner import AlsScan, ground_plane, scan_als
+    from radtree.lidar.scanner import AlsScan
     from radtree.lidar.voxels import tree_voxels
     from radtree.site.frame import FacadeFrame
     from radtree.trees.build import build_tree
     from radtree.trees.points_hull import sharpen, vertical_beams
-    from radtree.trees.synthetic_scan import GROUND, HIGH_VEGETATION, leaf_area_m2, write_scan
+    from radtree.trees.synthetic_scan import leaf_area_m2, scan_crown, write_scan
     from radtree.trees.volume import mean_cos
 
     toml = tmp / "radtree.toml"
@@ -141,13 +140,7 @@ def scan_crowns(tmp: Path, args: argparse.Namespace) -> tuple[str, list[tuple[fl
     areas = []
     for k in range(1, max(args.seeds, args.turbid_seeds if args.turbid else 0) + 1):
         leaf = build_tree(project, project.scenario(f"orig{k}"), frame).meshes[0]
-        lo = tuple(leaf.vertices[:, :2].min(axis=0) - 3.0)
-        hi = tuple(leaf.vertices[:, :2].max(axis=0) + 3.0)
-        gv, gf = ground_plane(lo, hi)
-        pts = scan_als(np.vstack([leaf.vertices, gv]),
-                       np.vstack([leaf.faces, gf + len(leaf.vertices)]),
-                       np.r_[np.full(len(leaf.faces), HIGH_VEGETATION), np.full(len(gf), GROUND)],
-                       lo, hi, AlsScan(pulse_density_m2=20.0, seed=k))
+        pts = scan_crown(leaf.vertices, leaf.faces, AlsScan(pulse_density_m2=20.0, seed=k))
         path = write_scan(pts, tmp / "data" / f"scan{k}.laz")
         grid = tree_voxels(path, mean_cos(project.tree.louvers), args.voxel)
         crown, _ = sharpen(grid, beams=vertical_beams(path))

@@ -99,13 +99,13 @@ def test_facade_direct_sun_of_crowns_rebuilt_from_scans(tmp_path: Path) -> None:
     from radtree.config import load_project
     from radtree.engines.common.turbid import MediumTracer
     from radtree.engines.common.voxels import VoxelTracer
-    from radtree.lidar.scanner import AlsScan, ground_plane, scan_als
+    from radtree.lidar.scanner import AlsScan
     from radtree.light.sun import local_datetime, sun_position
     from radtree.media_voxels import media_parts
     from radtree.sensor_grid import facade_circle, facade_dense_grid
     from radtree.site.frame import FacadeFrame
     from radtree.trees.build import build_tree
-    from radtree.trees.synthetic_scan import GROUND, HIGH_VEGETATION, write_scan
+    from radtree.trees.synthetic_scan import scan_crown, write_scan
 
     p = tmp_path / "study"
     shutil.copytree(MENDOZA, p, ignore=shutil.ignore_patterns(
@@ -121,14 +121,7 @@ def test_facade_direct_sun_of_crowns_rebuilt_from_scans(tmp_path: Path) -> None:
     frame = FacadeFrame(project.street.facade_azimuth_deg)
     for k in seeds:
         leaf = build_tree(project, project.scenario(f"orig{k}"), frame).meshes[0]
-        lo = tuple(leaf.vertices[:, :2].min(axis=0) - 3.0)
-        hi = tuple(leaf.vertices[:, :2].max(axis=0) + 3.0)
-        gv, gf = ground_plane(lo, hi)
-        pts = scan_als(np.vstack([leaf.vertices, gv]),
-                       np.vstack([leaf.faces, gf + len(leaf.vertices)]),
-                       np.r_[np.full(len(leaf.faces), HIGH_VEGETATION),
-                             np.full(len(gf), GROUND)],
-                       lo, hi, AlsScan(pulse_density_m2=20.0, seed=k))
+        pts = scan_crown(leaf.vertices, leaf.faces, AlsScan(pulse_density_m2=20.0, seed=k))
         write_scan(pts, p / "data" / f"scan{k}.laz")
     sensors = {"sensors": facade_circle(project.sensors, frame).points,
                "map": facade_dense_grid(project.sensors, frame).points}

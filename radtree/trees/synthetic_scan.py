@@ -116,6 +116,18 @@ def scan_street(trees: list[StreetTree], scan: AlsScan, lv: Louvers = STREET_LOU
             (lo, hi))
 
 
+def scan_crown(vertices: np.ndarray, faces: np.ndarray, scan: AlsScan,
+               margin_m: float = 3.0) -> ScanPoints:
+    """One crown mesh (its leaves, class 5) scanned over the ground plane z = 0 (class 2) by
+    ``scan``, across the crown's extent plus ``margin_m`` (m)."""
+    lo = tuple(vertices[:, :2].min(axis=0) - margin_m)
+    hi = tuple(vertices[:, :2].max(axis=0) + margin_m)
+    gv, gf = ground_plane(lo, hi)
+    return scan_als(np.vstack([vertices, gv]), np.vstack([faces, gf + len(vertices)]),
+                    np.r_[np.full(len(faces), HIGH_VEGETATION), np.full(len(gf), GROUND)],
+                    lo, hi, scan)
+
+
 def write_scan(points: ScanPoints, out: str | Path, offset: tuple[float, float] = (0.0, 0.0),
                crs: str | None = None) -> Path:
     """The scan as LAS/LAZ, x, y shifted by ``offset`` (m)."""
