@@ -240,7 +240,7 @@ def test_annual_matches_point_in_time_rtrace(tmp_path, room):
     same-sky 2.7 %, box sky-model 8.1 %) stay ≥ 1.8 points below each tolerance.
     """
     from radtree.annual.coefficients import CoefficientRunner, TraceParams, points_text
-    from radtree.annual.run import combine
+    from radtree.annual.combine import combine
     from radtree.annual.skymatrix import epw_to_wea, sky_matrix, sun_positions
     from radtree.engines.radiance.binaries import run
     from radtree.engines.radiance.sky import parse_gendaylit, perez_sky_suffix

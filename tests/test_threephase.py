@@ -61,7 +61,7 @@ def test_three_phase_sky_matches_rcontrib_on_the_same_bsdf_crown(runs):
     crown — radtree/annual/threephase.py; on the office example the two agree within 0.8 pp
     of UDI, benchmarks/threephase.py --same-crown)."""
     from radtree.annual.coefficients import CoefficientRunner, TraceParams
-    from radtree.annual.run import LUX
+    from radtree.annual.combine import LUX
     from radtree.annual.skymatrix import sky_matrix
     from radtree.annual.threephase import ThreePhase, _scene_with, crown_models, state_xmls
     from radtree.pipeline.assemble import make_scene
@@ -209,7 +209,8 @@ def test_sun_through_the_explicit_crown(runs, tmp_path):
     recomputed here on the annual scenes in a fresh folder, it agrees to float precision
     (shadow rays only: deterministic)."""
     from radtree.annual.coefficients import CoefficientRunner, TraceParams
-    from radtree.annual.run import LUX, annual_scenes, choose_scenarios
+    from radtree.annual.combine import LUX
+    from radtree.annual.run import annual_scenes, choose_scenarios
     from radtree.annual.weather_year import annual_weather
 
     project, first, _, _, _ = runs

@@ -52,6 +52,7 @@ import pandas as pd
 import radtree.annual.standards as standards
 from radtree.annual.branches import BranchParams, build_leaf_off
 from radtree.annual.coefficients import CoefficientRunner, TraceParams
+from radtree.annual.combine import combine
 from radtree.annual.phenology import Phenology, crown_year, phenology_of
 from radtree.annual.schedule import (
     DEFAULT_OCCUPANCY,
@@ -60,18 +61,16 @@ from radtree.annual.schedule import (
     occupied,
     parse_occupancy,
 )
-from radtree.annual.skymatrix import Suns, Wea, patch_count
+from radtree.annual.skymatrix import Wea, patch_count
 from radtree.annual.weather_year import YearInputs, annual_ground_reflectance, annual_weather
 from radtree.config import Project, Scenario, effective_project
 from radtree.errors import ConfigError
-from radtree.light.units import PHOTOPIC_RGB, WHITE_EFFICACY
 from radtree.light.weather import WeatherSource
 from radtree.log import progress
 from radtree.scene import Scene
 
 log = logging.getLogger(__name__)
 
-LUX = WHITE_EFFICACY * np.array(PHOTOPIC_RGB)  # lux per Radiance R, G, B
 VARIANTS = ("without", "leaf_on", "leaf_off")
 SUN_LW_MIN = 1e-3
 METHOD_NOTES = [
@@ -274,29 +273,6 @@ def annual_scenes(project: Project, with_sc: Scenario, without_sc: Scenario,
 
 
 # ---------------------------------------------------------------- combination
-def combine(c_sky: np.ndarray, sky: np.ndarray, c_dir: np.ndarray, suns: Suns,
-            c_ind: np.ndarray, verts: np.ndarray, weights: np.ndarray, n_hours: int
-            ) -> tuple[np.ndarray, np.ndarray]:
-    """(total, direct) lux, each (sensors, hours).
-
-    ``c_sky`` (sensors, patches, 3), ``sky`` (patches, hours, 3); ``c_dir`` (sensors, suns,
-    3); ``c_ind`` (sensors, patch vertices, 3) inter-reflected-sun coefficients indexed like
-    :func:`reinhart_directions` (row 0, the nadir, zero); ``verts``/``weights`` (suns, 3).
-    """
-    n = c_sky.shape[0]
-    total = np.zeros((n, n_hours), np.float64)
-    for ch in range(3):
-        total += LUX[ch] * (c_sky[:, :, ch].astype(np.float64) @ sky[:, :, ch].astype(np.float64))
-    direct = np.zeros((n, n_hours), np.float64)
-    if len(suns):
-        d = (c_dir.astype(np.float64) @ LUX) * suns.radiance[None, :]
-        direct[:, suns.hour_index] = d
-        ind_lux = c_ind.astype(np.float64) @ LUX  # (sensors, vertices)
-        ind = np.einsum("skj,kj->sk", ind_lux[:, verts], weights) * suns.radiance[None, :]
-        total[:, suns.hour_index] += d + ind
-    return total.astype(np.float32), direct.astype(np.float32)
-
-
 # ---------------------------------------------------------------- the run
 
 

@@ -130,8 +130,8 @@ from pathlib import Path
 import numpy as np
 
 from radtree.annual.coefficients import TraceParams, points_text, scene_text
+from radtree.annual.combine import LUX
 from radtree.annual.facets import FACETS, FacetGroup, facet_groups
-from radtree.annual.run import LUX
 from radtree.annual.skymatrix import (
     patch_count,
 )

@@ -32,6 +32,7 @@ import pandas as pd
 
 from radtree.annual import metrics as m
 from radtree.annual.coefficients import CoefficientRunner, TraceParams
+from radtree.annual.combine import combine
 from radtree.annual.weather_year import YearInputs
 
 #: grid metrics of :func:`grid_metrics` (percent; ``mean_lux`` in lux)
@@ -108,8 +109,6 @@ def year_replicates(runner: CoefficientRunner, year: YearInputs, mf: int, sun_mf
     :func:`radtree.annual.run.scene_year_lux` assembled from each replicate's sky and
     reflected-sun coefficients (the ``-ab 0`` direct sun is exact, the same in all). Their
     mean is ``scene_year_lux``'s year."""
-    from radtree.annual.run import combine
-
     if trace.replicates != sun_trace.replicates:
         raise ValueError("the sky and the reflected sun need the same number of replicates")
     _, wea, sky, suns, verts, weights, need, patch_dirs = year
