@@ -30,7 +30,7 @@ from collections.abc import Callable, Sequence
 import numpy as np
 import pandas as pd
 
-from radtree.annual import metrics as m
+import radtree.annual.metrics as m
 from radtree.annual.coefficients import CoefficientRunner, TraceParams
 from radtree.annual.combine import combine
 from radtree.annual.weather_year import YearInputs
