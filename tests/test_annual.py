@@ -18,6 +18,7 @@ from radtree.annual.skymatrix import (
     sun_patch_weights,
 )
 from radtree.errors import ConfigError
+from radtree.verify.annual import TINY_PROJECT
 from radtree.verify.annual import tiny_scene as _tiny_scene
 from tests.conftest import ROOT, copy_project, needs_radiance
 
@@ -238,59 +239,7 @@ def test_annual_matches_point_in_time_rtrace(tmp_path, room):
 
 
 # ---------------------------------------------------------------- the whole run
-TINY_TOML = """
-[project]
-name = "tiny annual test"
-
-[site]
-latitude = -32.89
-longitude = -68.83
-elevation_m = 750
-utc_offset_hours = -3
-date = "2024-12-22"
-hours = ["12:30"]
-
-[street]
-width_m = 20.0
-length_m = 40.0
-facade_azimuth_deg = 0.0
-ground_reflectance = 0.15
-
-[light]
-epw = "{epw}"
-
-[tree]
-leaf_on = "10-15"
-leaf_off = "06-01"
-form = "free"
-
-[tree.crown]
-count = 1
-radius_m = 3.0
-vertical_radius_m = 3.0
-base_height_m = 2.5
-trunk_distance_m = 3.5
-
-[tree.louvers]
-layers = 2
-slat_size_m = 0.6
-
-[sensors]
-dense_grid = false
-
-[engine]
-ab = 1
-ad = 64
-lw = 0.001
-
-[[scenario]]
-name = "with"
-model = "louvers"
-
-[[scenario]]
-name = "without"
-model = "none"
-"""
+TINY_TOML = TINY_PROJECT   # one small louvers crown (radtree.verify.annual)
 
 
 @pytest.fixture(scope="module")

@@ -22,6 +22,7 @@ from pathlib import Path
 
 import numpy as np
 
+from radtree.annual.coefficients import CoefficientRunner
 from radtree.scene import Scene
 from radtree.verify.checks import Check
 
@@ -32,6 +33,61 @@ PICKS = ((12, 22, 9.5), (12, 22, 13.5), (12, 22, 17.5), (6, 21, 10.5), (6, 21, 1
          (3, 20, 8.5))
 CLAIM = 0.05
 GROUND = 0.2
+
+#: one small louvers crown (free form) in front of the 8 façade sensors; ``{epw}`` the weather
+TINY_PROJECT = """
+[project]
+name = "tiny annual test"
+
+[site]
+latitude = -32.89
+longitude = -68.83
+elevation_m = 750
+utc_offset_hours = -3
+date = "2024-12-22"
+hours = ["12:30"]
+
+[street]
+width_m = 20.0
+length_m = 40.0
+facade_azimuth_deg = 0.0
+ground_reflectance = 0.15
+
+[light]
+epw = "{epw}"
+
+[tree]
+leaf_on = "10-15"
+leaf_off = "06-01"
+form = "free"
+
+[tree.crown]
+count = 1
+radius_m = 3.0
+vertical_radius_m = 3.0
+base_height_m = 2.5
+trunk_distance_m = 3.5
+
+[tree.louvers]
+layers = 2
+slat_size_m = 0.6
+
+[sensors]
+dense_grid = false
+
+[engine]
+ab = 1
+ad = 64
+lw = 0.001
+
+[[scenario]]
+name = "with"
+model = "louvers"
+
+[[scenario]]
+name = "without"
+model = "none"
+"""
 
 
 def tiny_scene(room: bool) -> Scene:
@@ -75,7 +131,7 @@ class DcYear:
     """The year by the daylight-coefficient method: ``total`` and ``direct`` (sensors, 8760)
     lx, the MF 1 sky coefficients ``c_sky`` and the runner that traced them."""
 
-    runner: object
+    runner: CoefficientRunner
     total: np.ndarray
     direct: np.ndarray
     c_sky: np.ndarray
@@ -86,7 +142,6 @@ def dc_year(scene: Scene, wea, folder: Path, params) -> DcYear:
     """``scene``'s grid ``g`` over ``wea``'s year (coefficients in ``folder``) as
     ``radtree annual`` combines it: MF 1 sky, exact direct sun, reflected sun interpolated
     from the MF 1 patch centres."""
-    from radtree.annual.coefficients import CoefficientRunner
     from radtree.annual.combine import combine
     from radtree.annual.skymatrix import (
         reinhart_directions,
@@ -117,23 +172,32 @@ def hour_index(wea, month: int, day: int, hour: float) -> int:
 
 
 def point_in_time(scene: Scene, scene_rad: Path, wea, i: int, folder: Path,
-                  ref_ad: int) -> tuple[np.ndarray, str]:
-    """rtrace (-ab 2 -ad ``ref_ad`` -lw 1e-5, rtrace's clock seed) of grid ``g`` under
-    gendaylit's sky and sun for WEA row ``i``: lux per sensor, and gendaylit's output."""
+                  ref_ad: int, *, grids: tuple[str, ...] = ("g",), rho: float = GROUND,
+                  ab: int = 2) -> tuple[np.ndarray, str]:
+    """rtrace (-ab ``ab`` -ad ``ref_ad`` -lw 1e-5, rtrace's clock seed) of ``grids`` (in
+    order) under gendaylit's sky and sun for WEA row ``i`` (ground reflectance ``rho``): lux
+    per sensor, and gendaylit's output."""
     from radtree.annual.coefficients import points_text
     from radtree.engines.radiance.binaries import run
     from radtree.engines.radiance.sky import perez_sky_suffix
 
     cmd = ["gendaylit", str(wea.month[i]), str(wea.day[i]), f"{wea.hour[i]:.3f}", "-a",
            f"{wea.latitude}", "-o", f"{wea.longitude_west}", "-m", f"{wea.meridian_west}",
-           "-W", f"{wea.dni[i]:g}", f"{wea.dhi[i]:g}", "-O", "0", "-g", f"{GROUND}"]
+           "-W", f"{wea.dni[i]:g}", f"{wea.dhi[i]:g}", "-O", "0", "-g", f"{rho:g}"]
     text = run(cmd).decode()
     (folder / "hour.sky").write_text(text + perez_sky_suffix(True))
     octree = folder / "hour.oct"
     run(["oconv", str(scene_rad), str(folder / "hour.sky")], stdout_path=octree)
-    out = run(["rtrace", "-h", "-I", "-ab", "2", "-ad", str(ref_ad), "-aa", "0", "-lw", "1e-5",
-               str(octree)], stdin=points_text(scene, ["g"]).encode())
+    out = run(["rtrace", "-h", "-I", "-ab", str(ab), "-ad", str(ref_ad), "-aa", "0", "-lw",
+               "1e-5", str(octree)], stdin=points_text(scene, list(grids)).encode())
     return np.loadtxt(out.decode().splitlines(), ndmin=2)[:, :3] @ LUX, text
+
+
+def office_epw() -> Path:
+    """The office example's generated Mendoza weather year."""
+    from radtree.verify.compare import MENDOZA
+
+    return MENDOZA.parent / "office-block" / "data" / "mendoza_generated.epw"
 
 
 def annual_checks(picks=PICKS, *, ad: int = 1024, ref_ad: int = 2048,
@@ -142,14 +206,11 @@ def annual_checks(picks=PICKS, *, ad: int = 1024, ref_ad: int = 2048,
     largest relative miss, annual vs point-in-time, within :data:`CLAIM`."""
     from radtree.annual.coefficients import TraceParams
     from radtree.annual.skymatrix import epw_to_wea
-    from radtree.verify.compare import MENDOZA
-
-    epw = MENDOZA.parent / "office-block" / "data" / "mendoza_generated.epw"
     scene = tiny_scene(False)
     out = []
     with tempfile.TemporaryDirectory(prefix="radtree-verify-annual-") as tmp:
         work = Path(folder or tmp)
-        wea = epw_to_wea(epw, work / "year.wea")
+        wea = epw_to_wea(office_epw(), work / "year.wea")
         year = dc_year(scene, wea, work / "coef", TraceParams(ab=2, ad=ad, lw=1e-5))
         for m, d, h in picks:
             i = hour_index(wea, m, d, h)
@@ -161,4 +222,43 @@ def annual_checks(picks=PICKS, *, ad: int = 1024, ref_ad: int = 2048,
                 f"{len(ref)} sensors (lx)", "radiance", float(ref[k]), float(year.total[k, i]),
                 CLAIM * float(ref[k]), CLAIM * float(ref[k]),
                 "rtrace -ab 2 -ad 2048 under gendaylit -W from the same WEA row"))
+    return out
+
+
+def crown_annual_checks(picks=PICKS, *, ad: int = 1024, ref_ad: int = 4096,
+                        folder: Path | None = None) -> list[Check]:
+    """``radtree annual`` (:func:`radtree.annual.run.compute_annual`) of :data:`TINY_PROJECT`
+    at ``-ab 2 -ad`` ``ad`` ``-lw 1e-5``: the leafed crown's scene at each picked hour against
+    rtrace of the same scene (its façade grid) under gendaylit — one row per hour, the
+    façade sensor with the largest relative miss, claim :data:`CLAIM`."""
+    from radtree.annual.coefficients import scene_text
+    from radtree.annual.run import AnnualOptions, annual_scenes, choose_scenarios, compute_annual
+    from radtree.config import load_project
+
+    out = []
+    with tempfile.TemporaryDirectory(prefix="radtree-verify-annual-crown-") as tmp:
+        root = Path(folder or tmp) / "tiny"
+        root.mkdir(parents=True, exist_ok=True)
+        (root / "radtree.toml").write_text(TINY_PROJECT.format(epw=office_epw().as_posix()))
+        project = load_project(root, overrides={"engine.ab": 2, "engine.ad": ad,
+                                                "engine.lw": 1e-5})
+        result = compute_annual(project, options=AnnualOptions(nproc=1))
+        with_sc, without_sc, _ = choose_scenarios(project, result.options)
+        scenes, grids, _, _ = annual_scenes(project, with_sc, without_sc,
+                                            result.options.branches, result.options.grids)
+        scene, rho, wea = scenes["leaf_on"], result.ground_reflectance, result.wea
+        rad = root / "verify_leaf_on.rad"
+        rad.write_text(scene_text(scene, rho))
+        for m, d, h in picks:
+            i = hour_index(wea, m, d, h)
+            ref, _ = point_in_time(scene, rad, wea, i, root, ref_ad, grids=tuple(grids),
+                                   rho=rho, ab=result.trace.ab)
+            ann = np.concatenate([result.total["leaf_on"][g][:, i] for g in grids])
+            k = int(np.argmax(np.abs(ann / ref - 1.0)))
+            out.append(Check(
+                f"annual (daylight coefficients, -ab 2 -ad {ad}) of one louvers crown (leaf on) "
+                f"vs rtrace under gendaylit sky + sun, {m:02d}-{d:02d} {h:g} h, the worst of "
+                f"{len(ref)} façade sensors (lx)", "radiance", float(ref[k]), float(ann[k]),
+                CLAIM * float(ref[k]), CLAIM * float(ref[k]),
+                f"rtrace -ab 2 -ad {ref_ad} of the same leafed scene under gendaylit -W"))
     return out

@@ -43,8 +43,10 @@ def fit_checks(strength: float = 18000.0, noise_lux: float = 20.0, seed: int = 1
     project = load_project(MENDOZA)
     ctx, effect = EffectContext(project), get_effect("sky_diffuse")
     ref = 12000.0
-    st = replace(effect.strength(ctx, Scenario("x", "louvers")), mode="linear", grid=(ref,),
-                 reference=ref)
+    base = effect.strength(ctx, Scenario("x", "louvers"))
+    if base is None:
+        raise RuntimeError("sky_diffuse has no strength to fit")
+    st = replace(base, mode="linear", grid=(ref,), reference=ref)
     sig = Signature(effect, "linear", st, np.array([ref]), SHAPE[None, :], np.zeros((1, 3)),
                     ["higher", "intermediate", "lower"], [], ref)
     rng = np.random.default_rng(seed)

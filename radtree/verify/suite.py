@@ -90,13 +90,14 @@ def _radiance() -> bool:
     return find_radiance() is not None
 
 
-def _annual(_full: bool, _b: list[str] | None) -> list[Check]:
-    """Annual vs point-in-time rtrace at six hours (needs Radiance; ≈ 5 s)."""
+def _annual(full: bool, _b: list[str] | None) -> list[Check]:
+    """Annual vs point-in-time rtrace at six hours on open ground (needs Radiance; ≈ 5 s);
+    with ``--full`` also ``radtree annual`` of one louvers crown."""
     if not _radiance():
         return []
-    from radtree.verify.annual import annual_checks
+    from radtree.verify.annual import annual_checks, crown_annual_checks
 
-    return annual_checks()
+    return annual_checks() + crown_annual_checks() if full else annual_checks()
 
 
 def _honeybee(full: bool, _b: list[str] | None) -> list[Check]:
@@ -108,7 +109,7 @@ def _honeybee(full: bool, _b: list[str] | None) -> list[Check]:
         return [missing_extra("Honeybee export", "honeybee")]
     from radtree.verify.honeybee import honeybee_checks
 
-    return honeybee_checks(trace=_radiance())
+    return honeybee_checks(trace=_radiance(), repeats=8 if full else 0)
 
 
 def _energyplus(full: bool, _b: list[str] | None) -> list[Check]:
