@@ -313,3 +313,21 @@ def test_a_missing_extra_is_unresolved_not_passed():
 
     c = missing_extra("Honeybee export", "honeybee")
     assert c.status == "unresolved" and "pip install 'radtree[honeybee]'" in c.check
+
+
+def test_honeybee_export_traced_by_honeybee_radiance():
+    pytest.importorskip("honeybee_radiance")
+    from radtree.engines.radiance.binaries import find_radiance
+    from radtree.verify.honeybee import honeybee_checks
+    from radtree.verify.page import path_of
+
+    if find_radiance() is None:
+        pytest.skip("Radiance not installed")
+    checks = honeybee_checks()
+    for c in checks:
+        print(c)
+        assert c.status == "pass", c
+        assert path_of(c) == ["Honeybee export"]
+    count, direct, lit = checks
+    assert count.got == count.expected > 1000
+    assert direct.got < 0.005 and "3 sunlit sensors" in direct.check and lit.got == 0
