@@ -227,28 +227,6 @@ def annual_checks(picks=PICKS, *, ad: int = 1024, ref_ad: int = 2048,
     return out
 
 
-def patch_means(sky, mf: int, n: int = 10) -> np.ndarray:
-    """Mean radiance (visible, W sr⁻¹ m⁻²) of a :class:`radtree.light.perez.PerezSky` over every
-    Reinhart patch (row 0: the ground brightness), equal-area sub-samples."""
-    from radtree.annual.skymatrix import _rnaz
-
-    alpha = np.radians(90.0 / (mf * 7 + 0.5))
-    vals = [sky.ground_brightness]
-    u = (np.arange(n) + 0.5) / n
-    for r in range(7 * mf + 1):
-        naz = _rnaz(r, mf)
-        lo = np.sin(r * alpha)
-        hi = np.sin((r + 1) * alpha) if r < 7 * mf else 1.0
-        alts = np.arcsin(lo + u * (hi - lo))
-        for c in range(naz):
-            w = 2 * np.pi / naz
-            azs = c * w + (u - 0.5) * w if naz > 1 else u * 2 * np.pi
-            A, Z = np.meshgrid(alts, azs)
-            d = np.stack([np.sin(Z) * np.cos(A), np.cos(Z) * np.cos(A), np.sin(A)], -1)
-            vals.append(float(sky.luminance(d).mean()))
-    return np.array(vals) / 179.0
-
-
 def crown_annual_checks(picks=PICKS, *, ad: int = 1024, ref_ad: int = 4096,
                         folder: Path | None = None) -> list[Check]:
     """``radtree annual`` (:func:`radtree.annual.run.compute_annual`, its defaults: sky MF 1,

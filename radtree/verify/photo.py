@@ -9,7 +9,7 @@
 * :func:`crown_round_trip` / :func:`round_trip_checks` — a crown of known leaf area density
   and leaf angles (ellipsoidal x = 2, mean tilt 38.5°, no clumping) rendered by radtree as three
   upward photos, fitted back into a crown: density within 5 %, mean tilt within 3°, the refit
-  crown's façade illuminance (NumPy engine, same seeds) within 3 % of the original's — issue
+  crown's façade illuminance (the seeded engine — NumPy — same seeds) within 3 % of the original's — issue
   16's round trip, the body of ``tests/test_photo_crowns.py``'s round-trip test.
 """
 
@@ -82,6 +82,7 @@ def crown_round_trip(root: Path, size: int = 500) -> RoundTrip:
     """Render, fit and trace the known crown in ``root`` (a copy of the Mendoza example):
     three upward photos of ``size`` pixels (crowns of seeds 1–3), one fit."""
     from radtree.config import Scenario, load_project
+    from radtree.engines.registry import seeded_engine
     from radtree.hemi.synthetic import save_png
     from radtree.photo.render import render_scenario
     from radtree.pipeline.assemble import make_scene
@@ -114,7 +115,7 @@ def crown_round_trip(root: Path, size: int = 500) -> RoundTrip:
     fit = make_scene(proj, refit).tree.photo["fitted"]
     lad = make_scene(proj, original).tree.info["density_per_m3"] * 0.15 ** 2
     out = simulate_project(replace(proj, scenarios=(original, refit)),
-                           options=RunOptions(engine="numpy"))
+                           options=RunOptions(engine=seeded_engine().name))
     if out is None:
         raise RuntimeError("the round trip's simulation returned nothing")
     mean = out.table[out.table["grid"] == "facade"].groupby("scenario")["lux"].mean()
@@ -125,8 +126,10 @@ def crown_round_trip(root: Path, size: int = 500) -> RoundTrip:
 
 def round_trip_checks(folder: Path | None = None) -> list[Check]:
     """:func:`crown_round_trip` on a copy of the Mendoza example as three checks."""
+    from radtree.engines.registry import seeded_engine
     from radtree.verify.compare import MENDOZA
 
+    engine = seeded_engine().name
     with tempfile.TemporaryDirectory(prefix="radtree-verify-photo-") as tmp:
         root = Path(folder or tmp) / "mendoza"
         shutil.copytree(MENDOZA, root, ignore=shutil.ignore_patterns(
@@ -139,6 +142,6 @@ def round_trip_checks(folder: Path | None = None) -> list[Check]:
                   LAD_CLAIM * rt.lad, LAD_CLAIM * rt.lad, ref),
             Check(f"{what}, mean leaf tilt (°)", "-", rt.tilt, rt.tilt_fit, TILT_CLAIM_DEG,
                   TILT_CLAIM_DEG, ref + " (ellipsoidal x = 2)"),
-            Check(f"{what}, façade mean at 12:30 (lx), NumPy, same seeds", "numpy", rt.facade,
-                  rt.facade_fit, FACADE_CLAIM * rt.facade, FACADE_CLAIM * rt.facade,
+            Check(f"{what}, façade mean at 12:30 (lx), seeded engine, same seeds", engine,
+                  rt.facade, rt.facade_fit, FACADE_CLAIM * rt.facade, FACADE_CLAIM * rt.facade,
                   "the known crown traced by the same engine and seeds")]
