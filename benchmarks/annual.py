@@ -26,8 +26,6 @@ import tempfile
 import time
 from pathlib import Path
 
-import numpy as np
-
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
@@ -36,21 +34,18 @@ from radtree.annual.publish import run_annual  # noqa: E402
 from radtree.annual.report import grid_summary  # noqa: E402
 from radtree.annual.run import AnnualOptions, AnnualResult, annual_scenes  # noqa: E402
 from radtree.config import load_project  # noqa: E402
-from radtree.light.units import PHOTOPIC_RGB, WHITE_EFFICACY  # noqa: E402
 
-LUX = WHITE_EFFICACY * np.array(PHOTOPIC_RGB)
 VALIDATE_HOURS = [(12, 22, 12.5), (6, 21, 12.5), (3, 20, 9.5)]
 
 
 def validate(result: AnnualResult, work: Path) -> None:
-    """Point-in-time rtrace against the annual values for a few hours."""
-    from radtree.annual.coefficients import points_text, scene_text
-    from radtree.engines.radiance.binaries import run
-    from radtree.engines.radiance.sky import perez_sky_suffix
+    """Point-in-time rtrace against the annual values for a few hours
+    (:func:`radtree.verify.annual.point_in_time`, as ``radtree verify --full``'s annual rows)."""
+    from radtree.annual.coefficients import scene_text
+    from radtree.annual.run import choose_scenarios
+    from radtree.verify.annual import hour_index, point_in_time
 
     project, wea = result.project, result.wea
-    from radtree.annual.run import choose_scenarios
-
     with_sc, without_sc, _ = choose_scenarios(project, result.options)
     scenes, grids, _, _ = annual_scenes(project, with_sc, without_sc, result.options.branches,
                                         result.options.grids)
@@ -60,21 +55,12 @@ def validate(result: AnnualResult, work: Path) -> None:
         scene = scenes[variant]
         rad = work / f"validate_{variant}.rad"
         rad.write_text(scene_text(scene, rho))
-        pts = points_text(scene, grids).encode()
         for m, d, h in VALIDATE_HOURS:
-            i = int(np.flatnonzero((wea.month == m) & (wea.day == d) & (wea.hour == h))[0])
-            cmd = ["gendaylit", str(m), str(d), f"{h:.3f}", "-a", f"{wea.latitude}", "-o",
-                   f"{wea.longitude_west}", "-m", f"{wea.meridian_west}", "-W",
-                   f"{wea.dni[i]:g}", f"{wea.dhi[i]:g}", "-O", "0", "-g", f"{rho:.4f}"]
-            sky = work / "validate.sky"
-            sky.write_text(run(cmd).decode() + perez_sky_suffix(True))
-            octree = work / "validate.oct"
-            run(["oconv", str(rad), str(sky)], stdout_path=octree)
+            i = hour_index(wea, m, d, h)
             t0 = time.perf_counter()
-            out = run(["rtrace", "-h", "-I", "-ab", str(t.ab), "-ad", str(max(4 * t.ad, 4096)),
-                       "-aa", "0", "-lw", f"{min(t.lw, 1e-5):g}", str(octree)], stdin=pts)
+            ref, _ = point_in_time(scene, rad, wea, i, work, max(4 * t.ad, 4096),
+                                   grids=tuple(grids), rho=rho, ab=t.ab)
             secs = time.perf_counter() - t0
-            ref = np.loadtxt(out.decode().splitlines(), ndmin=2)[:, :3] @ LUX
             start = 0
             parts = []
             for g in grids:

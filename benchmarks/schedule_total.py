@@ -61,102 +61,46 @@ import math
 import sys
 from pathlib import Path
 
-import numpy as np
-
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
 from radtree.config import load_project  # noqa: E402
-from radtree.engines.common.geometry import scene_geometry, scene_optics  # noqa: E402
-from radtree.engines.forward import ForwardSettings, trace_forward  # noqa: E402
-from radtree.engines.forward.direct import direct_sun  # noqa: E402
-from radtree.engines.numpy.scenes import sky_state  # noqa: E402
-from radtree.export.transmittance import (  # noqa: E402
-    crown_envelopes,
-    crown_models,
-    own_meshes,
-    own_tracer,
-    scattered_forward,
-    transmittances,
-)
+from radtree.export.transmittance import crown_envelopes, crown_models, own_meshes  # noqa: E402
 from radtree.pipeline.assemble import facade_frame  # noqa: E402
-from radtree.scene import Scene, SensorGrid  # noqa: E402
+from radtree.verify.compare import MENDOZA  # noqa: E402
+from radtree.verify.energyplus import (  # noqa: E402
+    DNI,
+    SUNS,
+    WHOLE,
+    cross_section,
+    scattered_through,
+    schedule_total,
+    sun_vector,
+)
 
-MENDOZA = Path(__file__).resolve().parents[1] / "examples" / "mendoza-street"
-
-SUNS = ((90.0, 0.0), (60.0, 135.0), (40.0, 250.0))  # (altitude, compass azimuth) degrees
-DNI = 1000.0
 NEAR = 8.0            # half-side of the near pyranometer square / crown radius
 PATCH = 0.5           # its patch side / crown radius
-WHOLE = 2048.0        # half-side of the whole-plane detector / crown radius
 RAYS = 65536          # schedule rays per sun position …
 SEEDS = (1, 2, 3, 4)  # … and seeds
 PHOTONS = 4_000_000
 
 
-def _sun_vector(alt: float, az: float) -> np.ndarray:
-    a, z = math.radians(alt), math.radians(az)
-    return np.array([math.cos(a) * math.sin(z), math.cos(a) * math.cos(z), math.sin(a)])
-
-
-def _plane(crown, s: np.ndarray, half: float, patch: float) -> tuple[SensorGrid, float]:
-    """Sun-facing sensors on a square lattice of spacing ``patch`` × r tiling a square of
-    half-side ``half`` × r perpendicular to ``s`` just behind the crown; the patch side (m)."""
-    c = crown.vertices.mean(axis=0)
-    r = float(np.linalg.norm(crown.vertices - c, axis=1).max())
-    u = np.cross([0.0, 0.0, 1.0], s) if abs(s[2]) < 0.999 else np.array([1.0, 0.0, 0.0])
-    u /= np.linalg.norm(u)
-    v = np.cross(s, u)
-    side = patch * r
-    n = max(1, int(round(2 * half / patch)))    # patches along a side
-    t = (np.arange(n) - (n - 1) / 2) * side
-    a, b = np.meshgrid(t, t)
-    pts = c - s * (r + 0.05) + a.ravel()[:, None] * u + b.ravel()[:, None] * v
-    return SensorGrid("facade", pts, np.tile(s, (len(pts), 1))), side
-
-
-def _scattered_through(own, materials, crown, s, alt, az, half, patch
-                       ) -> tuple[float, float]:
-    """Scattered flux (lm) crossing the square behind the crown, per batch mean and its
-    standard error, at ``DNI``."""
-    grid, side = _plane(crown, s, half, patch)
-    scene = Scene(own, materials, {"facade": grid})
-    st = sky_state("none", altitude=alt, azimuth=az, dni=DNI, ground_glow=False)
-    res = trace_forward(scene, st, ForwardSettings(
-        photons=PHOTONS, max_bounces=8, direct_sun=True, focus_m=min(side, crown_size(crown)),
-        patch_m=side, seed=5))
-    geo = scene_geometry(scene, "auto", 1)
-    at_points = direct_sun(geo, scene_optics(scene, st, geo.material_names), grid, s, DNI)
-    per_batch = (res.batches["facade"] - at_points).sum(axis=1) * side ** 2
-    return float(per_batch.mean()), float(per_batch.std(ddof=1) / math.sqrt(len(per_batch)))
-
-
-def crown_size(crown) -> float:
-    """The crown's radius about its vertices' mean (m)."""
-    c = crown.vertices.mean(axis=0)
-    return float(np.linalg.norm(crown.vertices - c, axis=1).max())
-
-
 def compare(scenario: str, form: str) -> None:
+    """Schedule total vs the near square and the whole plane (the helpers of
+    :mod:`radtree.verify.energyplus`, whose ``total_checks`` runs the whole-plane rows in
+    ``radtree verify --full``)."""
     proj = load_project(MENDOZA, overrides={"tree.form": form})
     sc = proj.scenario(scenario)
     frame = facade_frame(proj)
     crown = crown_envelopes(proj, sc, frame)[0]
     meshes, _, materials, _ = crown_models(proj, sc, frame)
     own = own_meshes(crown, meshes)
-    solid = crown.solid()
     for alt, az in SUNS:
-        s = _sun_vector(alt, az)
-        beam = float(transmittances(own_tracer(crown, meshes, materials), crown, s, RAYS)[0])
-        scat = np.array([scattered_forward(crown, meshes, materials, s, RAYS, seed=k)[0]
-                         for k in SEEDS])
-        total, total_se = beam + scat.mean(), scat.std(ddof=1) / math.sqrt(len(scat))
-        # the beam's cross-section: the crown's solid projected along the sun (Cauchy)
-        across = 0.25 * float(np.abs(np.cross(solid.triangles[:, 1] - solid.triangles[:, 0],
-                                              solid.triangles[:, 2] - solid.triangles[:, 0])
-                                     @ s).sum())
+        s = sun_vector(alt, az)
+        beam, total, total_se = schedule_total(crown, meshes, materials, s, RAYS, SEEDS)
+        across = cross_section(crown, s)
         out = []
         for half, patch in ((NEAR, PATCH), (WHOLE, 2 * WHOLE)):
-            flux, se = _scattered_through(own, materials, crown, s, alt, az, half, patch)
+            flux, se = scattered_through(own, materials, crown, (alt, az), half, patch, PHOTONS)
             ref, ref_se = beam + flux / (DNI * across), se / (DNI * across)
             out.append(f"{ref:.4f} ± {ref_se:.4f} ({total / ref - 1:+.2%} ± "
                        f"{math.hypot(total_se / ref, total * ref_se / ref ** 2):.2%})")

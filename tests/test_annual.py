@@ -18,6 +18,8 @@ from radtree.annual.skymatrix import (
     sun_patch_weights,
 )
 from radtree.errors import ConfigError
+from radtree.verify.annual import TINY_PROJECT
+from radtree.verify.annual import tiny_scene as _tiny_scene
 from tests.conftest import ROOT, copy_project, needs_radiance
 
 OFFICE_EPW = ROOT / "examples" / "office-block" / "data" / "mendoza_generated.epw"
@@ -159,40 +161,6 @@ def test_generated_epw_is_labelled_and_complete(tmp_path):
 
 
 # ---------------------------------------------------------------- method vs rtrace
-def _tiny_scene(room: bool):
-    from radtree.optics import Material, Plastic
-    from radtree.scene import Mesh, Scene, SensorGrid, quad
-
-    L = 60.0
-    meshes = [quad("ground", "ground", np.array([[-L, -L, 0], [L, -L, 0], [L, L, 0],
-                                                 [-L, L, 0]]))]
-    mats: dict[str, Material] = {"ground": Plastic("ground", 0.2)}
-    pts = [[0, 0, 1.5]] * 5
-    nrm = [[0, 0, 1], [0, 1, 0], [1, 0, 0], [0, -1, 0], [-1, 0, 0]]
-    if room:
-        # a black box 4 × 4 × 3 m, opening 3 × 2.4 m facing north
-        x0, x1, y0, y1, z0, z1 = 30.0, 34.0, -4.0, 0.0, 0.0, 3.0
-        box = [
-            [[x0, y0, z0], [x1, y0, z0], [x1, y0, z1], [x0, y0, z1]],
-            [[x0, y0, z0], [x0, y1, z0], [x0, y1, z1], [x0, y0, z1]],
-            [[x1, y0, z0], [x1, y1, z0], [x1, y1, z1], [x1, y0, z1]],
-            [[x0, y0, z1], [x1, y0, z1], [x1, y1, z1], [x0, y1, z1]],
-            [[x0, y0, 0.001], [x1, y0, 0.001], [x1, y1, 0.001], [x0, y1, 0.001]],
-            # north wall with an opening x 30.5–33.5, z 0.3–2.7
-            [[x0, y1, z0], [30.5, y1, z0], [30.5, y1, z1], [x0, y1, z1]],
-            [[33.5, y1, z0], [x1, y1, z0], [x1, y1, z1], [33.5, y1, z1]],
-            [[30.5, y1, z0], [33.5, y1, z0], [33.5, y1, 0.3], [30.5, y1, 0.3]],
-            [[30.5, y1, 2.7], [33.5, y1, 2.7], [33.5, y1, z1], [30.5, y1, z1]],
-        ]
-        meshes.append(Mesh.merge("box", "black", [quad(f"b{i}", "black", np.array(q, float))
-                                                  for i, q in enumerate(box)]))
-        mats["black"] = Plastic("black", 0.0)
-        pts += [[32.0, -1.0, 0.8], [32.0, -2.5, 0.8], [32.0, -0.5, 1.5]]
-        nrm += [[0, 0, 1], [0, 0, 1], [0, 1, 0]]
-    return Scene(meshes, mats, {"g": SensorGrid("g", np.array(pts, float),
-                                                np.array(nrm, float))})
-
-
 def _patch_means(sky, mf: int, n: int = 10) -> np.ndarray:
     """Mean radiance (visible, W sr⁻¹ m⁻²) of a :class:`radtree.light.perez.PerezSky` over every
     Reinhart patch (row 0: the ground brightness), equal-area sub-samples."""
@@ -215,10 +183,6 @@ def _patch_means(sky, mf: int, n: int = 10) -> np.ndarray:
     return np.array(vals) / 179.0
 
 
-PICKS = [(12, 22, 9.5), (12, 22, 13.5), (12, 22, 17.5), (6, 21, 10.5), (6, 21, 14.5),
-         (3, 20, 8.5)]
-
-
 @needs_radiance
 @pytest.mark.parametrize("room", [False, True], ids=["open-ground", "box-with-opening"])
 def test_annual_matches_point_in_time_rtrace(tmp_path, room):
@@ -239,11 +203,10 @@ def test_annual_matches_point_in_time_rtrace(tmp_path, room):
     (sd ≤ 0.25 % at twice the samples). The largest misses measured (open 3.2 %, box
     same-sky 2.7 %, box sky-model 8.1 %) stay ≥ 1.8 points below each tolerance.
     """
-    from radtree.annual.coefficients import CoefficientRunner, TraceParams, points_text
-    from radtree.annual.combine import combine
-    from radtree.annual.skymatrix import epw_to_wea, sky_matrix, sun_positions
-    from radtree.engines.radiance.binaries import run
-    from radtree.engines.radiance.sky import parse_gendaylit, perez_sky_suffix
+    from radtree.annual.coefficients import TraceParams
+    from radtree.annual.skymatrix import epw_to_wea
+    from radtree.engines.radiance.sky import parse_gendaylit
+    from radtree.verify.annual import PICKS, dc_year, hour_index, point_in_time
 
     scene = _tiny_scene(room)
     wea = epw_to_wea(OFFICE_EPW, tmp_path / "year.wea")
@@ -251,42 +214,22 @@ def test_annual_matches_point_in_time_rtrace(tmp_path, room):
     # sensors inside the box see the sky through the opening only: more samples (both sides)
     ad, ref_ad = (4096, 8192) if room else (1024, 2048)
     params = TraceParams(ab=2, ad=ad, lw=1e-5)
-    runner = CoefficientRunner(scene, ["g"], tmp_path / "coef", 0.2)
-    sky = sky_matrix(wea, 1, 0.2)
-    suns = sun_positions(wea, tmp_path / "coef")
-    verts, weights = sun_patch_weights(suns.direction, 1)
-    need = np.unique(verts)
-    need = need[need > 0]
-    centres = reinhart_directions(1)
-    c_ind = np.zeros((runner.n_sensors, len(centres), 3), np.float32)
-    c_ind[:, need] = (runner.suns("pN", centres[need], 2, params)
-                      - runner.suns("p0", centres[need], 0, params))
-    c_sky = runner.sky(1, params)
-    total, direct = combine(c_sky, sky, runner.suns("direct", suns.direction, 0, params),
-                            suns, c_ind, verts, weights, wea.n_hours)
+    year = dc_year(scene, wea, tmp_path / "coef", params)
+    runner, total, direct = year.runner, year.total, year.direct
     assert total.shape == (runner.n_sensors, 8760)
     night = (wea.dni + wea.dhi) == 0
     assert night.sum() > 4000
     assert np.all(total[:, night] == 0) and np.all(direct[:, night] == 0)
     assert np.all(direct <= total + 1e-3)
-    sun_part = total - np.einsum("spc,phc->sh", c_sky * LUX, sky)
+    sun_part = total - np.einsum("spc,phc->sh", year.c_sky * LUX, year.sky)
     c_sky4 = runner.sky(4, params) if room else None
     tolerance = np.full(runner.n_sensors, 0.05)
     if room:
         tolerance[6] = 0.15  # deep in the box: low northern sky only (see the docstring)
 
-    octree = tmp_path / "hour.oct"
     for m, d, h in PICKS:
-        i = int(np.flatnonzero((wea.month == m) & (wea.day == d) & (wea.hour == h))[0])
-        cmd = ["gendaylit", str(m), str(d), f"{h:.3f}", "-a", f"{wea.latitude}", "-o",
-               f"{wea.longitude_west}", "-m", f"{wea.meridian_west}", "-W", f"{wea.dni[i]:g}",
-               f"{wea.dhi[i]:g}", "-O", "0", "-g", "0.2"]
-        text = run(cmd).decode()
-        (tmp_path / "hour.sky").write_text(text + perez_sky_suffix(True))
-        run(["oconv", str(runner.scene_rad), str(tmp_path / "hour.sky")], stdout_path=octree)
-        out = run(["rtrace", "-h", "-I", "-ab", "2", "-ad", str(ref_ad), "-aa", "0",
-                   "-lw", "1e-5", str(octree)], stdin=points_text(scene, ["g"]).encode())
-        ref = np.loadtxt(out.decode().splitlines(), ndmin=2)[:, :3] @ LUX
+        i = hour_index(wea, m, d, h)
+        ref, text = point_in_time(scene, runner.scene_rad, wea, i, tmp_path, ref_ad)
         rel = np.abs(total[:, i] / ref - 1.0)
         assert np.all(rel < tolerance), (m, d, h, ref.round(0), total[:, i].round(0))
         if c_sky4 is not None:
@@ -296,59 +239,7 @@ def test_annual_matches_point_in_time_rtrace(tmp_path, room):
 
 
 # ---------------------------------------------------------------- the whole run
-TINY_TOML = """
-[project]
-name = "tiny annual test"
-
-[site]
-latitude = -32.89
-longitude = -68.83
-elevation_m = 750
-utc_offset_hours = -3
-date = "2024-12-22"
-hours = ["12:30"]
-
-[street]
-width_m = 20.0
-length_m = 40.0
-facade_azimuth_deg = 0.0
-ground_reflectance = 0.15
-
-[light]
-epw = "{epw}"
-
-[tree]
-leaf_on = "10-15"
-leaf_off = "06-01"
-form = "free"
-
-[tree.crown]
-count = 1
-radius_m = 3.0
-vertical_radius_m = 3.0
-base_height_m = 2.5
-trunk_distance_m = 3.5
-
-[tree.louvers]
-layers = 2
-slat_size_m = 0.6
-
-[sensors]
-dense_grid = false
-
-[engine]
-ab = 1
-ad = 64
-lw = 0.001
-
-[[scenario]]
-name = "with"
-model = "louvers"
-
-[[scenario]]
-name = "without"
-model = "none"
-"""
+TINY_TOML = TINY_PROJECT   # one small louvers crown (radtree.verify.annual)
 
 
 @pytest.fixture(scope="module")

@@ -17,47 +17,13 @@ from radtree.config import EngineParams, load_project
 from radtree.light.sky import SkyState
 from radtree.light.sun import local_datetime, sun_position
 from radtree.pipeline.assemble import facade_frame
+from radtree.verify.energyplus import SMALL_PROJECT
 
 from .conftest import needs_radiance
 
 pytest.importorskip("honeybee.model")   # a guard only: CI installs radtree[honeybee]
 
-TOML = """
-[site]
-name = "Mendoza"
-latitude = -32.89
-longitude = -68.83
-elevation_m = 750
-utc_offset_hours = -3
-date = "2023-12-22"
-hours = ["13:30"]
-[light]
-direct_normal = "dni.csv"
-[tree]
-leaf_on = "10-15"
-leaf_off = "06-01"
-form = "free"
-[tree.crown]
-count = 1
-radius_m = 3.0
-vertical_radius_m = 2.5
-base_height_m = 3.0
-trunk_distance_m = 4.0
-[tree.louvers]
-layers = 2
-cover_fraction = 0.6
-slat_size_m = 0.5
-transmittance = 0.5
-specular_fraction = 0.5
-[sensors]
-dense_grid = false
-[engine]
-ab = 0
-lw = 0.000001
-[[scenario]]
-name = "crown"
-model = "louvers"
-"""
+TOML = SMALL_PROJECT   # one free louvers crown (radtree.verify.energyplus)
 RAYS = 16
 
 

@@ -29,56 +29,11 @@ import pytest
 
 from radtree.config import load_project
 from radtree.errors import ConfigError
+from radtree.verify.honeybee import CROWN, TOML, office_model, write_project
 
 from .conftest import needs_radiance
 
 pytest.importorskip("honeybee.model")   # a guard only: CI installs radtree[honeybee]
-
-TOML = """
-[site]
-name = "honeybee test"
-latitude = -32.89
-longitude = -68.83
-utc_offset_hours = -3
-date = "2024-12-22"
-hours = ["13:30"]
-honeybee = "model.hbjson"
-honeybee_grid_spacing_m = 1.0
-[light]
-direct_normal = "dni.csv"
-sky = "perez"
-diffuse_horizontal_lux = 12000
-[sensors]
-dense_grid = false
-count = 1
-[engine]
-ab = 2
-ad = 256
-[[scenario]]
-name = "open"
-model = "none"
-"""
-
-
-def office_model(ratio: float = 0.4):
-    """One room 3 × 5 × 2.5 m behind the plane y = 0, window in its north wall."""
-    from honeybee.model import Model
-    from honeybee.room import Room
-    from ladybug_geometry.geometry3d import Point3D
-
-    room = Room.from_box("office", 3, 5, 2.5, origin=Point3D(-1.5, -5, 0))
-    north = [f for f in room.faces if f.normal.y > 0.99][0]
-    north.apertures_by_ratio(ratio)
-    return Model("office_model", [room], units="Meters", tolerance=0.01)
-
-
-def write_project(folder: Path, model=None, toml: str = TOML, dni: float = 80000) -> Path:
-    folder.mkdir(parents=True, exist_ok=True)
-    (model or office_model()).to_hbjson("model", folder=str(folder))
-    (folder / "dni.csv").write_text(f"time,direct_normal_lux\n13:30,{dni:g}\n")
-    (folder / "radtree.toml").write_text(toml)
-    return folder
-
 
 def test_reader_meshes_materials_grids(tmp_path):
     from radtree.pipeline.assemble import make_scene
@@ -170,25 +125,6 @@ def rtrace_lux(build: Path, hb_files: list[Path], opts: list[str], pts: str) -> 
     out = subprocess.run(["rtrace", *opts, str(oct_path)], cwd=build, input=pts.encode(),
                          capture_output=True, check=True, env=env).stdout
     return rgb_to_lux(np.loadtxt(out.decode().splitlines()).reshape(-1, 3))
-
-
-CROWN = """
-[tree]
-form = "free"
-[tree.crown]
-count = 1
-radius_m = 2.5
-vertical_radius_m = 2.0
-base_height_m = 2.0
-trunk_distance_m = 2.5
-[tree.louvers]
-arrangement = "volume"
-crossings = 4
-[[scenario]]
-name = "crown"
-model = "louvers"
-description = "one radtree crown in front of the window"
-"""
 
 
 @pytest.fixture(scope="module")

@@ -162,49 +162,16 @@ def test_round_trip_known_crown_render_fit(tmp_path):
     """A crown of known leaf area density, ellipsoidal leaf angles (x = 2, mean tilt 38.5°)
     and no clumping (random slats) → three synthetic upward photos (crowns of seeds 1–3) →
     one fit: density within 5 %, mean tilt within 3°, and the refit crown's façade
-    illuminance (NumPy, same seeds) within 3 % of the original's."""
-    from radtree.hemi.synthetic import save_png
-    from radtree.photo.render import render_scenario
-    from radtree.pipeline.assemble import make_scene
-    from radtree.pipeline.options import RunOptions
-    from radtree.pipeline.simulate import simulate_project
-    from radtree.trees.leaf_angles import mean_tilt
-    from radtree.trees.photo import PhotoSource
+    illuminance (NumPy, same seeds) within 3 % of the original's
+    (:func:`radtree.verify.photo.crown_round_trip`, also a row of ``radtree verify --full``)."""
+    from radtree.verify.photo import crown_round_trip
 
-    root = copy_project(tmp_path / "rt")
-    proj = load_project(root, overrides={
-        "site.hours": ["12:30"], "sensors.dense_grid": False, "sensors.dense_hours": [],
-        "engine.rays": 128, "tree.crown.count": 1, "tree.crown.trunk_distance_m": 8.0,
-        "tree.crown.radius_m": 7.0, "tree.crown.vertical_radius_m": 2.5,
-        "tree.crown.base_height_m": 3.0, "tree.photo_x_m": 1.0, "tree.photo_distance_m": 8.0,
-        "tree.photo_height_m": 1.0, "tree.photo_zenith_deg": 55.0})
-    known = {"louvers.arrangement": "volume", "louvers.inclination_distribution": "ellipsoidal",
-             "louvers.ellipsoid_x": 2.0, "louvers.crossings": 3.0, "louvers.slat_size_m": 0.15}
-    src = PhotoSource(root / "none.png", "equidistant", None, "upward", "tree.photo", 55.0)
-    (root / "photos").mkdir()
-    for k in (1, 2, 3):
-        r = render_scenario(proj, Scenario(name="T", model="louvers", form="free", switches={
-            **known, "louvers.seed": k}), 500, src=src)
-        save_png(r.image, root / "photos" / f"crown{k}.png")
-    m = r.geometry.mask
-    original = Scenario(name="T", model="louvers", reflection="traced", form="free",
-                        switches=known)
-    refit = Scenario(name="R", model="louvers", reflection="traced", form="free", switches={
-        **known, "louvers.ellipsoid_x": 1.0, "louvers.crossings": 1.0,
-        "tree.photo": str(root / "photos"), "tree.lens": "equidistant",
-        "tree.mask": [m.cx, m.cy, m.radius], "tree.photo_direction": "upward"})
-    fitted = make_scene(proj, refit).tree
-    fit = fitted.photo["fitted"]
-    true_lad = make_scene(proj, original).tree.info["density_per_m3"] * 0.15**2
-    assert fit["leaf_area_density_m2_m3"] == pytest.approx(true_lad, rel=0.05)
-    assert abs(fit["mean_tilt_deg"] - mean_tilt(2.0)) <= 3.0
-    assert fit["photos"] == 3 and fit["lad_sd"] > 0     # several photos → one fit + spread
-    assert len(fitted.photo["photos"]) == 3
-    run = replace(proj, scenarios=(original, refit))
-    out = simulate_project(run, options=RunOptions(engine="numpy"))
-    assert out is not None
-    mean = out.table[out.table["grid"] == "facade"].groupby("scenario")["lux"].mean()
-    assert mean["R"] == pytest.approx(mean["T"], rel=0.03)
+    rt = crown_round_trip(copy_project(tmp_path / "rt"))
+    print(rt)
+    assert rt.lad_fit == pytest.approx(rt.lad, rel=0.05)
+    assert abs(rt.tilt_fit - rt.tilt) <= 3.0
+    assert rt.photos == 3 and rt.lad_sd > 0  # several photos → one fit + spread
+    assert rt.facade_fit == pytest.approx(rt.facade, rel=0.03)
 
 
 def test_fixed_inclination_option_keeps_30_degrees(mendoza):

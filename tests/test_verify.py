@@ -106,6 +106,8 @@ def _fake_suite(monkeypatch, checks):
     monkeypatch.setattr(suite, "turbid_checks", lambda **_k: [])
     monkeypatch.setattr(suite, "voxel_checks", lambda **_k: [])
     monkeypatch.setattr(suite, "mist_checks", lambda **_k: [])
+    for group in ("annual", "honeybee", "energyplus", "gltf", "photo", "diagnose"):
+        monkeypatch.setitem(suite.GROUPS, group, lambda _full, _b: [])
 
 
 @pytest.mark.parametrize("got, code", [(1.0, 0), (2.0, 1)])
@@ -238,3 +240,94 @@ def test_forward_target_leaves_the_backward_error_room_within_the_claim():
     assert forward_target([0.002]) == pytest.approx(math.sqrt(0.006 ** 2 - 0.002 ** 2))
     assert forward_target([0.002, 0.0051]) == pytest.approx(math.sqrt(0.006 ** 2 - 0.0051 ** 2))
     assert forward_target([0.01]) == 0.002                 # no room: the floor
+
+
+# --------------------------------------------------------------------------- output paths
+
+
+def test_every_output_path_has_a_group_of_its_own():
+    from radtree.verify.page import ENGINE_PATHS, OUTPUT_PATHS
+    from radtree.verify.suite import GROUPS
+
+    others = set(OUTPUT_PATHS) - set(ENGINE_PATHS) - {"three-phase chain", "crown BSDF"}
+    assert {"annual", "honeybee", "energyplus", "gltf", "photo", "diagnose"} <= set(GROUPS)
+    assert len(others) == 6
+
+
+def test_gltf_read_back_without_trimesh():
+    from radtree.verify.gltf import gltf_checks
+    from radtree.verify.page import path_of
+
+    checks = gltf_checks()
+    for c in checks:
+        print(c)
+        assert c.status == "pass", c
+        assert path_of(c) == ["glTF export"]
+    count, area, box = checks
+    assert count.expected == count.got > 5000                # every triangle, mesh by mesh
+    assert area.expected == pytest.approx(316.78, abs=0.01)  # the louvers dome's leaf area
+    assert abs(area.got - area.expected) < 1e-5 * area.expected
+    assert box.got < 1e-5
+
+
+def test_idf_read_back_by_a_plain_parser():
+    from radtree.verify.energyplus import idf_checks, idf_objects
+    from radtree.verify.page import path_of
+
+    assert idf_objects("A,\n 1, ! one\n 2;\nB, x;") == [["A", "1", "2"], ["B", "x"]]
+    checks = idf_checks(rays=4)
+    for c in checks:
+        print(c)
+        assert c.status == "pass", c
+        assert path_of(c) == ["EnergyPlus schedules"]
+    values, shadow, shades = checks
+    assert values.got <= 5e-7 and shadow.got == 2.0 and shades.got == shades.expected > 100
+
+
+def test_synthetic_fisheye_openness_and_lai():
+    from radtree.verify.page import path_of
+    from radtree.verify.photo import hemi_checks, poisson_openness
+
+    assert poisson_openness(0.0) == pytest.approx(1.0, abs=1e-6)
+    openness, lai = hemi_checks(size=1000)
+    print(openness, lai)
+    assert openness.expected == pytest.approx(0.1485, abs=1e-4)
+    assert openness.status == lai.status == "pass"
+    assert path_of(lai) == ["photo round trip"]
+
+
+def test_diagnose_fit_recovers_the_injected_strength():
+    from radtree.verify.diagnose import fit_checks
+    from radtree.verify.page import path_of
+
+    (c,) = fit_checks()
+    print(c)
+    assert c.status == "pass" and c.got != c.expected      # noisy, yet within 3 SE
+    assert c.tolerance == pytest.approx(3 * 12000 * 20 / np.linalg.norm(
+        [200, 210, 190, 180, 190, 200, 215]))
+    assert path_of(c) == ["diagnose self-test"]
+
+
+def test_a_missing_extra_is_unresolved_not_passed():
+    from radtree.verify.suite import missing_extra
+
+    c = missing_extra("Honeybee export", "honeybee")
+    assert c.status == "unresolved" and "pip install 'radtree[honeybee]'" in c.check
+
+
+def test_honeybee_export_traced_by_honeybee_radiance():
+    pytest.importorskip("honeybee_radiance")
+    from radtree.engines.radiance.binaries import find_radiance
+    from radtree.verify.honeybee import honeybee_checks
+    from radtree.verify.page import path_of
+
+    if find_radiance() is None:
+        pytest.skip("Radiance not installed")
+    checks = honeybee_checks()
+    for c in checks:
+        print(c)
+        assert c.status == "pass", c
+        assert path_of(c) == ["Honeybee export"]
+    count, direct, lit = checks
+    assert count.got == count.expected > 1000
+    assert direct.got < 0.005 and "3 sunlit sensors" in direct.check and lit.got == 0

@@ -11,15 +11,17 @@ from radtree.cli.errors import CHECK_FAILED
 from radtree.cli.options import CONTEXT
 
 GROUP_NAMES = ("layers", "spheres", "energy", "media", "agreement-dome", "agreement-free",
-               "threephase")
+               "threephase", "annual", "honeybee", "energyplus", "gltf", "photo", "diagnose")
 
 
 @click.command("verify", context_settings=CONTEXT)
 @click.option("--full", is_flag=True,
               help="The long version: every row sampled until its 3 standard errors fit its "
                    "claim, scenarios A and B of the reduced dome and the free volume crown at "
-                   "10:30, 12:30 and 14:30 against NumPy, at 12:30 against Radiance, and the "
-                   "three-phase closure.")
+                   "10:30, 12:30 and 14:30 against NumPy, at 12:30 against Radiance, the "
+                   "three-phase closure, the annual method against point-in-time rtrace, the "
+                   "EnergyPlus schedule against pyranometers, the photo round trip of a known "
+                   "crown and the diagnose self-test.")
 @click.option("--out", "-o", type=click.Path(dir_okay=False, path_type=Path),
               default=Path("verify.csv"), show_default=True, help="Where to write the table.")
 @click.option("--page", type=click.Path(dir_okay=False, path_type=Path), default=None,
@@ -41,7 +43,9 @@ def verify_command(full: bool, out: Path, page: Path | None, backward: tuple[str
     """Physics checks: uncollided transmission through random leaf layers against
     exp(−G·LAI/cos θ) and under floating spheres against its numerical integral, energy
     conservation, turbid, voxel and mist crowns, forward vs backward engines on the reduced
-    Mendoza louvers dome and a free volume crown. Writes OUT (check, engine, expected, got,
+    Mendoza louvers dome and a free volume crown; then every output path beyond the engines:
+    annual, Honeybee and EnergyPlus exports, glTF, the photo round trip, the diagnose
+    self-test. Writes OUT (check, engine, expected, got,
     tolerance, claim, status, passed, reference, seconds)."""
     from radtree.verify.suite import read_checks, run_verify
 
