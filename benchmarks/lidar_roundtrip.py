@@ -84,7 +84,42 @@ from dataclasses import replace
 from pathlib import Path
 
 
+def _seeds(text: str) -> list[int]:
+    """"0-5" → [0, 1, 2, 3, 4, 5]; "0,2" → [0, 2]."""
+    out: list[int] = []
+    for part in text.split(","):
+        a, _, b = part.partition("-")
+        out.extend(range(int(a), int(b or a) + 1))
+    return out
+
+
 def main() -> int:
+    from radtree.lidar.scanner import AlsScan
+    from radtree.trees.synthetic_scan import STREET_LOUVERS
+
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--pulses", type=float, default=20.0, help="pulses per m²")
+    ap.add_argument("--crossings", type=float, default=STREET_LOUVERS.crossings)
+    ap.add_argument("--sidelap", type=float, default=AlsScan.sidelap)
+    ap.add_argument("--footprint-rays", type=int, default=1)
+    ap.add_argument("--seed", type=int, default=0, help="the scanner's seed")
+    ap.add_argument("--seeds", default=None,
+                    help="several scanner seeds (e.g. 0-5): a table per seed and a summary")
+    ap.add_argument("--vertical", action="store_true",
+                    help="invert along vertical columns (the former method) instead of beams")
+    args = ap.parse_args()
+    seeds = _seeds(args.seeds) if args.seeds else [args.seed]
+    summary = [run(args, seed) for seed in seeds]
+    if len(seeds) > 1:
+        print(f"\n{'seed':>4} {'det':>4} {'match':>5} {'h ok':>5} {'h max':>6} {'d ok':>5} "
+              f"{'d max%':>6} {'LA ok':>5} {'LA max%':>7} {'LA med%':>7} {'LA tot':>6}")
+        for seed, row in zip(seeds, summary):
+            print(f"{seed:4d} " + " ".join(row))
+    return 0
+
+
+def run(args: argparse.Namespace, seed: int) -> list[str]:
+    """One scan (scanner seed ``seed``): prints the per-tree table, returns the summary row."""
     import numpy as np
 
     from radtree.lidar.clip import write_subset
@@ -102,20 +137,11 @@ def main() -> int:
     )
     from radtree.trees.volume import mean_cos
 
-    ap = argparse.ArgumentParser()
-    ap.add_argument("--pulses", type=float, default=20.0, help="pulses per m²")
-    ap.add_argument("--crossings", type=float, default=STREET_LOUVERS.crossings)
-    ap.add_argument("--sidelap", type=float, default=AlsScan.sidelap)
-    ap.add_argument("--footprint-rays", type=int, default=1)
-    ap.add_argument("--seed", type=int, default=0, help="the scanner's seed")
-    ap.add_argument("--vertical", action="store_true",
-                    help="invert along vertical columns (the former method) instead of beams")
-    args = ap.parse_args()
     lv = replace(STREET_LOUVERS, crossings=args.crossings)
     trees = synthetic_street()
     t0 = time.perf_counter()
     scan = AlsScan(pulse_density_m2=args.pulses, sidelap=args.sidelap,
-                   footprint_rays=args.footprint_rays, seed=args.seed)
+                   footprint_rays=args.footprint_rays, seed=seed)
     pts, areas, _ = scan_street(trees, scan, lv)
     beams = None if args.vertical else {
         "origins": lambda t: scan.origins(t.xyz, line=t.source_id),
@@ -136,7 +162,7 @@ def main() -> int:
     seconds = time.perf_counter() - t0
     print(f"synthetic street: {len(trees)} trees, crossings {lv.crossings:g}, slats "
           f"{lv.slat_size_m:g} m at {lv.inclination_deg:g}°; scan {args.pulses:g} pulses/m², "
-          f"sidelap {args.sidelap:g}, {args.footprint_rays} ray(s) a pulse, seed {args.seed}, "
+          f"sidelap {args.sidelap:g}, {args.footprint_rays} ray(s) a pulse, seed {seed}, "
           f"{len(pts.xyz)} points, spacing {tile.spacing_m():.2f} m; inversion "
           f"{'vertical columns' if args.vertical else 'along the beams'}; {seconds:.1f} s")
     print(f"{'tree':5} {'det':5} {'dist':>5} {'h true':>7} {'h det':>6} {'dh':>6} "
@@ -158,9 +184,13 @@ def main() -> int:
         print(f"{name}: max |error| {scale * v.max():.2f} {unit}, median "
               f"{scale * np.median(v):.2f} {unit}, within ±{scale * lim:g} {unit}: "
               f"{int(np.sum(v <= lim))}/{len(v)} — {'met' if v.max() <= lim else 'NOT met'}")
+    la_tot = sum(r[3] for r in rows)
     print(f"voxel size {rows[0][5]:g} m ({DEFAULT_SPACINGS:g} point spacings); total leaf area true "
-          f"{sum(areas.values()):.0f} m², from the scan {sum(r[3] for r in rows):.0f} m²")
-    return 0
+          f"{sum(areas.values()):.0f} m², from the scan {la_tot:.0f} m²", flush=True)
+    return [f"{len(seg.trees):4d}", f"{len(rows):5d}", f"{int(np.sum(dh_a <= 0.5)):5d}",
+            f"{dh_a.max():6.2f}", f"{int(np.sum(dd_a <= 0.1)):5d}", f"{100 * dd_a.max():6.1f}",
+            f"{int(np.sum(dla_a <= 0.1)):5d}", f"{100 * dla_a.max():7.1f}",
+            f"{100 * np.median(dla_a):7.1f}", f"{la_tot:6.0f}"]
 
 
 if __name__ == "__main__":
