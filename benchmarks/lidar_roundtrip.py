@@ -11,6 +11,25 @@ vertical columns. Detected trees are matched one-to-one to the true trunks withi
 Targets: tree count exact, heights ±0.5 m, crown diameters ±10 %, leaf area ±10 % (each tree).
 The façade part of the issue's round trip is ``benchmarks/lidar_facade.py``.
 
+Scanner seeds 0–5 (``--seeds 0-5``), 2026-12-07 14:44 UTC, load 8.7 on 2 cores, 199 s wall
+(33–41 s a seed), after the segmentation's one top per dome (:mod:`radtree.lidar.segment`;
+before, seeds 1 and 2 split S02 into two tops):
+
+    seed  trees  heights ≤ 0.5 m (max)  diameters ≤ 10 % (max)  leaf area ≤ 10 % (max, median)
+       0  20/20       20/20 (0.33 m)         20/20 (6.9 %)            20/20 ( 9.3 %, 4.0 %)
+       1  20/20       20/20 (0.30 m)         20/20 (6.2 %)            19/20 (13.3 %, 3.2 %)
+       2  20/20       20/20 (0.32 m)         20/20 (5.5 %)            18/20 (12.8 %, 3.9 %)
+       3  20/20       20/20 (0.26 m)         20/20 (6.6 %)            18/20 (13.7 %, 3.3 %)
+       4  20/20       20/20 (0.29 m)         20/20 (6.2 %)            19/20 (10.2 %, 3.6 %)
+       5  20/20       20/20 (0.28 m)         20/20 (6.0 %)            20/20 ( 7.3 %, 2.8 %)
+
+Tree count exact, heights and diameters met at every seed; leaf area ±10 % for every tree at
+seeds 0 and 5 only (114 of 120 tree scans; totals 776–794 m² for 770 m²) — the target as
+the issue states it (each tree) is NOT met at seeds 1–4. S02 is one tree at every seed
+(+7.2 % and −0.8 % at seeds 1 and 2, was −24 / −35 % as the half of a split crown); the
+misses: S04 +13.3 % (seed 1), S17 +12.8 % and S10 +10.0 % (seed 2), S17 +13.7 % and S10
++10.1 % (seed 3), S05 +10.2 % (seed 4) — the scan noise described below, all over.
+
 Measured 2026-12-07 (load 17–24 on 2 cores, 50–150 s each), with the inversion of
 :mod:`radtree.lidar.voxels` along the beams as it now is by default (½ added to both counts;
 beams clipped to the crown envelope, the hull of the tree's returns pushed out by one point
@@ -71,7 +90,7 @@ mean inside the envelope):
   0.85–1.2 m here.
 
     python benchmarks/lidar_roundtrip.py [--pulses 20] [--crossings 2] [--sidelap 0.3]
-        [--footprint-rays 1] [--seed 0] [--vertical]
+        [--footprint-rays 1] [--seed 0 | --seeds 0-5] [--vertical]
 """
 
 from __future__ import annotations

@@ -1,8 +1,12 @@
 """Louvers crowns filled voxel by voxel from a tree's point cloud (``[tree] points``).
 
 The points (LAS/LAZ of one tree with its ground points, e.g. from ``radtree lidar clip``)
-become a grid of plant area density (:mod:`radtree.lidar.voxels`: Beer–Lambert inversion along
-vertical beams, voxel size ``tree.points_voxel_m`` or 5 point spacings; or, for terrestrial
+become a grid of plant area density (:mod:`radtree.lidar.voxels`: Beer–Lambert inversion, voxel
+size ``tree.points_voxel_m`` or 5 point spacings; airborne files along each beam rebuilt from
+its LAS scan angle and flight line when the file gives them (``tree.points_beams`` =
+"scan_angle", the default; :mod:`radtree.lidar.scan_angle`; ``benchmarks/lidar_als_user.py``:
+the 20 street trees clipped from the synthetic tile within 10 % for 20/20 trees against 9/20
+as vertical columns, scanner seed 0), else along vertical beams; or, for terrestrial
 scans whose positions ``tree.points_scans`` lists, along every beam from its scanner,
 :mod:`radtree.lidar.beams`, voxel size ``tree.points_voxel_m`` or :data:`TLS_VOXEL_M`; the
 projection G of the slats' own leaf angles — ``louvers.inclination_deg`` or its ellipsoidal distribution, which
@@ -194,6 +198,7 @@ def build_points_louvers(spec: CrownRowSpec, tree: Tree, source: str | None = No
             "points_inverted_leaf_area_m2": inv.leaf_area_m2, "points_cell_m": grid.size_m,
             "points_hull_unreached": float(unreached),
             "points_scan_positions": float(scan_positions(tree)),
+            "points_airborne_beams": float(airborne_beams(tree)),
             "points_height_m": float(len(z) * inv.size_m), "slats_cut": float(cut),
             "slats_dropped": float(dropped), "slat_mean_area_m2": lv.slat_size_m**2}
     for zk, ak in zip(z, area):
@@ -261,4 +266,6 @@ def _beams_text(info: dict[str, float]) -> str:
     if n:
         return (f"every beam of {n} terrestrial scan position{'s' if n > 1 else ''} (sky shots "
                 "included)")
+    if info.get("points_airborne_beams"):
+        return "each airborne beam from its scan angle and flight line"
     return "vertical beams"
