@@ -85,6 +85,15 @@ in the hull +0.8 % (mean of 32). Expectations — MET: sensors 10:30 vox/turb 0.
 (its standard error 13 %: the originals' 26 % scatter); map 13:30 1.017 ± 0.010 (7/8). The
 rebuilt crowns now shade the map 6.5 % less than the originals (open − crown 5 242 against
 5 605 lx; turbid 3.5 %: 5 233 against 5 423 lx).
+With ``tree.points_beams = "scan_angle"`` (the default since the scans carry LAS scan angles:
+each beam followed from its scan angle and flight line, :mod:`radtree.lidar.scan_angle`),
+``--seeds 8 --turbid-seeds 16`` (2026-12-07 15:10 UTC, load 4.9–7.4, 251 s wall, 121 s CPU):
+leaf area inverted −2.3 %, in the hull +0.8 % (mean of 16). Expectations vox/turb: sensors
+10:30 1.001 ± 0.003, 13:30 1.062 ± 0.015 — NOT met (worst 6.2 %) —, map 13:30 1.018 ± 0.004.
+Slats: 1.006 ± 0.004 (8/8), 1.036 ± 0.144 (1/8), map 1.010 ± 0.012 (7/8). The figures above
+are of vertical columns (``points_beams = "vertical"``), which keep the 13:30 rim; see the
+CHANGELOG entry "one top per dome, seeds 0–5, the user's airborne path".
+
 ``tests/test_points_hull.py`` holds the direct-sun figures in CI (4 scans).
 
     python benchmarks/lidar_facade.py [--seeds 8] [--turbid-seeds 32] [--hours 10:30 13:30]

@@ -11,6 +11,25 @@ vertical columns. Detected trees are matched one-to-one to the true trunks withi
 Targets: tree count exact, heights ±0.5 m, crown diameters ±10 %, leaf area ±10 % (each tree).
 The façade part of the issue's round trip is ``benchmarks/lidar_facade.py``.
 
+Scanner seeds 0–5 (``--seeds 0-5``), 2026-12-07 14:44 UTC, load 8.7 on 2 cores, 199 s wall
+(33–41 s a seed), after the segmentation's one top per dome (:mod:`radtree.lidar.segment`;
+before, seeds 1 and 2 split S02 into two tops):
+
+    seed  trees  heights ≤ 0.5 m (max)  diameters ≤ 10 % (max)  leaf area ≤ 10 % (max, median)
+       0  20/20       20/20 (0.33 m)         20/20 (6.9 %)            20/20 ( 9.3 %, 4.0 %)
+       1  20/20       20/20 (0.30 m)         20/20 (6.2 %)            19/20 (13.3 %, 3.2 %)
+       2  20/20       20/20 (0.32 m)         20/20 (5.5 %)            18/20 (12.8 %, 3.9 %)
+       3  20/20       20/20 (0.26 m)         20/20 (6.6 %)            18/20 (13.7 %, 3.3 %)
+       4  20/20       20/20 (0.29 m)         20/20 (6.2 %)            19/20 (10.2 %, 3.6 %)
+       5  20/20       20/20 (0.28 m)         20/20 (6.0 %)            20/20 ( 7.3 %, 2.8 %)
+
+Tree count exact, heights and diameters met at every seed; leaf area ±10 % for every tree at
+seeds 0 and 5 only (114 of 120 tree scans; totals 776–794 m² for 770 m²) — the target as
+the issue states it (each tree) is NOT met at seeds 1–4. S02 is one tree at every seed
+(+7.2 % and −0.8 % at seeds 1 and 2, was −24 / −35 % as the half of a split crown); the
+misses: S04 +13.3 % (seed 1), S17 +12.8 % and S10 +10.0 % (seed 2), S17 +13.7 % and S10
++10.1 % (seed 3), S05 +10.2 % (seed 4) — the scan noise described below, all over.
+
 Measured 2026-12-07 (load 17–24 on 2 cores, 50–150 s each), with the inversion of
 :mod:`radtree.lidar.voxels` along the beams as it now is by default (½ added to both counts;
 beams clipped to the crown envelope, the hull of the tree's returns pushed out by one point
@@ -71,7 +90,7 @@ mean inside the envelope):
   0.85–1.2 m here.
 
     python benchmarks/lidar_roundtrip.py [--pulses 20] [--crossings 2] [--sidelap 0.3]
-        [--footprint-rays 1] [--seed 0] [--vertical]
+        [--footprint-rays 1] [--seed 0 | --seeds 0-5] [--vertical]
 """
 
 from __future__ import annotations
@@ -84,7 +103,42 @@ from dataclasses import replace
 from pathlib import Path
 
 
+def _seeds(text: str) -> list[int]:
+    """"0-5" → [0, 1, 2, 3, 4, 5]; "0,2" → [0, 2]."""
+    out: list[int] = []
+    for part in text.split(","):
+        a, _, b = part.partition("-")
+        out.extend(range(int(a), int(b or a) + 1))
+    return out
+
+
 def main() -> int:
+    from radtree.lidar.scanner import AlsScan
+    from radtree.trees.synthetic_scan import STREET_LOUVERS
+
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--pulses", type=float, default=20.0, help="pulses per m²")
+    ap.add_argument("--crossings", type=float, default=STREET_LOUVERS.crossings)
+    ap.add_argument("--sidelap", type=float, default=AlsScan.sidelap)
+    ap.add_argument("--footprint-rays", type=int, default=1)
+    ap.add_argument("--seed", type=int, default=0, help="the scanner's seed")
+    ap.add_argument("--seeds", default=None,
+                    help="several scanner seeds (e.g. 0-5): a table per seed and a summary")
+    ap.add_argument("--vertical", action="store_true",
+                    help="invert along vertical columns (the former method) instead of beams")
+    args = ap.parse_args()
+    seeds = _seeds(args.seeds) if args.seeds else [args.seed]
+    summary = [run(args, seed) for seed in seeds]
+    if len(seeds) > 1:
+        print(f"\n{'seed':>4} {'det':>4} {'match':>5} {'h ok':>5} {'h max':>6} {'d ok':>5} "
+              f"{'d max%':>6} {'LA ok':>5} {'LA max%':>7} {'LA med%':>7} {'LA tot':>6}")
+        for seed, row in zip(seeds, summary):
+            print(f"{seed:4d} " + " ".join(row))
+    return 0
+
+
+def run(args: argparse.Namespace, seed: int) -> list[str]:
+    """One scan (scanner seed ``seed``): prints the per-tree table, returns the summary row."""
     import numpy as np
 
     from radtree.lidar.clip import write_subset
@@ -102,20 +156,11 @@ def main() -> int:
     )
     from radtree.trees.volume import mean_cos
 
-    ap = argparse.ArgumentParser()
-    ap.add_argument("--pulses", type=float, default=20.0, help="pulses per m²")
-    ap.add_argument("--crossings", type=float, default=STREET_LOUVERS.crossings)
-    ap.add_argument("--sidelap", type=float, default=AlsScan.sidelap)
-    ap.add_argument("--footprint-rays", type=int, default=1)
-    ap.add_argument("--seed", type=int, default=0, help="the scanner's seed")
-    ap.add_argument("--vertical", action="store_true",
-                    help="invert along vertical columns (the former method) instead of beams")
-    args = ap.parse_args()
     lv = replace(STREET_LOUVERS, crossings=args.crossings)
     trees = synthetic_street()
     t0 = time.perf_counter()
     scan = AlsScan(pulse_density_m2=args.pulses, sidelap=args.sidelap,
-                   footprint_rays=args.footprint_rays, seed=args.seed)
+                   footprint_rays=args.footprint_rays, seed=seed)
     pts, areas, _ = scan_street(trees, scan, lv)
     beams = None if args.vertical else {
         "origins": lambda t: scan.origins(t.xyz, line=t.source_id),
@@ -136,7 +181,7 @@ def main() -> int:
     seconds = time.perf_counter() - t0
     print(f"synthetic street: {len(trees)} trees, crossings {lv.crossings:g}, slats "
           f"{lv.slat_size_m:g} m at {lv.inclination_deg:g}°; scan {args.pulses:g} pulses/m², "
-          f"sidelap {args.sidelap:g}, {args.footprint_rays} ray(s) a pulse, seed {args.seed}, "
+          f"sidelap {args.sidelap:g}, {args.footprint_rays} ray(s) a pulse, seed {seed}, "
           f"{len(pts.xyz)} points, spacing {tile.spacing_m():.2f} m; inversion "
           f"{'vertical columns' if args.vertical else 'along the beams'}; {seconds:.1f} s")
     print(f"{'tree':5} {'det':5} {'dist':>5} {'h true':>7} {'h det':>6} {'dh':>6} "
@@ -158,9 +203,13 @@ def main() -> int:
         print(f"{name}: max |error| {scale * v.max():.2f} {unit}, median "
               f"{scale * np.median(v):.2f} {unit}, within ±{scale * lim:g} {unit}: "
               f"{int(np.sum(v <= lim))}/{len(v)} — {'met' if v.max() <= lim else 'NOT met'}")
+    la_tot = sum(r[3] for r in rows)
     print(f"voxel size {rows[0][5]:g} m ({DEFAULT_SPACINGS:g} point spacings); total leaf area true "
-          f"{sum(areas.values()):.0f} m², from the scan {sum(r[3] for r in rows):.0f} m²")
-    return 0
+          f"{sum(areas.values()):.0f} m², from the scan {la_tot:.0f} m²", flush=True)
+    return [f"{len(seg.trees):4d}", f"{len(rows):5d}", f"{int(np.sum(dh_a <= 0.5)):5d}",
+            f"{dh_a.max():6.2f}", f"{int(np.sum(dd_a <= 0.1)):5d}", f"{100 * dd_a.max():6.1f}",
+            f"{int(np.sum(dla_a <= 0.1)):5d}", f"{100 * dla_a.max():7.1f}",
+            f"{100 * np.median(dla_a):7.1f}", f"{la_tot:6.0f}"]
 
 
 if __name__ == "__main__":

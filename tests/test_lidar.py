@@ -72,6 +72,28 @@ def test_three_crowns_found_with_heights_and_diameters(tile: Path) -> None:
     assert seg.trees[0].height_m > seg.trees[1].height_m > seg.trees[2].height_m
 
 
+def test_one_top_per_dome_flat_crown_and_two_crowns() -> None:
+    """A flat crown top with two maxima equal to 2 mm, 2.1 m apart (beyond the 1.5 m of the
+    window at 7 m) and a 0.7 m dip between them: one tree (the street's S02 at scanner
+    seeds 1, 2 were two). The same two maxima over a 2.2 m saddle: two trees."""
+    from radtree.lidar.segment import tree_tops
+
+    cfg = SegmentConfig()
+    chm = np.zeros((20, 20))
+    ii, jj = np.meshgrid(np.arange(20), np.arange(20), indexing="ij")
+    r = np.hypot(ii - 9.5, jj - 9.5) * 0.5          # m from the crown's centre
+    chm[r < 3.2] = 6.3                               # a flat top, 6.4 m across
+    chm[6, 8], chm[9, 11] = 6.981, 6.979             # two slat tips, 3.6 cells apart
+    tops = tree_tops(chm, 0.5, cfg)
+    assert tops.tolist() == [[6, 8]]
+    chm[r < 3.2] = 4.8                               # a 2 m saddle: two crowns
+    for i, j, h in ((6, 8, 6.981), (9, 11, 6.979)):
+        chm[np.hypot(ii - i, jj - j) * 0.5 < 0.6] = 6.3
+        chm[i, j] = h
+    tops = tree_tops(chm, 0.5, cfg)
+    assert sorted(tops.tolist()) == [[6, 8], [9, 11]]
+
+
 def test_segment_cli_writes_inventory_new_reads(tile: Path, tmp_path: Path) -> None:
     out = tmp_path / "trees.geojson"
     r = CliRunner().invoke(main, ["lidar", "segment", str(tile), "--out", str(out),

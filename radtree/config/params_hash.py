@@ -88,6 +88,8 @@ def _project_payload(project: Any) -> dict[str, Any]:
         payload["tree"].pop(key, None)
     if payload["tree"].get("points_scans") is None:   # airborne points: hashes unchanged
         payload["tree"].pop("points_scans", None)
+    if payload["tree"].get("points") is None or "points_scans" in payload["tree"]:
+        payload["tree"].pop("points_beams", None)   # no airborne points: hashes unchanged
     if project.district is not None:   # inventory inputs: relative path + content (_file_key)
         payload["district"] = d["district"]
         if payload["district"].get("turbid_above") == 500:   # at its default: hashes unchanged

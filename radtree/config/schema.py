@@ -37,6 +37,7 @@ _PHOTO = photo_fields()
 _CLUMPING = clumping_fields()
 REFLECTION_MODES = ("traced", "calculated")
 WALL_POLICIES = ("clip", "refuse")    # a crown reaching a wall (radtree.trees.wall_policy)
+POINTS_BEAMS = ("scan_angle", "vertical")   # airborne [tree] points (radtree.trees.points_crown)
 #: Presets of the louvers slat optics (the switch ``"louvers.reading"``): the study's reading
 #: (every layer fully covered, T 0.5 in the slat) and near-opaque leaves with open gaps.
 LOUVER_READINGS: dict[str, dict[str, float]] = {
@@ -216,6 +217,10 @@ class Tree(Checked):
     #: without return included; voxel size ``points_voxel_m`` or 1 m (None: airborne,
     #: vertical beams)
     points_scans: Path | None = field(default=None)
+    #: airborne ``points`` (no ``points_scans``): follow each beam from its LAS scan angle and
+    #: flight line (``scan_angle``; vertical columns when the file's angles do not give the
+    #: beams, radtree.lidar.scan_angle) or take every beam as vertical (``vertical``)
+    points_beams: str = field(default="scan_angle", metadata=meta(choices=POINTS_BEAMS))
 
     def check(self) -> None:
         if self.voxels is not None and self.points is not None:

@@ -17,7 +17,7 @@ import numpy as np
 from radtree.errors import ConfigError
 from radtree.fileio import atomic_path
 from radtree.lidar.segment import SegmentConfig, segment_tile
-from radtree.lidar.tile import _las, read_tile
+from radtree.lidar.tile import SCAN_ANGLE_STEP, _las, read_tile
 
 
 def write_subset(tile_path: str | Path, mask: np.ndarray, out: str | Path) -> Path:
@@ -38,10 +38,12 @@ def write_points(out: str | Path, xyz: np.ndarray, classification: np.ndarray,
                  return_number: np.ndarray | None = None,
                  number_of_returns: np.ndarray | None = None, crs: str | None = None,
                  scale_m: float = 0.001, *, source_id: np.ndarray | None = None,
-                 gps_time: np.ndarray | None = None) -> Path:
+                 gps_time: np.ndarray | None = None,
+                 scan_angle_deg: np.ndarray | None = None) -> Path:
     """Write points (m) as LAS 1.4 point format 6 (LAZ when ``out`` ends in ``.laz``), with a
     CRS (anything pyproj reads) when given; coordinates to ``scale_m``; the point source id
-    (flight line, scan position) and GPS time (s) when given."""
+    (flight line, scan position), GPS time (s) and scan angle (degrees; LAS 1.4 stores it
+    in steps of 0.006°) when given."""
     import laspy
 
     out = Path(out)
@@ -64,6 +66,9 @@ def write_points(out: str | Path, xyz: np.ndarray, classification: np.ndarray,
         las.point_source_id = np.asarray(source_id, np.int64) % 65536   # LAS: uint16
     if gps_time is not None and len(gps_time):
         las.gps_time = np.asarray(gps_time, float)
+    if scan_angle_deg is not None and len(scan_angle_deg):
+        las.scan_angle = np.clip(np.round(np.asarray(scan_angle_deg, float) / SCAN_ANGLE_STEP),
+                                 -30000, 30000).astype(np.int16)
     return _write(las, out)
 
 

@@ -13,9 +13,11 @@ its swath each line lands pulses on its own jittered grid of ``pulse_density_m2`
 (on the ground, per pass; seeded), fired in the vertical plane across the line, so a pulse's
 zenith angle is its across-track scan angle (≤ atan(swath / 2 / altitude)). Every return
 records its flight line (LAS ``point_source_id``, :attr:`ScanPoints.line`) and its pulse's
-emission time (LAS ``gps_time``, :attr:`ScanPoints.time`: pulse index / ``PULSE_RATE_HZ``):
-with the flight geometry these give each beam's path (:meth:`AlsScan.origins`), which the
-voxel inversion follows (:mod:`radtree.lidar.beams`).
+emission time (LAS ``gps_time``, :attr:`ScanPoints.time`: pulse index / ``PULSE_RATE_HZ``)
+and its scan angle (LAS ``scan_angle``, :attr:`ScanPoints.scan_angle_deg`): with the flight
+geometry these give each beam's path (:meth:`AlsScan.origins`), which the voxel inversion
+follows (:mod:`radtree.lidar.beams`); without it, the scan angle and flight line alone
+(:mod:`radtree.lidar.scan_angle`).
 
 Footprint: a pulse is ``footprint_rays`` parallel sub-rays spread uniformly over a disc of
 diameter ``altitude · beam_divergence_mrad / 1000`` (m) across the beam. Each sub-ray stops at
@@ -85,7 +87,9 @@ PULSE_RATE_HZ = 100_000.0
 @dataclass(frozen=True)
 class ScanPoints:
     """Returns: positions (n, 3) m, ASPRS classes, return number and number of returns, the
-    flight line or scan position (LAS point source id) and the pulse's emission time (s)."""
+    flight line or scan position (LAS point source id), the pulse's emission time (s) and, of
+    airborne scans, its scan angle (degrees from nadir, positive to the right of the flight
+    direction: LAS ``scan_angle``)."""
 
     xyz: np.ndarray
     classification: np.ndarray
@@ -93,6 +97,7 @@ class ScanPoints:
     number_of_returns: np.ndarray
     line: np.ndarray = field(default_factory=lambda: np.zeros(0, np.int64))
     time: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    scan_angle_deg: np.ndarray = field(default_factory=lambda: np.zeros(0))
 
 
 def _pulses(lo: np.ndarray, hi: np.ndarray, scan: AlsScan, rng: np.random.Generator
@@ -153,7 +158,10 @@ def scan_als(vertices: np.ndarray, faces: np.ndarray, face_class: np.ndarray,
     keep = number <= scan.max_returns
     xyz, cls, number, pulse_of = xyz[keep], cls[keep], number[keep], pulse_of[keep]
     total = np.minimum(total[keep], scan.max_returns)
-    return ScanPoints(xyz, cls, number, total, lines[pulse_of], pulse_of / PULSE_RATE_HZ)
+    _, across = scan._axes()
+    angle = np.degrees(np.arctan2(d[:, :2] @ across, -d[:, 2]))   # + right of the line
+    return ScanPoints(xyz, cls, number, total, lines[pulse_of], pulse_of / PULSE_RATE_HZ,
+                      angle[pulse_of])
 
 
 def echoes(loc: np.ndarray, *, pulse: np.ndarray, dist: np.ndarray, tri: np.ndarray,

@@ -23,14 +23,18 @@ from radtree.errors import ConfigError
 GROUND_CLASS = 2   # ASPRS LAS 1.4 R15, Table 17: classification value 2 = ground
 #: the reference segmentation ids of lidR's example data (``treeID``; huge = no tree)
 NO_ID = 1e300
+#: degrees per unit of the LAS 1.4 ``scan_angle`` (point formats 6–10; e.g. ArcGIS Pro's
+#: ``LasPoint.ScanAngleDegree``: "each increment represents 0.006 degrees")
+SCAN_ANGLE_STEP = 0.006
 
 
 @dataclass(frozen=True)
 class Tile:
     """A point cloud: ``xyz`` (n, 3) m, ASPRS ``classification``, ``return_number``,
     ``number_of_returns``, ``extra`` dimensions by name, ``crs`` (WKT text or None), the
-    LAS ``point_source_id`` (flight line or scan position) and ``gps_time`` (s) of every
-    point (zeros when the file has none)."""
+    LAS ``point_source_id`` (flight line or scan position), ``gps_time`` (s) and scan angle
+    (degrees from nadir, + right of the flight direction) of every point (zeros when the file
+    has none)."""
 
     path: Path
     xyz: np.ndarray
@@ -41,6 +45,7 @@ class Tile:
     crs: str | None
     source_id: np.ndarray | None = None
     gps_time: np.ndarray | None = None
+    scan_angle_deg: np.ndarray | None = None
 
     def __len__(self) -> int:
         return len(self.xyz)
@@ -65,7 +70,8 @@ class Tile:
                     self.return_number[mask], self.number_of_returns[mask],
                     {k: v[mask] for k, v in self.extra.items()}, self.crs,
                     None if self.source_id is None else self.source_id[mask],
-                    None if self.gps_time is None else self.gps_time[mask])
+                    None if self.gps_time is None else self.gps_time[mask],
+                    None if self.scan_angle_deg is None else self.scan_angle_deg[mask])
 
 
 def _las(path: Path) -> Any:
@@ -96,6 +102,18 @@ def crs_wkt(las: Any) -> str | None:
     return None if crs is None else str(crs.to_wkt())
 
 
+def scan_angle(las: Any) -> np.ndarray:
+    """Every point's scan angle (degrees): LAS 1.4 point formats 6–10 store it in steps of
+    :data:`SCAN_ANGLE_STEP` (``scan_angle``), the older formats in whole degrees
+    (``scan_angle_rank``) (ASPRS LAS 1.4 R15, point data records)."""
+    names = las.point_format.dimension_names
+    if "scan_angle" in names:
+        return np.asarray(las.scan_angle, float) * SCAN_ANGLE_STEP
+    if "scan_angle_rank" in names:
+        return np.asarray(las.scan_angle_rank, float)
+    return np.zeros(len(las.points))
+
+
 def read_tile(path: str | Path) -> Tile:
     """Read ``path``: points, classes, returns, extra dimensions and CRS; checked (module text)."""
     path = Path(path)
@@ -117,7 +135,7 @@ def read_tile(path: str | Path) -> Tile:
                 np.asarray(las.number_of_returns, np.uint8), extra, crs_wkt(las),
                 np.asarray(las.point_source_id, np.int64),
                 np.asarray(las.gps_time, float) if "gps_time" in las.point_format.dimension_names
-                else np.zeros(n))
+                else np.zeros(n), scan_angle(las))
     check_metric(tile)
     return tile
 
