@@ -20,9 +20,11 @@ platform's or Radiance version's sampling moves rows by ~1 SE, a change of physi
 rewrites ``tests/golden/*_full.csv`` — only in a commit of its own that says why.
 
 ``office_radiance_ci`` is the CI-sized slice of the office table: the office block at the
-example's own settings (``-ad 2048``, ``-ab 6``, ``-aa 0``), both scenarios and both grids, one
-hour (13:30), small enough for every test run (``python -m tests.golden_full
-office_radiance_ci`` rewrites it).
+example's own engine settings (``-ad 2048``, ``-ab 6``, ``-aa 0``), both scenarios, both grids
+and all seven hours, on sensor grids of 1 m instead of 0.5 m (6 façade and 10 work-plane
+sensors per hour instead of 30 and 40), small enough for every test run (``python -m
+tests.golden_full office_radiance_ci`` rewrites it). ``office_radiance_full`` holds the example's
+own 0.5 m grids and is compared on demand (``pytest -m slow``).
 """
 
 from __future__ import annotations
@@ -46,7 +48,8 @@ Z_MAX = 5.0
 EXAMPLES = {"mendoza_radiance_full": "mendoza-street", "office_radiance_full": "office-block",
             "office_radiance_ci": "office-block"}
 #: overrides of a table beyond the example's own settings (every table: no dense façade map)
-OVERRIDES: dict[str, dict] = {"office_radiance_ci": {"site.hours": ["13:30"]}}
+OVERRIDES: dict[str, dict] = {"office_radiance_ci": {"office.grid_spacing_m": 1.0,
+                                                     "office.facade_grid_spacing_m": 1.0}}
 #: the tables the default generator run writes (office_radiance_ci only when named)
 DEFAULT = ("mendoza_radiance_full", "office_radiance_full")
 
