@@ -26,6 +26,7 @@ from radtree.annual.coefficients import CoefficientRunner
 from radtree.light.units import PHOTOPIC_RGB, WHITE_EFFICACY
 from radtree.scene import Scene
 from radtree.verify.checks import Check
+from radtree.verify.projects import FREE_TREE, SHORT_STREET, mendoza_site
 
 #: visible radiance → lux (179 lm/W and the photopic RGB weights)
 LUX = WHITE_EFFICACY * np.array(PHOTOPIC_RGB)
@@ -36,32 +37,9 @@ CLAIM = 0.05
 GROUND = 0.2
 
 #: one small louvers crown (free form) in front of the 8 façade sensors; ``{epw}`` the weather
-TINY_PROJECT = """
-[project]
-name = "tiny annual test"
-
-[site]
-latitude = -32.89
-longitude = -68.83
-elevation_m = 750
-utc_offset_hours = -3
-date = "2024-12-22"
-hours = ["12:30"]
-
-[street]
-width_m = 20.0
-length_m = 40.0
-facade_azimuth_deg = 0.0
-ground_reflectance = 0.15
-
-[light]
-epw = "{epw}"
-
-[tree]
-leaf_on = "10-15"
-leaf_off = "06-01"
-form = "free"
-
+TINY_PROJECT = ('[project]\nname = "tiny annual test"\n\n'
+                + mendoza_site(date="2024-12-22", hour="12:30") + SHORT_STREET
+                + '[light]\nepw = "{epw}"\n' + FREE_TREE + """
 [tree.crown]
 count = 1
 radius_m = 3.0
@@ -88,7 +66,7 @@ model = "louvers"
 [[scenario]]
 name = "without"
 model = "none"
-"""
+""")
 
 
 def tiny_scene(room: bool) -> Scene:

@@ -26,6 +26,7 @@ import numpy as np
 
 from radtree.scene import Scene, SensorGrid
 from radtree.verify.checks import FORWARD, Check
+from radtree.verify.projects import FREE_TREE, mendoza_site
 
 log = logging.getLogger(__name__)
 
@@ -40,22 +41,8 @@ WHOLE = 2048.0        # half-side of the whole-plane detector / crown radius
 
 #: one free-standing louvers crown (2 layers, cover 0.6: a crown the sun gets through), the
 #: project of ``tests/test_export.py``: a year of schedules at 16 rays in a few seconds
-SMALL_PROJECT = """
-[site]
-name = "Mendoza"
-latitude = -32.89
-longitude = -68.83
-elevation_m = 750
-utc_offset_hours = -3
-date = "2023-12-22"
-hours = ["13:30"]
-[light]
-direct_normal = "dni.csv"
-[tree]
-leaf_on = "10-15"
-leaf_off = "06-01"
-form = "free"
-[tree.crown]
+SMALL_PROJECT = (mendoza_site(date="2023-12-22", hour="13:30", name="Mendoza")
+                 + '[light]\ndirect_normal = "dni.csv"\n' + FREE_TREE + """[tree.crown]
 count = 1
 radius_m = 3.0
 vertical_radius_m = 2.5
@@ -75,7 +62,7 @@ lw = 0.000001
 [[scenario]]
 name = "crown"
 model = "louvers"
-"""
+""")
 
 
 def write_small_project(folder: Path) -> Path:

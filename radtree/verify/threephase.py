@@ -21,38 +21,16 @@ from dataclasses import replace
 from pathlib import Path
 
 from radtree.verify.checks import Check
+from radtree.verify.projects import FREE_TREE, SHORT_STREET, mendoza_site
 
 log = logging.getLogger(__name__)
 
 #: the relative agreement the chain claims with a direct trace of the same BSDF scene
 CLAIM = 0.03
 
-PROJECT = """
-[project]
-name = "verify: three-phase closure"
-
-[site]
-latitude = -32.89
-longitude = -68.83
-elevation_m = 750
-utc_offset_hours = -3
-date = "2024-12-22"
-hours = ["12:30"]
-
-[street]
-width_m = 20.0
-length_m = 40.0
-facade_azimuth_deg = 0.0
-ground_reflectance = 0.15
-
-[light]
-direct_normal = "dni.csv"
-
-[tree]
-leaf_on = "10-15"
-leaf_off = "06-01"
-form = "free"
-
+PROJECT = ('[project]\nname = "verify: three-phase closure"\n\n'
+           + mendoza_site(date="2024-12-22", hour="12:30") + SHORT_STREET
+           + '[light]\ndirect_normal = "dni.csv"\n' + FREE_TREE + """
 [tree.crown]
 count = 1
 radius_m = 3.0
@@ -77,7 +55,7 @@ dense_grid = false
 [[scenario]]
 name = "with"
 model = "louvers"
-"""
+""")
 
 
 def write_project(root: Path) -> Path:
