@@ -63,15 +63,12 @@ from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
-from radtree.config import load_project  # noqa: E402
-from radtree.export.transmittance import crown_envelopes, crown_models, own_meshes  # noqa: E402
-from radtree.pipeline.assemble import facade_frame  # noqa: E402
-from radtree.verify.compare import MENDOZA  # noqa: E402
 from radtree.verify.energyplus import (  # noqa: E402
     DNI,
     SUNS,
     WHOLE,
     cross_section,
+    mendoza_crown,
     scattered_through,
     schedule_total,
     sun_vector,
@@ -88,12 +85,7 @@ def compare(scenario: str, form: str) -> None:
     """Schedule total vs the near square and the whole plane (the helpers of
     :mod:`radtree.verify.energyplus`, whose ``total_checks`` runs the whole-plane rows in
     ``radtree verify --full``)."""
-    proj = load_project(MENDOZA, overrides={"tree.form": form})
-    sc = proj.scenario(scenario)
-    frame = facade_frame(proj)
-    crown = crown_envelopes(proj, sc, frame)[0]
-    meshes, _, materials, _ = crown_models(proj, sc, frame)
-    own = own_meshes(crown, meshes)
+    crown, meshes, materials, own = mendoza_crown(scenario, form)
     for alt, az in SUNS:
         s = sun_vector(alt, az)
         beam, total, total_se = schedule_total(crown, meshes, materials, s, RAYS, SEEDS)

@@ -84,38 +84,20 @@ def test_round_trip_clumped_crown(tmp_path):
     same density gives 3.2 % more light; at 12:30 only 0.15 %). 512 paths per sensor: the
     façade means' standard errors (~0.5 % each) keep the 3 % check 4 σ wide (at 128 paths a
     different random stream alone moved the difference from −1.2 % to −3.6 %)."""
-    from radtree.hemi.synthetic import save_png
-    from radtree.photo.render import render_scenario
     from radtree.pipeline.assemble import make_scene
     from radtree.pipeline.options import RunOptions
     from radtree.pipeline.simulate import simulate_project
     from radtree.trees.leaf_angles import mean_tilt
-    from radtree.trees.photo import PhotoSource
+    from radtree.verify.photo import KNOWN_CROWN, PHOTO_CROWN, photo_scenarios
 
     root = copy_project(tmp_path / "rt")
     proj = load_project(root, overrides={
         "site.hours": ["10:30", "16:30"], "sensors.dense_grid": False, "sensors.dense_hours": [],
-        "engine.rays": 512, "tree.crown.count": 1, "tree.crown.trunk_distance_m": 8.0,
-        "tree.crown.radius_m": 7.0, "tree.crown.vertical_radius_m": 2.5,
-        "tree.crown.base_height_m": 3.0, "tree.photo_x_m": 1.0, "tree.photo_distance_m": 8.0,
-        "tree.photo_height_m": 1.0, "tree.photo_zenith_deg": 55.0})
-    known = {"louvers.arrangement": "volume", "louvers.inclination_distribution": "ellipsoidal",
-             "louvers.ellipsoid_x": 2.0, "louvers.crossings": 3.0, "louvers.slat_size_m": 0.1,
-             "louvers.clumping": 0.7, "louvers.cluster_radius_m": 0.2}
-    src = PhotoSource(root / "none.png", "equidistant", None, "upward", "tree.photo", 55.0)
-    (root / "photos").mkdir()
-    for k in range(1, 7):
-        r = render_scenario(proj, Scenario(name="T", model="louvers", form="free", switches={
-            **known, "louvers.seed": k}), 250, src=src)
-        save_png(r.image, root / "photos" / f"crown{k}.png")
-    m = r.geometry.mask
-    original = Scenario(name="T", model="louvers", reflection="traced", form="free",
-                        switches=known)
-    refit = Scenario(name="R", model="louvers", reflection="traced", form="free", switches={
-        **known, "louvers.ellipsoid_x": 1.0, "louvers.crossings": 1.0,
-        "louvers.clumping": 1.0, "louvers.clumping_fit": True,
-        "tree.photo": str(root / "photos"), "tree.lens": "equidistant",
-        "tree.mask": [m.cx, m.cy, m.radius], "tree.photo_direction": "upward"})
+        "engine.rays": 512, **PHOTO_CROWN})
+    known = {**KNOWN_CROWN, "louvers.slat_size_m": 0.1, "louvers.clumping": 0.7,
+             "louvers.cluster_radius_m": 0.2}
+    original, refit = photo_scenarios(proj, root, known, seeds=range(1, 7), size=250, refit={
+        "louvers.clumping": 1.0, "louvers.clumping_fit": True})
     fitted = make_scene(proj, refit).tree
     fit = fitted.photo["fitted"]
     true_lad = make_scene(proj, original).tree.info["density_per_m3"] * 0.1**2

@@ -26,7 +26,7 @@ from radtree.annual.coefficients import CoefficientRunner
 from radtree.light.units import PHOTOPIC_RGB, WHITE_EFFICACY
 from radtree.scene import Scene
 from radtree.verify.checks import Check
-from radtree.verify.projects import FREE_TREE, SHORT_STREET, mendoza_site
+from radtree.verify.projects import FREE_TREE, SHORT_STREET, SMALL_CROWN, mendoza_site
 
 #: visible radiance → lux (179 lm/W and the photopic RGB weights)
 LUX = WHITE_EFFICACY * np.array(PHOTOPIC_RGB)
@@ -39,14 +39,7 @@ GROUND = 0.2
 #: one small louvers crown (free form) in front of the 8 façade sensors; ``{epw}`` the weather
 TINY_PROJECT = ('[project]\nname = "tiny annual test"\n\n'
                 + mendoza_site(date="2024-12-22", hour="12:30") + SHORT_STREET
-                + '[light]\nepw = "{epw}"\n' + FREE_TREE + """
-[tree.crown]
-count = 1
-radius_m = 3.0
-vertical_radius_m = 3.0
-base_height_m = 2.5
-trunk_distance_m = 3.5
-
+                + '[light]\nepw = "{epw}"\n' + FREE_TREE + SMALL_CROWN + """
 [tree.louvers]
 layers = 2
 slat_size_m = 0.6

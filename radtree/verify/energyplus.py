@@ -220,25 +220,31 @@ def schedule_total(crown, meshes, materials, s: np.ndarray, rays: int,
     return beam, beam + float(scat.mean()), float(scat.std(ddof=1) / math.sqrt(len(scat)))
 
 
+def mendoza_crown(scenario: str, form: str) -> tuple:
+    """The first crown of ``scenario`` of the Mendoza example built as ``form`` (dome | free):
+    (its envelope, the crown models' meshes, their materials, the meshes inside its envelope)."""
+    from radtree.config import load_project
+    from radtree.export.transmittance import crown_envelopes, crown_models, own_meshes
+    from radtree.pipeline.assemble import facade_frame
+    from radtree.verify.compare import MENDOZA
+
+    proj = load_project(MENDOZA, overrides={"tree.form": form})
+    sc = proj.scenario(scenario)
+    frame = facade_frame(proj)
+    crown = crown_envelopes(proj, sc, frame)[0]
+    meshes, _, materials, _ = crown_models(proj, sc, frame)
+    return crown, meshes, materials, own_meshes(crown, meshes)
+
+
 def total_checks(cases: tuple[tuple[str, str], ...] = CASES,
                  suns: tuple[tuple[float, float], ...] = SUNS, *, rays: int = 65536,
                  seeds: tuple[int, ...] = (1, 2, 3, 4), photons: int = 4_000_000
                  ) -> list[Check]:
     """The *total* schedule of each (scenario, crown form) of the Mendoza example at each sun
     against the whole-plane pyranometers: within 2 % or 3 combined standard errors."""
-    from radtree.config import load_project
-    from radtree.export.transmittance import crown_envelopes, crown_models, own_meshes
-    from radtree.pipeline.assemble import facade_frame
-    from radtree.verify.compare import MENDOZA
-
     out = []
     for scenario, form in cases:
-        proj = load_project(MENDOZA, overrides={"tree.form": form})
-        sc = proj.scenario(scenario)
-        frame = facade_frame(proj)
-        crown = crown_envelopes(proj, sc, frame)[0]
-        meshes, _, materials, _ = crown_models(proj, sc, frame)
-        own = own_meshes(crown, meshes)
+        crown, meshes, materials, own = mendoza_crown(scenario, form)
         for sun in suns:
             s = sun_vector(*sun)
             beam, total, total_se = schedule_total(crown, meshes, materials, s, rays, seeds)

@@ -18,8 +18,10 @@ from __future__ import annotations
 import logging
 import shutil
 import tempfile
+from collections.abc import Iterable
 from dataclasses import dataclass, replace
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -78,40 +80,60 @@ class RoundTrip:
     lad_sd: float
 
 
-def crown_round_trip(root: Path, size: int = 500) -> RoundTrip:
-    """Render, fit and trace the known crown in ``root`` (a copy of the Mendoza example):
-    three upward photos of ``size`` pixels (crowns of seeds 1–3), one fit."""
-    from radtree.config import Scenario, load_project
-    from radtree.engines.registry import seeded_engine
+#: one wide, flat crown 8 m from the façade photographed upward from 1 m under it (overrides
+#: of the Mendoza example for the photo round trips)
+PHOTO_CROWN = {"tree.crown.count": 1, "tree.crown.trunk_distance_m": 8.0,
+               "tree.crown.radius_m": 7.0, "tree.crown.vertical_radius_m": 2.5,
+               "tree.crown.base_height_m": 3.0, "tree.photo_x_m": 1.0,
+               "tree.photo_distance_m": 8.0, "tree.photo_height_m": 1.0,
+               "tree.photo_zenith_deg": 55.0}
+#: the known crown's louvers (ellipsoidal leaf angles x = 2, 3 crossings)
+KNOWN_CROWN = {"louvers.arrangement": "volume", "louvers.inclination_distribution": "ellipsoidal",
+               "louvers.ellipsoid_x": 2.0, "louvers.crossings": 3.0}
+
+
+def photo_scenarios(proj: Any, root: Path, known: dict, *, seeds: Iterable[int], size: int,
+                    refit: dict | None = None) -> tuple[Any, Any]:
+    """Upward photos of the crown ``known`` (louvers switches) rendered at ``size`` px, one per
+    seed, into ``root/photos``; returns the known crown's scenario ``T`` and the scenario ``R``
+    fitted to the photos from a neutral start (ellipsoidal x = 1, 1 crossing; ``refit``:
+    further switches of the fit)."""
+    from radtree.config import Scenario
     from radtree.hemi.synthetic import save_png
     from radtree.photo.render import render_scenario
-    from radtree.pipeline.assemble import make_scene
-    from radtree.pipeline.options import RunOptions
-    from radtree.pipeline.simulate import simulate_project
-    from radtree.trees.leaf_angles import mean_tilt
     from radtree.trees.photo import PhotoSource
 
-    proj = load_project(root, overrides={
-        "site.hours": ["12:30"], "sensors.dense_grid": False, "sensors.dense_hours": [],
-        "engine.rays": 128, "tree.crown.count": 1, "tree.crown.trunk_distance_m": 8.0,
-        "tree.crown.radius_m": 7.0, "tree.crown.vertical_radius_m": 2.5,
-        "tree.crown.base_height_m": 3.0, "tree.photo_x_m": 1.0, "tree.photo_distance_m": 8.0,
-        "tree.photo_height_m": 1.0, "tree.photo_zenith_deg": 55.0})
-    known = {"louvers.arrangement": "volume", "louvers.inclination_distribution": "ellipsoidal",
-             "louvers.ellipsoid_x": 2.0, "louvers.crossings": 3.0, "louvers.slat_size_m": 0.15}
     src = PhotoSource(root / "none.png", "equidistant", None, "upward", "tree.photo", 55.0)
     (root / "photos").mkdir(exist_ok=True)
-    for k in (1, 2, 3):
+    for k in seeds:
         r = render_scenario(proj, Scenario(name="T", model="louvers", form="free", switches={
             **known, "louvers.seed": k}), size, src=src)
         save_png(r.image, root / "photos" / f"crown{k}.png")
     m = r.geometry.mask
     original = Scenario(name="T", model="louvers", reflection="traced", form="free",
                         switches=known)
-    refit = Scenario(name="R", model="louvers", reflection="traced", form="free", switches={
-        **known, "louvers.ellipsoid_x": 1.0, "louvers.crossings": 1.0,
+    fitted = Scenario(name="R", model="louvers", reflection="traced", form="free", switches={
+        **known, "louvers.ellipsoid_x": 1.0, "louvers.crossings": 1.0, **(refit or {}),
         "tree.photo": str(root / "photos"), "tree.lens": "equidistant",
         "tree.mask": [m.cx, m.cy, m.radius], "tree.photo_direction": "upward"})
+    return original, fitted
+
+
+def crown_round_trip(root: Path, size: int = 500) -> RoundTrip:
+    """Render, fit and trace the known crown in ``root`` (a copy of the Mendoza example):
+    three upward photos of ``size`` pixels (crowns of seeds 1–3), one fit."""
+    from radtree.config import load_project
+    from radtree.engines.registry import seeded_engine
+    from radtree.pipeline.assemble import make_scene
+    from radtree.pipeline.options import RunOptions
+    from radtree.pipeline.simulate import simulate_project
+    from radtree.trees.leaf_angles import mean_tilt
+
+    proj = load_project(root, overrides={
+        "site.hours": ["12:30"], "sensors.dense_grid": False, "sensors.dense_hours": [],
+        "engine.rays": 128, **PHOTO_CROWN})
+    known = {**KNOWN_CROWN, "louvers.slat_size_m": 0.15}
+    original, refit = photo_scenarios(proj, root, known, seeds=(1, 2, 3), size=size)
     fit = make_scene(proj, refit).tree.photo["fitted"]
     lad = make_scene(proj, original).tree.info["density_per_m3"] * 0.15 ** 2
     out = simulate_project(replace(proj, scenarios=(original, refit)),

@@ -19,3 +19,8 @@ FREE_TREE = '[tree]\nleaf_on = "10-15"\nleaf_off = "06-01"\nform = "free"\n'
 #: a 20 m street facing north, 40 m long (``[street]``, TOML text)
 SHORT_STREET = ("[street]\nwidth_m = 20.0\nlength_m = 40.0\nfacade_azimuth_deg = 0.0\n"
                 "ground_reflectance = 0.15\n")
+
+#: one round crown of 3 m radius, its base 2.5 m up, its trunk 3.5 m from the façade
+#: (``[tree.crown]``, TOML text)
+SMALL_CROWN = ("[tree.crown]\ncount = 1\nradius_m = 3.0\nvertical_radius_m = 3.0\n"
+               "base_height_m = 2.5\ntrunk_distance_m = 3.5\n")

@@ -21,7 +21,7 @@ from dataclasses import replace
 from pathlib import Path
 
 from radtree.verify.checks import Check
-from radtree.verify.projects import FREE_TREE, SHORT_STREET, mendoza_site
+from radtree.verify.projects import FREE_TREE, SHORT_STREET, SMALL_CROWN, mendoza_site
 
 log = logging.getLogger(__name__)
 
@@ -30,14 +30,7 @@ CLAIM = 0.03
 
 PROJECT = ('[project]\nname = "verify: three-phase closure"\n\n'
            + mendoza_site(date="2024-12-22", hour="12:30") + SHORT_STREET
-           + '[light]\ndirect_normal = "dni.csv"\n' + FREE_TREE + """
-[tree.crown]
-count = 1
-radius_m = 3.0
-vertical_radius_m = 3.0
-base_height_m = 2.5
-trunk_distance_m = 3.5
-segments = 12
+           + '[light]\ndirect_normal = "dni.csv"\n' + FREE_TREE + SMALL_CROWN + """segments = 12
 
 [tree.louvers]
 arrangement = "volume"
