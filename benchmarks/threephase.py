@@ -37,6 +37,13 @@ bare by the schedule; and without), their differences in percentage points, the 
 times and the cost of the second leaf state (3-phase: its daylight matrices, rmtxop and the
 sun runs on the bare BSDF crown; dc: the rcontrib runs of the bare-branch scene).
 
+Measured 2026-12-07 (``--samples 50 --daylight-samples 100 --sun-crowns
+fivephase,explicit,bsdf --no-second-weather``, facet-plane grouping, load 4–9 on 2 cores;
+3-phase 1 151 s wall): 3-phase − dc on every band and sDA, façade / work plane, with the
+tree — ``explicit`` within 0.5 pp on both; ``bsdf`` up to +14.2 pp (work plane UDI <100);
+``fivephase`` up to +9.0 / +14.9 pp (UDI <100; the difference of two noisy BSDF sun runs
+per sensor-hour, :mod:`radtree.annual.fivephase`; CHANGELOG.md).
+
 Run: ``nice .venv/bin/python benchmarks/threephase.py [--work DIR] [--samples 200] [-j 2]``.
 """
 
