@@ -16,9 +16,10 @@ the same reflected-sun computation (measured on the office example, leaf-on work
 ±34 % per point, 3.5 pp of UDI < 100 lx; README, three-phase section). The scene without
 the tree is always traced in each copy (its difference is that noise floor without a crown).
 
-Options: ``--sun-crowns explicit,bsdf`` (``AnnualOptions.sun_crown`` variants of the 3-phase
-run, the later ones reusing the first's matrices: the sun runs through the explicit crown, as
-the default method's, or on the BSDF crown), ``--no-second-weather`` (a quicker comparison);
+Options: ``--sun-crowns explicit,bsdf,fivephase`` (``AnnualOptions.sun_crown`` variants of
+the 3-phase run, the later ones reusing the first's matrices: the sun runs through the
+explicit crown, as the default method's, on the BSDF crown, or by the five-phase idea,
+:mod:`radtree.annual.fivephase`), ``--no-second-weather`` (a quicker comparison);
 ``--samples 50 --daylight-samples 100`` is a quicker variant (≈ 9 min from scratch at load
 2–5 on 2 cores, of which the BSDFs 396 s).
 
@@ -35,6 +36,13 @@ and prints, per grid, sDA300/50 and the UDI bands of both methods (with the tree
 bare by the schedule; and without), their differences in percentage points, the wall and CPU
 times and the cost of the second leaf state (3-phase: its daylight matrices, rmtxop and the
 sun runs on the bare BSDF crown; dc: the rcontrib runs of the bare-branch scene).
+
+Measured 2026-12-07 (``--samples 50 --daylight-samples 100 --sun-crowns
+fivephase,explicit,bsdf --no-second-weather``, facet-plane grouping, load 4–9 on 2 cores;
+3-phase 1 151 s wall): 3-phase − dc on every band and sDA, façade / work plane, with the
+tree — ``explicit`` within 0.5 pp on both; ``bsdf`` up to +14.2 pp (work plane UDI <100);
+``fivephase`` up to +9.0 / +14.9 pp (UDI <100; the difference of two noisy BSDF sun runs
+per sensor-hour, :mod:`radtree.annual.fivephase`; CHANGELOG.md).
 
 Run: ``nice .venv/bin/python benchmarks/threephase.py [--work DIR] [--samples 200] [-j 2]``.
 """
@@ -171,7 +179,8 @@ def main() -> None:
                     help="also trace rcontrib sky coefficients on the 3-phase BSDF crowns")
     ap.add_argument("--methods", default="dc,3phase", help="comma-separated: dc, 3phase")
     ap.add_argument("--sun-crowns", default="explicit,bsdf",
-                    help="3phase variants run in turn (AnnualOptions.sun_crown): the first is "
+                    help="3phase variants run in turn (AnnualOptions.sun_crown: explicit, bsdf, "
+                         "fivephase): the first is "
                          "'3phase' (timed, second weather file), the others reuse its matrices")
     ap.add_argument("--sun-runs", choices=("shared", "own"), default="shared",
                     help="shared: the 3-phase copy uses the default method's sun runs (as one "

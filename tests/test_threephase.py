@@ -275,3 +275,47 @@ def test_default_method_reuses_the_three_phase_sun_runs(runs):
     # the sky is what differs: the totals are not the same numbers
     assert any(not np.array_equal(dc.total["leaf_on"][g], first.total["leaf_on"][g])
                for g in first.total["leaf_on"])
+
+
+@needs_radiance
+def test_five_phase_sun(runs):
+    """``sun_crown = "fivephase"``: the sun reflected by the surroundings through the BSDF
+    crown (its run minus the same run with the surroundings black) plus the sun through the
+    explicit crown with the surroundings black. The hourly direct sun is the explicit
+    crown's (-ab 0: the surroundings' colour plays no part), the same as the default's to
+    float precision; only the surroundings' plastics turn black; the year's totals (sky +
+    sun, the sky the same chain) stay near the all-explicit sun's (the runs differ only in
+    how the surroundings' reflection crosses the crown)."""
+    from radtree.annual.fivephase import black_surroundings
+    from radtree.annual.methods import compute as compute_annual
+    from radtree.annual.run import AnnualOptions, plan_annual
+    from radtree.optics import Plastic
+
+    project, first, _, _, _ = runs
+    five = compute_annual(project, options=AnnualOptions(
+        nproc=1, method="3phase", daylight_samples=24, sun_ad=32, sun_crown="fivephase"))
+    assert any("five-phase" in n for n in five.notes)
+    for state in ("leaf_on", "leaf_off"):
+        for g in first.direct[state]:
+            np.testing.assert_allclose(five.direct[state][g], first.direct[state][g],
+                                       rtol=1e-5, atol=1e-3)
+    ratios = {}
+    for state in ("leaf_on", "leaf_off"):
+        a = np.concatenate([five.total[state][g] for g in five.total[state]]).sum()
+        b = np.concatenate([first.total[state][g] for g in first.total[state]]).sum()
+        ratios[state] = a / b
+    # measured (fixed seed): 0.939 leaf-on, 1.123 leaf-off — the bare-branch slab's BSDF
+    # carries about twice the surroundings' reflected sun of the explicit branches
+    assert abs(ratios["leaf_on"] - 0.939) < 0.03, ratios
+    assert abs(ratios["leaf_off"] - 1.123) < 0.03, ratios
+    folder = project.results_dir / "annual" / "threephase"
+    for sub in ("sun_leaf_on", "sun_leaf_on_black", "sun_leaf_on_explicit_black"):
+        assert list((folder / sub).glob("sun_direct_*.npy")), sub
+    plan = plan_annual(project, five.options)
+    bare = plan.scenes["without"]
+    black = black_surroundings(plan.scenes["leaf_on"], bare)
+    for name, m in black.materials.items():
+        if name in bare.materials and isinstance(bare.materials[name], Plastic):
+            assert isinstance(m, Plastic) and m.reflectance == 0.0
+        else:
+            assert m == plan.scenes["leaf_on"].materials[name]

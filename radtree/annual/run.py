@@ -92,7 +92,9 @@ METHODS = ("dc", "3phase")
 #: four by ≈ 1.1 pp (sDA's SE falls as R^-¼: benchmarks/annual_precision.py)
 DEFAULT_REPLICATES = 4
 #: ``AnnualOptions.sun_crown`` values (3phase)
-SUN_CROWNS = ("explicit", "bsdf")
+SUN_CROWNS = ("explicit", "bsdf", "fivephase")
+
+
 @dataclass(frozen=True)
 class AnnualOptions:
     """Settings of an annual run (None = from the project)."""
@@ -126,7 +128,9 @@ class AnnualOptions:
     daylight_samples: int = 400
     #: 3phase: the crown the sun is traced through (:data:`SUN_CROWNS`): "explicit" (the
     #: default method's sun runs — hourly direct sun and reflected sun — on its leaf-on /
-    #: bare-branch scenes) or "bsdf" (both on the BSDF-crown scene)
+    #: bare-branch scenes), "bsdf" (both on the BSDF-crown scene) or "fivephase" (the sun
+    #: reflected by the surroundings through the BSDF crown, the sun through the crown from
+    #: the explicit crown with the surroundings black: :mod:`radtree.annual.fivephase`)
     sun_crown: str = "explicit"
     #: EN 17037 exposure to sunlight: the date (MM-DD, 1 February – 21 March)
     sunlight_date: str = standards.SUNLIGHT_DATE

@@ -45,8 +45,11 @@ most (work-plane UDI > 3000 lx +5.4 pp, façade +9.6 pp with ``"bsdf"``; +0.7 / 
 ``"explicit"``, for 214 s more of sun runs through the slats). Tracing only the ``-ab 0``
 direct sun through the explicit crown and the reflected sun on the BSDF crown counts the
 crown's gaps twice (the BSDF's ``-ab N`` run carries them) and was no better than ``"bsdf"``
-(CHANGELOG.md). The scene without the tree is computed as the default
-method does.
+(CHANGELOG.md). ``"fivephase"`` (issue 40) does what that tried, the five-phase way
+(:mod:`radtree.annual.fivephase`): the sun on the BSDF-crown scene, minus the same run with
+the surroundings black (the sun through the BSDF crown with no bounce off the surroundings),
+plus the sun through the explicit crown with the surroundings black — the crown's gaps once.
+The scene without the tree is computed as the default method does.
 
 **Closure (issue 40): the chain against a direct trace of the same BSDF scene.**
 :mod:`radtree.annual.closure` and ``benchmarks/threephase_closure.py`` compare Σ V·T·D (+ the

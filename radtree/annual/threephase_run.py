@@ -19,6 +19,7 @@ from pathlib import Path
 import numpy as np
 
 from radtree.annual.coefficients import CoefficientRunner
+from radtree.annual.fivephase import five_phase_sun
 from radtree.annual.run import (
     AnnualOptions,
     AnnualPlan,
@@ -50,6 +51,9 @@ log = logging.getLogger(__name__)
 SUN_NOTES = {
     "explicit": "both on the explicit crown (slats, bare branches) of each leaf state",
     "bsdf": "both on the BSDF-crown scene of each leaf state",
+    "fivephase": ("by the five-phase idea: the sun on the BSDF-crown scene minus the same "
+                  "with the surroundings black, plus the sun through the explicit crown "
+                  "(slats, bare branches) with the surroundings black"),
 }
 
 
@@ -87,12 +91,23 @@ def _scene_lux(plan: AnnualPlan, year: YearInputs, scene: Scene, folder: Path,
 def _state_lux(plan: AnnualPlan, year: YearInputs, *, state: str, tp: ThreePhase,
                crown: Scene, views: tuple[list[Path], np.ndarray], work: Path,
                timing: dict[str, float]) -> tuple[np.ndarray, np.ndarray]:
-    """(total, direct) lux of one leaf state: the sun runs (on the explicit scene or the
-    BSDF-crown scene ``crown``, as ``sun_crown`` says) plus the chain's sky light."""
+    """(total, direct) lux of one leaf state: the sun runs (on the explicit scene, the
+    BSDF-crown scene ``crown``, or both by the five-phase idea, as ``sun_crown`` says) plus
+    the chain's sky light."""
     tv = time.perf_counter()
     if plan.options.sun_crown == "explicit":   # the default method's sun runs and cache
         sun_tot, sun_dir = _scene_lux(plan, year, plan.scenes[state],
                                       work / "coefficients" / state, False)
+    elif plan.options.sun_crown == "fivephase":
+        o = plan.options
+        folder = work / "threephase"
+        sun_tot, sun_dir = five_phase_sun(
+            lambda r: scene_year_lux(r, year, o.mf, o.sun_mf, plan.trace, plan.sun_trace,
+                                     False),
+            bsdf_crown=crown, explicit=plan.scenes[state], surroundings=tp.bare,
+            grids=plan.grids, rho=plan.rho,
+            folders=(folder / f"sun_{state}", folder / f"sun_{state}_black",
+                     folder / f"sun_{state}_explicit_black"))
     else:
         sun_tot, sun_dir = _scene_lux(plan, year, crown, work / "threephase" / f"sun_{state}",
                                       False)

@@ -56,10 +56,12 @@ from radtree.cli.options import CONTEXT, writes
 @click.option("--method", type=click.Choice(["dc", "3phase"]), default="dc", show_default=True,
               help="dc: daylight coefficients of the explicit crown; 3phase: view matrix · "
                    "crown BSDF (leaf-on/off) · daylight matrix · sky (rfluxmtx, dctimestep).")
-@click.option("--sun-crown", type=click.Choice(["explicit", "bsdf"]), default="explicit",
-              show_default=True,
+@click.option("--sun-crown", type=click.Choice(["explicit", "bsdf", "fivephase"]),
+              default="explicit", show_default=True,
               help="3phase: the hourly sun traced through the explicit crown (its gaps and "
-                   "slats, as the dc method does) or through the BSDF crown.")
+                   "slats, as the dc method does), through the BSDF crown, or by the "
+                   "five-phase idea (the sun reflected by the surroundings through the BSDF "
+                   "crown, the sun through the crown itself from its explicit geometry).")
 @click.option("--sunlight-date", default="03-21", show_default=True, metavar="MM-DD",
               help="EN 17037 exposure to sunlight: the date (1 February – 21 March).")
 def annual_command(*, project: Path, leaf_on: str | None, leaf_off: str | None, mf: int,
