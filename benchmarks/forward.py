@@ -338,18 +338,25 @@ def crossings(hours: list[str], scenarios: list[str], seeds: list[int], window: 
 
     class Recording(ForwardTracer):
         counted = False
+        sky = 0.0   # 1 while tracing a launch that did not start as the sun's beam
+
+        def run(self, photons):  # type: ignore[no-untyped-def]
+            self.sky = 0.0 if photons.direct.all() else 1.0
+            return super().run(photons)
 
         def _advance(self, ph):  # type: ignore[no-untyped-def]
             seen = ph if not ph.direct.any() else ph.take(~ph.direct)
-            tri, t = self.geo.caster.first_hit(seen.o, seen.d)
+            tri, t = self.geo.caster.first_hit(seen.o, seen.d)   # (explicit surfaces only)
             t = np.where(tri < 0, np.inf, t)
             rows = np.zeros((len(seen), self.det.count))
             self.det.tally(seen.o, seen.d, t, seen.w, np.arange(len(seen)), rows)
             c = rows.sum(axis=1)
             hit = np.flatnonzero(c > 0)
             if len(hit) and self.counted and (window <= 0 or self.window is not None):
+                dist = np.linalg.norm(seen.o[hit] - self.det_centre, axis=1)
                 rec.append(np.column_stack([c[hit], seen.w[hit], seen.w0[hit],
-                                            seen.ndiff[hit], seen.nspec[hit]]))
+                                            seen.ndiff[hit], seen.nspec[hit],
+                                            np.full(len(hit), self.sky), dist]))
             return super()._advance(ph)
 
     def tracer(h, batches):  # type: ignore[no-untyped-def]
@@ -359,6 +366,7 @@ def crossings(hours: list[str], scenarios: list[str], seeds: list[int], window: 
                        max_specular=s.max_specular, chunk=s.chunk, rng=h.rng,
                        splitting_near=h.near, guide=h.guide)
         tr.counted = batches > 1   # the pilot's scout traces one batch: not recorded
+        tr.det_centre = h.target
         return tr
 
     forward_run._tracer = tracer  # type: ignore[assignment]
@@ -383,6 +391,35 @@ def crossings(hours: list[str], scenarios: list[str], seeds: list[int], window: 
                       f"; their launched flux median {np.median(w0[big]) if big.any() else 0:7.1f}"
                       f" lm (all: {np.median(w0):.1f}), flux / launched max "
                       f"{(w / w0)[big].max() if big.any() else 0:.2f}", flush=True)
+            _crossing_classes(a, mc)
+
+
+def _crossing_classes(a: np.ndarray, mean_crossing: float) -> None:
+    """Per class of crossing (source; diffuse/specular events before it; where its segment
+    started): its share of the crossings' flux, of the heavy crossings (> 10 × the mean) and
+    the equal crossings it is worth (Σc)² / Σc²."""
+    c, nd, ns, sky, dist = a[:, 0], a[:, 3], a[:, 4], a[:, 5], a[:, 6]
+    total = c.sum()
+    classes = {
+        "sky, no event": (sky == 1) & (nd == 0) & (ns == 0),
+        "sky, specular only": (sky == 1) & (nd == 0) & (ns > 0),
+        "sky, diffuse": (sky == 1) & (nd > 0),
+        "sun, specular only": (sky == 0) & (nd == 0),
+        "sun, 1 diffuse": (sky == 0) & (nd == 1),
+        "sun, ≥ 2 diffuse": (sky == 0) & (nd >= 2),
+        "segment from < 0.5 m": dist < 0.5,
+        "segment from 0.5–2 m": (dist >= 0.5) & (dist < 2.0),
+        "segment from ≥ 2 m": dist >= 2.0,
+    }
+    big = c > 10 * mean_crossing
+    for label, m in classes.items():
+        if not m.any():
+            continue
+        cm = c[m]
+        print(f"    {label:22s}: {m.sum():7d} crossings, {cm.sum() / total:6.1%} of the flux, "
+              f"worth {cm.sum() ** 2 / (cm ** 2).sum():8.0f}; > 10 × mean: {(m & big).sum():4d} "
+              f"({c[m & big].sum() / total:5.1%} of the flux), largest {cm.max() / total:.2%}",
+              flush=True)
 
 
 def radiance_repeats(hours: list[str], scenarios: list[str], repeats: int) -> None:

@@ -31,6 +31,7 @@ from radtree.engines.forward.strata import (
     Stratum,
     allocate,
     pilot,
+    predicted_crossings,
     reallocate,
     ring_edges,
     trace_strata,
@@ -200,6 +201,20 @@ def _focus(h: _Hour) -> tuple[list[Stratum] | None, int, int]:
     return strata, n_pilot, scout.segments
 
 
+def _window_from_pilot(h: _Hour, tracer: ForwardTracer, strata: list[Stratum] | None) -> None:
+    """The weight window opened before the first round, its level from the pilot's patch
+    crossings as the first round's allocation will make them
+    (:func:`~radtree.engines.forward.strata.predicted_crossings`): every round, the sizing
+    round included, then traces with it (without crossings in the pilot: after the first
+    round, :func:`_open_window`)."""
+    if strata is None or h.settings.window <= 0:
+        return
+    crossings, flux = predicted_crossings(strata)
+    level = window_level(h.settings.window, flux, crossings)
+    if level is not None:
+        tracer.window = WeightWindow(h.target, h.reach, level)
+
+
 def _at_points(h: _Hour) -> np.ndarray:
     """The sun's direct light at the sensor points (lux; zeros when it is not counted there)."""
     out = np.zeros(h.det.count)
@@ -293,6 +308,7 @@ def trace_forward(scene: Scene, state: SkyState, settings: ForwardSettings,
     h = _plan(scene, state, settings, grids, backend=backend, workers=workers, label=label)
     tracer = _tracer(h, settings.batches)
     strata, n_pilot, pilot_segments = _focus(h)
+    _window_from_pilot(h, tracer, strata)
     counted, per_batch, rounds, warning, sizing = _rounds(h, tracer, strata)
     out, per = {}, {}
     for name in h.names:

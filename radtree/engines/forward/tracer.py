@@ -147,6 +147,9 @@ class ForwardTracer:
         #: the weight window (None: none), set by the run after its first round
         self.window: WeightWindow | None = None
         self.window_splits = 0   # copies the window added
+        #: a guided diffuse event scales the photon's reference flux (the roulette's) by the
+        #: same factor as its flux (module text, *Roulette after a guided event*)
+        self.guided_reference = True
         #: with ``escape_axes`` (batches, 3) unit vectors: per batch, the flux escaping the scene
         #: along its axis (d · axis > 0, lm), and the part still the direct beam
         self.axes = escape_axes
@@ -311,6 +314,9 @@ class ForwardTracer:
                 led.killed += float(np.maximum(old - new, 0.0).sum())
                 cw = cw.copy()
                 cw[diffuse] = new
+                if self.guided_reference:   # the roulette's reference follows the weight
+                    w0 = w0.copy()
+                    w0[diffuse] = w0[diffuse] * factor
         if mir.any():
             new_d[mir] = mirror(d[mir], n[mir])
         side = np.where(diff_t | spec_t, -1.0, 1.0)

@@ -85,7 +85,7 @@ class WeightWindow:
         return np.clip(n, 1, self.max_split).astype(np.int64)
 
 
-def window_level(factor: float, crossed_flux: float, crossings: int) -> float | None:
+def window_level(factor: float, crossed_flux: float, crossings: float) -> float | None:
     """The window's ``level`` (lm): ``factor`` × the mean flux per patch crossing
     (``crossed_flux`` lm over ``crossings``); None (no window) without crossings or factor."""
     if factor <= 0 or crossings <= 0 or crossed_flux <= 0:
