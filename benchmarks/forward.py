@@ -364,7 +364,8 @@ def crossings(hours: list[str], scenarios: list[str], seeds: list[int], window: 
         tr = Recording(h.geo, h.optics, h.det, batches, threshold=s.threshold,
                        splitting=s.splitting, max_bounces=s.max_bounces,
                        max_specular=s.max_specular, chunk=s.chunk, rng=h.rng,
-                       splitting_near=h.near, guide=h.guide)
+                       splitting_near=h.near, guide=h.guide,
+                       guided_roulette=s.guided_roulette)
         tr.counted = batches > 1   # the pilot's scout traces one batch: not recorded
         tr.det_centre = h.target
         return tr

@@ -180,7 +180,8 @@ def _tracer(h: _Hour, batches: int) -> ForwardTracer:
     return ForwardTracer(h.geo, h.optics, h.det, batches, threshold=s.threshold,
                          splitting=s.splitting, max_bounces=s.max_bounces,
                          max_specular=s.max_specular, chunk=s.chunk, rng=h.rng,
-                         splitting_near=h.near, guide=h.guide)
+                         splitting_near=h.near, guide=h.guide,
+                         guided_roulette=s.guided_roulette)
 
 
 def _focus(h: _Hour) -> tuple[list[Stratum] | None, int, int]:
