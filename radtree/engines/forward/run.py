@@ -253,8 +253,9 @@ def _round(h: _Hour, tracer: ForwardTracer, strata: list[Stratum] | None,
 
 
 def _open_window(h: _Hour, tracer: ForwardTracer) -> None:
-    """After the hour's first round: the weight window for every later round, its level
-    from that round's patch crossings (:mod:`radtree.engines.forward.window`)."""
+    """After the hour's first round, when the pilot did not open it (no focused launch, or
+    no crossings in the pilot): the weight window for every later round, its level from that
+    round's patch crossings (:mod:`radtree.engines.forward.window`)."""
     if tracer.window is not None or h.settings.window <= 0:
         return
     level = window_level(h.settings.window, tracer.crossed_flux, tracer.crossings)
