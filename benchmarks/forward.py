@@ -28,7 +28,9 @@ Issue 40 (the estimator a user can trust by default), each a separate mode:
   (fixed seed, traced façade mean); ``--radiance-repeats N``: Radiance alone, N clock-seeded
   runs on the build ``--zscores`` traces (F: its first crown), mean ± s.e.
 * ``--crossings SEED …``: every patch crossing of those runs recorded (``--window`` factor):
-  how much of the façade light the heavy crossings carry and where they started.
+  how much of the façade light the heavy crossings carry and where they started;
+  ``--lineage SEED …``: every launched photon's whole contribution per launch ring, one round
+  (benchmarks/forward_tails.py).
 * ``--patch-bias``: the NumPy engine at the 8 sensor points vs averaged over their squares of
   ``--patch`` m (why a patch tally of the direct sun cannot stand for point sensors).
 
@@ -324,105 +326,6 @@ def against_golden(hours: list[str], scenarios: list[str], realisations: int | N
     print(f" within 2 % or 3 combined s.e.: {ok} of {n}", flush=True)
 
 
-def crossings(hours: list[str], scenarios: list[str], seeds: list[int], window: float) -> None:
-    """Every patch crossing of runs at the project's defaults (``window``: the weight-window
-    factor; with a window only the rounds it applies to, without one every main round),
-    recorded with the crossing photon's flux, launched flux (its ring: the focused
-    launch gives each ring's photons an equal share of the ring's flux) and events: where the
-    heavy tail of the façade estimate comes from. The tracer is subclassed here (each segment
-    tallied once more into a row per photon), so the runs are slower than plain ones."""
-    from radtree.engines.forward import run as forward_run
-    from radtree.engines.forward.tracer import ForwardTracer
-
-    rec: list[np.ndarray] = []
-
-    class Recording(ForwardTracer):
-        counted = False
-        sky = 0.0   # 1 while tracing a launch that did not start as the sun's beam
-
-        def run(self, photons):  # type: ignore[no-untyped-def]
-            self.sky = 0.0 if photons.direct.all() else 1.0
-            return super().run(photons)
-
-        def _advance(self, ph):  # type: ignore[no-untyped-def]
-            seen = ph if not ph.direct.any() else ph.take(~ph.direct)
-            tri, t = self.geo.caster.first_hit(seen.o, seen.d)   # (explicit surfaces only)
-            t = np.where(tri < 0, np.inf, t)
-            rows = np.zeros((len(seen), self.det.count))
-            self.det.tally(seen.o, seen.d, t, seen.w, np.arange(len(seen)), rows)
-            c = rows.sum(axis=1)
-            hit = np.flatnonzero(c > 0)
-            if len(hit) and self.counted and (window <= 0 or self.window is not None):
-                dist = np.linalg.norm(seen.o[hit] - self.det_centre, axis=1)
-                rec.append(np.column_stack([c[hit], seen.w[hit], seen.w0[hit],
-                                            seen.ndiff[hit], seen.nspec[hit],
-                                            np.full(len(hit), self.sky), dist]))
-            return super()._advance(ph)
-
-    def tracer(h, batches):  # type: ignore[no-untyped-def]
-        s = h.settings
-        tr = Recording(h.geo, h.optics, h.det, batches, threshold=s.threshold,
-                       splitting=s.splitting, max_bounces=s.max_bounces,
-                       max_specular=s.max_specular, chunk=s.chunk, rng=h.rng,
-                       splitting_near=h.near, guide=h.guide,
-                       guided_roulette=s.guided_roulette)
-        tr.counted = batches > 1   # the pilot's scout traces one batch: not recorded
-        tr.det_centre = h.target
-        return tr
-
-    forward_run._tracer = tracer  # type: ignore[assignment]
-    for proj, name, hour, built, st in _cases(hours, scenarios):
-        s = replace(ForwardSettings.from_params(proj.engine, built.ab), window=window)
-        for k in seeds:
-            rec.clear()
-            with warnings.catch_warnings():
-                warnings.simplefilter("ignore")
-                r = trace_forward(built.scene, st, replace(s, seed=k), ["facade"], workers=1)
-            m, se = r.grid_mean("facade")
-            a = np.vstack(rec)
-            c, w, w0 = a[:, 0], a[:, 1], a[:, 2]
-            mc = c.mean()
-            print(f"  {name} {hour} seed {k} window {window:g}: {m:.1f} ± {se:.1f} lx, "
-                  f"{(r.photons + r.sizing_photons) / 1e6:.1f} M photons (sizing round "
-                  f"included), {len(c)} crossings, effective {c.sum() ** 2 / (c ** 2).sum():.0f}"
-                  f"; largest {c.max() / c.sum():.2%} of the total", flush=True)
-            for f in (10, 30, 100):
-                big = c > f * mc
-                print(f"    crossings > {f:3d} × mean: {big.sum():5d} carry {c[big].sum() / c.sum():6.1%}"
-                      f"; their launched flux median {np.median(w0[big]) if big.any() else 0:7.1f}"
-                      f" lm (all: {np.median(w0):.1f}), flux / launched max "
-                      f"{(w / w0)[big].max() if big.any() else 0:.2f}", flush=True)
-            _crossing_classes(a, mc)
-
-
-def _crossing_classes(a: np.ndarray, mean_crossing: float) -> None:
-    """Per class of crossing (source; diffuse/specular events before it; where its segment
-    started): its share of the crossings' flux, of the heavy crossings (> 10 × the mean) and
-    the equal crossings it is worth (Σc)² / Σc²."""
-    c, nd, ns, sky, dist = a[:, 0], a[:, 3], a[:, 4], a[:, 5], a[:, 6]
-    total = c.sum()
-    classes = {
-        "sky, no event": (sky == 1) & (nd == 0) & (ns == 0),
-        "sky, specular only": (sky == 1) & (nd == 0) & (ns > 0),
-        "sky, diffuse": (sky == 1) & (nd > 0),
-        "sun, specular only": (sky == 0) & (nd == 0),
-        "sun, 1 diffuse": (sky == 0) & (nd == 1),
-        "sun, ≥ 2 diffuse": (sky == 0) & (nd >= 2),
-        "segment from < 0.5 m": dist < 0.5,
-        "segment from 0.5–2 m": (dist >= 0.5) & (dist < 2.0),
-        "segment from ≥ 2 m": dist >= 2.0,
-    }
-    big = c > 10 * mean_crossing
-    for label, m in classes.items():
-        if not m.any():
-            continue
-        cm = c[m]
-        print(f"    {label:22s}: {m.sum():7d} crossings, {cm.sum() / total:6.1%} of the flux, "
-              f"worth {cm.sum() ** 2 / (cm ** 2).sum():8.0f}; > 10 × mean: {(m & big).sum():4d} "
-              f"({c[m & big].sum() / total:5.1%} of the flux), largest {cm.max() / total:.2%}",
-              flush=True)
-
-
 def radiance_repeats(hours: list[str], scenarios: list[str], repeats: int) -> None:
     """Radiance at the scenario's own settings (its switches applied), the traced façade mean
     of ``repeats`` clock-seeded runs (rtrace ``-u+``) on the build the forward z-scores trace
@@ -484,6 +387,10 @@ def main() -> None:
     ap.add_argument("--crossings", type=int, nargs="+", default=None, metavar="SEED",
                     help="record every patch crossing of these seeds' runs")
     ap.add_argument("--window", type=float, default=2.0, help="--crossings: window factor")
+    ap.add_argument("--lineage", type=int, nargs="+", default=None, metavar="SEED",
+                    help="each launched photon's whole contribution per launch ring, one round")
+    ap.add_argument("--launched-reference", action="store_true",
+                    help="--lineage: the roulette's reference stays the launched flux (before)")
     ap.add_argument("--patch", type=float, default=0.5)
     a = ap.parse_args()
     every = ["A", "B", "C", "D", "E", "A-sky", "F"]
@@ -492,8 +399,14 @@ def main() -> None:
     elif a.zscores:
         zscores(a.hours, a.scenarios or every, range(a.z_first, a.z_first + a.zscores),
                 a.z_target, a.z_round, a.z_out)
-    elif a.crossings:
-        crossings(a.hours, a.scenarios or ["B"], a.crossings, a.window)
+    elif a.crossings or a.lineage:
+        from forward_tails import crossings, lineage  # benchmarks/forward_tails.py
+
+        cases = _cases(a.hours, a.scenarios or ["B"])
+        if a.crossings:
+            crossings(cases, a.crossings, a.window)
+        else:
+            lineage(cases, a.lineage, not a.launched_reference)
     elif a.radiance_repeats:
         radiance_repeats(a.hours, a.scenarios or every, a.radiance_repeats)
     elif a.golden:
