@@ -37,6 +37,37 @@ Issue 40 (the estimator a user can trust by default), each a separate mode:
 ``--hours`` and ``--scenarios`` choose the scenario-hours (hour-major order, each line printed
 when done, so a partial run reports what it covered).
 
+With the guided roulette (radtree.engines.forward.tracer, *Roulette after a guided event*) and
+the window's level from the pilot (radtree.engines.forward.window) — measured 2026-12-07
+15:00–16:00 UTC, 2 shared cores at load 6–10 from other sessions (this process 30–50 % of a
+core):
+
+* ``--lineage 1 --hours 12:30 --scenarios F`` (scratch script of the same computation, window
+  opened after the first round as before): with the launched flux as the roulette's reference
+  the sun rings 8–24 m held 92 % of the variance, the ten largest of a ring's 146 688 photons
+  40 % of its light (kurtosis 18 000): one round 1 233 ± 79 lx besides the direct sun (64.5 lx).
+  With the reference following the guide: ten largest 3 %, 1 340 ± 14 lx (variance ÷ 32); the
+  sky's inner ring is then the largest share (27 %). ``--crossings`` had not shown it: the
+  window's identical copies cross as many light crossings (194 128 worth 66 646 equal ones).
+* ``--golden --scenarios F`` (all 7 hours, each of the 8 crowns traced, its own seed; 2 046 s):
+  **6 of 7 within 2 % or 3 combined s.e.**: 12:30 −1.50 % (−2.00 s.e.), 10:30 +0.35 %
+  (+0.39), 16:30 −0.35 % (−0.61), **11:30 −2.03 % (−3.14): MISS**, 15:30 −2.15 % (−2.82),
+  13:30 −2.44 % (−2.66), 14:30 −1.23 % (−1.74). Forward relative s.e. 0.34–0.47 % (each crown
+  ≤ 2 %), 0.9 M counted photons per crown-hour but at 12:30 and 10:30 (1.2 M): the 2 % target
+  reached in the first round almost always (before: 31 of 32 runs of crown 1 at the 15 M cap).
+  The forward means sit 1.5 % low on average over the hours, with the same 8 crowns at every
+  hour: the forward engine's patches, not its estimator (below, *patch against point*).
+* Patch against point (scratch script, NumPy engine, crown 1 at 12:30, 8 192 paths per point
+  sensor, 128 stratified points × 256 paths per 0.5 m patch, direct sun exact): the light
+  besides the direct sun reads 1 399 lx at the 8 points and 1 346 averaged over their patches
+  (−3.8 %); the direct sun 64.5 lx at the points (82.5 on the patches: ``forward_direct_sun``
+  is not the cause here). The forward engine's quantity (direct sun at the points, the rest
+  on the patches) 1 414 lx against 1 464 at the points (−3.4 %); forward seeds 1–2 read
+  1 422, 1 391. The slats reach 5 mm in front of the sensors (the crown's clip plane), so one
+  crown's light varies across a 0.5 m patch by more than the 2 % target; over 8 crowns that
+  does not average away. Not fixed here (a point estimate of the scattered light — next-event
+  estimation to the sensor points, MCNP's point detector with its exclusion sphere — would).
+
 With the weight window (radtree.engines.forward.window, ``engine.forward_window`` = 2) —
 measured 2026-12-07, 2 shared cores at load 3–27 from other sessions (runs of 1–30 min each):
 
