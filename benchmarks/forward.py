@@ -57,6 +57,15 @@ core):
   reached in the first round almost always (before: 31 of 32 runs of crown 1 at the 15 M cap).
   The forward means sit 1.5 % low on average over the hours, with the same 8 crowns at every
   hour: the forward engine's patches, not its estimator (below, *patch against point*).
+* ``--zscores 50 --hours 12:30 --scenarios F`` (first crown, defaults, seeds 1–50, one
+  process, 1 203 s): **z s.d. 0.953 (met), |z| > 3 in 2 % — 1 run, seed 8, 1 369.3 ± 12.1 lx,
+  z −3.37: not met** (≤ 1 %: 0 of 50 allowed); max |z| otherwise below 3. Spread of the means
+  / r.m.s. s.e. 0.88; relative s.e. 0.66–1.52 % (mean 1.06 %); 47 of 50 runs reached 2 % in
+  their first round (0.9 M photons counted), the others 2–3 M; none at the cap (before: z s.d.
+  1.28, 31 of 32 at the cap). Mean 1 409.8 lx against Radiance on the same crown 1 442.7 ± 4.1
+  (4 clock-seeded runs, above): −2.3 %, the patch against point difference below. What is left
+  of the tail: the sky's inner ring (27 % of the variance in the lineage view, its ten largest
+  photons 36 % of its light) — not diagnosed further.
 * Patch against point (scratch script, NumPy engine, crown 1 at 12:30, 8 192 paths per point
   sensor, 128 stratified points × 256 paths per 0.5 m patch, direct sun exact): the light
   besides the direct sun reads 1 399 lx at the 8 points and 1 346 averaged over their patches
