@@ -74,7 +74,10 @@ core):
   on the patches) 1 414 lx against 1 464 at the points (−3.4 %); forward seeds 1–2 read
   1 422, 1 391. The slats reach 5 mm in front of the sensors (the crown's clip plane), so one
   crown's light varies across a 0.5 m patch by more than the 2 % target; over 8 crowns that
-  does not average away. Not fixed here (a point estimate of the scattered light — next-event
+  does not average away. All 8 crowns at 11:30 (the missed hour; 4 096 paths per point, 128 ×
+  128 per patch): the forward engine's quantity 1 219.2 lx against 1 233.6 at the points
+  (−1.17 %; per crown −3.97 … +2.07 %); the forward engine read 1 221.0 ± 4.2 (+0.15 % from
+  the NumPy patch quantity), the golden 1 246.3 ± 6.9. Not fixed here (a point estimate of the scattered light — next-event
   estimation to the sensor points, MCNP's point detector with its exclusion sphere — would).
 
 With the weight window (radtree.engines.forward.window, ``engine.forward_window`` = 2) —
