@@ -57,6 +57,12 @@ core):
   reached in the first round almost always (before: 31 of 32 runs of crown 1 at the 15 M cap).
   The forward means sit 1.5 % low on average over the hours, with the same 8 crowns at every
   hour: the forward engine's patches, not its estimator (below, *patch against point*).
+* ``--golden --scenarios A B C D E A-sky --hours 12:30`` and ``--hours 14:30`` (the roulette
+  changes every guided run): **12 of 12 within 2 % or 3 combined s.e.**; 12:30 A +1.06 %
+  (+2.24 s.e.), B −0.11 %, C +1.93 % (+0.78), D −0.75 %, E −1.27 % (−1.14), A-sky +0.30 %;
+  14:30 A +1.27 % (+2.56), B +1.16 % (+0.89; before +3.34 %), C −1.82 % (−1.20), D +0.07 %
+  (8.0 M photons), E −1.19 % (−1.08), A-sky +0.03 %; all others at 0.9 M photons (before
+  0.9–15 M), relative s.e. 0.34–1.57 %.
 * ``--zscores 50 --hours 12:30 --scenarios F`` (first crown, defaults, seeds 1–50, one
   process, 1 203 s): **z s.d. 0.953 (met), |z| > 3 in 2 % — 1 run, seed 8, 1 369.3 ± 12.1 lx,
   z −3.37: not met** (≤ 1 %: 0 of 50 allowed); max |z| otherwise below 3. Spread of the means
