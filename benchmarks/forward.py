@@ -70,8 +70,17 @@ core):
   their first round (0.9 M photons counted), the others 2–3 M; none at the cap (before: z s.d.
   1.28, 31 of 32 at the cap). Mean 1 409.8 lx against Radiance on the same crown 1 442.7 ± 4.1
   (4 clock-seeded runs, above): −2.3 %, the patch against point difference below. What is left
-  of the tail: the sky's inner ring (27 % of the variance in the lineage view, its ten largest
-  photons 36 % of its light) — not diagnosed further.
+  of the tail — ``--lineage 8 --hours 12:30 --scenarios F`` at the defaults (28 s): one round
+  1 327.6 ± 14.6 lx besides the direct sun; the sky's inner ring (sky photons launched within
+  1 m of the line through the target) holds **43 % of the variance**, its ten largest of 13 696
+  photons 61 % of its 39.5 lx (kurtosis 4 455); every sun ring ≤ 19 %, ten largest ≤ 22 %. A
+  run short of those few photons reads ~3 % low with a normal-looking error (seed 8: −3.0 %,
+  z −3.37). They are most likely the sky seen straight through the crown's gaps (unscattered
+  sky photons crossing a patch with their launched flux: ``--crossings`` found such crossings
+  all above 10 × the mean). Not fixed here; the fix this points to is the one the direct sun
+  already has (:mod:`radtree.engines.forward.direct`): the unscattered sky computed at the
+  sensor points by sampled directions through the specular transmittances, sky photons
+  tallied only once scattered.
 * Patch against point (scratch script, NumPy engine, crown 1 at 12:30, 8 192 paths per point
   sensor, 128 stratified points × 256 paths per 0.5 m patch, direct sun exact): the light
   besides the direct sun reads 1 399 lx at the 8 points and 1 346 averaged over their patches
