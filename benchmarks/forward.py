@@ -39,7 +39,7 @@ when done, so a partial run reports what it covered).
 
 With the guided roulette (radtree.engines.forward.tracer, *Roulette after a guided event*) and
 the window's level from the pilot (radtree.engines.forward.window) — measured 2026-12-07
-15:00–16:00 UTC, 2 shared cores at load 6–10 from other sessions (this process 30–50 % of a
+14:40–15:50 UTC, 2 shared cores at load 4–10 from other sessions (this process 30–50 % of a
 core):
 
 * ``--lineage 1 --hours 12:30 --scenarios F`` (scratch script of the same computation, window
