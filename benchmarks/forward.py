@@ -63,6 +63,10 @@ core):
   14:30 A +1.27 % (+2.56), B +1.16 % (+0.89; before +3.34 %), C −1.82 % (−1.20), D +0.07 %
   (8.0 M photons), E −1.19 % (−1.08), A-sky +0.03 %; all others at 0.9 M photons (before
   0.9–15 M), relative s.e. 0.34–1.57 %.
+* ``--zscores 30 --hours 12:30 --scenarios B`` (seeds 1–30, 656 s, load 4–5): **z s.d. 1.087,
+  max |z| 2.64, none above 3**; spread of the means / r.m.s. s.e. 0.98; mean 1 272.6 lx
+  (golden 1 262.5 ± 3.2, Radiance repeats 1 270.3 ± 5.8); relative s.e. mean 0.86 %, median
+  0.9 M photons (max 2.0 M; before: median 8.5 M, 20 of 50 at the cap). 30 seeds, not 50.
 * ``--zscores 50 --hours 12:30 --scenarios F`` (first crown, defaults, seeds 1–50, one
   process, 1 203 s): **z s.d. 0.953 (met), |z| > 3 in 2 % — 1 run, seed 8, 1 369.3 ± 12.1 lx,
   z −3.37: not met** (≤ 1 %: 0 of 50 allowed); max |z| otherwise below 3. Spread of the means
