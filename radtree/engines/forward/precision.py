@@ -34,10 +34,11 @@ in the runs that missed the heavy hits, so z has a negative tail (same runs: z s
 min −4.4). Figures on the street: benchmarks/forward.py. The heavy hits left after the
 re-allocation came with the launch, not from the guide: the outer rings' photons start with
 100–3 000 lm against 4–30 lm in the inner rings, and crossings above 10 × the mean crossing
-(~1 % of them) carried 25–30 % of the façade's scattered light. So from the second round on a
-**weight window** (:mod:`radtree.engines.forward.window`, MCNP's method) splits every photon
-heavier than its bound into lighter copies; the first round — the sizing round — runs without
-it and sets its level.
+(~1 % of them) carried 25–30 % of the façade's scattered light. So a **weight window**
+(:mod:`radtree.engines.forward.window`, MCNP's method) splits every photon heavier than its
+bound into lighter copies, its level predicted from the pilot (every round traces with it).
+On the free crowns (F) the tail was the roulette after a guided event: see
+:mod:`radtree.engines.forward.tracer`, *Roulette after a guided event*.
 
 **Stopping.** After the first round the photons needed are predicted from the standard
 error's 1/√N law, N = N₁ · (r / target)² with r the worst grid's relative error, plus 10 %

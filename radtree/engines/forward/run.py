@@ -31,6 +31,7 @@ from radtree.engines.forward.strata import (
     Stratum,
     allocate,
     pilot,
+    predicted_crossings,
     reallocate,
     ring_edges,
     trace_strata,
@@ -179,7 +180,8 @@ def _tracer(h: _Hour, batches: int) -> ForwardTracer:
     return ForwardTracer(h.geo, h.optics, h.det, batches, threshold=s.threshold,
                          splitting=s.splitting, max_bounces=s.max_bounces,
                          max_specular=s.max_specular, chunk=s.chunk, rng=h.rng,
-                         splitting_near=h.near, guide=h.guide)
+                         splitting_near=h.near, guide=h.guide,
+                         guided_roulette=s.guided_roulette)
 
 
 def _focus(h: _Hour) -> tuple[list[Stratum] | None, int, int]:
@@ -198,6 +200,20 @@ def _focus(h: _Hour) -> tuple[list[Stratum] | None, int, int]:
     n_pilot = per_ring * len(strata)
     allocate(strata, max(s.photons - n_pilot, b * len(strata)), b)
     return strata, n_pilot, scout.segments
+
+
+def _window_from_pilot(h: _Hour, tracer: ForwardTracer, strata: list[Stratum] | None) -> None:
+    """The weight window opened before the first round, its level from the pilot's patch
+    crossings as the first round's allocation will make them
+    (:func:`~radtree.engines.forward.strata.predicted_crossings`): every round, the sizing
+    round included, then traces with it (without crossings in the pilot: after the first
+    round, :func:`_open_window`)."""
+    if strata is None or h.settings.window <= 0:
+        return
+    crossings, flux = predicted_crossings(strata)
+    level = window_level(h.settings.window, flux, crossings)
+    if level is not None:
+        tracer.window = WeightWindow(h.target, h.reach, level)
 
 
 def _at_points(h: _Hour) -> np.ndarray:
@@ -237,8 +253,9 @@ def _round(h: _Hour, tracer: ForwardTracer, strata: list[Stratum] | None,
 
 
 def _open_window(h: _Hour, tracer: ForwardTracer) -> None:
-    """After the hour's first round: the weight window for every later round, its level
-    from that round's patch crossings (:mod:`radtree.engines.forward.window`)."""
+    """After the hour's first round, when the pilot did not open it (no focused launch, or
+    no crossings in the pilot): the weight window for every later round, its level from that
+    round's patch crossings (:mod:`radtree.engines.forward.window`)."""
     if tracer.window is not None or h.settings.window <= 0:
         return
     level = window_level(h.settings.window, tracer.crossed_flux, tracer.crossings)
@@ -293,6 +310,7 @@ def trace_forward(scene: Scene, state: SkyState, settings: ForwardSettings,
     h = _plan(scene, state, settings, grids, backend=backend, workers=workers, label=label)
     tracer = _tracer(h, settings.batches)
     strata, n_pilot, pilot_segments = _focus(h)
+    _window_from_pilot(h, tracer, strata)
     counted, per_batch, rounds, warning, sizing = _rounds(h, tracer, strata)
     out, per = {}, {}
     for name in h.names:

@@ -63,7 +63,10 @@ class ForwardSettings:
     ``max_photons``: the cap (then a :class:`~radtree.engines.forward.precision.PrecisionWarning`
     with the error reached). ``direct_sun``: the sun's direct beam computed at the sensor points
     and sun photons tallied on the patches only once scattered (:mod:`.direct`; whole-scene
-    sun only).
+    sun only). ``window``: the weight window's factor (0: none, :mod:`.window`).
+    ``guided_roulette``: a guided diffuse event scales the photon's reference flux (the
+    roulette's) with its flux (:mod:`.tracer`, *Roulette after a guided event*; False: the
+    reference stays the launched flux, as before 2026-12-07 — kept for comparisons only).
     """
 
     photons: int = 1_000_000
@@ -85,6 +88,7 @@ class ForwardSettings:
     max_photons: int = 64_000_000
     direct_sun: bool = False
     window: float = 0.0
+    guided_roulette: bool = True
 
     def __post_init__(self) -> None:
         if isinstance(self.photons, bool) or not isinstance(self.photons, int) or self.photons < 1:
@@ -141,6 +145,9 @@ class ForwardSettings:
         if isinstance(ww, bool) or not isinstance(ww, int | float) or not math.isfinite(ww) \
                 or ww < 0:
             raise _bad("forward_window", f"must be ≥ 0 (0: no weight window), got {ww!r}")
+        if not isinstance(self.guided_roulette, bool):
+            raise _bad("forward_guide", f"guided_roulette must be true or false, got "
+                       f"{self.guided_roulette!r}")
         if self.max_bounces < 0 or self.max_specular < 0 or self.chunk < 1:
             raise _bad("max_bounces", "bounce caps must be ≥ 0 and the chunk ≥ 1")
 

@@ -77,6 +77,9 @@ class Stratum:
     var_sum: float = 0.0   # Σ n σ² over the pilot and the main rounds
     got: float = 0.0       # the main run's estimate of the ring's contribution (lux) …
     got_se: float = 0.0    # … and its standard error from the batches
+    pilot_photons: int = 0     # the pilot's photons in the ring …
+    pilot_crossings: int = 0   # … their patch crossings …
+    pilot_crossed: float = 0.0  # … and the flux those carried (lm)
 
 
 def _batches(k: int, batches: int, offset: int = 0) -> np.ndarray:
@@ -94,8 +97,12 @@ def pilot(sources: list, strata: list[Stratum], target: np.ndarray, tracer: Forw
     for st in strata:
         tracer.tally = np.zeros((per_ring, det.count))
         before = tracer.segments
+        crossings, crossed = tracer.crossings, tracer.crossed_flux
         launch = sources[st.source].ring_launch(per_ring, st.a, st.b, target, rng)
         tracer.run(Photons.start(launch, np.arange(per_ring), st.source in direct))
+        st.pilot_photons = per_ring
+        st.pilot_crossings = tracer.crossings - crossings
+        st.pilot_crossed = tracer.crossed_flux - crossed
         y = tracer.tally.sum(axis=1) / (det.count * det.area) * per_ring
         st.sigma = float(y.std(ddof=1))
         st.seen, st.var_sum = per_ring, per_ring * st.sigma ** 2
@@ -120,6 +127,16 @@ def allocate(strata: list[Stratum], photons: int, batches: int, floor: float = F
     share = floor / n + (1.0 - floor) * weight / weight.sum()
     for s, f in zip(strata, share):
         s.photons = batches * max(1, math.ceil(photons * f / batches))
+
+
+def predicted_crossings(strata: list[Stratum]) -> tuple[float, float]:
+    """The patch crossings a round with the strata's current ``photons`` is expected to make
+    and the flux they carry (lm), from the pilot's: a ring's crossings scale with its photons
+    and the flux of each with 1 / its photons (its flux is shared equally), so its crossed
+    flux is the pilot's. (0, 0) when the pilot crossed no patch."""
+    n = sum(st.pilot_crossings * st.photons / st.pilot_photons
+            for st in strata if st.pilot_photons > 0)
+    return float(n), float(sum(st.pilot_crossed for st in strata))
 
 
 def trace_strata(sources: list, strata: list[Stratum], target: np.ndarray,

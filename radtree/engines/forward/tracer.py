@@ -22,6 +22,24 @@ carrying 1/``factor`` of the flux (and of the threshold's reference flux, so rou
 undo the split), at most ``levels`` times per lineage: more photons where the detectors can see
 them, the expected tally unchanged.
 
+**Roulette after a guided event.** A guided diffuse event (:mod:`.guide`) multiplies the
+photon's flux by the Lambertian density over the mixture's, far below 1 for a direction drawn
+in the cone towards the detectors (≈ 0.005 from 10 m for a 0.6 m sphere); the photon's
+reference flux — the roulette's floor is ``threshold`` × it — is multiplied by the same factor.
+Measured on the reference street's free crowns (scenario F at 12:30, one round, every photon's
+contribution recorded per launch ring): with the launched flux as the reference, a photon
+aimed from the sunlit street at the façade lost 99.5 % of its flux to the guide, fell below the
+floor at its first slat and survived the roulette with ~1 % chance carrying the whole floor:
+the ten largest of a ring's 146 688 photons made 40 % of its light, kurtosis 18 000, and the
+façade mean's error after 15 M photons was 1.8–3 % (32 seeds: z s.d. 1.28). With the
+reference following the guide: the ten largest made 3 %, the error of one round fell from 79
+to 14 lx (variance ÷ 32). Roulette and splitting then work on the photon's expected
+contribution, not on a weight the guide has already rescaled — the condition for them not to
+undo importance-sampled directions (Vorba & Křivánek 2016, "Adjoint-driven Russian roulette
+and splitting in light transport simulation", ACM TOG 35(4), doi 10.1145/2897824.2925912: a
+weight window on weight × adjoint). Any reference keeps the roulette unbiased (a survivor
+carries the floor with probability flux / floor); only the variance changes.
+
 Diffuse events per photon are capped at ``max_bounces`` (``-ab``: the diffuse part of a hit
 beyond the cap is dropped, like a backward path that may not bounce again) and specular events
 at ``max_specular``. Every lumen is accounted for in a :class:`Ledger`: launched = escaped +
@@ -130,7 +148,8 @@ class ForwardTracer:
     def __init__(self, geo: Geometry, optics: Optics, detectors: PatchDetectors, batches: int,
                  *, threshold: float, splitting: bool, max_bounces: int, max_specular: int,
                  chunk: int, rng: np.random.Generator, splitting_near: Splitting | None = None,
-                 guide: Guide | None = None, escape_axes: np.ndarray | None = None):
+                 guide: Guide | None = None, escape_axes: np.ndarray | None = None,
+                 guided_roulette: bool = True):
         self.geo, self.opt, self.det = geo, optics, detectors
         self.near, self.guide = splitting_near, guide
         self.threshold, self.splitting = float(threshold), bool(splitting)
@@ -147,6 +166,9 @@ class ForwardTracer:
         #: the weight window (None: none), set by the run after its first round
         self.window: WeightWindow | None = None
         self.window_splits = 0   # copies the window added
+        #: a guided diffuse event scales the photon's reference flux (the roulette's) by the
+        #: same factor as its flux (module text, *Roulette after a guided event*)
+        self.guided_reference = bool(guided_roulette)
         #: with ``escape_axes`` (batches, 3) unit vectors: per batch, the flux escaping the scene
         #: along its axis (d · axis > 0, lm), and the part still the direct beam
         self.axes = escape_axes
@@ -311,6 +333,9 @@ class ForwardTracer:
                 led.killed += float(np.maximum(old - new, 0.0).sum())
                 cw = cw.copy()
                 cw[diffuse] = new
+                if self.guided_reference:   # the roulette's reference follows the weight
+                    w0 = w0.copy()
+                    w0[diffuse] = w0[diffuse] * factor
         if mir.any():
             new_d[mir] = mirror(d[mir], n[mir])
         side = np.where(diff_t | spec_t, -1.0, 1.0)

@@ -31,10 +31,19 @@ of its flux (the guide's cone, :mod:`.guide`), so
 
     W(p) = level · max(1, (d / r)²),
 
-``level`` (lm) = ``factor`` × the mean flux per patch crossing of the hour's first round (traced
-without the window; every later round uses the same level, so whether a photon splits never
-depends on the round it belongs to). Near the patches a photon may carry at most ``factor``
-mean crossings; far away proportionally more, since only (r/d)² of it can arrive.
+``level`` (lm) = ``factor`` × the mean flux per patch crossing. With the focused launch it is
+predicted from the pilot's crossings as the first round's allocation will make them
+(:func:`radtree.engines.forward.strata.predicted_crossings`), so every round — the sizing round
+too — traces with the window; otherwise it comes from the hour's first round, traced without
+it. Every later round uses the same level, so whether a photon splits never depends on the
+round it belongs to. Near the patches a photon may carry at most ``factor`` mean crossings;
+far away proportionally more, since only (r/d)² of it can arrive.
+
+**Why from the pilot** (2026-12-07): a sizing round without the window read a 2–4 × larger
+error than the windowed rounds after it, so it predicted 2–4 × the photons needed (B 12:30:
+runs ended at 0.7–1.9 % for the 2 % target, 20 of 50 at the 15 M cap; F 12:30 with the
+roulette of :mod:`.tracer` fixed: 4–5 M photons for 0.5–0.9 %). With the level from the pilot
+F and B 12:30 reach 2 % in their first round (0.9 M photons counted; F: 47 of 50 seeds).
 """
 
 from __future__ import annotations
@@ -85,7 +94,7 @@ class WeightWindow:
         return np.clip(n, 1, self.max_split).astype(np.int64)
 
 
-def window_level(factor: float, crossed_flux: float, crossings: int) -> float | None:
+def window_level(factor: float, crossed_flux: float, crossings: float) -> float | None:
     """The window's ``level`` (lm): ``factor`` × the mean flux per patch crossing
     (``crossed_flux`` lm over ``crossings``); None (no window) without crossings or factor."""
     if factor <= 0 or crossings <= 0 or crossed_flux <= 0:
