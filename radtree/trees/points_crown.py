@@ -112,9 +112,18 @@ def points_crown_grid(tree: Tree, source: str | None = None) -> tuple[VoxelGrid,
 
     grid = points_grid(tree, source)
     assert tree.points is not None
-    vertical = tree.points_scans is None and not airborne_beams(tree)
+    tilted = airborne_beams(tree)
+    vertical = tree.points_scans is None and not tilted
     beams = vertical_beams(tree.points) if vertical else None
-    fine, unreached = sharpen(grid, beams=beams)
+    density = None
+    if tilted:
+        from radtree.trees.points_rim import beam_footprint_density, tilted_beams
+
+        rays, g_of_mu = tilted_beams(tree.points), _g_of_mu(tree.louvers)
+
+        def density(gr: VoxelGrid, ins: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+            return beam_footprint_density(gr, ins, beams=rays, g_of_mu=g_of_mu)
+    fine, unreached = sharpen(grid, beams=beams, density=density)
     return grid, fine, unreached
 
 
