@@ -31,8 +31,11 @@ scale: only voxels the hull crosses change). The density in a voxel's inside cel
   where the hull covers a sliver of the voxel; benchmarks/lidar_facade.py.) A voxel no beam
   through its hull part reached (occluded, filled from its layer) keeps its leaf area,
   spread over its inside cells;
-* beams along their own paths (terrestrial scans, :mod:`radtree.lidar.beams`): the voxel's
-  plant area PAD·v³ spread over its inside cells (area-conserving).
+* airborne beams rebuilt from the scan angle (:mod:`radtree.lidar.scan_angle`): the same
+  re-inversion along each tilted beam's own path through the voxel's inside cells
+  (:mod:`radtree.trees.points_rim`);
+* beams along their own paths from terrestrial scans (:mod:`radtree.lidar.beams`): the
+  voxel's plant area PAD·v³ spread over its inside cells (area-conserving).
 
 A voxel with plant area but no inside cell (an occluded voxel filled from its layer, outside
 the hull) keeps its density in all its cells. The grid is cropped horizontally to the cells

@@ -68,7 +68,8 @@ def beam_footprint_density(grid: VoxelGrid, inside: np.ndarray, *, beams: Beams,
     """(u m²/m³, counted) per voxel of ``grid``: the density of each voxel's inside cells
     (``inside``, the hull cells of :func:`radtree.trees.points_hull.hull_inside`) solved on
     the beams through them (module text); ``counted``: voxels at least ``pulse_min`` beams
-    entered through their inside cells."""
+    entered through their inside cells and that the hull crosses (rim voxels; a voxel wholly
+    inside keeps the inversion's own estimate)."""
     nx, ny, nz = grid.pad.shape
     sub = inside.shape[0] // nx
     v = grid.size_m
@@ -96,7 +97,8 @@ def beam_footprint_density(grid: VoxelGrid, inside: np.ndarray, *, beams: Beams,
     n = nx * ny * nz
     entering = np.bincount(pv, weights=wb, minlength=n)
     hits = np.bincount(pv, weights=wb * hit, minlength=n)
-    counted = entering >= pulse_min
+    rim = (inside.reshape(nx, sub, ny, sub, nz, sub).sum(axis=(1, 3, 5)) < sub**3).ravel()
+    counted = (entering >= pulse_min) & rim
     with np.errstate(divide="ignore", invalid="ignore"):
         gap = (np.maximum(entering - hits, 0.0) + 0.5) / (entering + 0.5)
     u = _solve_pairs(pv, weights=wb, optical=gb * ell, gap=np.where(counted, gap, 1.0), n=n)
