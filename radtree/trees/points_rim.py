@@ -64,7 +64,8 @@ def tilted_beams(path: str | Path, origins: np.ndarray | None = None) -> Beams:
 
 def beam_footprint_density(grid: VoxelGrid, inside: np.ndarray, *, beams: Beams,
                            g_of_mu: Callable[[np.ndarray], np.ndarray],
-                           pulse_min: float = PULSE_MIN) -> tuple[np.ndarray, np.ndarray]:
+                           pulse_min: float = PULSE_MIN, estimator: str = "mean_path"
+                           ) -> tuple[np.ndarray, np.ndarray]:
     """(u m²/m³, counted) per voxel of ``grid``: the density of each voxel's inside cells
     (``inside``, the hull cells of :func:`radtree.trees.points_hull.hull_inside`) solved on
     the beams through them (module text); ``counted``: voxels at least ``pulse_min`` beams
@@ -101,7 +102,14 @@ def beam_footprint_density(grid: VoxelGrid, inside: np.ndarray, *, beams: Beams,
     counted = (entering >= pulse_min) & rim
     with np.errstate(divide="ignore", invalid="ignore"):
         gap = (np.maximum(entering - hits, 0.0) + 0.5) / (entering + 0.5)
-    u = _solve_pairs(pv, weights=wb, optical=gb * ell, gap=np.where(counted, gap, 1.0), n=n)
+    if estimator == "mean_path":
+        optical = np.bincount(pv, weights=wb * gb * ell, minlength=n)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            u = np.where(counted & (optical > 0),
+                         -np.log(np.minimum(gap, 1.0)) * entering / optical, 0.0)
+    else:
+        u = _solve_pairs(pv, weights=wb, optical=gb * ell, gap=np.where(counted, gap, 1.0),
+                         n=n)
     return u.reshape(nx, ny, nz), counted.reshape(nx, ny, nz)
 
 
