@@ -12,20 +12,31 @@ Sens. 10:1580). Measured (``benchmarks/lidar_facade.py``, 2026-12-07): the near-
 wall-side rim 6 % too transparent at 13:30 along the beams (1.062) against 1.003 with the
 vertical re-inversion.
 
-Here the same rule along the tilted beams: every beam b (origin → return; an intercepted
+Here the re-inversion along the tilted beams: every beam b (origin → return; an intercepted
 beam on to the exit of its return's voxel, the chord it was exposed to, as
 :mod:`radtree.lidar.beams` counts it) is walked on the hull's cells (side w = v / sub,
 Amanatides & Woo 1987 via :func:`radtree.lidar.beams.traverse`); ℓ_b is its length in the
-voxel's inside cells. Of the beams with ℓ_b > 0 (weight 1/number of returns), N enter and I
-are intercepted in the voxel; u solves
+voxel's inside cells. Of the beams with ℓ_b > 0 (weight w_b = 1/number of returns), N enter
+and I are intercepted in the voxel; the density u of the inside cells is
 
-    Σ_b w_b exp(−u·G(μ_b)·ℓ_b) / Σ_b w_b = (N − I + ½) / (N + ½)
+    u = −ln( (N − I + ½) / (N + ½) ) / l̄_G,   l̄_G = Σ_b w_b·G(μ_b)·ℓ_b / N
 
-(the ½ correction of :mod:`radtree.lidar.voxels`; for vertical beams this is the column rule
-of :mod:`radtree.trees.points_hull`). A voxel that fewer than ``pulse_min`` beams entered
-through its hull part keeps the inversion's leaf area spread over its inside cells (the
-undersampled voxels' rule of :mod:`radtree.lidar.voxels`). Units: metres, heights above
-ground.
+(the voxel inversion's own estimator, :mod:`radtree.lidar.beams`, on the beams through the
+hull part only, ``estimator = "mean_path"``, the default), or u solving
+Σ_b w_b exp(−u·G(μ_b)·ℓ_b) / Σ_b w_b = (N − I + ½) / (N + ½) (``"sum_exp"``, the vertical
+columns' rule of :mod:`radtree.trees.points_hull`, which takes each beam's own path in the
+hull part into account). Only rim voxels (the hull crosses them) are re-inverted: a voxel
+wholly inside the hull keeps the inversion's estimate. A voxel that fewer than ``pulse_min``
+beams entered through its hull part keeps the inversion's leaf area spread over its inside
+cells (the undersampled voxels' rule of :mod:`radtree.lidar.voxels`).
+
+Measured (2026-12-07, ``benchmarks/lidar_facade.py --seeds 8 --turbid-seeds 16``, turbid
+expectations vox/turb; load 5–7) at the 10:30 sensors / 13:30 sensors / 13:30 map: spread
+(before) 1.001 / 1.062 ± 0.015 / 1.018; mean-path (default) 1.001 / 1.037 ± 0.018 / 1.015;
+sum-exp 1.000 / 1.025 ± 0.019 / 1.011 (all voxels or rim voxels only: the same). Street leaf
+area (``benchmarks/lidar_als_user.py --seeds 0-5``): see that benchmark's docstring — the
+sum-exp rule raises the rim's leaf area: 51 of 55 tree scans within 10 % at seeds 0–2 (rim
+voxels only; 57 of 60 before). Units: metres, heights above ground.
 """
 
 from __future__ import annotations
@@ -67,8 +78,8 @@ def beam_footprint_density(grid: VoxelGrid, inside: np.ndarray, *, beams: Beams,
                            pulse_min: float = PULSE_MIN, estimator: str = "mean_path"
                            ) -> tuple[np.ndarray, np.ndarray]:
     """(u m²/m³, counted) per voxel of ``grid``: the density of each voxel's inside cells
-    (``inside``, the hull cells of :func:`radtree.trees.points_hull.hull_inside`) solved on
-    the beams through them (module text); ``counted``: voxels at least ``pulse_min`` beams
+    (``inside``, the hull cells of :func:`radtree.trees.points_hull.hull_inside`) from the
+    beams through them, ``estimator`` "mean_path" or "sum_exp" (module text); ``counted``: voxels at least ``pulse_min`` beams
     entered through their inside cells and that the hull crosses (rim voxels; a voxel wholly
     inside keeps the inversion's own estimate)."""
     nx, ny, nz = grid.pad.shape
