@@ -36,8 +36,17 @@ beams rebuilt from the clip's own scan angles and flight lines 115 of 120 (misse
 and S15 −10.1 % at seed 1, S17 +12.9 % at seed 2, S10 +10.2 % and S17 +13.7 % at seed 3) —
 per tree within 1.0 point (mean 0.12) of lidar_roundtrip.py, which knows the flight lines
 (there 114 of 120; S15 at seed 1 −9.5 % there, −10.1 % here): the clip alone gives the
-beams. The crown kept in the
-hull equals the inversion along the beams (area-conserving, :mod:`radtree.trees.points_hull`).
+beams. (Then the crown kept in the hull equalled the inversion along the beams,
+area-conserving.)
+
+Since each rim voxel is re-inverted along the beams through its hull part
+(:mod:`radtree.trees.points_rim`, mean-path estimator; 2026-12-07 15:53–15:56 UTC, load
+5.3–6.6, 130 s wall): along the scan-angle beams 20/20, 18/20, 19/20, 19/20, 20/20, 19/20 =
+115 of 120 (max 8.4, 10.5, 12.9, 10.8, 9.7, 11.1 %; median 3.0–4.0 %; mean −0.0, +0.1, −0.2,
++0.8, +1.8, −1.0 %); misses S04 +10.5 and S15 −10.1 % (seed 1), S17 +12.9 % (2), S17 +10.8 %
+(3), S20 −11.1 % (5). Vertical columns unchanged. With the vertical columns' sum-exp rule
+(``estimator = "sum_exp"``) 51 of 55 at seeds 0–2 (18, 19, 14/15 when stopped; S05 +11.2,
+S11 +11.5, S04 +12.8, S10 +10.7 %): the rim's leaf area raised, not taken.
 
     python benchmarks/lidar_als_user.py [--seeds 0-5]
 """

@@ -94,6 +94,15 @@ Slats: 1.006 ± 0.004 (8/8), 1.036 ± 0.144 (1/8), map 1.010 ± 0.012 (7/8). The
 are of vertical columns (``points_beams = "vertical"``), which keep the 13:30 rim; see the
 CHANGELOG entry "one top per dome, seeds 0–5, the user's airborne path".
 
+Then each rim voxel re-inverted along the scan-angle beams through its hull part
+(:mod:`radtree.trees.points_rim`, the default since), ``--seeds 8 --turbid-seeds 16``
+(2026-12-07 15:47–15:53 UTC, load 5–6.5, 391 s wall, 198 s CPU): expectations vox/turb
+sensors 10:30 1.001 ± 0.003, 13:30 1.037 ± 0.018 — met —, map 13:30 1.015 ± 0.004; slats
+1.004 ± 0.004 (8/8), 1.003 ± 0.141 (1/8), 1.012 ± 0.012 (7/8). With the vertical columns'
+sum-exp rule (``estimator = "sum_exp"``, not the default: street leaf area worse) 1.000 /
+1.025 ± 0.019 / 1.011. (The "crown in the returns' hull" leaf area this script prints is of
+vertical columns.)
+
 ``tests/test_points_hull.py`` holds the direct-sun figures in CI (4 scans).
 
     python benchmarks/lidar_facade.py [--seeds 8] [--turbid-seeds 32] [--hours 10:30 13:30]

@@ -98,7 +98,11 @@ def test_facade_direct_sun_of_crowns_rebuilt_from_scans(tmp_path: Path) -> None:
     kept in the hull 1.24: the rim too thin). Those figures are of vertical columns; the scans
     now carry scan angles, so the default ``tree.points_beams = "scan_angle"`` follows the
     beams: over 8 scans 0.988 / 0.993 / 1.099 at 10:30 sensors / 13:30 map / 13:30 sensors
-    (vertical columns on the same scans 0.988 / 1.014 / 1.017; CHANGELOG)."""
+    (vertical columns on the same scans 0.988 / 1.014 / 1.017; CHANGELOG). With each rim
+    voxel re-inverted along the beams through its hull part (:mod:`radtree.trees.points_rim`)
+    these 4 scans give 0.986 / 1.016 / 1.011 (8 scans: 13:30 sensors 1.035; the rim spread
+    over its hull cells, as before, 4 scans 0.986 / 1.020 / 1.046), so the 13:30 sensors are
+    held within 3 %."""
     from radtree.config import load_project
     from radtree.engines.common.turbid import MediumTracer
     from radtree.engines.common.voxels import VoxelTracer
@@ -150,4 +154,4 @@ def test_facade_direct_sun_of_crowns_rebuilt_from_scans(tmp_path: Path) -> None:
             ratios[hour, where] = rebuilt / transmission("turb", o, d)
     assert ratios["10:30", "sensors"] == pytest.approx(1.0, abs=0.03), ratios
     assert ratios["13:30", "map"] == pytest.approx(1.0, abs=0.04), ratios
-    assert ratios["13:30", "sensors"] == pytest.approx(1.0, abs=0.10), ratios
+    assert ratios["13:30", "sensors"] == pytest.approx(1.0, abs=0.03), ratios

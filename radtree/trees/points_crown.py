@@ -22,7 +22,8 @@ voxel by voxel; ``cover_fraction`` plays no part (the slats' optics do: the gap 
 near-opaque real leaves, is the consistent one). Before filling, the grid is kept inside the
 convex hull of the crown's returns on cells of a quarter voxel (:func:`points_crown_grid`,
 :mod:`radtree.trees.points_hull`: the rim stays sharp, and each rim voxel's measured gap is
-held by the part of it inside the hull), and the slats fill those cells. The cloud is placed on
+held by the part of it inside the hull — re-inverted on the beams through that part, vertical
+or along the scan-angle beams, :mod:`radtree.trees.points_rim`), and the slats fill those cells. The cloud is placed on
 every trunk of the row: the centre of the crown's outline seen from above
 (:func:`radtree.trees.points_hull.crown_centre`) on the trunk axis, its ground at the street
 (z = 0), its x along the façade (u) and y away from it (n). Slats are then clipped like the volume arrangement's
@@ -107,14 +108,25 @@ def points_crown_grid(tree: Tree, source: str | None = None) -> tuple[VoxelGrid,
     """(the inversion grid of :func:`points_grid`, the crown's grid kept inside the returns'
     hull on cells of 1/:data:`~radtree.trees.points_hull.SUB` voxel — what the crowns are
     filled from and placed by —, voxels with leaves no beam through their hull part reached):
-    :func:`radtree.trees.points_hull.sharpen`, vertical-beam form for airborne scans."""
+    :func:`radtree.trees.points_hull.sharpen`, re-inverted on the beams through each voxel's
+    hull part for airborne scans (vertical, or along the scan-angle beams:
+    :func:`radtree.trees.points_rim.beam_footprint_density`)."""
     from radtree.trees.points_hull import sharpen, vertical_beams
 
     grid = points_grid(tree, source)
     assert tree.points is not None
-    vertical = tree.points_scans is None and not airborne_beams(tree)
+    tilted = airborne_beams(tree)
+    vertical = tree.points_scans is None and not tilted
     beams = vertical_beams(tree.points) if vertical else None
-    fine, unreached = sharpen(grid, beams=beams)
+    density = None
+    if tilted:
+        from radtree.trees.points_rim import beam_footprint_density, tilted_beams
+
+        rays, g_of_mu = tilted_beams(tree.points), _g_of_mu(tree.louvers)
+
+        def density(gr: VoxelGrid, ins: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+            return beam_footprint_density(gr, ins, beams=rays, g_of_mu=g_of_mu)
+    fine, unreached = sharpen(grid, beams=beams, density=density)
     return grid, fine, unreached
 
 

@@ -31,8 +31,11 @@ scale: only voxels the hull crosses change). The density in a voxel's inside cel
   where the hull covers a sliver of the voxel; benchmarks/lidar_facade.py.) A voxel no beam
   through its hull part reached (occluded, filled from its layer) keeps its leaf area,
   spread over its inside cells;
-* beams along their own paths (terrestrial scans, :mod:`radtree.lidar.beams`): the voxel's
-  plant area PAD·v³ spread over its inside cells (area-conserving).
+* airborne beams rebuilt from the scan angle (:mod:`radtree.lidar.scan_angle`): the same
+  re-inversion along each tilted beam's own path through the voxel's inside cells
+  (:mod:`radtree.trees.points_rim`);
+* beams along their own paths from terrestrial scans (:mod:`radtree.lidar.beams`): the
+  voxel's plant area PAD·v³ spread over its inside cells (area-conserving).
 
 A voxel with plant area but no inside cell (an occluded voxel filled from its layer, outside
 the hull) keeps its density in all its cells. The grid is cropped horizontally to the cells
@@ -41,6 +44,7 @@ with plant area.
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from pathlib import Path
 
 import numpy as np
@@ -179,13 +183,16 @@ def footprint_density(grid: VoxelGrid, inside: np.ndarray, *, xy: np.ndarray,
 
 
 def sharpen(grid: VoxelGrid, *, sub: int = SUB,
-            beams: tuple[np.ndarray, np.ndarray] | None = None, margin_m: float = 0.0
-            ) -> tuple[VoxelGrid, int]:
+            beams: tuple[np.ndarray, np.ndarray] | None = None, margin_m: float = 0.0,
+            density: Callable[[VoxelGrid, np.ndarray], tuple[np.ndarray, np.ndarray]]
+            | None = None) -> tuple[VoxelGrid, int]:
     """(the grid on cells of side size_m/``sub`` with its plant area inside the returns' hull
     (widened by ``margin_m``), voxels with plant area that no beam through their hull part
     reached — their leaf area kept, spread over their inside cells) (module text). ``beams``:
     (x, y, heights) of :func:`vertical_beams` for the vertical-beam inversion; None spreads
-    every voxel's leaf area over its inside cells."""
+    every voxel's leaf area over its inside cells. ``density``: (grid, inside) → (u, counted)
+    instead, e.g. the re-inversion along tilted beams
+    (:func:`radtree.trees.points_rim.beam_footprint_density`)."""
     inside = hull_inside(grid, sub, margin_m)
     nx, ny, nz = grid.pad.shape
     w = grid.size_m / sub
@@ -196,8 +203,11 @@ def sharpen(grid: VoxelGrid, *, sub: int = SUB,
     dense = (grid.pad > 0) & (count > 0)
     u = np.where(dense, grid.pad * sub**3 / np.maximum(count, 1), grid.pad)  # area-conserving
     unreached = 0
-    if beams is not None and dense.any():
-        uf, counted = footprint_density(grid, inside, xy=beams[0], heights=beams[1])
+    if beams is not None and density is None:
+        def density(gr: VoxelGrid, ins: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+            return footprint_density(gr, ins, xy=beams[0], heights=beams[1])
+    if density is not None and dense.any():
+        uf, counted = density(grid, inside)
         u = np.where(dense & counted, uf, u)
         unreached = int((dense & ~counted).sum())
     keep = np.where(dense[..., None, None, None], blocks, True)
