@@ -98,7 +98,7 @@ def _traverse_block(o: np.ndarray, *, e: np.ndarray, lo: np.ndarray, size: float
     return row, np.ravel_multi_index(ijk.T, shape), ln
 
 
-def _chord_beyond(end: np.ndarray, *, d: np.ndarray, lo: np.ndarray, size: float) -> np.ndarray:
+def chord_beyond(end: np.ndarray, *, d: np.ndarray, lo: np.ndarray, size: float) -> np.ndarray:
     """Length (m) from each return ``end`` along the unit direction ``d`` to the exit of
     the voxel holding it."""
     cell = np.floor((end - lo) / size)
@@ -128,7 +128,7 @@ def beam_density(beams: Beams, *, lo: np.ndarray, size: float, shape: tuple[int,
     hit_cell = np.ravel_multi_index(k[ok].T, shape)
     hits = np.bincount(hit_cell, weights=w[ok], minlength=n)
     # an intercepted beam was exposed to its whole chord through the voxel
-    beyond = _chord_beyond(beams.end[ok], d=d[ok], lo=lo, size=size)
+    beyond = chord_beyond(beams.end[ok], d=d[ok], lo=lo, size=size)
     if beyond_max is not None:
         beyond = np.minimum(beyond, np.asarray(beyond_max, float)[ok])
     optical += np.bincount(hit_cell, weights=g[ok] * beyond, minlength=n)

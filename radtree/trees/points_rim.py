@@ -46,7 +46,7 @@ from pathlib import Path
 
 import numpy as np
 
-from radtree.lidar.beams import Beams, _chord_beyond, traverse
+from radtree.lidar.beams import Beams, chord_beyond, traverse
 from radtree.lidar.voxels import PULSE_MIN, VoxelGrid
 
 
@@ -89,7 +89,7 @@ def beam_footprint_density(grid: VoxelGrid, inside: np.ndarray, *, beams: Beams,
     lo = np.array([grid.x0, grid.y0, 0.0])
     d = beams.end - beams.origin
     d /= np.maximum(np.linalg.norm(d, axis=1), 1e-12)[:, None]
-    beyond = np.where(beams.hit, _chord_beyond(beams.end, d=d, lo=lo, size=v), 0.0)
+    beyond = np.where(beams.hit, chord_beyond(beams.end, d=d, lo=lo, size=v), 0.0)
     end = beams.end + (beyond * (1.0 - 1e-9))[:, None] * d
     seg, cell, length = traverse(beams.origin, end=end, lo=lo, size=w, shape=inside.shape)
     keep = inside.ravel()[cell]
