@@ -130,10 +130,18 @@ def _solve_u(paths: np.ndarray, *, weights: np.ndarray, gap: np.ndarray, g: floa
         return np.sum(weights * np.exp(-uu[:, None] * g * paths), axis=1) / wsum
 
     solved = np.sum(weights * (paths <= 0), axis=1) / wsum < gap - 1e-9
+    return solve_mean_gap(mean_gap, gap, solved), solved
+
+
+def solve_mean_gap(mean_gap: Callable[[np.ndarray], np.ndarray], gap: np.ndarray,
+                   want: np.ndarray) -> np.ndarray:
+    """The density u (m²/m³) per entry where ``mean_gap(u)`` (falling in u) equals ``gap``,
+    for the entries ``want`` (bracket doubled from 1 until it holds the root, then 60
+    bisections); the others are left at the bracket's middle."""
     lo = np.zeros(len(gap))
     hi = np.full(len(gap), 1.0)
     for _ in range(60):          # grow the bracket until it holds the root
-        short = solved & (mean_gap(hi) > gap)
+        short = want & (mean_gap(hi) > gap)
         if not short.any():
             break
         hi[short] *= 2.0
@@ -142,7 +150,7 @@ def _solve_u(paths: np.ndarray, *, weights: np.ndarray, gap: np.ndarray, g: floa
         above = mean_gap(mid) > gap
         lo = np.where(above, mid, lo)
         hi = np.where(above, hi, mid)
-    return 0.5 * (lo + hi), solved
+    return 0.5 * (lo + hi)
 
 
 def footprint_density(grid: VoxelGrid, inside: np.ndarray, *, xy: np.ndarray,

@@ -48,6 +48,7 @@ import numpy as np
 
 from radtree.lidar.beams import Beams, chord_beyond, traverse
 from radtree.lidar.voxels import PULSE_MIN, VoxelGrid
+from radtree.trees.points_hull import solve_mean_gap
 
 
 def tilted_beams(path: str | Path, origins: np.ndarray | None = None) -> Beams:
@@ -134,14 +135,4 @@ def _solve_pairs(pv: np.ndarray, *, weights: np.ndarray, optical: np.ndarray,
         return np.bincount(pv, weights=weights * np.exp(-u[pv] * optical), minlength=n) / wsum
 
     want = gap < 1.0 - 1e-12
-    lo, hi = np.zeros(n), np.ones(n)
-    for _ in range(60):          # grow the bracket until it holds the root
-        short = want & (mean_gap(hi) > gap)
-        if not short.any():
-            break
-        hi[short] *= 2.0
-    for _ in range(60):          # bisection: the mean gap falls as u grows
-        mid = 0.5 * (lo + hi)
-        above = mean_gap(mid) > gap
-        lo, hi = np.where(above, mid, lo), np.where(above, hi, mid)
-    return np.where(want, 0.5 * (lo + hi), 0.0)
+    return np.where(want, solve_mean_gap(mean_gap, gap, want), 0.0)
