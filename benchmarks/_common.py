@@ -67,3 +67,12 @@ def print_resources_at_exit() -> None:
     _STATE["t0"] = time.perf_counter()
     _STATE["load0"] = _load()
     atexit.register(lambda: print(resources_line(), flush=True))
+
+
+def seed_list(text: str) -> list[int]:
+    """A ``--seeds`` argument as a list: "0-5" → [0, 1, 2, 3, 4, 5]; "0,2" → [0, 2]."""
+    out: list[int] = []
+    for part in text.split(","):
+        a, _, b = part.partition("-")
+        out.extend(range(int(a), int(b or a) + 1))
+    return out

@@ -65,11 +65,9 @@ MODES = ("vertical", "scan_angle")
 
 
 def _seeds(text: str) -> list[int]:
-    out: list[int] = []
-    for part in text.split(","):
-        a, _, b = part.partition("-")
-        out.extend(range(int(a), int(b or a) + 1))
-    return out
+    from _common import seed_list  # benchmarks/_common.py
+
+    return seed_list(text)
 
 
 def crown_leaf_area(clip: Path, mode: str) -> tuple[float, float]:

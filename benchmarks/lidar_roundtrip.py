@@ -104,12 +104,9 @@ from pathlib import Path
 
 
 def _seeds(text: str) -> list[int]:
-    """"0-5" → [0, 1, 2, 3, 4, 5]; "0,2" → [0, 2]."""
-    out: list[int] = []
-    for part in text.split(","):
-        a, _, b = part.partition("-")
-        out.extend(range(int(a), int(b or a) + 1))
-    return out
+    from _common import seed_list  # benchmarks/_common.py
+
+    return seed_list(text)
 
 
 def main() -> int:
