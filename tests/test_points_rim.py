@@ -14,6 +14,7 @@ from radtree.lidar.clip import write_points
 from radtree.lidar.voxels import tree_voxels
 from radtree.trees.points_hull import sharpen
 from radtree.trees.points_rim import beam_footprint_density, tilted_beams
+from tests.test_points_hull import chord_depth
 
 R, ZC, U, G = 3.0, 5.0, 0.5, 0.5      # sphere radius m, centre height m, PAD m²/m³, projection
 TRACK_X, ALT = -100.0, 300.0          # the flight line (x m, altitude m), along y
@@ -45,13 +46,7 @@ def tilted_sphere_scan(tmp: Path, seed: int) -> tuple[Path, np.ndarray]:
 
 def rim_transmission(fine, o: np.ndarray, d: np.ndarray) -> float:
     """Mean uncollided transmission along rays o + t d through the grid, by 2 cm steps."""
-    t = np.arange(0.0, 12.0, 0.02)
-    p = o[:, None, :] + t[None, :, None] * d
-    idx = np.floor((p - [fine.x0, fine.y0, 0.0]) / fine.size_m).astype(np.int64)
-    ok = np.all((idx >= 0) & (idx < fine.pad.shape), axis=2)
-    u = np.zeros(ok.shape)
-    u[ok] = fine.pad[idx[ok][:, 0], idx[ok][:, 1], idx[ok][:, 2]]
-    return float(np.exp(-G * u.sum(axis=1) * 0.02).mean())
+    return float(np.exp(-G * chord_depth(fine, o, d)).mean())
 
 
 @pytest.mark.parametrize(("estimator", "rel", "measured"),
