@@ -254,15 +254,21 @@ def test_every_output_path_has_a_group_of_its_own():
     assert len(others) == 6
 
 
-def test_gltf_read_back_without_trimesh():
-    from radtree.verify.gltf import gltf_checks
+
+def assert_all_pass(checks, path: str) -> None:
+    """Every check passes and is filed under the output path ``path`` on the page."""
     from radtree.verify.page import path_of
 
-    checks = gltf_checks()
     for c in checks:
         print(c)
         assert c.status == "pass", c
-        assert path_of(c) == ["glTF export"]
+        assert path_of(c) == [path]
+
+def test_gltf_read_back_without_trimesh():
+    from radtree.verify.gltf import gltf_checks
+
+    checks = gltf_checks()
+    assert_all_pass(checks, "glTF export")
     count, area, box = checks
     assert count.expected == count.got > 5000                # every triangle, mesh by mesh
     assert area.expected == pytest.approx(316.78, abs=0.01)  # the louvers dome's leaf area
@@ -272,14 +278,10 @@ def test_gltf_read_back_without_trimesh():
 
 def test_idf_read_back_by_a_plain_parser():
     from radtree.verify.energyplus import idf_checks, idf_objects
-    from radtree.verify.page import path_of
 
     assert idf_objects("A,\n 1, ! one\n 2;\nB, x;") == [["A", "1", "2"], ["B", "x"]]
     checks = idf_checks(rays=4)
-    for c in checks:
-        print(c)
-        assert c.status == "pass", c
-        assert path_of(c) == ["EnergyPlus schedules"]
+    assert_all_pass(checks, "EnergyPlus schedules")
     values, shadow, shades = checks
     assert values.got <= 5e-7 and shadow.got == 2.0 and shades.got == shades.expected > 100
 
@@ -319,15 +321,11 @@ def test_honeybee_export_traced_by_honeybee_radiance():
     pytest.importorskip("honeybee_radiance")
     from radtree.engines.radiance.binaries import find_radiance
     from radtree.verify.honeybee import honeybee_checks
-    from radtree.verify.page import path_of
 
     if find_radiance() is None:
         pytest.skip("Radiance not installed")
     checks = honeybee_checks()
-    for c in checks:
-        print(c)
-        assert c.status == "pass", c
-        assert path_of(c) == ["Honeybee export"]
+    assert_all_pass(checks, "Honeybee export")
     count, direct, lit = checks
     assert count.got == count.expected > 1000
     assert direct.got < 0.005 and "3 sunlit sensors" in direct.check and lit.got == 0
