@@ -241,3 +241,17 @@ def test_species_tree_from_a_species_and_a_size() -> None:
     assert species_tree(dense, sp).louvers.cover_fraction == 1.0          # its own density
     untouched = species_tree(p.tree, sp)
     assert untouched.crown == p.tree.crown and untouched.louvers.inclination_deg == 44.2
+
+
+def test_species_line_gives_the_southern_sites_leaf_calendar() -> None:
+    """The library's days are the northern hemisphere's; a southern site's note gives the
+    days it uses (182 days later), a northern site's does not."""
+    sp = load_species("morus_alba")
+    south = sp.describe(-32.89)
+    assert "leaves out day 76, full 106, fall 288–335 (northern hemisphere)" in south
+    assert "at this southern site 182 days later: leaves out day 258, full 288, fall 105–152" \
+        in south
+    assert sp.describe(40.4) == sp.describe() and "southern" not in sp.describe(40.4)
+    # the calendar the note prints is the one the leaf area follows: full leaf from day 288
+    assert sp.leaf_area_fraction(288.0, -32.89) == 1.0
+    assert sp.leaf_area_fraction(257.0, -32.89) == 0.0

@@ -202,7 +202,10 @@ class Species:
         f = self.leaf_area_fraction(day_of_year, latitude_deg)
         return self.lai_leaf_off + f * (self.lai_leaf_on - self.lai_leaf_off)
 
-    def describe(self) -> str:
+    def describe(self, latitude_deg: float | None = None) -> str:
+        """One line of the species' values; its leaf calendar (day of year) is the northern
+        hemisphere's, and at a southern ``latitude_deg`` the line also gives the days
+        shifted by ``southern_shift_days`` that the site uses."""
         return (f"{self.name} ({self.common_name}): leaf R {self.leaf_reflectance:g}, "
                 f"T diffuse {self.leaf_transmittance_diffuse:g} / global "
                 f"{self.leaf_transmittance_global:g}, tilt {self.mean_leaf_tilt_deg:g}° "
@@ -210,7 +213,16 @@ class Species:
                 f"{self.lai_leaf_off:g} bare, permeability {self.permeability_leaf_on:g} / "
                 f"{self.permeability_leaf_off:g}; leaves out day {self.leaf_out_doy:g}, full "
                 f"{self.full_leaf_doy:g}, fall {self.leaf_fall_start_doy:g}–"
-                f"{self.leaf_fall_end_doy:g} (northern hemisphere)")
+                f"{self.leaf_fall_end_doy:g} (northern hemisphere)" + self._southern(latitude_deg))
+
+    def _southern(self, latitude_deg: float | None) -> str:
+        if latitude_deg is None or latitude_deg >= 0:
+            return ""
+        days = [(d + self.southern_shift_days - 1) % DAYS + 1 for d in (
+            self.leaf_out_doy, self.full_leaf_doy, self.leaf_fall_start_doy,
+            self.leaf_fall_end_doy)]
+        return (f", at this southern site {self.southern_shift_days:g} days later: leaves out "
+                f"day {days[0]:g}, full {days[1]:g}, fall {days[2]:g}–{days[3]:g}")
 
 
 # ---------------------------------------------------------------- the library

@@ -92,7 +92,7 @@ def build_crown(project: Project, model: str, form: str, frame: FacadeFrame,
         sp = load_species(tree.species)
         result.notes.insert(0, f"Species {sp.name} ({sp.common_name}, "
                             f"materials/species/{sp.key}.toml) fills the leaf optics, leaf tilt "
-                            f"and permeability the [tree.*] tables leave out: {sp.describe()}.")
+                            f"and permeability the [tree.*] tables leave out: {sp.describe(project.site.latitude)}.")
     result.build_seconds = time.perf_counter() - t0
     result.frame = frame
     result.triangles = sum(m.n_triangles for m in result.meshes)
