@@ -306,14 +306,31 @@ def z_from_files(paths: list[Path]) -> None:
     z_summary(sorted(seen.values(), key=lambda r: (r[0], r[1], r[2])))
 
 
+class Tally:
+    """Counts the scenario-hours whose forward mean is within 2 % or 3 (combined) standard
+    errors of its reference."""
+
+    def __init__(self) -> None:
+        self.ok = self.n = 0
+
+    def verdict(self, mean: float, ref: float, se: float) -> str:
+        """``diff ±x % = ±z s.e.  ok|MISS`` of ``mean`` against ``ref`` (``se``: combined)."""
+        d = mean - ref
+        good = abs(d) <= max(0.02 * ref, 3 * se)
+        self.ok, self.n = self.ok + int(good), self.n + 1
+        return f"diff {d / ref:+6.2%} = {d / se:+5.2f} s.e.  {'ok' if good else 'MISS'}"
+
+    def __str__(self) -> str:
+        return f"{self.ok} of {self.n}"
+
+
 def against_radiance(hours: list[str], scenarios: list[str]) -> None:
     from radtree.engines.registry import get_engine
 
     print("forward (project defaults) vs Radiance (project settings, point sensors), traced "
           "façade mean")
     rad = get_engine("radiance")
-    ok = 0
-    n = 0
+    tally = Tally()
     for proj, name, hour, built, st in _cases(hours, scenarios):
         t0 = time.perf_counter()
         rl = float(rad.trace_once(built.scene, st, proj.engine, built.ab, ["facade"])
@@ -322,15 +339,10 @@ def against_radiance(hours: list[str], scenarios: list[str]) -> None:
         fw = trace_forward(built.scene, st, ForwardSettings.from_params(proj.engine, built.ab),
                            ["facade"], workers=1)
         m, se = fw.grid_mean("facade")
-        d = m - rl
-        good = abs(d) <= max(0.02 * rl, 3 * se)
-        ok += good
-        n += 1
         print(f"  {name:6s} {hour}: radiance {rl:8.1f}  forward {m:8.1f} ± {se:6.1f} "
-              f"({fw.photons / 1e6:.1f} M photons)  diff {d / rl:+6.2%} = {d / se:+5.2f} s.e.  "
-              f"{'ok' if good else 'MISS'}  (radiance {t1 - t0:.0f} s, forward "
-              f"{time.perf_counter() - t1:.0f} s)", flush=True)
-    print(f" within 2 % or 3 s.e.: {ok} of {n}", flush=True)
+              f"({fw.photons / 1e6:.1f} M photons)  {tally.verdict(m, rl, se)}  (radiance "
+              f"{t1 - t0:.0f} s, forward {time.perf_counter() - t1:.0f} s)", flush=True)
+    print(f" within 2 % or 3 s.e.: {tally}", flush=True)
 
 
 def against_golden(hours: list[str], scenarios: list[str], realisations: int | None) -> None:
@@ -355,7 +367,7 @@ def against_golden(hours: list[str], scenarios: list[str], realisations: int | N
                                             "sensors.dense_hours": hours[:1]})
     print("forward (project defaults, weight window factor "
           f"{proj.engine.forward.forward_window:g}) vs the Radiance golden, façade mean", flush=True)
-    ok = n = 0
+    tally = Tally()
     for hour in hours:
         for name in scenarios:
             subs = realisations_of(proj, proj.scenario(name))[:realisations or None]
@@ -377,15 +389,11 @@ def against_golden(hours: list[str], scenarios: list[str], realisations: int | N
             m, se = float(np.mean(ms)), float(np.sqrt(np.sum(np.square(ses))) / len(ses))
             g = gold[(gold["scenario"] == name) & (gold["time"] == hour)]
             gm, gse = float(g["lux"].mean()), float(np.sqrt((g["lux_se"] ** 2).sum()) / len(g))
-            d, c = m - gm, math.hypot(se, gse)
-            good = abs(d) <= max(0.02 * gm, 3 * c)
-            ok += good
-            n += 1
             print(f"  {name:6s} {hour}: golden {gm:8.1f} ± {gse:5.1f}  forward {m:8.1f} ± {se:6.1f}"
-                  f" ({se / m:5.2%}, {photons / 1e6:5.1f} M photons, {len(subs)} crown(s))  diff "
-                  f"{d / gm:+6.2%} = {d / c:+5.2f} s.e.  {'ok' if good else 'MISS'}  "
+                  f" ({se / m:5.2%}, {photons / 1e6:5.1f} M photons, {len(subs)} crown(s))  "
+                  f"{tally.verdict(m, gm, math.hypot(se, gse))}  "
                   f"({time.perf_counter() - t0:.0f} s)", flush=True)
-    print(f" within 2 % or 3 combined s.e.: {ok} of {n}", flush=True)
+    print(f" within 2 % or 3 combined s.e.: {tally}", flush=True)
 
 
 def radiance_repeats(hours: list[str], scenarios: list[str], repeats: int) -> None:
