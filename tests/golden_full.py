@@ -19,12 +19,7 @@ platform's or Radiance version's sampling moves rows by ~1 SE, a change of physi
 ``python -m tests.golden_full`` (from the repository root; long: both runs of both examples)
 rewrites ``tests/golden/*_full.csv`` — only in a commit of its own that says why.
 
-``office_radiance_ci`` is the CI-sized slice of the office table: the office block at the
-example's own engine settings (``-ad 2048``, ``-ab 6``, ``-aa 0``), both scenarios, both grids
-and all seven hours, on sensor grids of 1 m instead of 0.5 m (6 façade and 10 work-plane
-sensors per hour instead of 30 and 40), small enough for every test run (``python -m
-tests.golden_full office_radiance_ci`` rewrites it). ``office_radiance_full`` holds the example's
-own 0.5 m grids and is compared on demand (``pytest -m slow``).
+Both tables are compared in every test run (the office's 980 rows cost ≈ 300 CPU-s).
 """
 
 from __future__ import annotations
@@ -45,13 +40,7 @@ GOLDEN = ROOT / "tests" / "golden"
 KEYS = ["scenario", "time", "grid", "sensor"]
 #: largest |z| a row may reach: ~700 rows, P(|z| > 5) ≈ 6e-7 per row for Gaussian noise
 Z_MAX = 5.0
-EXAMPLES = {"mendoza_radiance_full": "mendoza-street", "office_radiance_full": "office-block",
-            "office_radiance_ci": "office-block"}
-#: overrides of a table beyond the example's own settings (every table: no dense façade map)
-OVERRIDES: dict[str, dict] = {"office_radiance_ci": {"office.grid_spacing_m": 1.0,
-                                                     "office.facade_grid_spacing_m": 1.0}}
-#: the tables the default generator run writes (office_radiance_ci only when named)
-DEFAULT = ("mendoza_radiance_full", "office_radiance_full")
+EXAMPLES = {"mendoza_radiance_full": "mendoza-street", "office_radiance_full": "office-block"}
 
 
 def _copy(example: str, dst: Path) -> Path:
@@ -70,7 +59,7 @@ def run_table(name: str, workdir: Path, seed_flag: str = "-u-") -> pd.DataFrame:
     from radtree.pipeline.simulate import simulate_project
 
     proj = load_project(_copy(EXAMPLES[name], workdir / f"{name}{seed_flag}"),
-                        overrides={"sensors.dense_grid": False, **OVERRIDES.get(name, {})})
+                        overrides={"sensors.dense_grid": False})
     saved = writer.FIXED_SEED
     writer.FIXED_SEED = seed_flag          # the golden runs: -u-; the SE run: -u+
     try:
@@ -112,7 +101,7 @@ def read_golden(name: str) -> pd.DataFrame:
 
 
 def main() -> None:
-    names = sys.argv[1:] or list(DEFAULT)
+    names = sys.argv[1:] or list(EXAMPLES)
     GOLDEN.mkdir(parents=True, exist_ok=True)
     with tempfile.TemporaryDirectory(prefix="radtree-golden-full-") as tmp:
         for name in names:

@@ -7,7 +7,6 @@ rewrites the files (only in a commit of its own that says why the numbers moved)
 from __future__ import annotations
 
 import difflib
-import os
 from pathlib import Path
 
 import pytest
@@ -58,31 +57,23 @@ def assert_within_standard_errors(name: str, tmp_path: Path):
     return new
 
 
-#: the office's full-grid table (980 rows, ≈ 400 CPU-s) is compared on demand:
-#: RADTREE_GOLDEN_FULL=1 pytest tests/test_golden.py -k office_radiance_full
-ON_DEMAND = {"office_radiance_full"}
+@needs_radiance
+@pytest.mark.radiance
+@pytest.mark.slow
+def test_mendoza_radiance_every_hour_at_the_examples_settings_within_standard_errors(tmp_path):
+    """Every hour of the Mendoza street (A–F, A-sky) at its own settings (tests/golden_full.py)."""
+    assert_within_standard_errors("mendoza_radiance_full", tmp_path)
 
 
 @needs_radiance
 @pytest.mark.radiance
 @pytest.mark.slow
-@pytest.mark.parametrize("name", ["office_radiance_full", "mendoza_radiance_full"])
-def test_radiance_tables_at_the_examples_settings_within_standard_errors(name, tmp_path):
-    """Every hour of the examples at their own settings (tests/golden_full.py)."""
-    if name in ON_DEMAND and not os.environ.get("RADTREE_GOLDEN_FULL"):
-        pytest.skip(f"{name} is compared on demand (RADTREE_GOLDEN_FULL=1); CI compares "
-                    "office_radiance_ci, every hour on 1 m grids")
-    assert_within_standard_errors(name, tmp_path)
-
-
-@needs_radiance
-@pytest.mark.radiance
 def test_office_radiance_every_hour_at_the_examples_settings_within_standard_errors(tmp_path):
-    """The office block at its engine settings (-ad 2048, -ab 6; both scenarios, façade and
-    work plane, all seven hours) on 1 m sensor grids: every sensor within Z_MAX standard errors
-    of tests/golden/office_radiance_ci.csv (tests/golden_full.py); and the crowns lower the
-    façade's mean every hour (with < without)."""
-    t = assert_within_standard_errors("office_radiance_ci", tmp_path)
+    """The office block exactly as the example runs it (-ad 2048, -ab 6, its 0.5 m façade and
+    work-plane grids; both scenarios, all seven hours; 980 rows): every sensor within Z_MAX
+    standard errors of tests/golden/office_radiance_full.csv (tests/golden_full.py); and the
+    crowns lower the façade's mean every hour (with < without)."""
+    t = assert_within_standard_errors("office_radiance_full", tmp_path)
     mean = t[t["grid"] == "facade"].groupby(["time", "scenario"])["lux"].mean().unstack()
     assert len(mean) == 7
     assert (mean["with"] < mean["without"]).all(), mean

@@ -391,4 +391,4 @@ def test_unglazed_opening_under_uniform_sky_matches_view_factor(project):
 
 
 # The crowns lower the façade's mean every hour: asserted on the office's Radiance golden run
-# at the example's settings (tests/test_golden.py, office_radiance_ci, all seven hours).
+# at the example's settings (tests/test_golden.py, office_radiance_full: its 0.5 m grids, all seven hours).
