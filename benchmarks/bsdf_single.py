@@ -66,6 +66,8 @@ from radtree.pipeline.dome_curvature import curved_ring_row
 from radtree.pipeline.trace import trace_scenario
 
 ROOT = Path(__file__).resolve().parents[1]
+#: switches that change the trace, not the XMLs (their build folders are shared)
+TRACE_ONLY = ("tree.bsdf.material",)
 
 
 def ints(text: str) -> list[int]:
@@ -144,9 +146,10 @@ def main() -> None:
     ex = explicit_runs(project, sc, args.explicit_ads, args.work / "explicit.csv")
     e_m = ex.mean(axis=1)
     e_se = ex.std(axis=1, ddof=1) / np.sqrt(ex.shape[1])
-    # the XMLs' build folders are named by the switches that change them (not engine.*)
+    # the XMLs' build folders are named by the switches that change them (not engine.*,
+    # not the shell's material)
     tag = "".join(f"-{k}{v}" for k, v in extra.items()
-                  if not k.startswith("engine.")).replace(".", "")
+                  if not k.startswith("engine.") and k not in TRACE_ONLY).replace(".", "")
     sets = pd.DataFrame({k: xml_set(project, replace(sc, name=f"{sc.name}{tag}"), k, extra)
                          for k in range(args.xmls)})
     ratio = sets.div(e_m, axis=0)

@@ -128,6 +128,7 @@ import logging
 import os
 import time
 from collections.abc import Callable
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -225,9 +226,13 @@ def crown_models(project: Project, scenario: Scenario,
     return models, form
 
 
-def _scene_with(bare: Scene, model: TreeModel) -> Scene:
+def _scene_with(bare: Scene, model: TreeModel, *, peak: bool = True) -> Scene:
+    """``bare`` and the crown of ``model``; ``peak=False``: its shell's materials plain
+    ``BSDF`` even when ``tree.bsdf.material = "aBSDF"`` (the daylight matrices: the chain
+    applies the XML as it is, without the peak extraction)."""
     materials = dict(bare.materials)
-    materials.update(model.materials)
+    materials.update({n: m if peak or not isinstance(m, Bsdf) else replace(m, peak=False)
+                      for n, m in model.materials.items()})
     return Scene(bare.meshes + list(model.meshes), materials, bare.grids,
                  bare.notes + list(model.notes), bare.ground_material)
 
@@ -360,7 +365,7 @@ class ThreePhase:
         """The daylight matrix of each of ``groups``: of the light it transmits into the
         room (the dome's: one for both states), or (``room_side``) of the light arriving at
         it from the room's side, which it reflects back."""
-        with_crown = _scene_with(self.bare, self.models[state])
+        with_crown = _scene_with(self.bare, self.models[state], peak=False)
         own = self.inside and not room_side      # the dome's outward D meets no crown
         scene = _without_shell(with_crown) if own else with_crown
         text = scene_text(scene, self.rho) + ("" if own else "".join(

@@ -19,7 +19,7 @@ facets' outward normals, each with the slats as a facet of that orientation sees
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 import numpy as np
@@ -180,6 +180,10 @@ def build_bsdf_crown(tree: Tree, sensors: Sensors, street: Street, frame: Facade
     else:
         shell = _free_shell(tree, sensors=sensors, street=street, frame=frame, bands=bands,
                             wall=wall, source=source)
+    if tree.bsdf.material == "aBSDF":
+        for name, mat in list(shell.materials.items()):
+            if isinstance(mat, Bsdf):
+                shell.materials[name] = replace(mat, peak=True)
     notes, info = shell.notes, shell.info
     notes.append(f"Representation: BSDF — the crown is a shell of the Radiance BSDF material "
                  f"({', '.join(Path(b[2]).name for b in bands)}, Klems 145 × 145), the planar "
