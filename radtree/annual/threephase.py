@@ -289,7 +289,8 @@ class ThreePhase:
         receivers = (rad3.group_receivers_text([(g.triangles, g.normal) for g in groups],
                                                [g.up for g in groups])
                      + "\n" + rad3.sky_receivers_text(self.mf))
-        scene = _without_shell(_scene_with(self.bare, self.models["leaf_on"]))  # trunks stay
+        # trunks stay; the shell's materials as the matrices see them (plain BSDF)
+        scene = _without_shell(_scene_with(self.bare, self.models["leaf_on"], peak=False))
         octree_text = scene_text(scene, self.rho)
         ambient = self.trace.ambient()
         key = "|".join(["-I+ -faf", receivers, octree_text, self.points, " ".join(ambient)])

@@ -1,5 +1,7 @@
 """The BSDF representation of a crown (``[tree] representation = "bsdf"``): the sensor dome or
-the free crowns' envelopes as a shell of the Radiance ``BSDF`` material, no slats.
+the free crowns' envelopes as a shell of the Radiance ``aBSDF`` material (``tree.bsdf.material``;
+or ``BSDF``), no slats. ``aBSDF`` extracts the XML's straight-through peak, so the sun (a
+shadow ray) passes the shell deterministically instead of being found by ambient sampling.
 
 The shell's normals point inwards (to the sensors, inside the crown): the XML's back side,
 genBSDF's +z. Its up vector is world +z, so the XML's +y (the planar sample's "up", towards
@@ -185,7 +187,8 @@ def build_bsdf_crown(tree: Tree, sensors: Sensors, street: Street, frame: Facade
             if isinstance(mat, Bsdf):
                 shell.materials[name] = replace(mat, peak=True)
     notes, info = shell.notes, shell.info
-    notes.append(f"Representation: BSDF — the crown is a shell of the Radiance BSDF material "
+    notes.append(f"Representation: BSDF — the crown is a shell of the Radiance "
+                 f"{tree.bsdf.material} material "
                  f"({', '.join(Path(b[2]).name for b in bands)}, Klems 145 × 145), the planar "
                  "periodic sample of its slat layer; no slats are traced. A BSDF moves light only in direction, not "
                  "sideways: light entering a thick layer at one place leaves it at the same place.")
