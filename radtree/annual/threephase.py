@@ -37,12 +37,19 @@ inter-reflected sun from unit suns at Reinhart patch centres (``-ab N`` minus ``
 ``AnnualOptions.sun_crown`` says through which crown: ``"explicit"`` (default) runs the
 default method's sun runs on its explicit scenes of each leaf state (slats, bare branches;
 its folders and cache, so a project that ran ``--method dc`` reuses them); ``"bsdf"`` traces
-both on the BSDF-crown scene (a Klems BSDF passes no sun at ``-ab 0``, measured: 0.0 lx on
-the office example; the sun through the crown, gaps included, comes from the ``-ab N`` run,
-smeared over Klems patches). Measured on the office example (CHANGELOG.md,
-three-phase section): the sun scattered by the BSDF crown is where the two methods differed
-most (work-plane UDI > 3000 lx +5.4 pp, façade +9.6 pp with ``"bsdf"``; +0.7 / +0.9 pp with
-``"explicit"``, for 214 s more of sun runs through the slats). Tracing only the ``-ab 0``
+both on the BSDF-crown scene. The shell is Radiance's ``aBSDF`` by default
+(``tree.bsdf.material``): the XML's straight-through Klems patch passes the ``-ab 0`` sun as
+a shadow ray (the plain ``BSDF`` passes none: 0.0 lx on the office example, the sun through
+the crown then found only by the ``-ab N`` run's sampling). That peak holds the light within
+≈ 5° of the straight line, not only the gaps: on the office example the BSDF crown's ``-ab
+0`` sun sums to 2.5 × the explicit crown's (leaf-on, all sensors and suns), so with
+``"bsdf"`` the hourly *direct* output (LM-83) holds forward-scattered light. The daylight
+matrices ignore the material (:func:`_scene_with` ``peak=False``: the chain applies the XML
+as it is). Measured on the office example (CHANGELOG.md, three-phase section): the sun
+scattered by the BSDF crown is where the two methods differed most (work-plane UDI > 3000 lx
++5.4 pp, façade +9.6 pp with ``"bsdf"`` on the plain BSDF; +0.7 / +0.9 pp with
+``"explicit"``, for 214 s more of sun runs through the slats; with the aBSDF shell ``"bsdf"``
+is within 2.2 pp on the façade, work plane up to 8.5 pp). Tracing only the ``-ab 0``
 direct sun through the explicit crown and the reflected sun on the BSDF crown counts the
 crown's gaps twice (the BSDF's ``-ab N`` run carries them) and was no better than ``"bsdf"``
 (CHANGELOG.md). ``"fivephase"`` (issue 40) does what that tried, the five-phase way
