@@ -165,8 +165,9 @@ class Bsdf:
     (Radiance keeps it in the plane of the normal and ``up``). ``peak``: Radiance's ``aBSDF``
     instead (``void aBSDF NAME 5 xml ux uy uz . 0 0``, no thickness): the XML's
     straight-through peak, when it has one, passes shadow and view rays unscattered, so a
-    light source is seen through it directly (Radiance reference manual, "aBSDF"; ``src/rt/
-    m_bsdf.c`` ``compute_through``). Radiance only: the in-process engines refuse it."""
+    light source is seen through it directly (Radiance ``src/rt/m_bsdf.c``,
+    ``compute_through``: the BTDF at 29 directions round the straight line, the values not
+    below ⅛ of the peak's mean taken as the through component). Radiance only: the in-process engines refuse it."""
 
     name: str
     xml: str
