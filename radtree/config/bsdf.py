@@ -43,7 +43,7 @@ half chord h cos ψ, h the crown centre's distance from the cap; before).
 straight-through peak passes shadow and view rays unscattered: the sun is seen through the
 shell directly instead of found by ambient sampling; Radiance ``src/rt/m_bsdf.c``
 ``compute_through``). Default ``"aBSDF"``: one default run of scenario B's dome within 5 % of
-the slats every hour for three independently computed XML sets (worst 3.4–4.7 %), where
+the slats every hour for four independently computed XML sets (worst 3.4–4.7 %), where
 ``"BSDF"`` missed by up to 9.9 %; the trace takes as long (``benchmarks/bsdf_single.py``).
 ``tensor_tree``: 0, or the log2 resolution
 of an extra rank-4 tensor-tree XML. ``xml``: use this leaf-on XML instead of computing it
