@@ -82,3 +82,22 @@ def test_absdf_passes_the_sun_through_the_klems_peak(tmp_path):
     total = sensor_lux(tmp_path, peak, 1)
     np.testing.assert_allclose(total, e_h * (TAU_PEAK + TAU_DIFFUSE), rtol=0.005)
     assert total.std() < 1e-3 * total.mean()            # deterministic: no disc to find
+
+
+def test_three_phase_matrices_see_the_plain_bsdf():
+    """The chain applies the XML as it is: its daylight and view scenes carry the shell as
+    ``BSDF`` (``_scene_with(..., peak=False)``); the sun runs' scene keeps the ``aBSDF``."""
+    from radtree.annual.coefficients import scene_text
+    from radtree.annual.threephase import _scene_with
+    from radtree.scene import Mesh, Scene
+    from radtree.trees.bsdf_shell import BSDF_SHELL
+    from radtree.trees.model import TreeModel
+
+    v = np.array([[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]])
+    model = TreeModel(meshes=[Mesh("s", BSDF_SHELL, v, np.array([[0, 1, 2]]))],
+                      materials={BSDF_SHELL: Bsdf(BSDF_SHELL, "/x/crown.xml", peak=True)},
+                      notes=[], recommended_ab=6, form="free", model="louvers")
+    bare = Scene([], {}, {}, [])
+    assert "void aBSDF crown_bsdf\n5 /x/crown.xml" in scene_text(_scene_with(bare, model), 0.2)
+    plain = scene_text(_scene_with(bare, model, peak=False), 0.2)
+    assert "void BSDF crown_bsdf\n6 0 /x/crown.xml" in plain and "aBSDF" not in plain
