@@ -47,15 +47,16 @@ set 0 at -ad 8192     0.976  0.964  0.959  0.966  0.988  0.972  0.976  4.1 %
 the same at ``-ad 8192``): the spread fell from 1.7–8.5 % to 0.5–1.0 %, the sun through
 the shell now a shadow ray through the peak (at ``-ab 0`` aBSDF passes 1.01–1.20 × the
 slats' direct sun, the peak patch holding light scattered within 5° as well; BSDF 0.0 lx).
-The offset is the XMLs', not the peak extraction's: the plain BSDF's mean over the hours
-drifts towards it as ``-ad`` rises (set 0: 1.018 at 2048, 0.995 at 8192, 0.983 at 16384),
+The offset points to the XMLs (against the slats) rather than to the peak extraction: the
+plain BSDF's 7-hour mean drifts towards aBSDF's 0.973 as ``-ad`` rises (set 0: 1.018 at
+2048, 0.995 at 8192, 0.983 at 16384),
 and on a near-infinite plane (``benchmarks/absdf_plane.py``: set 0's band-1 centre-sector
 XML under a normal sun) aBSDF gives the XML's own transmitted flux +0.6 %, where BSDF at
 ``-ab 1 -ad 16384`` reads −5 %. Margin: at 12:30 the sets' mean is 0.961 ± 0.005 (s.d.),
 13:30 0.962 ± 0.010, so a single run outside 5 % there is not excluded (1–2 s.d. away).
 
-Before (the plain ``BSDF`` material), measured 2026-12-07 (``--xmls 3 --trace-ads 8192,16384``; load 8–9 on 2 cores shared with
-other jobs; each XML set 421–482 s, a 7-hour trace 17–19 s at ``-ad 2048``, 41 s at 8192,
+Before (the plain ``BSDF`` material), measured 2026-12-07 (``--xmls 3 --trace-ads
+8192,16384``; load 8–9 on 2 cores shared with other jobs; each XML set 421–482 s, a 7-hour trace 17–19 s at ``-ad 2048``, 41 s at 8192,
 54 s at 16384). Explicit slats (5 runs): 738.6 / 1028.2 / 1261.9 / 1362.8 / 1259.5 / 1075.3
 / 784.3 lx at 10:30 … 16:30, s.e. 0.09–0.29 %. BSDF / explicit, one run at the defaults:
 
