@@ -44,6 +44,15 @@ tree — ``explicit`` within 0.5 pp on both; ``bsdf`` up to +14.2 pp (work plane
 ``fivephase`` up to +9.0 / +14.9 pp (UDI <100; the difference of two noisy BSDF sun runs
 per sensor-hour, :mod:`radtree.annual.fivephase`; CHANGELOG.md).
 
+Measured again 2026-12-07 16:58–17:10 UTC with the BSDF shell as ``aBSDF`` (the default
+since; ``--sun-crowns fivephase,bsdf,explicit``, otherwise as above, the earlier run's
+folder copied so its BSDFs and dc runs were reused; load 4.5–7.7; 3-phase 625 s wall, of it
+the leaf-on sun runs 247 s): ``fivephase`` façade within 1.1 pp on every band (UDI <100
++0.9, 100–300 +1.0, 300–3000 −1.1, >3000 −0.8), work plane UDI <100 +5.2, 100–300 −5.8,
+300–3000 −0.3, >3000 +0.9, sDA 0 — **met on the façade, not on the work plane**; ``bsdf``
+façade within 2.2 pp (>3000 +2.2), work plane UDI <100 +8.1, 100–300 −8.5, sDA −2.5;
+``explicit`` within 0.5 pp as before.
+
 Run: ``nice .venv/bin/python benchmarks/threephase.py [--work DIR] [--samples 200] [-j 2]``.
 """
 

@@ -162,13 +162,18 @@ class Bsdf:
     """A surface scattering by a measured or computed BSDF (LBNL/WINDOW XML, Klems or tensor
     tree): ``void BSDF NAME 6 thickness xml ux uy uz . 0 0``. The surface normal points to the
     XML's *back* side (genBSDF's +z, the room); ``up`` is the world direction of the XML's +y
-    (Radiance keeps it in the plane of the normal and ``up``). Radiance only: the in-process
-    engines refuse it."""
+    (Radiance keeps it in the plane of the normal and ``up``). ``peak``: Radiance's ``aBSDF``
+    instead (``void aBSDF NAME 5 xml ux uy uz . 0 0``, no thickness): the XML's
+    straight-through peak, when it has one, passes shadow and view rays unscattered, so a
+    light source is seen through it directly (Radiance ``src/rt/m_bsdf.c``,
+    ``compute_through``: the BTDF at 29 directions round the straight line, the values not
+    below ⅛ of the peak's mean taken as the through component). Radiance only: the in-process engines refuse it."""
 
     name: str
     xml: str
     up: tuple[float, float, float] = (0.0, 0.0, 1.0)
     thickness: float = 0.0
+    peak: bool = False
 
     def __post_init__(self) -> None:
         if not self.xml.endswith(".xml"):
@@ -176,6 +181,8 @@ class Bsdf:
                              f"got {self.xml!r}")
         if not math.isfinite(self.thickness) or self.thickness < 0:
             raise ValueError(f"material '{self.name}': thickness must be ≥ 0 m")
+        if self.peak and self.thickness:
+            raise ValueError(f"material '{self.name}': aBSDF (peak) has no thickness")
 
 
 #: The Klems full basis (LBNL/WINDOW "LBNL/Klems Full"): per θ ring (lower, upper, centre

@@ -109,6 +109,9 @@ def test_branch_slab_cover_and_config_keys():
     # the dome's defaults: 5 sectors on a 48-ring shell (the setting that holds every hour of
     # the Mendoza dome within 5 % of the slats)
     assert (CrownBsdf().sectors, CrownBsdf().segments) == (5, 192)
+    assert CrownBsdf().material == "aBSDF"
+    with pytest.raises(ConfigError):
+        CrownBsdf(material="bsdf")
     assert check_key("bsdf.segments", 96)[0].name == "tree.bsdf.segments"
     with pytest.raises(ConfigError, match="tree.bsdf.sectors"):
         CrownBsdf(sectors=0)
@@ -168,8 +171,9 @@ def test_bsdf_crown_scene_and_in_process_engines_refuse_it(tmp_path):
         area += m.area()
     r = proj.tree.dome.radius_m
     assert area == pytest.approx(2 * math.pi * r * r, rel=0.02)   # the whole hemisphere
+    # the default shell material is aBSDF (peak extraction; tests/test_absdf.py)
     assert material_text(built.scene.materials["crown_bsdf_b1_low"]) == (
-        f"void BSDF crown_bsdf_b1_low\n6 0 {xml.resolve()} 0 0 -1 .\n0\n0\n")
+        f"void aBSDF crown_bsdf_b1_low\n5 {xml.resolve()} 0 0 -1 .\n0\n0\n")
     with pytest.raises(EngineError, match="Radiance only"):
         trace_hours(proj, proj.scenario("B"), NumpyEngine(), grids=["facade"], built=built)
 

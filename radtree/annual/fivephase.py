@@ -34,16 +34,21 @@ patch suns' reflected part at ``-ab N``) on a scene:
 
 (1) − (2) is the sun reflected by the surroundings, carried to and from them by the BSDF
 crown. Noise: (1) and (2) are separate Monte Carlo estimates (blackening changes the ray
-trees), so their difference holds the noise of both, per sensor-hour larger than the
-difference itself where the sensors see the sun through the Klems BSDF (see
-:func:`five_phase_sun`). The hourly direct sun (the ``direct`` output,
-LM-83) is (3)'s ``-ab 0`` part.
+trees), so their difference holds the noise of both. With the shell as Radiance's ``aBSDF``
+(``tree.bsdf.material``, the default) the sun through the XML's straight-through peak is a
+shadow ray, the same in (1) and (2) (their ``-ab 0`` runs agree exactly and cancel); with the
+plain ``BSDF`` it was found by each run's ambient sampling, and the difference was larger
+than itself where the sensors see the sun through the crown (see :func:`five_phase_sun`).
+The hourly direct sun (the ``direct`` output, LM-83) is (3)'s ``-ab 0`` part.
 
-Measured on the office example (``benchmarks/threephase.py``, CHANGELOG.md): the year's sun
-sums agree with the all-explicit sun (leaf-on 0.78, leaf-off 0.99), but the per-sensor-hour
-noise of (1) − (2) (negative at 5–10 % of sensor-hours) moves UDI < 100 lx by +9 / +15
-percentage points (façade / work plane) against the explicit-crown annual, where
-``sun_crown = "explicit"`` stays within 0.5 pp: not the default.
+Measured on the office example (``benchmarks/threephase.py``, CHANGELOG.md), against the
+explicit-crown annual (``sun_crown = "explicit"`` within 0.5 pp on every band): with the
+plain BSDF the per-sensor-hour noise of (1) − (2) moved UDI < 100 lx by +9.0 / +14.9
+percentage points (façade / work plane); with the aBSDF shell every band within 1.1 pp on
+the façade, the work plane UDI < 100 +5.2, 100–300 −5.8 pp — not met, and now a bias rather
+than noise: summed over sensors and the Reinhart patch suns, the surroundings' reflected
+sun (1) − (2) is 0.71 × the explicit crown's (0.67 with the plain BSDF), while the
+sensor-patch values below zero fell from 9.7 % to 1.7 %. Not the default.
 """
 
 from __future__ import annotations
@@ -83,10 +88,11 @@ def five_phase_sun(year_lux, *, bsdf_crown: Scene, explicit: Scene, surroundings
                                            grids, folders[1], 0.0))
     tot_eb, dir_e = year_lux(CoefficientRunner(black_surroundings(explicit, surroundings),
                                                grids, folders[2], 0.0))
-    # (1) − (2) ≥ 0 in expectation, not per sensor-hour: the sun through the Klems BSDF is a
-    # bright patch-sized disc the ambient rays of each run hit differently (blackening changes
-    # the ray trees, so the runs decorrelate). Clipping would bias: on the test crown
-    # (sun -ad 32) clipping the total at the direct sun raised the leaf-on year's sun by 44 %,
+    # (1) − (2) ≥ 0 in expectation, not per sensor-hour: the runs' ambient rays differ
+    # (blackening changes the ray trees). With a plain BSDF shell the sun through the Klems
+    # peak is a bright patch-sized disc each run hits differently; the aBSDF shell (default)
+    # passes it as a shadow ray in both. Clipping would bias: on the test crown (plain BSDF,
+    # sun -ad 32) clipping the total at the direct sun raised the leaf-on year's sun by 44 %,
     # at 0 by 27 %. The sum is kept unclipped (unbiased; a sensor-hour may read below zero).
     total = tot_b.astype(np.float64) - tot_bb + tot_eb
     return total.astype(np.float32), dir_e

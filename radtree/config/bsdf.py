@@ -39,6 +39,12 @@ ring to the traced ring sums (the planar azimuthal shape kept; the correction be
 Klems patch as seen from the sensors' point on the cap (``"sensors"``, default,
 :mod:`radtree.pipeline.wall_cap`), or per ring as at the cap's foot point (``"centre"``: the
 half chord h cos ψ, h the crown centre's distance from the cap; before).
+``material``: the shell's Radiance material, ``"BSDF"`` or ``"aBSDF"`` (the XML's
+straight-through peak passes shadow and view rays unscattered: the sun is seen through the
+shell directly instead of found by ambient sampling; Radiance ``src/rt/m_bsdf.c``
+``compute_through``). Default ``"aBSDF"``: one default run of scenario B's dome within 5 % of
+the slats every hour for four independently computed XML sets (worst 3.4–4.7 %), where
+``"BSDF"`` missed by up to 9.9 %; the trace takes as long (``benchmarks/bsdf_single.py``).
 ``tensor_tree``: 0, or the log2 resolution
 of an extra rank-4 tensor-tree XML. ``xml``: use this leaf-on XML instead of computing it
 (computed XMLs are cached under ``build/bsdf/<scenario>/``).
@@ -56,6 +62,7 @@ REPRESENTATIONS = ("explicit", "bsdf", "turbid")
 CROSSINGS = ("chord", "slab")
 CURVATURES = ("traced", "rings", "planar")
 WALL_DEPTHS = ("sensors", "centre")
+SHELL_MATERIALS = ("BSDF", "aBSDF")
 
 
 @dataclass(frozen=True)
@@ -77,6 +84,7 @@ class CrownBsdf(Checked):
     curvature: str = field(default="traced", metadata=meta(choices=CURVATURES))
     wall_depth: str = field(default="sensors", metadata=meta(choices=WALL_DEPTHS))
     tensor_tree: int = field(default=0, metadata=meta(0, 6))
+    material: str = field(default="aBSDF", metadata=meta(choices=SHELL_MATERIALS))
     xml: Path | None = None
 
     def check(self) -> None:

@@ -1,5 +1,7 @@
 """The BSDF representation of a crown (``[tree] representation = "bsdf"``): the sensor dome or
-the free crowns' envelopes as a shell of the Radiance ``BSDF`` material, no slats.
+the free crowns' envelopes as a shell of the Radiance ``aBSDF`` material (``tree.bsdf.material``;
+or ``BSDF``), no slats. ``aBSDF`` extracts the XML's straight-through peak, so the sun (a
+shadow ray) passes the shell deterministically instead of being found by ambient sampling.
 
 The shell's normals point inwards (to the sensors, inside the crown): the XML's back side,
 genBSDF's +z. Its up vector is world +z, so the XML's +y (the planar sample's "up", towards
@@ -19,7 +21,7 @@ facets' outward normals, each with the slats as a facet of that orientation sees
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 import numpy as np
@@ -180,8 +182,13 @@ def build_bsdf_crown(tree: Tree, sensors: Sensors, street: Street, frame: Facade
     else:
         shell = _free_shell(tree, sensors=sensors, street=street, frame=frame, bands=bands,
                             wall=wall, source=source)
+    if tree.bsdf.material == "aBSDF":
+        for name, mat in list(shell.materials.items()):
+            if isinstance(mat, Bsdf):
+                shell.materials[name] = replace(mat, peak=True)
     notes, info = shell.notes, shell.info
-    notes.append(f"Representation: BSDF — the crown is a shell of the Radiance BSDF material "
+    notes.append(f"Representation: BSDF — the crown is a shell of the Radiance "
+                 f"{tree.bsdf.material} material "
                  f"({', '.join(Path(b[2]).name for b in bands)}, Klems 145 × 145), the planar "
                  "periodic sample of its slat layer; no slats are traced. A BSDF moves light only in direction, not "
                  "sideways: light entering a thick layer at one place leaves it at the same place.")

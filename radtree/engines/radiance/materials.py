@@ -9,7 +9,8 @@ coefficients via :func:`radtree.optics.fmt`):
 * :class:`~radtree.optics.Glass` → ``void glass NAME 0 0 3 tn tn tn`` (transmissivity);
 * :class:`~radtree.optics.Hole` → nothing (its geometry is not written);
 * :class:`~radtree.optics.Bsdf` → ``void BSDF NAME 6 thickness xml ux uy uz . 0 0`` (the
-  surface normal towards the XML's back side, ``up`` the world direction of its +y);
+  surface normal towards the XML's back side, ``up`` the world direction of its +y); with
+  ``peak``: ``void aBSDF NAME 5 xml ux uy uz . 0 0`` (the straight-through peak extracted);
 * a turbid crown's medium → ``void mist NAME N src… 0 7 σ σ σ ω ω ω g`` (:func:`mist_text`).
 """
 
@@ -54,6 +55,8 @@ def _(material: Hole) -> str:
 @material_text.register
 def _(material: Bsdf) -> str:
     ux, uy, uz = (f"{v:g}" for v in material.up)
+    if material.peak:
+        return f"void aBSDF {material.name}\n5 {material.xml} {ux} {uy} {uz} .\n0\n0\n"
     return (f"void BSDF {material.name}\n6 {material.thickness:g} {material.xml} {ux} {uy} {uz} ."
             "\n0\n0\n")
 
