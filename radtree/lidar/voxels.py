@@ -300,10 +300,11 @@ def tree_voxels(path: str | Path, g: float, size_m: float | None = None,
             g_of_mu=g_of_mu or (lambda mu: np.full(np.shape(mu), g)),
             empty=None if empty is None else empty(tile),
             envelope_m=spacing if envelope else None)
+        entering = counts.entering
     lowest_k = int(np.floor(heights[veg].min() / size))
     if frac is not None:
         if fill:
-            pad, _ = fill_undersampled(pad, counts.entering, inside=frac > 0,
+            pad, _ = fill_undersampled(pad, entering, inside=frac > 0,
                                        lowest_k=lowest_k, pulse_min=pulse_min,
                                        counts=counts if pool else None)
         pad = pad * frac
