@@ -116,6 +116,35 @@ def beam_density(beams: Beams, *, lo: np.ndarray, size: float, shape: tuple[int,
     text); ``g_of_mu`` gives G for |cos zenith| of the beams. ``beyond_max`` (m, one per
     beam): how far an intercepted beam's chord may run on past its return (the crown
     envelope's exit, :mod:`radtree.lidar.envelope`); unbounded when None."""
+    c = beam_counts(beams, lo=lo, size=size, shape=shape, g_of_mu=g_of_mu,
+                    beyond_max=beyond_max)
+    return density(c.entering, c.hits, c.optical), c.entering, c.hits
+
+
+@dataclass(frozen=True)
+class BeamCounts:
+    """Per voxel (arrays of the grid's shape): the beams entering N and intercepted I
+    (weighted) and their summed optical path per unit density Σ w·G(μ)·l (m)."""
+
+    entering: np.ndarray
+    hits: np.ndarray
+    optical: np.ndarray
+
+
+def density(entering: np.ndarray, hits: np.ndarray, optical: np.ndarray) -> np.ndarray:
+    """PAD (m²/m³) = −ln((N − I + ½)/(N + ½)) / l̄_G with l̄_G = optical / N (module
+    text); 0 where no beam entered."""
+    with np.errstate(divide="ignore", invalid="ignore"):
+        gap = (np.maximum(entering - hits, 0.0) + 0.5) / (entering + 0.5)   # module text
+        path = optical / entering
+        return np.where((entering > 0) & (path > 0), -np.log(np.minimum(gap, 1.0)) / path,
+                        0.0)
+
+
+def beam_counts(beams: Beams, *, lo: np.ndarray, size: float, shape: tuple[int, int, int],
+                g_of_mu: Callable[[np.ndarray], np.ndarray],
+                beyond_max: np.ndarray | None = None) -> BeamCounts:
+    """The counts of :func:`beam_density` per voxel (:class:`BeamCounts`)."""
     d = beams.end - beams.origin
     d /= np.maximum(np.linalg.norm(d, axis=1), 1e-12)[:, None]
     w = beams.weight
@@ -137,8 +166,4 @@ def beam_density(beams: Beams, *, lo: np.ndarray, size: float, shape: tuple[int,
     pair = seg * n + cell
     first[1:] = pair[1:] != pair[:-1]
     entering = np.bincount(cell[first], weights=w[seg[first]], minlength=n)
-    with np.errstate(divide="ignore", invalid="ignore"):
-        gap = (np.maximum(entering - hits, 0.0) + 0.5) / (entering + 0.5)   # module text
-        path = optical / entering
-        pad = np.where((entering > 0) & (path > 0), -np.log(np.minimum(gap, 1.0)) / path, 0.0)
-    return pad.reshape(shape), entering.reshape(shape), hits.reshape(shape)
+    return BeamCounts(entering.reshape(shape), hits.reshape(shape), optical.reshape(shape))

@@ -28,8 +28,12 @@ envelope. Units: metres; the grid's frame (heights above ground).
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
+
+if TYPE_CHECKING:
+    from radtree.lidar.beams import BeamCounts
 
 #: sub-points per voxel edge for the volume fraction inside the envelope (4³ = 64 a voxel)
 FRACTION_POINTS = 4
@@ -106,14 +110,32 @@ class Envelope:
 
 
 def fill_undersampled(pad: np.ndarray, entering: np.ndarray, *, inside: np.ndarray,
-                      lowest_k: int, pulse_min: float) -> tuple[np.ndarray, int]:
+                      lowest_k: int, pulse_min: float, counts: BeamCounts | None = None
+                      ) -> tuple[np.ndarray, int]:
     """(pad, voxels filled): voxels inside the envelope (``inside``) reached by fewer than
-    ``pulse_min`` beams and not below layer ``lowest_k`` take the mean density of the voxels
-    of their layer inside the envelope reached by at least ``pulse_min`` (m²/m³, density of
-    the part inside the envelope)."""
+    ``pulse_min`` beams and not below layer ``lowest_k`` take one density per layer (m²/m³,
+    of the part inside the envelope). With ``counts`` (the beams' counts per voxel,
+    :class:`radtree.lidar.beams.BeamCounts`): the Beer–Lambert estimate of the layer's
+    undersampled voxels pooled as one (their entering and intercepted beams and optical
+    paths summed) where together at least ``pulse_min`` beams entered them; else, and without
+    ``counts``, the mean density of the layer's voxels reached by at least ``pulse_min``;
+    a layer with neither takes the value of the nearest layer above that has one."""
+    from radtree.lidar.beams import density
+
     k = np.arange(pad.shape[2])[None, None, :]
     sampled = inside & (entering >= pulse_min)
     under = inside & ~sampled & (k >= lowest_k)
     with np.errstate(invalid="ignore"):
-        layer = np.nan_to_num(np.sum(pad * sampled, axis=(0, 1)) / np.sum(sampled, axis=(0, 1)))
+        n_sampled = np.sum(sampled, axis=(0, 1))
+        layer = np.where(n_sampled > 0, np.sum(pad * sampled, axis=(0, 1))
+                         / np.maximum(n_sampled, 1), np.nan)
+    if counts is not None:
+        n_u = np.sum(counts.entering * under, axis=(0, 1))
+        pooled = density(n_u, np.sum(counts.hits * under, axis=(0, 1)),
+                         np.sum(counts.optical * under, axis=(0, 1)))
+        layer = np.where(n_u >= pulse_min, pooled, layer)
+    for i in range(len(layer) - 2, -1, -1):          # nothing in a layer: the one above
+        if np.isnan(layer[i]):
+            layer[i] = layer[i + 1]
+    layer = np.nan_to_num(layer)
     return np.where(under, layer[None, None, :], pad), int(under.sum())
