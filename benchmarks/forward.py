@@ -37,6 +37,28 @@ Issue 40 (the estimator a user can trust by default), each a separate mode:
 ``--hours`` and ``--scenarios`` choose the scenario-hours (hour-major order, each line printed
 when done, so a partial run reports what it covered).
 
+With the unscattered sky at the sensor points (radtree.engines.forward.skypoint,
+``engine.forward_direct_sky``, default on: sky and ground glow through specular transmissions
+estimated at the points, 1 024 directions per sensor and round, sky photons tallied only once
+scattered) — measured 2026-12-07 16:58–18:00 UTC, 2 shared cores at load 3.5–7.8 from other
+sessions, one process at a time:
+
+* ``--golden --scenarios F --hours 11:30 12:30 10:30 13:30 14:30 15:30 16:30`` (8 crowns each,
+  1 830 s): **6 of 7 within 2 % or 3 combined s.e.**: 11:30 −1.55 % (−2.41 s.e.; before −2.03
+  %, −3.14: now ok), 12:30 −1.98 % (−2.89), 10:30 −0.20 % (−0.23), 13:30 −1.69 % (−1.89),
+  14:30 −0.80 % (−1.14), **15:30 −2.79 % (−3.82): MISS** (before −2.15 %, −2.82), 16:30 +0.71 %
+  (+1.38). Mean over the hours −1.47 % (before −1.5 %): the systematic low reading is the
+  scattered light averaged over the 0.5 m patches (*patch against point*, below), which this
+  change does not touch. Forward relative s.e. 0.31–0.41 %, 7.2–9.3 M photons per hour (8
+  crowns).
+* The unscattered sky alone, points against patches (scratch script: the point estimator at
+  the 8 points, 4 096 directions each, and at 128 stratified points × 512 directions per 0.5 m
+  patch), F, all 8 crowns at 11:30: 32.1 lx at the points, 33.9 over the patches (−1.8 lx,
+  −0.15 % of the façade's 1 227 lx; per crown −3.9 … +0.5 lx): moving it to the points lowers
+  the mean slightly; the +6 lx at 11:30 above is the heavy tail no longer missed (runs short
+  of the few straight-through sky photons read low).
+ZSCORES_PLACEHOLDER
+
 With the guided roulette (radtree.engines.forward.tracer, *Roulette after a guided event*) and
 the window's level from the pilot (radtree.engines.forward.window) — measured 2026-12-07
 14:40–15:50 UTC, 2 shared cores at load 4–10 from other sessions (this process 30–50 % of a

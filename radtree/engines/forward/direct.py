@@ -15,7 +15,8 @@ So, with a whole-scene sun, the forward engine splits the light as a backward en
   mean transmittance exp(−τ) along it (as the NumPy engine's shadow rays): exact, no noise;
 * sun photons are **not tallied** on the patches until their first diffuse event or mirror
   reflection (what remains is scattered light, smooth across a patch); sky and ground-glow
-  photons are tallied from the start as before.
+  photons likewise with ``engine.forward_direct_sky`` (their unscattered light estimated at the
+  points by :mod:`.skypoint`, through the same :func:`transmittance`), else from the start.
 
 Every lumen still travels (the ledger is unchanged); only what the patches count changes.
 """

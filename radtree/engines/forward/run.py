@@ -6,7 +6,10 @@ the hour's :class:`~radtree.engines.forward.tracer.Ledger` and counters. Photons
 rounds of ``settings.photons`` (``settings.batches`` batches each); with
 ``settings.target_rel_se`` rounds are added until every grid's mean reaches it or
 ``settings.max_photons`` (:mod:`radtree.engines.forward.precision`; a first round that misses
-the target only sizes the run and is not counted).
+the target only sizes the run and is not counted). The unscattered sun and sky are counted
+at the sensor points instead of on the patches when the settings ask for it
+(:mod:`.direct`, :mod:`.skypoint`): the sun's exactly, the sky's estimated afresh for every
+batch of every round.
 """
 
 from __future__ import annotations
