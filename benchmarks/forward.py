@@ -57,7 +57,12 @@ sessions, one process at a time:
   −0.15 % of the façade's 1 227 lx; per crown −3.9 … +0.5 lx): moving it to the points lowers
   the mean slightly; the +6 lx at 11:30 above is the heavy tail no longer missed (runs short
   of the few straight-through sky photons read low).
-ZSCORES_PLACEHOLDER
+* ``--zscores 50 --hours 12:30 --scenarios F`` (first crown, defaults, seeds 1–50, one
+  process, 989 s, load 2.5–6.3): **z s.d. 0.983, |z| > 3 in 0 % (max |z| 2.84): met**
+  (0.8–1.25, ≤ 1 %; before: 0.953, 2 %, seed 8 at z −3.37 — now 1 414.0 ± 11.6 lx). Spread of
+  the means / r.m.s. s.e. 0.85; relative s.e. mean 0.97 %; every run reached 2 % in its first
+  round (0.90 M photons counted). Mean 1 408.8 lx against Radiance on the same crown 1 442.7 ±
+  4.1 (4 clock-seeded runs, below): −2.35 %, the patch against point difference.
 
 With the guided roulette (radtree.engines.forward.tracer, *Roulette after a guided event*) and
 the window's level from the pilot (radtree.engines.forward.window) — measured 2026-12-07
