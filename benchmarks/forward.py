@@ -63,6 +63,11 @@ sessions, one process at a time:
   the means / r.m.s. s.e. 0.85; relative s.e. mean 0.97 %; every run reached 2 % in its first
   round (0.90 M photons counted). Mean 1 408.8 lx against Radiance on the same crown 1 442.7 ±
   4.1 (4 clock-seeded runs, below): −2.35 %, the patch against point difference.
+* ``--lineage 8 --hours 12:30 --scenarios F`` (defaults, 21 s): one round 1 310.4 ± 11.3 lx
+  besides the direct sun (64.5 lx) and the unscattered sky at the points; the sky's inner
+  ring (0–1 m) now **0.4 % of the variance** (was 43 %), every sky ring ≤ 3.8 % (all sky
+  rings 13 %); the sun rings 8–24 m hold 74 %, their ten largest photons 3.5–4.3 % of a
+  ring's light.
 
 With the guided roulette (radtree.engines.forward.tracer, *Roulette after a guided event*) and
 the window's level from the pilot (radtree.engines.forward.window) — measured 2026-12-07
