@@ -36,14 +36,15 @@ def transmittance(geo: Geometry, optics: Optics, origins: np.ndarray, dirs: np.n
                   ) -> np.ndarray:
     """Undeviated transmittance along the rays ``origins + t·dirs`` (t > 0, unit ``dirs``,
     (k, 3) each): the product of the specular transmittances of the surfaces crossed (``Trans``
-    T_s, ``Glass`` T(θ), opaque 0; more than :data:`MAX_LAYERS`: 0) times the turbid crowns'
-    mean transmittance exp(−τ) (as the NumPy engine's shadow rays)."""
-    o = np.array(origins, float, copy=True)
-    d = np.ascontiguousarray(np.broadcast_to(np.asarray(dirs, float), o.shape))
-    tau = np.ones(len(o))
-    if len(o) == 0:
+    T_s, ``Glass`` T(θ), opaque 0; more than :data:`MAX_LAYERS`: 0; the surface rays start a
+    hair along ``dirs``) times the turbid crowns' mean transmittance exp(−τ) from ``origins``
+    (as the NumPy engine's shadow rays)."""
+    d = np.ascontiguousarray(np.broadcast_to(np.asarray(dirs, float), np.shape(origins)))
+    tau = np.ones(len(d))
+    if len(d) == 0:
         return tau
     eps = max(1e-5, 2e-6 * geo.size)
+    o = np.asarray(origins, float) + eps * d
     live = np.arange(len(o))
     for _ in range(MAX_LAYERS):
         tri, t = geo.caster.first_hit(o[live], d[live])
@@ -83,7 +84,6 @@ def direct_sun(geo: Geometry, optics: Optics, grid: SensorGrid, sun: np.ndarray,
     idx = np.flatnonzero(out > 0)
     if len(idx) == 0:
         return out
-    eps = max(1e-5, 2e-6 * geo.size)
-    o = np.asarray(grid.points, float)[idx] + eps * s
-    out[idx] *= transmittance(geo, optics, o, np.tile(s, (len(idx), 1)))
+    out[idx] *= transmittance(geo, optics, np.asarray(grid.points, float)[idx],
+                              np.tile(s, (len(idx), 1)))
     return out

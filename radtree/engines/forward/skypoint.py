@@ -122,6 +122,5 @@ def _samples(geo: Geometry, optics: Optics, env: EnvironmentSource,
     f[live] = np.asarray(env.luminance(w[live]), float) * cos[live] / pdf[live]
     go = live[f[live] > 0]
     if len(go):
-        eps = max(1e-5, 2e-6 * geo.size)
-        f[go] *= transmittance(geo, optics, origins[go] + eps * w[go], w[go])
+        f[go] *= transmittance(geo, optics, origins[go], w[go])
     return f
