@@ -57,6 +57,11 @@ sessions, one process at a time:
   −0.15 % of the façade's 1 227 lx; per crown −3.9 … +0.5 lx): moving it to the points lowers
   the mean slightly; the +6 lx at 11:30 above is the heavy tail no longer missed (runs short
   of the few straight-through sky photons read low).
+* The missed hour with a smaller patch (scratch script, ``--golden``'s steps with
+  ``patch_m`` = 0.25, F 15:30, 8 crowns, 363 s): 1 210.8 ± 3.3 lx against 1 203.1 ± 3.7 with
+  0.5 m patches, golden 1 237.6 ± 8.2: −2.17 % (−3.03 s.e.), still a miss by a hair; 20.5 M
+  photons (6 crowns at 0.9–2 M, one at 12 M) against 7.2 M. The patch bias shrinks with the
+  patch but not to zero at 0.25 m; not made the default (its z-scores not measured).
 * ``--zscores 50 --hours 12:30 --scenarios F`` (first crown, defaults, seeds 1–50, one
   process, 989 s, load 2.5–6.3): **z s.d. 0.983, |z| > 3 in 0 % (max |z| 2.84): met**
   (0.8–1.25, ≤ 1 %; before: 0.953, 2 %, seed 8 at z −3.37 — now 1 414.0 ± 11.6 lx). Spread of
