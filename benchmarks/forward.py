@@ -57,6 +57,11 @@ sessions, one process at a time:
   −0.15 % of the façade's 1 227 lx; per crown −3.9 … +0.5 lx): moving it to the points lowers
   the mean slightly; the +6 lx at 11:30 above is the heavy tail no longer missed (runs short
   of the few straight-through sky photons read low).
+* ``--golden --scenarios A B C D E A-sky --hours 12:30 15:30`` (88 s): **12 of 12 within 2 %
+  or 3 combined s.e.**; A, C, D, E (no sky source) unchanged to the digit; B 12:30 −0.57 %
+  (−0.80 s.e.), A-sky 12:30 +0.96 % (+1.97), B 15:30 −0.00 %, A-sky 15:30 −0.02 %; A 12:30
+  +1.06 % (+2.24), C 12:30 +1.93 % (+0.78), D 15:30 −1.78 % (−1.74; 2.0 M photons), the rest
+  within ±1.3 %; 0.9 M photons each but D 15:30.
 * The missed hour with a smaller patch (scratch script, ``--golden``'s steps with
   ``patch_m`` = 0.25, F 15:30, 8 crowns, 363 s): 1 210.8 ± 3.3 lx against 1 203.1 ± 3.7 with
   0.5 m patches, golden 1 237.6 ± 8.2: −2.17 % (−3.03 s.e.), still a miss by a hair; 20.5 M
