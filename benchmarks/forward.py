@@ -73,6 +73,17 @@ sessions, one process at a time:
   the means / r.m.s. s.e. 0.85; relative s.e. mean 0.97 %; every run reached 2 % in its first
   round (0.90 M photons counted). Mean 1 408.8 lx against Radiance on the same crown 1 442.7 ±
   4.1 (4 clock-seeded runs, below): −2.35 %, the patch against point difference.
+* ``--zscores 50 --hours 12:30 --scenarios B`` (defaults, seeds 1–50, 664 s, load 3.3–4.6):
+  **z s.d. 1.271, |z| > 3 in 2 % (1 run, seed 31, 1 252.1 ± 6.9 lx, z −3.14): not met**;
+  seeds 1–30 alone 1.328 (before this change, same seeds, other streams: 1.087); spread of
+  the means / r.m.s. s.e. 1.11; mean 1 273.8 lx (golden 1 262.5 ± 3.2); every run 0.9 M
+  photons. The low runs have the small errors (correlation of mean and s.e. +0.34, skew
+  +0.32): the sun's rare heavy hits, as before; the window's level is unchanged by the sky at
+  the points (seeds 3, 31: 0.0696 → 0.0659, 0.0709 → 0.0701 lm). The same
+  50 seeds with ``forward_direct_sky`` = false (scratch script, project override, 18:08–18:20
+  UTC): z s.d. 1.128, max |z| 2.44, 0 %, spread / r.m.s. s.e. 1.06, mean 1 274.3 lx. Each z
+  s.d. from 50 runs is uncertain by ±0.1 (more with heavy tails); whether the sky at the
+  points worsens B was not settled here.
 * ``--lineage 8 --hours 12:30 --scenarios F`` (defaults, 21 s): one round 1 310.4 ± 11.3 lx
   besides the direct sun (64.5 lx) and the unscattered sky at the points; the sky's inner
   ring (0–1 m) now **0.4 % of the variance** (was 43 %), every sky ring ≤ 3.8 % (all sky
