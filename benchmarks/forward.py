@@ -40,7 +40,7 @@ when done, so a partial run reports what it covered).
 With the unscattered sky at the sensor points (radtree.engines.forward.skypoint,
 ``engine.forward_direct_sky``, default on: sky and ground glow through specular transmissions
 estimated at the points, 1 024 directions per sensor and round, sky photons tallied only once
-scattered) — measured 2026-12-07 16:58–18:00 UTC, 2 shared cores at load 3.5–7.8 from other
+scattered) — measured 2026-12-07 16:58–18:20 UTC, 2 shared cores at load 1.7–7.8 from other
 sessions, one process at a time:
 
 * ``--golden --scenarios F --hours 11:30 12:30 10:30 13:30 14:30 15:30 16:30`` (8 crowns each,
@@ -65,7 +65,7 @@ sessions, one process at a time:
 * The missed hour with a smaller patch (scratch script, ``--golden``'s steps with
   ``patch_m`` = 0.25, F 15:30, 8 crowns, 363 s): 1 210.8 ± 3.3 lx against 1 203.1 ± 3.7 with
   0.5 m patches, golden 1 237.6 ± 8.2: −2.17 % (−3.03 s.e.), still a miss by a hair; 20.5 M
-  photons (6 crowns at 0.9–2 M, one at 12 M) against 7.2 M. The patch bias shrinks with the
+  photons (5 crowns at 0.9 M, 2 at 2 M, 1 at 12 M) against 7.2 M. The patch bias shrinks with the
   patch but not to zero at 0.25 m; not made the default (its z-scores not measured).
 * ``--zscores 50 --hours 12:30 --scenarios F`` (first crown, defaults, seeds 1–50, one
   process, 989 s, load 2.5–6.3): **z s.d. 0.983, |z| > 3 in 0 % (max |z| 2.84): met**
