@@ -43,7 +43,9 @@ def crossings(cases, seeds: list[int], window: float) -> None:  # type: ignore[n
         sky = 0.0   # 1 while tracing a launch that did not start as the sun's beam
 
         def run(self, photons):  # type: ignore[no-untyped-def]
-            self.sky = 0.0 if photons.direct.all() else 1.0
+            # the sun's photons all travel one way (the sky's: each its own direction)
+            self.sky = 0.0 if len(photons) > 1 and np.ptp(photons.d, axis=0).max() < 1e-12 \
+                else 1.0
             return super().run(photons)
 
         def _advance(self, ph):  # type: ignore[no-untyped-def]
@@ -131,6 +133,7 @@ def lineage(cases, seeds: list[int], guided: bool = True) -> None:  # type: igno
     scenario's own settings (its switches applied); ``guided`` False: the roulette's reference
     stays the launched flux (``ForwardSettings.guided_roulette``, the behaviour before)."""
     from radtree.engines.forward import run as forward_run
+    from radtree.engines.forward.sources import EnvironmentSource
 
     for proj, name, hour, built, st in cases:
         eff = effective_project(proj, proj.scenario(name)).engine
@@ -144,15 +147,19 @@ def lineage(cases, seeds: list[int], guided: bool = True) -> None:  # type: igno
             assert strata is not None, "the lineage view needs the focused launch"
             forward_run._window_from_pilot(h, tr, strata)
             at = forward_run._at_points(h)
+            sky = forward_run._sky_rows(h)
+            sky_lux = 0.0 if sky is None else float(sky.mean())
             level = "none" if tr.window is None else f"{tr.window.level:.3g} lm"
             print(f"  {name} {hour} seed {seed}: direct sun at the points {at.mean():.1f} lx, "
-                  f"window level {level}, guided roulette {s.guided_roulette}", flush=True)
+                  f"unscattered sky at the points {sky_lux:.1f} lx, window level {level}, "
+                  f"guided roulette {s.guided_roulette}", flush=True)
             rows = [_ring(h, tr, st_) for st_ in strata]
             var = sum(r[2] ** 2 for r in rows)
             print(f"   one round: {sum(r[1] for r in rows):.1f} ± {var ** 0.5:.1f} lx (the rest of "
                   f"the façade mean)", flush=True)
             for st_, (n, mu, se, hit, top, kurt) in zip(strata, rows):
-                print(f"   {'sun' if st_.source in h.direct else 'sky'} ring {st_.a:5.1f}–"
+                kind = "sky" if isinstance(h.sources[st_.source], EnvironmentSource) else "sun"
+                print(f"   {kind} ring {st_.a:5.1f}–"
                       f"{st_.b:5.1f} m: {n:7d} photons, {mu:8.2f} ± {se:6.2f} lx (variance share "
                       f"{se * se / var if var > 0 else 0:6.1%}), reach {hit:.4f}, ten largest "
                       f"{top:.3f}, kurtosis {kurt:.0f}", flush=True)

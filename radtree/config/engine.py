@@ -117,6 +117,10 @@ class ForwardParams(Checked):
     # crossings (× (d / r)², d from the target grid's centre) split into copies (0 = none):
     # radtree.engines.forward.window
     forward_window: float = field(default=2.0, metadata=meta(0.0))
+    # the sky's unscattered light (sky and ground glow through specular transmissions only)
+    # estimated at the sensor points, sky photons tallied on the patches only once scattered:
+    # radtree.engines.forward.skypoint
+    forward_direct_sky: bool = True
 
 
 #: the parameter groups of :class:`EngineParams`: attribute → class

@@ -15,7 +15,8 @@ So, with a whole-scene sun, the forward engine splits the light as a backward en
   mean transmittance exp(−τ) along it (as the NumPy engine's shadow rays): exact, no noise;
 * sun photons are **not tallied** on the patches until their first diffuse event or mirror
   reflection (what remains is scattered light, smooth across a patch); sky and ground-glow
-  photons are tallied from the start as before.
+  photons likewise with ``engine.forward_direct_sky`` (their unscattered light estimated at the
+  points by :mod:`.skypoint`, through the same :func:`transmittance`), else from the start.
 
 Every lumen still travels (the ledger is unchanged); only what the patches count changes.
 """
@@ -31,6 +32,46 @@ MAX_LAYERS = 64
 """Surfaces a ray towards the sun may cross (then it counts as blocked)."""
 
 
+def transmittance(geo: Geometry, optics: Optics, origins: np.ndarray, dirs: np.ndarray
+                  ) -> np.ndarray:
+    """Undeviated transmittance along the rays ``origins + t·dirs`` (t > 0, unit ``dirs``,
+    (k, 3) each): the product of the specular transmittances of the surfaces crossed (``Trans``
+    T_s, ``Glass`` T(θ), opaque 0; more than :data:`MAX_LAYERS`: 0; the surface rays start a
+    hair along ``dirs``) times the turbid crowns' mean transmittance exp(−τ) from ``origins``
+    (as the NumPy engine's shadow rays)."""
+    d = np.ascontiguousarray(np.broadcast_to(np.asarray(dirs, float), np.shape(origins)))
+    tau = np.ones(len(d))
+    if len(d) == 0:
+        return tau
+    eps = max(1e-5, 2e-6 * geo.size)
+    o = np.asarray(origins, float) + eps * d
+    live = np.arange(len(o))
+    for _ in range(MAX_LAYERS):
+        tri, t = geo.caster.first_hit(o[live], d[live])
+        hit = tri >= 0
+        if not hit.any():
+            break
+        live, tri, t = live[hit], tri[hit], t[hit]
+        mat = geo.tri_material[tri]
+        ts = optics.ts[mat].copy()
+        glass = np.isfinite(optics.glass_tn[mat])
+        if glass.any():
+            cos_i = np.abs(np.einsum("ij,ij->i", geo.normals[tri[glass]], d[live[glass]]))
+            ts[glass] = glass_coefficients(cos_i, optics.glass_tn[mat][glass])[0]
+        tau[live] *= ts
+        o[live] = o[live] + (t + eps)[:, None] * d[live]
+        live = live[tau[live] > 0]
+        if len(live) == 0:
+            break
+    else:
+        tau[live] = 0.0
+    if geo.media is not None:   # turbid crowns: their exact mean transmittance exp(−τ)
+        on = np.flatnonzero(tau > 0)
+        if len(on):
+            tau[on] *= geo.media.transmittance(np.asarray(origins, float)[on], d[on])
+    return tau
+
+
 def direct_sun(geo: Geometry, optics: Optics, grid: SensorGrid, sun: np.ndarray,
                dni: float) -> np.ndarray:
     """Direct sun illuminance (lux) at each sensor point of ``grid``: ``dni`` (lux, normal to
@@ -43,31 +84,6 @@ def direct_sun(geo: Geometry, optics: Optics, grid: SensorGrid, sun: np.ndarray,
     idx = np.flatnonzero(out > 0)
     if len(idx) == 0:
         return out
-    eps = max(1e-5, 2e-6 * geo.size)
-    o = np.asarray(grid.points, float)[idx] + eps * s
-    tau = np.ones(len(idx))
-    live = np.arange(len(idx))
-    d = np.tile(s, (len(idx), 1))
-    for _ in range(MAX_LAYERS):
-        tri, t = geo.caster.first_hit(o[live], d[live])
-        hit = tri >= 0
-        if not hit.any():
-            break
-        live, tri, t = live[hit], tri[hit], t[hit]
-        mat = geo.tri_material[tri]
-        ts = optics.ts[mat].copy()
-        glass = np.isfinite(optics.glass_tn[mat])
-        if glass.any():
-            cos_i = np.abs(geo.normals[tri[glass]] @ s)
-            ts[glass] = glass_coefficients(cos_i, optics.glass_tn[mat][glass])[0]
-        tau[live] *= ts
-        o[live] = o[live] + (t + eps)[:, None] * s
-        live = live[tau[live] > 0]
-        if len(live) == 0:
-            break
-    else:
-        tau[live] = 0.0
-    if geo.media is not None:   # turbid crowns: their exact mean transmittance exp(−τ)
-        tau *= geo.media.transmittance(np.asarray(grid.points, float)[idx], d)
-    out[idx] *= tau
+    out[idx] *= transmittance(geo, optics, np.asarray(grid.points, float)[idx],
+                              np.tile(s, (len(idx), 1)))
     return out

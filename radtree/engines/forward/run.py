@@ -6,7 +6,10 @@ the hour's :class:`~radtree.engines.forward.tracer.Ledger` and counters. Photons
 rounds of ``settings.photons`` (``settings.batches`` batches each); with
 ``settings.target_rel_se`` rounds are added until every grid's mean reaches it or
 ``settings.max_photons`` (:mod:`radtree.engines.forward.precision`; a first round that misses
-the target only sizes the run and is not counted).
+the target only sizes the run and is not counted). The unscattered sun and sky are counted
+at the sensor points instead of on the patches when the settings ask for it
+(:mod:`.direct`, :mod:`.skypoint`): the sun's exactly, the sky's estimated afresh for every
+batch of every round.
 """
 
 from __future__ import annotations
@@ -25,6 +28,7 @@ from radtree.engines.forward.direct import direct_sun
 from radtree.engines.forward.guide import Guide
 from radtree.engines.forward.precision import Budget, worst_relative_se
 from radtree.engines.forward.settings import ForwardSettings
+from radtree.engines.forward.skypoint import direct_sky
 from radtree.engines.forward.sources import EnvironmentSource, SunSource, bounding_sphere
 from radtree.engines.forward.strata import (
     PILOT,
@@ -115,8 +119,9 @@ def sun_source(scene: Scene, state: SkyState, settings: ForwardSettings, sphere
 @dataclass(frozen=True)
 class _Hour:
     """One hour's forward trace, planned: the grids ``names``, geometry and optics, patch
-    detectors, bounding sphere, sources (``direct``: the indices whose beam is counted at the
-    points), the random generator, the target grid's centre (m) and the variance reduction
+    detectors, bounding sphere, sources (``direct``: the indices whose unscattered light is
+    counted at the points, not on the patches; ``sun_direct``, ``sky``: the sun's beam and the
+    environment source counted there), the random generator, the target grid's centre (m) and the variance reduction
     near it (splitting, guiding)."""
 
     scene: Scene
@@ -129,6 +134,8 @@ class _Hour:
     sphere: Any
     sources: list
     direct: frozenset[int]
+    sun_direct: bool
+    sky: EnvironmentSource | None
     rng: np.random.Generator
     target: np.ndarray
     near: Splitting | None
@@ -150,15 +157,20 @@ def _plan(scene: Scene, state: SkyState, settings: ForwardSettings, grids: list[
                      *([] if geo.media is None else [geo.media.corners()])])
     sphere = bounding_sphere(pts)
     sources: list = []
-    direct: frozenset[int] = frozenset()
+    direct: set[int] = set()
+    sky: EnvironmentSource | None = None
+    whole = settings.beam_diameter_m is None
     if state.sun_on:
         sources.append(sun_source(scene, state, settings, sphere))
-        if settings.direct_sun and settings.beam_diameter_m is None:
-            direct = frozenset({0})  # the sun's beam at the points, not on the patches
-    if settings.beam_diameter_m is None:  # a beam is the study's only source: no sky, no glow
+        if settings.direct_sun and whole:
+            direct.add(0)  # the sun's beam at the points, not on the patches
+    if whole:  # a beam is the study's only source: no sky, no glow
         env = EnvironmentSource(Environment(state), sphere)
         if env.cdf is not None and env.flux > 0:
             sources.append(env)
+            if settings.direct_sky:   # the unscattered sky at the points (skypoint.py)
+                direct.add(len(sources) - 1)
+                sky = env
     rng = np.random.default_rng(np.random.SeedSequence(
         [int(settings.seed) & 0xFFFFFFFF, zlib.crc32((label or state.label).encode())]))
     optics = scene_optics(scene, state, geo.material_names)
@@ -171,8 +183,9 @@ def _plan(scene: Scene, state: SkyState, settings: ForwardSettings, grids: list[
         corners = det.corners()[det.slices[aim]].reshape(-1, 3)
         radius = float(np.linalg.norm(corners - target, axis=1).max())
     guide = Guide(target, radius, settings.guide) if settings.guide > 0 else None
-    return _Hour(scene, state, settings, names, geo, optics, det, sphere, sources, direct, rng,
-                 target, near, guide, radius)
+    return _Hour(scene, state, settings, names, geo, optics, det, sphere, sources,
+                 frozenset(direct), bool(state.sun_on and 0 in direct), sky, rng, target, near,
+                 guide, radius)
 
 
 def _tracer(h: _Hour, batches: int) -> ForwardTracer:
@@ -219,12 +232,26 @@ def _window_from_pilot(h: _Hour, tracer: ForwardTracer, strata: list[Stratum] | 
 def _at_points(h: _Hour) -> np.ndarray:
     """The sun's direct light at the sensor points (lux; zeros when it is not counted there)."""
     out = np.zeros(h.det.count)
-    if h.direct:
+    if h.sun_direct:
         sun = np.asarray(h.state.sun.vector, float)
         for name in h.names:
             out[h.det.slices[name]] = direct_sun(h.geo, h.optics, h.scene.grids[name], sun,
                                                  h.state.direct_normal_lux)
     return out
+
+
+def _sky_rows(h: _Hour) -> np.ndarray | None:
+    """(batches, detectors) estimates of the unscattered sky at the sensor points (lux), each
+    batch from its own directions (:mod:`radtree.engines.forward.skypoint`); None: not
+    counted there."""
+    if h.sky is None:
+        return None
+    s = h.settings
+    rows = np.zeros((s.batches, h.det.count))
+    for name in h.names:
+        rows[:, h.det.slices[name]] = direct_sky(h.geo, h.optics, h.scene.grids[name], h.sky,
+                                                 s.sky_rays, s.batches, h.rng)
+    return rows
 
 
 def _round(h: _Hour, tracer: ForwardTracer, strata: list[Stratum] | None,
@@ -238,17 +265,20 @@ def _round(h: _Hour, tracer: ForwardTracer, strata: list[Stratum] | None,
         n = sum(st.photons for st in strata)
     else:
         counts = _allot(s.photons, [src.flux for src in h.sources], b)
-        for src, n_src in zip(h.sources, counts):
+        for i, (src, n_src) in enumerate(zip(h.sources, counts)):
             per_photon = src.flux / n_src
             for c0 in range(0, n_src, s.chunk):
                 k = min(s.chunk, n_src - c0)
                 batch = (c0 + np.arange(k)) % b
                 tracer.run(Photons.start(src.launch(k, per_photon, h.rng), batch,
-                                         src is h.sources[0] and bool(h.direct)))
+                                         i in h.direct))
         n = sum(counts)
     rows = tracer.tally * b / h.det.area
-    if h.direct:
+    if h.sun_direct:
         rows += at_points  # the direct sun, exact at the points: the same in every batch
+    sky = _sky_rows(h)
+    if sky is not None:
+        rows += sky        # the unscattered sky at the points: each batch its own estimate
     return n, rows
 
 

@@ -21,7 +21,8 @@ flux corrected: :mod:`radtree.engines.forward.guide`; 0 = Lambertian scattering 
 mean has that relative standard error, or that many photons:
 :mod:`radtree.engines.forward.precision`; unset = one round) and ``forward_direct_sun`` (the
 sun's direct beam computed at the sensor points, sun photons tallied only once scattered:
-:mod:`radtree.engines.forward.direct`).
+:mod:`radtree.engines.forward.direct`) and ``forward_direct_sky`` (the same for the sky's
+unscattered light, estimated at the points: :mod:`radtree.engines.forward.skypoint`).
 """
 
 from __future__ import annotations
@@ -67,6 +68,9 @@ class ForwardSettings:
     ``guided_roulette``: a guided diffuse event scales the photon's reference flux (the
     roulette's) with its flux (:mod:`.tracer`, *Roulette after a guided event*; False: the
     reference stays the launched flux, as before 2026-12-07 — kept for comparisons only).
+    ``direct_sky``: the unscattered sky (and ground glow) estimated at the sensor points from
+    ``sky_rays`` directions per sensor, batch and round, sky photons tallied on the patches
+    only once scattered (:mod:`.skypoint`; whole-scene sun and sky only).
     """
 
     photons: int = 1_000_000
@@ -89,6 +93,8 @@ class ForwardSettings:
     direct_sun: bool = False
     window: float = 0.0
     guided_roulette: bool = True
+    direct_sky: bool = False
+    sky_rays: int = 32
 
     def __post_init__(self) -> None:
         if isinstance(self.photons, bool) or not isinstance(self.photons, int) or self.photons < 1:
@@ -141,6 +147,12 @@ class ForwardSettings:
                        f"({self.photons}), got {m!r}")
         if not isinstance(self.direct_sun, bool):
             raise _bad("forward_direct_sun", f"must be true or false, got {self.direct_sun!r}")
+        if not isinstance(self.direct_sky, bool):
+            raise _bad("forward_direct_sky", f"must be true or false, got {self.direct_sky!r}")
+        if isinstance(self.sky_rays, bool) or not isinstance(self.sky_rays, int) \
+                or self.sky_rays < 1:
+            raise _bad("forward_direct_sky", f"sky_rays must be a whole number ≥ 1, got "
+                       f"{self.sky_rays!r}")
         ww = self.window
         if isinstance(ww, bool) or not isinstance(ww, int | float) or not math.isfinite(ww) \
                 or ww < 0:
@@ -165,7 +177,8 @@ class ForwardSettings:
                    split=f.forward_split, split_radius_m=f.forward_split_radius_m,
                    guide=f.forward_guide, guide_radius_m=f.forward_guide_radius_m,
                    target_rel_se=f.target_rel_se, max_photons=f.max_photons,
-                   direct_sun=f.forward_direct_sun, window=f.forward_window)
+                   direct_sun=f.forward_direct_sun, window=f.forward_window,
+                   direct_sky=f.forward_direct_sky)
 
     def describe(self) -> str:
         source = ("sun over the whole scene" if self.beam_diameter_m is None
@@ -174,6 +187,8 @@ class ForwardSettings:
             source += f", focused launch from {self.focus_m:g} m"
         if self.direct_sun and self.beam_diameter_m is None:
             source += ", direct sun at the points"
+        if self.direct_sky and self.beam_diameter_m is None:
+            source += ", unscattered sky at the points"
         scatter = "ray splitting" if self.splitting else "Russian roulette"
         if self.split > 1:
             scatter += f", ×{self.split} within {self.split_radius_m:g} m of the target"

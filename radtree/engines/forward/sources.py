@@ -130,6 +130,7 @@ class EnvironmentSource:
         s = np.sqrt(1.0 - Z * Z)
         d = np.column_stack([(s * np.cos(P)).ravel(), (s * np.sin(P)).ravel(), Z.ravel()])
         self.luminance = luminance
+        self.cell_dirs = d   # (cells, 3) unit directions of the cell centres
         self.cell_l = np.maximum(np.asarray(luminance(d), float), 0.0)
         self.omega = 4.0 * math.pi / (nz * nphi)
         total = float(self.cell_l.sum())
