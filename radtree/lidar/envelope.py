@@ -28,12 +28,10 @@ envelope. Units: metres; the grid's frame (heights above ground).
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import TYPE_CHECKING
 
 import numpy as np
 
-if TYPE_CHECKING:
-    from radtree.lidar.beams import BeamCounts
+from radtree.lidar.beams import BeamCounts, density
 
 #: sub-points per voxel edge for the volume fraction inside the envelope (4³ = 64 a voxel)
 FRACTION_POINTS = 4
@@ -120,8 +118,6 @@ def fill_undersampled(pad: np.ndarray, entering: np.ndarray, *, inside: np.ndarr
     paths summed) where together at least ``pulse_min`` beams entered them; else, and without
     ``counts``, the mean density of the layer's voxels reached by at least ``pulse_min``;
     a layer with neither takes the value of the nearest layer above that has one."""
-    from radtree.lidar.beams import density
-
     k = np.arange(pad.shape[2])[None, None, :]
     sampled = inside & (entering >= pulse_min)
     under = inside & ~sampled & (k >= lowest_k)

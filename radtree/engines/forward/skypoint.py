@@ -47,14 +47,6 @@ CHUNK = 1 << 18
 """Directions traced at once (bounded memory)."""
 
 
-def _cell_of(env: EnvironmentSource, w: np.ndarray) -> np.ndarray:
-    """The luminance table's cell holding each unit direction ``w`` (k, 3)."""
-    iz = np.clip(((w[:, 2] + 1.0) * 0.5 * env.nz).astype(np.int64), 0, env.nz - 1)
-    phi = np.mod(np.arctan2(w[:, 1], w[:, 0]), 2.0 * math.pi)
-    ip = np.clip((phi / (2.0 * math.pi) * env.nphi).astype(np.int64), 0, env.nphi - 1)
-    return iz * env.nphi + ip
-
-
 def _table(env: EnvironmentSource, normal: np.ndarray) -> np.ndarray | None:
     """Probabilities of the table's cells for a sensor of unit ``normal``: ∝ L · cos⁺ at the
     cell centres (None: the hemisphere's cells are all dark)."""
@@ -64,27 +56,20 @@ def _table(env: EnvironmentSource, normal: np.ndarray) -> np.ndarray | None:
 
 
 def _draw(env: EnvironmentSource, normal: np.ndarray, prob: np.ndarray | None, k: int,
-          rng: np.random.Generator) -> tuple[np.ndarray, np.ndarray]:
+          rng: np.random.Generator) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """``k`` unit directions towards the sky for a sensor of unit ``normal`` from the
-    mixture, and the mixture's density at each (per steradian)."""
+    mixture, their cos⁺ on ``normal`` and the mixture's density at each (per steradian)."""
     share = 1.0 if prob is None else COSINE_SHARE
     normals = np.broadcast_to(normal, (k, 3))
     w = cosine_directions(rng.random(k), rng.random(k), normals)
     if prob is not None:
         table = rng.random(k) >= share
-        m = int(table.sum())
-        cell = np.minimum(np.searchsorted(np.cumsum(prob), rng.random(m), side="right"),
-                          len(prob) - 1)
-        iz, ip = cell // env.nphi, cell % env.nphi
-        z = -1.0 + (iz + rng.random(m)) * 2.0 / env.nz
-        phi = (ip + rng.random(m)) * 2.0 * math.pi / env.nphi
-        s = np.sqrt(np.maximum(0.0, 1.0 - z * z))
-        w[table] = np.column_stack([s * np.cos(phi), s * np.sin(phi), z])
+        w[table] = env.draw_cells(np.cumsum(prob), int(table.sum()), rng)[0]
     cos = np.maximum(w @ normal, 0.0)
     pdf = share * cos / math.pi
     if prob is not None:
-        pdf = pdf + (1.0 - share) * prob[_cell_of(env, w)] / env.omega
-    return w, pdf
+        pdf = pdf + (1.0 - share) * prob[env.cell_of(w)] / env.omega
+    return w, cos, pdf
 
 
 def direct_sky(geo: Geometry, optics: Optics, grid: SensorGrid, env: EnvironmentSource,
@@ -115,8 +100,7 @@ def _samples(geo: Geometry, optics: Optics, env: EnvironmentSource,
     normal and cell probabilities)."""
     normal, prob = table
     k = len(origins)
-    w, pdf = _draw(env, normal, prob, k, rng)
-    cos = np.maximum(w @ normal, 0.0)
+    w, cos, pdf = _draw(env, normal, prob, k, rng)
     f = np.zeros(k)
     live = np.flatnonzero((cos > 0) & (pdf > 0))
     f[live] = np.asarray(env.luminance(w[live]), float) * cos[live] / pdf[live]

@@ -139,17 +139,29 @@ class EnvironmentSource:
         self.flux = self.area * self.density
         self.cdf = np.cumsum(self.cell_l) / total if total > 0 else None
 
-    def _directions(self, k: int, rng: np.random.Generator) -> tuple[np.ndarray, np.ndarray]:
-        """``k`` unit directions towards the source drawn ∝ L·Ω, and each one's flux
-        correction L(ω) / L(cell)."""
-        assert self.cdf is not None
-        cell = np.minimum(np.searchsorted(self.cdf, rng.random(k), side="right"),
-                          len(self.cdf) - 1)
+    def draw_cells(self, cdf: np.ndarray, k: int, rng: np.random.Generator
+                   ) -> tuple[np.ndarray, np.ndarray]:
+        """``k`` (unit directions, cells): cells of the table drawn by the cumulative
+        distribution ``cdf`` over them, each direction uniform within its cell."""
+        cell = np.minimum(np.searchsorted(cdf, rng.random(k), side="right"), len(cdf) - 1)
         iz, ip = cell // self.nphi, cell % self.nphi
         z = -1.0 + (iz + rng.random(k)) * 2.0 / self.nz
         phi = (ip + rng.random(k)) * 2.0 * math.pi / self.nphi
         s = np.sqrt(np.maximum(0.0, 1.0 - z * z))
-        w = np.column_stack([s * np.cos(phi), s * np.sin(phi), z])
+        return np.column_stack([s * np.cos(phi), s * np.sin(phi), z]), cell
+
+    def cell_of(self, w: np.ndarray) -> np.ndarray:
+        """The table's cell holding each unit direction ``w`` (k, 3)."""
+        iz = np.clip(((w[:, 2] + 1.0) * 0.5 * self.nz).astype(np.int64), 0, self.nz - 1)
+        phi = np.mod(np.arctan2(w[:, 1], w[:, 0]), 2.0 * math.pi)
+        ip = np.clip((phi / (2.0 * math.pi) * self.nphi).astype(np.int64), 0, self.nphi - 1)
+        return iz * self.nphi + ip
+
+    def _directions(self, k: int, rng: np.random.Generator) -> tuple[np.ndarray, np.ndarray]:
+        """``k`` unit directions towards the source drawn ∝ L·Ω, and each one's flux
+        correction L(ω) / L(cell)."""
+        assert self.cdf is not None
+        w, cell = self.draw_cells(self.cdf, k, rng)
         return w, np.asarray(self.luminance(w), float) / self.cell_l[cell]
 
     def launch(self, k: int, photon_flux: float, rng: np.random.Generator) -> Launch:
