@@ -294,15 +294,17 @@ def _closed_faces(crown: Crown, solid: trimesh.Trimesh) -> np.ndarray:
 
 
 def scattered_forward(crown: Crown, meshes: list[Mesh], materials: dict[str, Material],
-                      suns: np.ndarray, rays: int, seed: int = 1) -> np.ndarray:
+                      suns: np.ndarray, rays: int, seed: int = 1, *,
+                      own_only: bool = False) -> np.ndarray:
     """The part of the ``total`` definition beyond the beam, per sun of ``suns`` (k, 3): the
     crown's forward-scattered sunlight over the open beam on its shadow (0–1), forward-traced
-    from the :func:`lattice` bundle (photons start above the crown, travel along −s)."""
+    from the :func:`lattice` bundle (photons start above the crown, travel along −s).
+    ``own_only``: ``meshes`` are already the crown's :func:`own_meshes`."""
     from radtree.engines.forward.passage import beam_passage
 
     suns = np.atleast_2d(np.asarray(suns, float))
     suns = suns / np.linalg.norm(suns, axis=1)[:, None]
-    own = own_meshes(crown, meshes)
+    own = meshes if own_only else own_meshes(crown, meshes)
     top = max([float(crown.vertices[:, 2].max())]
               + [float(m.vertices[:, 2].max()) for m in own if m.n_triangles]) + PLANE_GAP_M
     solid = crown.solid()
@@ -378,9 +380,9 @@ class _Trace:
     def __call__(self, suns: np.ndarray, seed: int) -> np.ndarray:
         rays = self.options.rays
         values = transmittances(self.tracer, self.crown, suns, rays)
-        if self.options.definition == "total":   # own_meshes(own) is own
+        if self.options.definition == "total":
             values = values + scattered_forward(self.crown, self.own, self.materials, suns,
-                                                rays, seed=seed)
+                                                rays, seed=seed, own_only=True)
         return values
 
 
