@@ -67,7 +67,7 @@ typecheck: $(STAMP)
 	$(BIN)/mypy radtree
 
 pytest: $(STAMP)
-	$(BIN)/python -m pytest -q -x -n 2 --durations=15
+	$(BIN)/python -m pytest -q -x -n 2 --dist worksteal --durations=15
 
 test: lint typecheck pytest docs
 
