@@ -36,6 +36,7 @@ from radtree.config import Project, Scenario, effective_project
 from radtree.engines.base import Engine, TreeAttribution
 from radtree.engines.registry import attributing_engine
 from radtree.fileio import atomic_path
+from radtree.log import progress
 from radtree.pipeline.build import hour_grids
 from radtree.pipeline.realisations import is_later_realisation, parent_name
 
@@ -94,7 +95,7 @@ def scenario_impact(project: Project, sc: Scenario, built: BuiltScene, states: l
     scene = built.scene
     params = effective_project(project, sc).engine
     frames = []
-    for st in states:
+    for st in progress(states, desc=f"tree impact ({parent_name(sc.name)})"):
         use = hour_grids(project, st.time, list(scene.grids), grids, sc)
         got = engine.attribute_trees(scene, st, params, built.ab, use)
         for g, att in got.items():
