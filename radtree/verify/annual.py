@@ -23,6 +23,7 @@ from pathlib import Path
 import numpy as np
 
 from radtree.annual.coefficients import CoefficientRunner
+from radtree.annual.run import DEFAULT_SUN_MF
 from radtree.light.units import PHOTOPIC_RGB, WHITE_EFFICACY
 from radtree.scene import Scene
 from radtree.verify.checks import Check
@@ -111,10 +112,10 @@ class DcYear:
 
 
 def dc_year(scene: Scene, wea, folder: Path, params, grids: tuple[str, ...] = ("g",),
-            sun_mf: int = 1) -> DcYear:
+            sun_mf: int = DEFAULT_SUN_MF) -> DcYear:
     """``scene``'s ``grids`` over ``wea``'s year (coefficients in ``folder``) as
     ``radtree annual`` combines it: MF 1 sky, exact direct sun, reflected sun interpolated
-    from the patch centres of MF ``sun_mf``."""
+    from the patch centres of MF ``sun_mf`` (default: ``radtree annual``'s)."""
     from radtree.annual.combine import combine
     from radtree.annual.skymatrix import (
         reinhart_directions,
@@ -190,7 +191,8 @@ def annual_checks(picks=PICKS, *, ad: int = 1024, ref_ad: int = 2048,
             ref, _ = point_in_time(scene, year.runner.scene_rad, wea, i, work, ref_ad)
             k = int(np.argmax(np.abs(year.total[:, i] / ref - 1.0)))
             out.append(Check(
-                f"annual (daylight coefficients, MF 1, -ab 2 -ad {ad}) vs rtrace under "
+                f"annual (daylight coefficients, sky MF 1, sun MF {DEFAULT_SUN_MF}, -ab 2 -ad {ad}) "
+                f"vs rtrace under "
                 f"gendaylit sky + sun, open ground, {m:02d}-{d:02d} {h:g} h, the worst of "
                 f"{len(ref)} sensors (lx)", "radiance", float(ref[k]), float(year.total[k, i]),
                 CLAIM * float(ref[k]), CLAIM * float(ref[k]),
