@@ -34,8 +34,9 @@ irradiance):
   sensors, 22 Dec 9:30 and 17:30, 21 Jun 10:30; all traced at -ad 2048 -lw 1e-5, 4 passes,
   ``-u+``): MF 1 missed the 5 %
   claim at three hours, MF 2 at one (21 Jun 10:30, +6.7 %: gendaymtx's sky +2 % over
-  gendaylit's, the MF 2 interpolation +1 %, and this run's sampling noise, ± 2–4 % per sensor
-  there). The MF 2 sun runs cost ≈ 3.3 × those of MF 1 (266 suns instead of 80).
+  gendaylit's, the MF 2 interpolation +1 %, this run's sampling noise, ± 2–7 % per sensor
+  there, and the fixed-seed sampling's +0 … +7 %: radtree.verify.annual). The MF 2 sun runs
+  trace 266 unit suns instead of 80.
 
 Why not ``gendaymtx -5 0.533 -d`` (the five-phase sun matrix)? The Radiance shipped in the
 pyradiance wheel has no ``-5`` option; ``-D`` gives each hour's sun exactly, and with
