@@ -226,8 +226,9 @@ def crown_annual_checks(picks=PICKS, *, ad: int = 1024, ref_ad: int = 4096,
     and the fixed-seed sampling (``-u-``) reads the reflected sun 0.99–1.07 × the
     clock-seeded (``-u+``) rtrace and rcontrib at ``-ad 4096`` (which agree within 1 %), its
     passes not averaging that out.
-    Only MF 3 with ``-ad 1024 -lw 1e-5`` for the reflected sun and ``-u+`` brought every hour
-    within 5 % (worst +4.7 %, 21 June; 224 s against the default's 18 s on this scene)."""
+    Against the mean of three rtrace runs, ``--sun-mf 4 --sun-ad 1024 --sun-lw 1e-5`` brought
+    every hour within 5 % (worst +3.4 %, 21 June; 216 s against the default's 18 s on this
+    scene); MF 3 at the same sampling did with ``-u+`` (+4.7 %), not with ``-u-`` (+6.9 %)."""
     from radtree.annual.coefficients import scene_text
     from radtree.annual.run import AnnualOptions, annual_scenes, choose_scenarios, compute_annual
     from radtree.config import load_project
