@@ -36,7 +36,11 @@ irradiance):
   claim at three hours, MF 2 at one (21 Jun 10:30, +6.7 %: gendaymtx's sky +2 % over
   gendaylit's, the MF 2 interpolation +1 %, this run's sampling noise, ± 2–7 % per sensor
   there, and the fixed-seed sampling's +0 … +7 %: radtree.verify.annual). The MF 2 sun runs
-  trace 266 unit suns instead of 80.
+  trace 266 unit suns instead of 80: behind the office example's leafed crowns (every
+  ambient hit tests a shadow ray per sun through the slats) that run took 3.8 × as long
+  (7 of its 70 sensors, 1 pass, -ab 6 -ad 512: 135 s against 35.5 s), and at MF 1 it was
+  35 of the whole office annual's 37 min (``-j 1``, load 3–5 on 2 cores): ≈ 2.3 h at MF 2
+  (projected from those two measurements, 7 Dec 2026).
 
 Why not ``gendaymtx -5 0.533 -d`` (the five-phase sun matrix)? The Radiance shipped in the
 pyradiance wheel has no ``-5`` option; ``-D`` gives each hour's sun exactly, and with
@@ -93,8 +97,8 @@ METHOD_NOTES = [
     "(MF 1: −7 … +11 %; radtree.verify.annual); the direct sun (ASE) is exact for every hour.",
 ]
 #: Reinhart subdivision of the unit suns of the reflected sun (``radtree annual --sun-mf``):
-#: MF 2, whose interpolation error behind a crown at low sun is a third of MF 1's (module
-#: docstring, measured 7 Dec 2026), for ≈ 3.3 × the reflected-sun run's time
+#: MF 2, whose interpolation error behind a crown at low sun is about half of MF 1's (module
+#: docstring, measured 7 Dec 2026), for 3.8 × the reflected-sun run's time behind a crown
 DEFAULT_SUN_MF = 2
 METHODS = ("dc", "3phase")
 #: replicates of a dc run (``radtree annual --replicates``): 4 passes of every Monte Carlo
