@@ -16,8 +16,9 @@ irradiance):
   luminous efficacy gendaymtx uses for the sky); ``C_dir`` — a unit 0.533° sun exactly at
   each hour's position, ``-ab 0``: the direct sunlight of IES LM-83 (ASE uses this term
   alone).
-* inter-reflected sun — unit suns at the Reinhart patch centres (``sun_mf``) around the
-  sun's path, ``-ab N`` minus ``-ab 0`` (the direct part is deterministic, so the
+* inter-reflected sun — unit suns at the Reinhart patch centres (``sun_mf``, default
+  :data:`DEFAULT_SUN_MF` = 2: the 266 of 578 MF 2 centres around Mendoza's sun path) around
+  the sun's path, ``-ab N`` minus ``-ab 0`` (the direct part is deterministic, so the
   difference is exactly the reflected part); each hour interpolates between the three
   centres around its sun with weights that reproduce every sunlit plane's n·d exactly
   (:func:`radtree.annual.skymatrix.sun_patch_weights`). Each of these unit suns is a light
@@ -26,10 +27,20 @@ irradiance):
   sunlight is a smaller, smoother share than the direct sun, and its sampling noise is
   spread over the many hours each patch serves. Measured against point-in-time ``rtrace``
   under ``gendaylit`` (``radtree verify --full --group annual``, docs/validation.md): on an
-  open ground plane every sensor within −3.1 … +0.8 % at six hours; behind one louvers crown
-  three of six hours miss 5 % (−5.3, −5.8, +8.5 % at the worst sensor, low sun): the
-  reflected sun interpolated from MF 1 centres reads 0.92–1.14 × rtrace there (MF 2:
-  0.96–1.07) and gendaymtx's sky differs from gendaylit's near the horizon.
+  open ground plane every sensor within −3.1 … +0.8 % at six hours. Behind one louvers crown
+  (:func:`radtree.verify.annual.crown_annual_checks`) the reflected sun, ≈ 55 % of the
+  shaded façade's light at low sun, interpolated from the centres of MF 1 / 2 / 3 / 4 / 6
+  reads 0.93–1.11 / 0.94–1.03 / 0.99–1.04 / 0.97–1.03 / 0.98–1.03 × the exact sun's (8
+  sensors, 22 Dec 9:30 and 17:30, 21 Jun 10:30; all traced at -ad 2048 -lw 1e-5, 4 passes,
+  ``-u+``): MF 1 missed the 5 %
+  claim at three hours, MF 2 at one (21 Jun 10:30, +6.7 %: gendaymtx's sky +2 % over
+  gendaylit's, the MF 2 interpolation +1 %, this run's sampling noise, ± 2–7 % per sensor
+  there, and the fixed-seed sampling's +0 … +7 %: radtree.verify.annual). The MF 2 sun runs
+  trace 266 unit suns instead of 80: behind the office example's leafed crowns (every
+  ambient hit tests a shadow ray per sun through the slats) that run took 3.8 × as long
+  (7 of its 70 sensors, 1 pass, -ab 6 -ad 512: 135 s against 35.5 s), and at MF 1 it was
+  35 of the whole office annual's 37 min (``-j 1``, load 3–5 on 2 cores): ≈ 2.3 h at MF 2
+  (projected from those two measurements, 7 Dec 2026).
 
 Why not ``gendaymtx -5 0.533 -d`` (the five-phase sun matrix)? The Radiance shipped in the
 pyradiance wheel has no ``-5`` option; ``-D`` gives each hour's sun exactly, and with
@@ -81,10 +92,14 @@ METHOD_NOTES = [
     "Sky model: gendaymtx's Perez sky patches do not blend the sky into the ground near the "
     "horizon as gendaylit's perezlum.cal does (the point-in-time runs); sensors that see "
     "mostly low sky get a few per cent (up to ≈ 8 % in a test box) more sky light here.",
-    "Reflected sunlight is interpolated between unit suns at Reinhart patch centres: on the "
-    "office work plane within ≈ 2–7 % of rcontrib with the exact sun (benchmarks/annual.py); "
-    "the direct sun (ASE) is exact for every hour.",
+    "Reflected sunlight is interpolated between unit suns at Reinhart patch centres (MF 2 by "
+    "default): behind a louvers crown at low sun within −6 … +3 % of the exact sun's "
+    "(MF 1: −7 … +11 %; radtree.verify.annual); the direct sun (ASE) is exact for every hour.",
 ]
+#: Reinhart subdivision of the unit suns of the reflected sun (``radtree annual --sun-mf``):
+#: MF 2, whose interpolation error behind a crown at low sun is about half of MF 1's (module
+#: docstring, measured 7 Dec 2026), for 3.8 × the reflected-sun run's time behind a crown
+DEFAULT_SUN_MF = 2
 METHODS = ("dc", "3phase")
 #: replicates of a dc run (``radtree annual --replicates``): 4 passes of every Monte Carlo
 #: trace, 4 × the time of one, report the metrics' standard errors and halve those of DA
@@ -102,7 +117,7 @@ class AnnualOptions:
     #: the leaf season; None: :func:`radtree.annual.schedule.leaf_season` of the project
     leaf: LeafSchedule | None = None
     mf: int = 1
-    sun_mf: int = 1
+    sun_mf: int = DEFAULT_SUN_MF
     occupancy: tuple[float, float] = DEFAULT_OCCUPANCY
     ab: int | None = None
     ad: int | None = None

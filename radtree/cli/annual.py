@@ -6,6 +6,7 @@ from pathlib import Path
 
 import click
 
+from radtree.annual.run import DEFAULT_SUN_MF
 from radtree.annual.schedule import leaf_season, parse_occupancy
 from radtree.cli.options import CONTEXT, writes
 
@@ -21,8 +22,13 @@ from radtree.cli.options import CONTEXT, writes
               help="First day the crown is bare (branches only); with --leaf-on.")
 @click.option("--mf", default=1, show_default=True, type=click.IntRange(1, 8),
               help="Reinhart sky subdivision (1 = 145 patches + ground).")
-@click.option("--sun-mf", default=1, show_default=True, type=click.IntRange(1, 8),
-              help="Reinhart subdivision of the unit suns for reflected sunlight.")
+@click.option("--sun-mf", default=DEFAULT_SUN_MF, show_default=True, type=click.IntRange(1, 8),
+              help="Reinhart subdivision of the unit suns for reflected sunlight. Behind a "
+                   "louvers crown at low sun its interpolation reads −6 … +3 % of the exact "
+                   "sun's at 2, −7 … +11 % at 1, −3 … +3 % at 4. Its unit suns (office "
+                   "year: 80 at 1, 266 at 2, 679 at 4) set the reflected-sun run's time: "
+                   "behind the office's crowns 2 takes 3.8 × as long as 1, the whole office "
+                   "annual ≈ 2.3 h instead of 37 min with -j 1.")
 @click.option("--occupancy", default="8-18", show_default=True, metavar="START-END",
               help="Occupied hours, local standard time, every day.")
 @click.option("--epw", type=click.Path(exists=True, dir_okay=False, path_type=Path),

@@ -23,6 +23,7 @@ from pathlib import Path
 import numpy as np
 
 from radtree.annual.coefficients import CoefficientRunner
+from radtree.annual.run import DEFAULT_SUN_MF
 from radtree.light.units import PHOTOPIC_RGB, WHITE_EFFICACY
 from radtree.scene import Scene
 from radtree.verify.checks import Check
@@ -111,10 +112,10 @@ class DcYear:
 
 
 def dc_year(scene: Scene, wea, folder: Path, params, grids: tuple[str, ...] = ("g",),
-            sun_mf: int = 1) -> DcYear:
+            sun_mf: int = DEFAULT_SUN_MF) -> DcYear:
     """``scene``'s ``grids`` over ``wea``'s year (coefficients in ``folder``) as
     ``radtree annual`` combines it: MF 1 sky, exact direct sun, reflected sun interpolated
-    from the patch centres of MF ``sun_mf``."""
+    from the patch centres of MF ``sun_mf`` (default: ``radtree annual``'s)."""
     from radtree.annual.combine import combine
     from radtree.annual.skymatrix import (
         reinhart_directions,
@@ -190,7 +191,8 @@ def annual_checks(picks=PICKS, *, ad: int = 1024, ref_ad: int = 2048,
             ref, _ = point_in_time(scene, year.runner.scene_rad, wea, i, work, ref_ad)
             k = int(np.argmax(np.abs(year.total[:, i] / ref - 1.0)))
             out.append(Check(
-                f"annual (daylight coefficients, MF 1, -ab 2 -ad {ad}) vs rtrace under "
+                f"annual (daylight coefficients, sky MF 1, sun MF {DEFAULT_SUN_MF}, -ab 2 -ad {ad}) "
+                f"vs rtrace under "
                 f"gendaylit sky + sun, open ground, {m:02d}-{d:02d} {h:g} h, the worst of "
                 f"{len(ref)} sensors (lx)", "radiance", float(ref[k]), float(year.total[k, i]),
                 CLAIM * float(ref[k]), CLAIM * float(ref[k]),
@@ -201,24 +203,32 @@ def annual_checks(picks=PICKS, *, ad: int = 1024, ref_ad: int = 2048,
 def crown_annual_checks(picks=PICKS, *, ad: int = 1024, ref_ad: int = 4096,
                         folder: Path | None = None) -> list[Check]:
     """``radtree annual`` (:func:`radtree.annual.run.compute_annual`, its defaults: sky MF 1,
-    reflected sun from MF 1 patch centres at ``-ad`` ÷ 4, ``-lw`` ≥ 1e-3) of
-    :data:`TINY_PROJECT` at ``-ab 2 -ad`` ``ad`` ``-lw 1e-5``: the leafed crown's scene at
-    each picked hour against rtrace of the same scene (its façade grid) under gendaylit — one
-    row per hour, the façade sensor with the largest relative miss, claim :data:`CLAIM`.
+    reflected sun from the patch centres of MF :data:`~radtree.annual.run.DEFAULT_SUN_MF`
+    (2) at ``-ad`` ÷ 4, ``-lw`` ≥ 1e-3, 4 passes) of :data:`TINY_PROJECT` at ``-ab 2 -ad``
+    ``ad`` ``-lw 1e-5``: the leafed crown's scene at each picked hour against rtrace of the
+    same scene (its façade grid) under gendaylit — one row per hour, the façade sensor with
+    the largest relative miss, claim :data:`CLAIM`.
 
-    Measured 7 Dec 2026 (load ≈ 7 on 2 cores): the three hours when this north façade has no
-    direct sun (22 Dec 9:30 and 17:30, 21 Jun 10:30) miss by −5.4 %, −5.7 %, +8.3 % at the
-    worst sensor (all 8 sensors −2.4 … −5.7 % in December, +2.0 … +8.6 % in June); the other
-    three hours are within 0.5 %. The reference's own repeat moves it by ≤ 0.6 % (2.8 % at one
-    sensor); the reflected sun at ``-ad 1024 -lw 1e-5`` instead of 256 / 1e-3 moves the year by
-    ≤ 1.5 %. Split at 22 Dec 9:30 and 21 Jun 10:30 (rtrace with gendaylit's sun switched off
-    gives its sky part; reflected sun ≈ 55 % of the façade's light at those hours): the sky
-    part (MF 4 coefficients × gendaylit's own sky on the patches) reads 0.93–1.01 × rtrace's;
-    the reflected sun interpolated from the MF 1 patch centres 0.92–0.95 (Dec) and 1.05–1.14
-    (Jun) × rtrace's, and 0.98–1.01 / 0.96–1.07 from MF 2 centres
-    (:func:`dc_year` ``sun_mf=2``): the default reflected-sun interpolation is the larger part
-    of the miss with a crown, the sky models (gendaymtx vs gendaylit near the horizon,
-    ``tests/test_annual.py``) the rest."""
+    Measured 7 Dec 2026 (load 3–5 on 2 cores). With MF 1 sun patches (the default until
+    then) the three hours when this north façade has no direct sun (22 Dec 9:30 and 17:30,
+    21 Jun 10:30; the reflected sun ≈ 55 % of its light) missed by −4.8 … −5.5, −5.5 … −5.8,
+    +8.1 … +9.1 % at the worst sensor (four runs). Split there (rtrace with gendaylit's sun or
+    sky switched off; the reflected sun of the exact hour's sun by rcontrib, ``-u+``, -ad 4096,
+    4 passes, reads 0.995–1.018 × the mean of 8 rtrace runs on 21 June): the reflected sun
+    interpolated from the patch centres of MF 1 / 2 / 3 / 4 / 6 (all at -ad 2048 -lw 1e-5, 4
+    passes, ``-u+``) reads 0.93–0.94, 0.94–0.95 and 1.07–1.11 / 0.94–1.03 /
+    0.99–1.04 / 0.97–1.03 / 0.98–1.03 × the exact sun's; the sky part (gendaymtx × MF 1
+    coefficients) 0.99–1.01 × rtrace's in December and 1.01–1.04 on 21 June 10:30 (gendaymtx's
+    Perez sky vs gendaylit's near the horizon, ``tests/test_annual.py``). With MF 2 (the
+    default since) the worst sensors read −2.4 %, −3.6 % and +6.8 % (the other three hours
+    within 1.1 %): 21 June 10:30 still misses. There the default reflected-sun run's noise is
+    ± 2–7 % per sensor for one sun (standard error of its 4 passes at ``-ad 256 -lw 1e-3``),
+    and the fixed-seed sampling (``-u-``) reads the reflected sun 0.99–1.07 × the
+    clock-seeded (``-u+``) rtrace and rcontrib at ``-ad 4096`` (which agree within 1 %), its
+    passes not averaging that out.
+    Against the mean of three rtrace runs, ``--sun-mf 4 --sun-ad 1024 --sun-lw 1e-5`` brought
+    every hour within 5 % (worst +3.4 %, 21 June; 216 s against the default's 18 s on this
+    scene); MF 3 at the same sampling did with ``-u+`` (+4.7 %), not with ``-u-`` (+6.9 %)."""
     from radtree.annual.coefficients import scene_text
     from radtree.annual.run import AnnualOptions, annual_scenes, choose_scenarios, compute_annual
     from radtree.config import load_project
