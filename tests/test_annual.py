@@ -201,8 +201,8 @@ def test_annual_matches_point_in_time_rtrace(tmp_path, room):
     correlated samples gave errors of up to 5 % at single sensors (south façade, 22 Dec 13:30:
     17 493 lx against 16 660 lx), while ``-u+`` runs a second apart moved by at most 0.7 %
     (sd ≤ 0.25 % at twice the samples). The largest misses measured (open 3.2 %, box
-    same-sky 2.7 %, box sky-model 8.1 %, reflected sun from MF 1 patch centres; from MF 2,
-    the default since 7 Dec 2026, one run: 0.9 %, 2.5 %, 7.8 %) stay ≥ 1.8 points below
+    same-sky 2.7 %, box sky-model 8.1 %, reflected sun from MF 1 patch centres; from MF 2
+    (``--sun-mf 2``), one run: 0.9 %, 2.5 %, 7.8 %) stay ≥ 1.8 points below
     each tolerance.
     """
     from radtree.annual.coefficients import TraceParams

@@ -17,18 +17,20 @@ LUX = 179.0 * np.array([0.265, 0.670, 0.065])
 LOW_SUN = ((12, 22, 9.5), (12, 22, 17.5), (6, 21, 10.5))
 
 
-def test_default_is_mf_2_in_the_options_and_the_command():
+def test_one_default_in_the_options_and_the_command():
+    """MF 1 (MF 2 halves the interpolation error at ≈ 4 × the reflected-sun run's time:
+    radtree.annual.run), the same in the API and on the command line."""
     from radtree.cli.annual import annual_command
 
-    assert DEFAULT_SUN_MF == 2 and AnnualOptions().sun_mf == 2
+    assert DEFAULT_SUN_MF == 1 and AnnualOptions().sun_mf == 1
     opt = next(p for p in annual_command.params if p.name == "sun_mf")
-    assert opt.default == 2
+    assert opt.default == 1
 
 
 @needs_radiance
 def test_sun_patches_of_the_mendoza_year(tmp_path):
     """The generated Mendoza year's 4431 suns touch 80 MF 1 centres and 266 MF 2 centres:
-    the reflected-sun run traces 3.3 × the unit suns at the default."""
+    MF 2 traces 3.3 × the unit suns of the default."""
     from radtree.annual.skymatrix import sun_positions
 
     wea = epw_to_wea(OFFICE_EPW, tmp_path / "year.wea")

@@ -17,7 +17,7 @@ irradiance):
   each hour's position, ``-ab 0``: the direct sunlight of IES LM-83 (ASE uses this term
   alone).
 * inter-reflected sun — unit suns at the Reinhart patch centres (``sun_mf``, default
-  :data:`DEFAULT_SUN_MF` = 2: the 266 of 578 MF 2 centres around Mendoza's sun path) around
+  :data:`DEFAULT_SUN_MF` = 1: the 80 of 145 MF 1 centres around Mendoza's sun path) around
   the sun's path, ``-ab N`` minus ``-ab 0`` (the direct part is deterministic, so the
   difference is exactly the reflected part); each hour interpolates between the three
   centres around its sun with weights that reproduce every sunlit plane's n·d exactly
@@ -35,12 +35,14 @@ irradiance):
   ``-u+``): MF 1 missed the 5 %
   claim at three hours, MF 2 at one (21 Jun 10:30, +6.7 %: gendaymtx's sky +2 % over
   gendaylit's, the MF 2 interpolation +1 %, this run's sampling noise, ± 2–7 % per sensor
-  there, and the fixed-seed sampling's +0 … +7 %: radtree.verify.annual). The MF 2 sun runs
-  trace 266 unit suns instead of 80: behind the office example's leafed crowns (every
+  there, and the fixed-seed sampling's +0 … +7 %: radtree.verify.annual). MF 2 stays an
+  option (``--sun-mf 2``), not the default: its sun runs trace 266 unit suns instead of 80: behind the office example's leafed crowns (every
   ambient hit tests a shadow ray per sun through the slats) that run took 3.8 × as long
   (7 of its 70 sensors, 1 pass, -ab 6 -ad 512: 135 s against 35.5 s), and at MF 1 it was
   35 of the whole office annual's 37 min (``-j 1``, load 3–5 on 2 cores): ≈ 2.3 h at MF 2
-  (projected from those two measurements, 7 Dec 2026).
+  (projected from those two measurements, 7 Dec 2026) — a fourfold wait for a fix of
+  low-sun hours behind crowns that still misses one of them, its effect on the year's metrics
+  not measured.
 
 Why not ``gendaymtx -5 0.533 -d`` (the five-phase sun matrix)? The Radiance shipped in the
 pyradiance wheel has no ``-5`` option; ``-D`` gives each hour's sun exactly, and with
@@ -92,14 +94,15 @@ METHOD_NOTES = [
     "Sky model: gendaymtx's Perez sky patches do not blend the sky into the ground near the "
     "horizon as gendaylit's perezlum.cal does (the point-in-time runs); sensors that see "
     "mostly low sky get a few per cent (up to ≈ 8 % in a test box) more sky light here.",
-    "Reflected sunlight is interpolated between unit suns at Reinhart patch centres (MF 2 by "
-    "default): behind a louvers crown at low sun within −6 … +3 % of the exact sun's "
-    "(MF 1: −7 … +11 %; radtree.verify.annual); the direct sun (ASE) is exact for every hour.",
+    "Reflected sunlight is interpolated between unit suns at Reinhart patch centres (MF 1 by "
+    "default): behind a louvers crown at low sun within −7 … +11 % of the exact sun's "
+    "(--sun-mf 2: −6 … +3 %, at ≈ 4 × the reflected-sun run's time; radtree.verify.annual); "
+    "the direct sun (ASE) is exact for every hour.",
 ]
 #: Reinhart subdivision of the unit suns of the reflected sun (``radtree annual --sun-mf``):
-#: MF 2, whose interpolation error behind a crown at low sun is about half of MF 1's (module
-#: docstring, measured 7 Dec 2026), for 3.8 × the reflected-sun run's time behind a crown
-DEFAULT_SUN_MF = 2
+#: MF 1. MF 2 halves the interpolation error behind a crown at low sun but takes 3.8 × the
+#: reflected-sun run's time behind a crown (module docstring, measured 7 Dec 2026)
+DEFAULT_SUN_MF = 1
 METHODS = ("dc", "3phase")
 #: replicates of a dc run (``radtree annual --replicates``): 4 passes of every Monte Carlo
 #: trace, 4 × the time of one, report the metrics' standard errors and halve those of DA

@@ -24,8 +24,8 @@ from radtree.cli.options import CONTEXT, writes
               help="Reinhart sky subdivision (1 = 145 patches + ground).")
 @click.option("--sun-mf", default=DEFAULT_SUN_MF, show_default=True, type=click.IntRange(1, 8),
               help="Reinhart subdivision of the unit suns for reflected sunlight. Behind a "
-                   "louvers crown at low sun its interpolation reads −6 … +3 % of the exact "
-                   "sun's at 2, −7 … +11 % at 1, −3 … +3 % at 4. Its unit suns (office "
+                   "louvers crown at low sun its interpolation reads −7 … +11 % of the exact "
+                   "sun's at 1, −6 … +3 % at 2, −3 … +3 % at 4. Its unit suns (office "
                    "year: 80 at 1, 266 at 2, 679 at 4) set the reflected-sun run's time: "
                    "behind the office's crowns 2 takes 3.8 × as long as 1, the whole office "
                    "annual ≈ 2.3 h instead of 37 min with -j 1.")

@@ -204,13 +204,12 @@ def crown_annual_checks(picks=PICKS, *, ad: int = 1024, ref_ad: int = 4096,
                         folder: Path | None = None) -> list[Check]:
     """``radtree annual`` (:func:`radtree.annual.run.compute_annual`, its defaults: sky MF 1,
     reflected sun from the patch centres of MF :data:`~radtree.annual.run.DEFAULT_SUN_MF`
-    (2) at ``-ad`` ÷ 4, ``-lw`` ≥ 1e-3, 4 passes) of :data:`TINY_PROJECT` at ``-ab 2 -ad``
+    (1) at ``-ad`` ÷ 4, ``-lw`` ≥ 1e-3, 4 passes) of :data:`TINY_PROJECT` at ``-ab 2 -ad``
     ``ad`` ``-lw 1e-5``: the leafed crown's scene at each picked hour against rtrace of the
     same scene (its façade grid) under gendaylit — one row per hour, the façade sensor with
     the largest relative miss, claim :data:`CLAIM`.
 
-    Measured 7 Dec 2026 (load 3–5 on 2 cores). With MF 1 sun patches (the default until
-    then) the three hours when this north façade has no direct sun (22 Dec 9:30 and 17:30,
+    Measured 7 Dec 2026 (load 3–5 on 2 cores). With MF 1 sun patches (the default) the three hours when this north façade has no direct sun (22 Dec 9:30 and 17:30,
     21 Jun 10:30; the reflected sun ≈ 55 % of its light) missed by −4.8 … −5.5, −5.5 … −5.8,
     +8.1 … +9.1 % at the worst sensor (four runs). Split there (rtrace with gendaylit's sun or
     sky switched off; the reflected sun of the exact hour's sun by rcontrib, ``-u+``, -ad 4096,
@@ -219,8 +218,9 @@ def crown_annual_checks(picks=PICKS, *, ad: int = 1024, ref_ad: int = 4096,
     passes, ``-u+``) reads 0.93–0.94, 0.94–0.95 and 1.07–1.11 / 0.94–1.03 /
     0.99–1.04 / 0.97–1.03 / 0.98–1.03 × the exact sun's; the sky part (gendaymtx × MF 1
     coefficients) 0.99–1.01 × rtrace's in December and 1.01–1.04 on 21 June 10:30 (gendaymtx's
-    Perez sky vs gendaylit's near the horizon, ``tests/test_annual.py``). With MF 2 (the
-    default since) the worst sensors read −2.4 %, −3.6 % and +6.8 % (the other three hours
+    Perez sky vs gendaylit's near the horizon, ``tests/test_annual.py``). With MF 2
+    (``--sun-mf 2``; not made the default: 3.8 × the reflected-sun run's time behind a crown,
+    :mod:`radtree.annual.run`) the worst sensors read −2.4 %, −3.6 % and +6.8 % (the other three hours
     within 1.1 %): 21 June 10:30 still misses. There the default reflected-sun run's noise is
     ± 2–7 % per sensor for one sun (standard error of its 4 passes at ``-ad 256 -lw 1e-3``),
     and the fixed-seed sampling (``-u-``) reads the reflected sun 0.99–1.07 × the
