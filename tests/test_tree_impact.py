@@ -160,3 +160,36 @@ def test_an_engine_that_cannot_attribute_hands_over_and_says_so(district, caplog
     # no pair, no table: the reference street has no scenario without trees
     street = load_project(EXAMPLES / "mendoza-street")
     assert tree_impact(street, radiance, [street.scenario("F")], {"F": (built, [])}) is None
+
+
+def test_simulate_with_and_without_the_tree_impact(tmp_path):
+    """``radtree simulate --no-tree-impact`` writes the illuminance table alone (the same
+    numbers); the default also attributes the light to the trees (results/tree_impact.csv)."""
+    import re
+    import shutil
+
+    import pandas as pd
+    from click.testing import CliRunner
+
+    from radtree.cli import main
+
+    p = tmp_path / "office"
+    shutil.copytree(EXAMPLES / "office-block", p,
+                    ignore=shutil.ignore_patterns("build", "results", "report"))
+    toml = p / "radtree.toml"
+    text = toml.read_text()
+    for pat, rep in ((r"^rays = \d+", "rays = 16"), (r"^workers = \d+", "workers = 1")):
+        text, n = re.subn(pat, rep, text, flags=re.M)
+        assert n == 1
+    toml.write_text(text)
+    args = ["simulate", str(p), "--engine", "numpy", "--hour", "13:30"]
+    skipped = CliRunner().invoke(main, [*args, "--no-tree-impact"])
+    assert skipped.exit_code == 0, skipped.output
+    impact = p / "results" / "tree_impact.csv"
+    assert not impact.exists()
+    lux = pd.read_csv(p / "results" / "illuminance.csv")["lux"].to_numpy()
+    full = CliRunner().invoke(main, [*args, "--fresh"])
+    assert full.exit_code == 0, full.output
+    table = pd.read_csv(impact)
+    assert set(table["scenario"]) == {"with"} and (table["lux_removed"].abs() > 0).any()
+    np.testing.assert_array_equal(pd.read_csv(p / "results" / "illuminance.csv")["lux"], lux)

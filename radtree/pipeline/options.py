@@ -43,7 +43,9 @@ class RunOptions:
     thread pool in this process), ``"sequential"``, ``"local"`` (a Dask LocalCluster) or a Dask
     scheduler address ``"tcp://HOST:PORT"`` (:mod:`radtree.pipeline.executor`). ``fresh``:
     recompute every finished part (``simulate``) or earlier ``-ab`` step (``convergence``)
-    instead of resuming from it."""
+    instead of resuming from it. ``tree_impact``: ``simulate`` attributes the light each tree
+    takes (``results/tree_impact.csv``, when the project has a scenario without trees); False
+    skips it — the NumPy engine's attribution traces each hour two to three times more."""
 
     engine: Any = None
     scenarios: tuple[str, ...] | None = None
@@ -52,6 +54,7 @@ class RunOptions:
     workers: int | None = None
     scheduler: str | None = None
     fresh: bool = False
+    tree_impact: bool = True
 
     def __post_init__(self) -> None:
         for name in ("scenarios", "hours", "grids"):

@@ -55,6 +55,8 @@ class Run:
     prepared: dict[str, Prepared]
     grids: tuple[str, ...] | None
     traced: frozenset[str]
+    #: attribute the light each tree takes (:attr:`RunOptions.tree_impact`)
+    tree_impact: bool = True
 
 
 def publish(run: Run, frames: list[pd.DataFrame], timing: dict[str, dict[str, float]],
@@ -140,6 +142,11 @@ def _tree_impact(run: Run) -> pd.DataFrame | None:
     unless every one of them was reused from earlier parts and the table is there."""
     from radtree.pipeline.tree_impact import tree_impact, tree_impact_path
 
+    if not run.tree_impact:
+        if tree_impact_path(run.project).exists():
+            log.warning("  tree impact: not attributed in this run (--no-tree-impact); %s is "
+                        "from an earlier run", tree_impact_path(run.project))
+        return None
     if not run.traced and tree_impact_path(run.project).exists():
         return None
     return tree_impact(run.project, run.engine, list(run.chosen),

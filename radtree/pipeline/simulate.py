@@ -148,7 +148,7 @@ def plan_simulation(project: Project, *, options: RunOptions) -> SimulationPlan:
     timing = {n: {"preparation_s": p.seconds, "geometry_s": p.built.geometry_seconds,
                   "tracing_s": 0.0} for n, p in prepared.items()}
     run = Run(project, eng, tuple(chosen), prepared, options.grids,
-              frozenset(j.scenario.name for j in jobs))
+              frozenset(j.scenario.name for j in jobs), options.tree_impact)
     return SimulationPlan(run, jobs, reused, executor, layout, timing)
 
 
