@@ -97,7 +97,8 @@ def office_summary(engine: str, workdir: Path) -> pd.DataFrame:
 
     proj = load_project(_copy("office-block", workdir / f"office-{engine}"),
                         overrides=OFFICE_OVERRIDES)
-    simulate_project(proj, options=RunOptions(engine=engine, fresh=True))
+    # the summary reads the illuminance only: no tree attribution (simulate --no-tree-impact)
+    simulate_project(proj, options=RunOptions(engine=engine, fresh=True, tree_impact=False))
     path = write_summary(proj, maps=False)
     return pd.read_csv(path, dtype={"time": str})
 
