@@ -84,6 +84,14 @@ sessions, one process at a time:
   UTC): z s.d. 1.128, max |z| 2.44, 0 %, spread / r.m.s. s.e. 1.06, mean 1 274.3 lx. Each z
   s.d. from 50 runs is uncertain by ±0.1 (more with heavy tails); whether the sky at the
   points worsens B was not settled here.
+* ``--zscores 50 --z-first 1`` and ``--z-first 51`` ``--hours 12:30 --scenarios B`` (two
+  processes, one CSV, ``--z-from``; session 23, 2026-12-07 21:04–21:15 UTC, load ≈ 2, 612 and
+  627 s): seeds 1–50 reproduce the runs above to the digit (z s.d. 1.271, seed 31 1 252.1 ±
+  6.9 lx); seeds 51–100 alone z s.d. 1.107, 1 of 50 beyond 3 (seed 71). **All 100: z s.d.
+  1.182 (within 0.8–1.25), |z| > 3 in 2 % (seeds 31 and 71, z −3.12 and −3.15) — the ≤ 1 %
+  not met**; spread of the means / r.m.s. s.e. 1.05, mean 1 273.6 lx, correlation of mean
+  and s.e. +0.31; one run (of seeds 51–100) needed 4.0 M photons. Both misses are low: runs
+  that drew few of the sun's heavy hits.
 * ``--lineage 8 --hours 12:30 --scenarios F`` (defaults, 21 s): one round 1 310.4 ± 11.3 lx
   besides the direct sun (64.5 lx) and the unscattered sky at the points; the sky's inner
   ring (0–1 m) now **0.4 % of the variance** (was 43 %), every sky ring ≤ 3.8 % (all sky
