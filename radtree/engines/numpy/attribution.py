@@ -102,12 +102,17 @@ class _Crowns:
         lo, hi = self.lo - pad, self.hi + pad
         for s in range(0, len(o), _BOX_CHUNK):
             oo, dd, rr = o[s:s + _BOX_CHUNK], d[s:s + _BOX_CHUNK], reach[s:s + _BOX_CHUNK]
+            # the slabs one axis at a time; a NaN entry (a ray in a slab's plane, parallel to
+            # it) leaves near / far as they are (fmax / fmin skip NaN)
+            near = np.full((len(oo), len(lo)), -np.inf)
+            far = np.full((len(oo), len(lo)), np.inf)
             with np.errstate(divide="ignore", invalid="ignore"):
-                inv = 1.0 / dd
-                t1 = (lo[None, :, :] - oo[:, None, :]) * inv[:, None, :]
-                t2 = (hi[None, :, :] - oo[:, None, :]) * inv[:, None, :]
-            near = np.nan_to_num(np.minimum(t1, t2), nan=-np.inf).max(axis=2)
-            far = np.nan_to_num(np.maximum(t1, t2), nan=np.inf).min(axis=2)
+                for a in range(3):
+                    inv = (1.0 / dd[:, a])[:, None]
+                    t1 = (lo[None, :, a] - oo[:, a, None]) * inv
+                    t2 = (hi[None, :, a] - oo[:, a, None]) * inv
+                    np.fmax(near, np.minimum(t1, t2), out=near)
+                    np.fmin(far, np.maximum(t1, t2), out=far)
             out[s:s + _BOX_CHUNK] = (near <= far) & (far >= 0.0) & (near < rr[:, None])
         return out
 
