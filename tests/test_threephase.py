@@ -40,9 +40,7 @@ def runs(project_dir):
     from radtree.config import load_project
 
     project = load_project(project_dir)
-    # MF 1 sun patches (80 unit suns, not the default's 266): these tests check the chain,
-    # not the reflected sun's interpolation (tests/test_annual_sun_mf.py), and stay quick
-    quick = dict(nproc=1, method="3phase", daylight_samples=24, sun_ad=32, sun_mf=1)
+    quick = dict(nproc=1, method="3phase", daylight_samples=24, sun_ad=32)
     first = compute_annual(project, options=AnnualOptions(**quick))
     folder = project.results_dir / "annual" / "threephase"
     stamps = {f.name: f.stat().st_mtime_ns for f in folder.iterdir()
@@ -267,7 +265,7 @@ def test_default_method_reuses_the_three_phase_sun_runs(runs):
               for f in (coeffs / s).glob("sun_*.npy")}
     assert len(before) == 6                  # direct, patch -ab 0, patch -ab N per state
     dc = compute_annual(project, options=AnnualOptions(nproc=1, method="dc", sun_ad=32,
-                                                       sun_mf=1, replicates=1))
+                                                       replicates=1))
     after = {f: f.stat().st_mtime_ns for s in ("leaf_on", "leaf_off")
              for f in (coeffs / s).glob("sun_*.npy")}
     assert after == before
@@ -295,8 +293,7 @@ def test_five_phase_sun(runs):
 
     project, first, _, _, _ = runs
     five = compute_annual(project, options=AnnualOptions(
-        nproc=1, method="3phase", daylight_samples=24, sun_ad=32, sun_mf=1,
-        sun_crown="fivephase"))
+        nproc=1, method="3phase", daylight_samples=24, sun_ad=32, sun_crown="fivephase"))
     assert any("five-phase" in n for n in five.notes)
     for state in ("leaf_on", "leaf_off"):
         for g in first.direct[state]:

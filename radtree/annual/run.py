@@ -17,8 +17,8 @@ irradiance):
   each hour's position, ``-ab 0``: the direct sunlight of IES LM-83 (ASE uses this term
   alone).
 * inter-reflected sun — unit suns at the Reinhart patch centres (``sun_mf``, default
-  :data:`DEFAULT_SUN_MF` = 1: the 80 of 145 MF 1 centres around Mendoza's sun path) around
-  the sun's path, ``-ab N`` minus ``-ab 0`` (the direct part is deterministic, so the
+  :data:`DEFAULT_SUN_MF` = 1; the office example's year needs 80 of the 145) around the
+  sun's path, ``-ab N`` minus ``-ab 0`` (the direct part is deterministic, so the
   difference is exactly the reflected part); each hour interpolates between the three
   centres around its sun with weights that reproduce every sunlit plane's n·d exactly
   (:func:`radtree.annual.skymatrix.sun_patch_weights`). Each of these unit suns is a light

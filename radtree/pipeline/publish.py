@@ -142,12 +142,13 @@ def _tree_impact(run: Run) -> pd.DataFrame | None:
     unless every one of them was reused from earlier parts and the table is there."""
     from radtree.pipeline.tree_impact import tree_impact, tree_impact_path
 
+    path = tree_impact_path(run.project)
     if not run.tree_impact:
-        if tree_impact_path(run.project).exists():
+        if path.exists():
             log.warning("  tree impact: not attributed in this run (--no-tree-impact); %s is "
-                        "from an earlier run", tree_impact_path(run.project))
+                        "from an earlier run", path)
         return None
-    if not run.traced and tree_impact_path(run.project).exists():
+    if not run.traced and path.exists():
         return None
     return tree_impact(run.project, run.engine, list(run.chosen),
                        {n: (p.built, p.states) for n, p in run.prepared.items()},
