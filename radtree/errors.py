@@ -64,3 +64,9 @@ class Terminated(KeyboardInterrupt):
     def __init__(self, signum: int = 15):
         self.signum = signum
         super().__init__(f"terminated by signal {signum}")
+
+
+def install_extra(extra: str) -> str:
+    """How to install radtree's optional ``extra`` (the text every "missing extra" message
+    ends with): ``make demo`` installs radtree without its extras, ``make install`` with all."""
+    return f"pip install 'radtree[{extra}]' (in a source checkout: make install)"

@@ -52,6 +52,20 @@ def test_make_executor_kinds():
         make_executor("bogus", None)
 
 
+def test_a_dask_scheduler_without_dask_names_the_extra(monkeypatch):
+    """``make demo`` installs radtree without its extras: ``--scheduler local`` then says how
+    to add dask, as a ConfigError (exit 2), not an ImportError's traceback."""
+    import radtree.pipeline.executor as executor
+
+    monkeypatch.setattr(executor, "find_spec", lambda name: None)
+    for scheduler in ("local", "tcp://127.0.0.1:8786"):
+        with pytest.raises(ConfigError, match=r"field 'scheduler': scheduler '.+' runs on dask, "
+                           r"which is not installed: pip install 'radtree\[sweep\]' \(in a "
+                           r"source checkout: make install\)"):
+            RunOptions(scheduler=scheduler)
+    assert isinstance(make_executor("sequential", None), SequentialExecutor)
+
+
 def test_run_options_are_checked_on_creation():
     o = RunOptions(scenarios=["A", "B", "A"], hours=["10:30"], workers=2)
     assert o.scenarios == ("A", "B") and o.hours == ("10:30",) and o.resume

@@ -19,7 +19,7 @@ from importlib.util import find_spec
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-from radtree.errors import ConfigError, RadtreeError
+from radtree.errors import ConfigError, RadtreeError, install_extra
 
 if TYPE_CHECKING:
     from radtree.config import Project, Scenario
@@ -100,7 +100,7 @@ class ExportFormat:
 
     @property
     def missing_hint(self) -> str:
-        return f"it needs the '{self.extra}' extra: pip install 'radtree[{self.extra}]'"
+        return f"it needs the '{self.extra}' extra: {install_extra(str(self.extra))}"
 
 
 def _f(target: str, summary: str, *needs: str, extra: str | None = None) -> ExportFormat:

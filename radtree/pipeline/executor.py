@@ -26,9 +26,10 @@ from collections.abc import Callable, Iterator, Sequence
 from concurrent.futures import Future, ThreadPoolExecutor, as_completed
 from dataclasses import dataclass
 from functools import partial
+from importlib.util import find_spec
 from typing import Any, ClassVar
 
-from radtree.errors import ConfigError, RadtreeError
+from radtree.errors import ConfigError, RadtreeError, install_extra
 
 __all__ = ["Executor", "Finished", "ThreadExecutor", "SequentialExecutor", "DaskExecutor",
            "make_executor", "default_workers", "scheduler_problem"]
@@ -181,7 +182,12 @@ def open_client(scheduler: str, workers: int | None, tasks: int) -> tuple[Any, A
 
 def scheduler_problem(scheduler: str) -> str:
     """Why ``scheduler`` names no executor ("" when it does)."""
-    if scheduler in ("local", "sequential") or "://" in scheduler:
+    if scheduler == "sequential":
+        return ""
+    if scheduler == "local" or "://" in scheduler:
+        if find_spec("distributed") is None:
+            return (f"scheduler {scheduler!r} runs on dask, which is not installed: "
+                    f"{install_extra('sweep')}")
         return ""
     return (f"scheduler {scheduler!r}: expected 'local', 'sequential' or a dask scheduler "
             "address such as tcp://127.0.0.1:8786")

@@ -32,7 +32,7 @@ from typing import Any
 import numpy as np
 
 from radtree.config.honeybee import HoneybeeSite
-from radtree.errors import ConfigError
+from radtree.errors import ConfigError, install_extra
 from radtree.light.units import PHOTOPIC_RGB
 from radtree.optics import Glass, Material, Plastic, Trans
 from radtree.scene import Mesh, SensorGrid, quad
@@ -85,7 +85,7 @@ def load_model(path: Path) -> Any:
         from honeybee.model import Model
     except ImportError as exc:  # pragma: no cover - the extra is installed in CI
         raise _fail(path, "reading a Honeybee model needs honeybee-core and honeybee-radiance "
-                    "(pip install 'radtree[honeybee]')") from exc
+                    f"({install_extra('honeybee')})") from exc
     try:
         data = json.loads(Path(path).read_text(encoding="utf-8"))
     except (OSError, UnicodeDecodeError, json.JSONDecodeError) as exc:

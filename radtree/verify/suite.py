@@ -28,6 +28,7 @@ from pathlib import Path
 import pandas as pd
 
 from radtree.engines.registry import seeded_engine
+from radtree.errors import install_extra
 from radtree.fileio import atomic_path
 from radtree.verify.checks import (
     FORWARD,
@@ -146,7 +147,7 @@ def _diagnose(full: bool, _b: list[str] | None) -> list[Check]:
 def missing_extra(path: str, extra: str) -> Check:
     """A row saying ``path`` was not checked: its extra is not installed (``unresolved``: not
     a failure of radtree, never a pass)."""
-    return Check(f"{path}: not checked, its extra is missing (pip install 'radtree[{extra}]')",
+    return Check(f"{path}: not checked, its extra is missing ({install_extra(extra)})",
                  "-", 0.0, 0.0, 1.0, 0.0, "—")
 
 
