@@ -306,7 +306,7 @@ def _cases(hours: list[str], scenarios: list[str]):
 
 
 def zscores(hours: list[str], scenarios: list[str], seeds: range, target: float,
-            round_photons: int, out: Path | None) -> None:
+            round_photons: int, out: Path | None, stages: int | None = None) -> None:
     """Seeded repeats per scenario-hour (``seeds``), one line per run (appended to ``out`` as
     CSV when given, so several processes can share the seeds), then :func:`z_summary`."""
     print(f"z-scores: seeds {seeds.start}–{seeds.stop - 1} per scenario-hour, target "
@@ -316,6 +316,8 @@ def zscores(hours: list[str], scenarios: list[str], seeds: range, target: float,
     for proj, name, hour, built, st in _cases(hours, scenarios):
         s = replace(ForwardSettings.from_params(proj.engine, built.ab), photons=round_photons,
                     target_rel_se=target)
+        if stages is not None:
+            s = replace(s, stages=stages)
         for k in seeds:
             t0 = time.perf_counter()
             with warnings.catch_warnings():
@@ -506,6 +508,8 @@ def main() -> None:
     ap.add_argument("--z-target", type=float, default=0.02)
     ap.add_argument("--z-round", type=int, default=1_000_000)
     ap.add_argument("--z-out", type=Path, default=None, help="append the runs to this CSV")
+    ap.add_argument("--z-stages", type=int, default=None,
+                    help="engine.forward_stages of --zscores (default: the project's)")
     ap.add_argument("--z-from", type=Path, nargs="+", default=None,
                     help="no tracing: z of the runs in these --z-out files")
     ap.add_argument("--radiance", action="store_true")
@@ -529,7 +533,7 @@ def main() -> None:
         z_from_files(a.z_from)
     elif a.zscores:
         zscores(a.hours, a.scenarios or every, range(a.z_first, a.z_first + a.zscores),
-                a.z_target, a.z_round, a.z_out)
+                a.z_target, a.z_round, a.z_out, a.z_stages)
     elif a.crossings or a.lineage:
         from forward_tails import crossings, lineage  # benchmarks/forward_tails.py
 

@@ -159,14 +159,14 @@ def scan_crowns(tmp: Path, args: argparse.Namespace) -> tuple[str, list[tuple[fl
     and (built, inverted from the scan, the crown kept in the returns' hull) leaf areas m² per
     realisation."""
 
+    from dataclasses import replace
+
     from radtree.config import load_project
     from radtree.lidar.scanner import AlsScan
-    from radtree.lidar.voxels import tree_voxels
     from radtree.site.frame import FacadeFrame
     from radtree.trees.build import build_tree
-    from radtree.trees.points_hull import sharpen, vertical_beams
+    from radtree.trees.points_crown import points_crown_grid
     from radtree.trees.synthetic_scan import leaf_area_m2, scan_crown, write_scan
-    from radtree.trees.volume import mean_cos
 
     toml = tmp / "radtree.toml"
     text = toml.read_text()
@@ -178,8 +178,9 @@ def scan_crowns(tmp: Path, args: argparse.Namespace) -> tuple[str, list[tuple[fl
         leaf = build_tree(project, project.scenario(f"orig{k}"), frame).meshes[0]
         pts = scan_crown(leaf.vertices, leaf.faces, AlsScan(pulse_density_m2=20.0, seed=k))
         path = write_scan(pts, tmp / "data" / f"scan{k}.laz")
-        grid = tree_voxels(path, mean_cos(project.tree.louvers), args.voxel)
-        crown, _ = sharpen(grid, beams=vertical_beams(path))
+        # the grids a scan scenario's crown is built from (its beams: the file's scan angles)
+        grid, crown, _ = points_crown_grid(replace(project.tree, points=path,
+                                                   points_voxel_m=args.voxel))
         areas.append((leaf_area_m2([leaf.vertices[f] for f in leaf.faces]), grid.leaf_area_m2,
                       crown.leaf_area_m2))
         if k <= args.seeds:

@@ -84,6 +84,31 @@ def test_rounds_reallocated_keep_the_floor_reflection():
     assert abs(r.ledger.balance) < 1e-9 * r.ledger.launched
 
 
+def test_stages_reallocate_within_a_round_and_keep_the_floor_reflection():
+    """One round in 4 stages (engine.forward_stages): the rings allotted again before each
+    stage from all photons so far, each stage its own batches (4 × 32 rows), the photons of
+    the one round counted once; the analytic value within 3 standard errors, every lumen
+    accounted for; a round with fewer photons than batches a stage is refused."""
+    scene, expected = _floor_scene()
+    st = sky_state("none", altitude=60, azimuth=30, dni=DNI, ground_glow=False)
+    one, four = (trace_forward(scene, st, ForwardSettings(photons=100_000, max_bounces=1,
+                                                          patch_m=SIDE, focus_m=0.5, batches=32,
+                                                          stages=k, seed=4))
+                 for k in (1, 4))
+    assert one.batches["facade"].shape == (32, 1) and four.batches["facade"].shape == (128, 1)
+    assert four.rounds == one.rounds == 1 and four.strata is not None
+    assert sum(s.traced for s in four.strata) == four.photons
+    assert abs(four.photons - one.photons) <= 32 * len(four.strata) * 4   # rounded per ring
+    for r in (one, four):
+        got, se = r.grid_mean("facade")
+        print(f"floor reflection, {r.batches['facade'].shape[0] // 32} stage(s): expected "
+              f"{expected:.0f}, got {got:.0f} ± {se:.0f}")
+        assert abs(got - expected) <= 3 * se and se < 0.03 * expected
+        assert abs(r.ledger.balance) < 1e-9 * r.ledger.launched
+    with pytest.raises(ConfigError, match="engine.forward_stages"):
+        ForwardSettings(photons=100, batches=32, stages=4)
+
+
 def test_splitting_near_the_target_keeps_the_floor_reflection():
     """Diffuse events within 5 m of the detector split into 4 children (flux and threshold
     reference divided): the same expected tally, a smaller standard error, every lumen

@@ -121,6 +121,9 @@ class ForwardParams(Checked):
     # estimated at the sensor points, sky photons tallied on the patches only once scattered:
     # radtree.engines.forward.skypoint
     forward_direct_sky: bool = True
+    # every round traced in this many stages, the focused launch's rings allotted again before
+    # each from all photons so far (1 = the round at once): radtree.engines.forward.strata
+    forward_stages: int = field(default=1, metadata=meta(1))
 
 
 #: the parameter groups of :class:`EngineParams`: attribute → class

@@ -27,7 +27,7 @@ FORWARD_KEYS = ("photons", "forward_threshold", "forward_splitting", "beam_diame
                 "patch_m", "forward_batches", "forward_focus_m", "forward_split",
                 "forward_split_radius_m", "forward_guide", "forward_guide_radius_m",
                 "target_rel_se", "max_photons", "forward_direct_sun",
-                "forward_window", "forward_direct_sky")
+                "forward_window", "forward_direct_sky", "forward_stages")
 
 
 def plain(obj: Any, path: Callable[[Path], Any] = str) -> Any:

@@ -211,7 +211,7 @@ def _focus(h: _Hour) -> tuple[list[Stratum] | None, int, int]:
     scout = _tracer(h, 1)
     pilot(h.sources, strata, h.target, scout, per_ring, h.rng, h.direct)
     n_pilot = per_ring * len(strata)
-    allocate(strata, max(s.photons - n_pilot, b * len(strata)), b)
+    allocate(strata, max(s.photons - n_pilot, b * len(strata)) // s.stages, b)
     return strata, n_pilot, scout.segments
 
 
@@ -255,16 +255,17 @@ def _sky_rows(h: _Hour) -> np.ndarray | None:
 
 
 def _round(h: _Hour, tracer: ForwardTracer, strata: list[Stratum] | None,
-           at_points: np.ndarray) -> tuple[int, np.ndarray]:
-    """One round of photons into a fresh tally: its photons and (batches, detectors) lux of
-    each batch."""
+           at_points: np.ndarray, photons: int) -> tuple[int, np.ndarray]:
+    """One round (or stage) of photons into a fresh tally: its photons and (batches,
+    detectors) lux of each batch; ``photons``: of the uniform launch (the focused launch's
+    are the strata's)."""
     s, b = h.settings, h.settings.batches
     tracer.tally = np.zeros((b, h.det.count))
     if strata is not None:
         trace_strata(h.sources, strata, h.target, tracer, s.chunk, b, h.rng, h.direct)
         n = sum(st.photons for st in strata)
     else:
-        counts = _allot(s.photons, [src.flux for src in h.sources], b)
+        counts = _allot(photons, [src.flux for src in h.sources], b)
         for i, (src, n_src) in enumerate(zip(h.sources, counts)):
             per_photon = src.flux / n_src
             for c0 in range(0, n_src, s.chunk):
@@ -305,26 +306,31 @@ def _rounds(h: _Hour, tracer: ForwardTracer, strata: list[Stratum] | None
     s = h.settings
     at_points = _at_points(h)
     budget = Budget(s.photons, s.target_rel_se, s.max_photons)
-    traced, sizing, rows = 0, 0, []
+    traced, sizing, rows, rounds = 0, 0, [], 0
+    # a stage's photons: the first round's as _focus allotted them (the pilot's taken off)
+    stage = s.photons // s.stages if strata is None else sum(st.photons for st in strata)
     leg = s.photons
     while leg > 0:
         for _ in range(max(1, leg // s.photons)):
-            if strata is not None and traced:   # later rounds: allotted from all so far
-                reallocate(strata, s.photons, s.batches)
-            n, r = _round(h, tracer, strata, at_points)
-            traced += n
-            rows.append(r)
-            _open_window(h, tracer)
+            for _ in range(s.stages):
+                if strata is not None and traced:   # later stages: allotted from all so far
+                    reallocate(strata, stage, s.batches)
+                n, r = _round(h, tracer, strata, at_points, stage)
+                traced += n
+                rows.append(r)
+                _open_window(h, tracer)
+            rounds += 1
+            stage = s.photons // s.stages
         per_batch = np.vstack(rows)
         grid_batches = {name: per_batch[:, h.det.slices[name]].mean(axis=1)
                         for name in h.names}
         rel = worst_relative_se(grid_batches)[1]
         leg = budget.next_leg(traced - sizing, rel, spent=sizing)
-        if leg and not sizing and len(rows) == 1:
+        if leg and not sizing and rounds == 1:
             fresh = budget.sized_leg(traced, rel)
             if fresh:   # the first round sized the run: trace the prediction afresh
-                sizing, leg, rows = traced, fresh, []
-    return (traced - sizing, per_batch, len(rows), budget.warn_if_short(traced, grid_batches),
+                sizing, leg, rows, rounds = traced, fresh, [], 0
+    return (traced - sizing, per_batch, rounds, budget.warn_if_short(traced, grid_batches),
             sizing)
 
 

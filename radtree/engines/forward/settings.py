@@ -69,8 +69,10 @@ class ForwardSettings:
     roulette's) with its flux (:mod:`.tracer`, *Roulette after a guided event*; False: the
     reference stays the launched flux, as before 2026-12-07 — kept for comparisons only).
     ``direct_sky``: the unscattered sky (and ground glow) estimated at the sensor points from
-    ``sky_rays`` directions per sensor, batch and round, sky photons tallied on the patches
-    only once scattered (:mod:`.skypoint`; whole-scene sun and sky only).
+    ``sky_rays`` directions per sensor, batch and stage, sky photons tallied on the patches
+    only once scattered (:mod:`.skypoint`; whole-scene sun and sky only). ``stages``: every
+    round traced in that many equal stages, the focused launch's rings allotted again before
+    each from all photons so far (:mod:`.strata`, *Re-allocation*; 1: the round at once).
     """
 
     photons: int = 1_000_000
@@ -95,6 +97,7 @@ class ForwardSettings:
     guided_roulette: bool = True
     direct_sky: bool = False
     sky_rays: int = 32
+    stages: int = 1
 
     def __post_init__(self) -> None:
         if isinstance(self.photons, bool) or not isinstance(self.photons, int) or self.photons < 1:
@@ -153,6 +156,11 @@ class ForwardSettings:
                 or self.sky_rays < 1:
             raise _bad("forward_direct_sky", f"sky_rays must be a whole number ≥ 1, got "
                        f"{self.sky_rays!r}")
+        k = self.stages
+        if isinstance(k, bool) or not isinstance(k, int) or k < 1 \
+                or self.photons // k < self.batches:
+            raise _bad("forward_stages", f"must be a whole number ≥ 1 that leaves each stage "
+                       f"at least {self.batches} photons of the round's {self.photons}, got {k!r}")
         ww = self.window
         if isinstance(ww, bool) or not isinstance(ww, int | float) or not math.isfinite(ww) \
                 or ww < 0:
@@ -178,7 +186,7 @@ class ForwardSettings:
                    guide=f.forward_guide, guide_radius_m=f.forward_guide_radius_m,
                    target_rel_se=f.target_rel_se, max_photons=f.max_photons,
                    direct_sun=f.forward_direct_sun, window=f.forward_window,
-                   direct_sky=f.forward_direct_sky)
+                   direct_sky=f.forward_direct_sky, stages=f.forward_stages)
 
     def describe(self) -> str:
         source = ("sun over the whole scene" if self.beam_diameter_m is None
