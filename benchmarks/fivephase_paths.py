@@ -22,48 +22,55 @@ method), their materials varied:
 6. **position** — the same cones at points inside the central crown (x 0.4, y 3 m) at
    heights 4–11.5 m (its base 3 m, centre 7.75 m, top 12.5 m), facing the cone.
 
-Measured 2026-12-07 22:00–22:15 UTC (load 2–5 on 2 cores; the scenes of the 16:58 run of
-``benchmarks/threephase.py --samples 50 --daylight-samples 100``; these figures from the
-equivalent scratch scripts, 2–3 repeats, ``-ad 1024`` (cones 2048)):
+Measured 2026-12-07 (``--work`` a copy of the 16:58 run's ``3phase`` folder, ``--samples
+50``, ``--repeats 2``; steps 1–5 22:23–22:31 UTC at load 2.8–3.1, steps 6–8 with ``--only 6,7``
+22:34–22:36 at load 1.4–2.5; 2 cores):
 
-* The 0.71 of the brief is both grids together (façade 0.68 by itself; its reflected sun is 7 ×
-  the work plane's); the work plane alone is 0.94 over the 80 patch suns (0.93 over the leaf-on
-  occupied hours).
-* (1) façade, patch alt 54° az 0°: reflected by all surroundings BSDF 1.79e-5, explicit
-  2.69e-5 (**0.665**); by the ground alone 1.39e-5 / 2.20e-5 (**0.632**, ± 1 %); by the
-  façade paint alone 1.09e-6 / 0.76e-6 (1.43); by the opposite façade ≈ 0 — the ground holds
-  the deficit.
-* (a) ground irradiance, sun through the crown: y < 8 m BSDF/explicit **1.000**, y ≥ 8 m (in
-  the opposite building's shadow) 0.92; the sun reaches the street right.
-* (b) uniform glowing ground → façade: **0.609** (whole street; 0.602 for y < 8 m, 0.615
-  beyond); the light from the street to the façade through the crown is 0.61 ×.
-* (c) the crown's reflection of the façade paint's light back to the façade: 1.43 ×, but
-  4 % of the reflected sun.
-* direction, façade: cones below the horizon (e −70, −50, −30, −15°) 0.52, 0.66, 0.55, 0.53;
-  above (+20, +45°) 0.85, 0.95 (the upper hemisphere as a whole 1.45, the lower 0.61).
-* position, inside the crown: from below (e −50°) BSDF/explicit 0.16, 0.21, 0.94, 2.9, 2.0
-  at z 4, 5, 7.75, 10.5, 11.5 m; from above (e +50°) 3.1, 2.5, 1.3, 0.49, 0.29. The explicit
-  crown's light field varies 25 × from base to top; the shell's is the same everywhere inside
-  (0.003–0.004).
-
-Checked and not the cause: the lower facets (up −z) are the upper ones mirrored (a single
-facet's transmittance for mirrored incidence agrees within 2 %, every band); the wall cap's
-XML is oriented as its depth table says (light arriving from +60° τ 0.12, from −60° 0.84;
-with its up flipped the upper hemisphere reads 4.8 × and the lower 0.48 ×); the straight-line
-crown depth from the sensors' point through the cap and the far facet matches the envelope
-within 0.35 m for elevations −50…+70° (1.8 m too deep at −70°, where the cap's one-slat floor
-binds).
+* The 0.71 of issue 40 is both grids together: summed over sensors and the 80 patch suns of the
+  cached runs the façade reads 0.68, the work plane 0.94 (the façade's reflected sun is 7 × the
+  work plane's).
+* step 1: façade, unit sun at patch alt 54° az 0°, reflected by all surroundings: BSDF 1.80e-5,
+  explicit 2.67e-5 — **0.673**; by the ground alone 1.39e-5 / 2.21e-5 — **0.627** (± 2 %);
+  step 4 (c): by the façade paint alone 1.08e-6 / 1.04e-6 (1.04 ± 0.14; 1.43 in a first scratch
+  run) — the ground holds the deficit.
+* step 2: (a) the sun on the street through the crown: y < 8 m **0.996**, y ≥ 8 m (in the opposite
+  building's shadow) 0.925 — the sun reaches the ground right.
+* step 3: (b) glowing street → façade: **0.613** (y < 8 m 0.610, beyond 0.598).
+* step 5: cones below the horizon e −50, −30, −15°: 0.649, 0.585, 0.490; above, e +45°: 0.925
+  (scratch, same settings: −70° 0.52, +20° 0.85; the whole upper hemisphere 1.45, the lower
+  0.61).
+* step 6: inside the crown, from below (e −50°): 0.143, 1.11, 1.57 at z 4, 7.75, 11.5 m; from
+  above (e +50°): 2.37, 1.45, 0.265. The explicit crown's field varies 16–17 × from base to
+  top, the shell's within 2 ×.
+* step 7: facets: every band's upper facet and its mirrored lower twin within 2.5 % (e.g. b1
+  0.0400 / 0.0409, 0.1635 / 0.1634); step 8, the wall cap, up +z: from +60, +20, −20, −60°:
+  τ 0.115, 0.227, 0.521, 0.841 — dark towards the crown's top, as its depth table says (up
+  −z mirrors it; in the whole scene, scratch, that reads 4.8 × above, 0.48 × below).
+* Straight-line depth (scratch, ``radtree.pipeline.wall_cap`` functions): from the façade
+  sensors through the cap and the far facet the shell's depth is within 0.35 m of the
+  envelope's for −50…+70° (−30°: 3.44 vs 3.66 m); at −70° 3.4 vs 1.6 m (the cap's one-slat
+  floor).
 
 Cause: the representation's limit, not a defect. A BSDF shell holds the crown's depth at its
 surface, so the light inside it does not depend on where the receiver sits; the office's
 window (3.75–6.25 m) lies in the lower third of a crown that reaches the wall (base 3 m,
 centre 7.75 m). Light from the sunlit street enters through the crown's base 1–2 m below the
-window and, in the real crown, reaches it through little foliage; in the shell it first crosses
+window and in the real crown reaches it through little foliage; in the shell it first crosses
 the base facet's whole half chord (R cos θ). The cap's per-patch depth makes straight lines
-from one point right, but not light scattered inside the crown.
+from one point right, not light scattered inside the crown.
+
+Work plane (scratch scripts: the 16:58 run's cached sun coefficients replayed hour by hour
+with the dc sky and the leaf dates): five-phase − explicit UDI <100
++4.5, 100–300 −4.7 pp; the explicit reflected sun × the BSDF's per-patch ratio (0.72–1.09)
+alone +2.5 / −2.0; two more realisations of (1) and (2) (``rcontrib`` replicates, same
+settings) +3.3 / −3.1 and +4.9 / −4.7, the three's mean +4.3 / −3.9 against the one explicit
+realisation. Per sensor and patch one realisation's s.d. is 64 % of the mean explicit value
+(two explicit runs differ by ± 34 % per point, 3.5 pp of UDI < 100:
+``benchmarks/threephase.py``), so at the sun runs'
+``-ad 512`` the work plane's 3 pp is not resolved by one explicit run.
 
 Run: ``nice -n 10 .venv/bin/python benchmarks/fivephase_paths.py --work /tmp/threephase_bench``
-(≈ 10 min).
+(≈ 10 min at load 3).
 """
 
 from __future__ import annotations
@@ -282,8 +289,8 @@ def shell_checks(bsdf: Scene, tracer: Tracer) -> None:
                 up = " ".join(f"{u:g}" for u in m.up)
                 taus.append(panel_tau(tracer, f"void aBSDF panel\n5 {m.xml} {up} .\n0\n0\n",
                                       n_out, src))
-            print(f"  {name} (normal ±{math.degrees(e):.0f}°), sun {off:+d}° towards "
-                  f"{'up' if off > 0 else 'down'}: {taus[0]:.4f} / {taus[1]:.4f}")
+            print(f"  {name} (normal ±{math.degrees(e):.0f}°), sun {off:+d}° from the normal "
+                  f"(+: towards the zenith, mirrored for the twin): {taus[0]:.4f} / {taus[1]:.4f}")
     cap = bsdf.materials.get("crown_bsdf_wall")
     if cap is None:
         return
