@@ -49,6 +49,24 @@ the façade, the work plane UDI < 100 +5.2, 100–300 −5.8 pp — not met, and
 than noise: summed over sensors and the Reinhart patch suns, the surroundings' reflected
 sun (1) − (2) is 0.71 × the explicit crown's (0.67 with the plain BSDF), while the
 sensor-patch values below zero fell from 9.7 % to 1.7 %. Not the default.
+
+Where the 0.71 comes from (``benchmarks/fivephase_paths.py``): it is both grids together,
+the façade's 0.68 (its reflected sun 7 × the work plane's; work plane alone 0.94). On the
+façade the *ground* holds the deficit (ground-reflected sun 0.63 ×; the sun reaching the
+street through the crown 1.00 ×; the crown sending the façade paint's light back 1.0–1.4 ×,
+4 % of the total): the light from the street to the window through the crown is 0.61 × (a
+uniformly glowing ground), 0.52–0.66 × from every direction below the horizon, 0.85–0.95 ×
+from above. The shell's facets and cap are oriented right (lower facets = upper mirrored;
+cap depth as its table); the cause is the representation: a shell holds the crown's depth at
+its surface, so the light inside it is the same wherever the receiver sits, while the window
+lies in the crown's lower third, 1–2 m above its base, where the real crown passes 4–6 × more
+of the street's light than at its centre (inside the crown, from below, BSDF/explicit 0.14–0.16 at
+z 4 m, 0.9–1.1 at the centre). On the work plane, applying the explicit crown's reflected sun
+times the BSDF's per-patch ratio (0.72–1.09) moves UDI < 100 / 100–300 by +2.5 / −2.0 pp;
+the rest of the +4.5 / −4.7 pp (hourly replay of the cached runs; +3.3 / −3.1 and +4.9 / −4.7
+with two more realisations of (1) and (2)) is per-sensor, per-patch scatter: one realisation's
+s.d. there is 64 % of the explicit value, so one explicit run at the sun runs' ``-ad 512``
+does not resolve 3 pp on the work plane.
 """
 
 from __future__ import annotations
