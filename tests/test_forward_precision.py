@@ -84,7 +84,7 @@ def test_bad_precision_settings(kwargs, field):
 
 def test_project_defaults_set_a_target():
     s = ForwardSettings.from_params(EngineParams())
-    assert (s.target_rel_se, s.max_photons, s.batches) == (0.02, 16_000_000, 32)
+    assert (s.target_rel_se, s.max_photons, s.batches, s.stages) == (0.02, 16_000_000, 32, 4)
     assert "to a 2.0% standard error of each grid mean" in s.describe()
 
 

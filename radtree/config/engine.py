@@ -122,8 +122,9 @@ class ForwardParams(Checked):
     # radtree.engines.forward.skypoint
     forward_direct_sky: bool = True
     # every round traced in this many stages, the focused launch's rings allotted again before
-    # each from all photons so far (1 = the round at once): radtree.engines.forward.strata
-    forward_stages: int = field(default=1, metadata=meta(1))
+    # each from all photons so far (1 = the round at once; default 4: the error's heavy tail
+    # of a round allotted from the pilot alone, benchmarks/forward.py): radtree.engines.forward.strata
+    forward_stages: int = field(default=4, metadata=meta(1))
 
 
 #: the parameter groups of :class:`EngineParams`: attribute → class

@@ -27,7 +27,9 @@ inner-ring hit; the pilot (~4 000 photons a ring) saw none, the rings ran on the
 floor, and a run's few such hits — or their absence, which lowers the mean and its error
 together — made the tail (B at 12:30: −9.5 %, z −5.7 against Radiance). The strata are
 therefore **re-allocated before every further round** from all photons so far
-(:func:`radtree.engines.forward.strata.reallocate`). What stays is the skew of a mean of
+(:func:`radtree.engines.forward.strata.reallocate`), and within every round before each of
+its ``engine.forward_stages`` stages (default 4; :mod:`radtree.engines.forward.strata`,
+*Stages*: B at 12:30, 200 seeds, |z| > 3 in 1.5 % with the round at once, none in 4 stages). What stays is the skew of a mean of
 rare, heavy hits: its batch-means error is right on average (a 2 m patch over a sunlit floor,
 focused launch, 40 seeds of 100 000 photons: spread of the means / r.m.s. error 1.03) but low
 in the runs that missed the heavy hits, so z has a negative tail (same runs: z s.d. 1.30,
