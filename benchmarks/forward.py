@@ -37,6 +37,32 @@ Issue 40 (the estimator a user can trust by default), each a separate mode:
 ``--hours`` and ``--scenarios`` choose the scenario-hours (hour-major order, each line printed
 when done, so a partial run reports what it covered).
 
+With every round in stages (``engine.forward_stages`` = 4, the default since session 24: the
+rings re-allotted before each stage from all photons so far, radtree.engines.forward.strata,
+*Stages*) — measured 2026-12-07 22:16–23:00 UTC, 2 shared cores (load 2–3), two processes
+per run of seeds:
+
+* Before the change, the same defaults with one stage: ``--zscores 50`` at seeds 101–150 and
+  151–200 (``--hours 12:30 --scenarios B``, 1 104 s and 1 109 s) gave z s.d. 1.289 (|z| > 3
+  2 %, seed 113 1 244.8 ± 8.8 lx) and 0.880 (0 %); with seeds 1–100 (below) **200 runs: z
+  s.d. 1.134, |z| > 3 in 1.5 % (3 runs): not met.** ``--lineage 31 113 1 2`` (63 s): the
+  sun's 24–32 m ring got 23 264, 48 256, 10 176, 19 648 photons (the pilot's σ of a ring
+  whose ten largest photons carry ≈ half its light) and read 24.0 ± 4.7, 15.6 ± 2.8, 25.4 ±
+  5.4, 11.0 ± 1.0 lx: a run that drew none of its heavy hits is low with a small error.
+* ``--zscores 50 --z-first 1`` and ``--z-first 51`` ``--z-stages 4`` (then the default,
+  ``--z-first 101`` and ``151``), B at 12:30: seeds 1–100 z s.d. 1.035, max |z| 2.60; seeds
+  101–200 0.991, max 2.54; **all 200: z s.d. 1.013, max |z| 2.63, |z| > 3 in 0 % — met**
+  (0.8–1.25, ≤ 1 %); spread of the means / r.m.s. s.e. 0.99, mean 1 272.1 lx, mean relative
+  s.e. 0.85 % (one stage: 0.86 %), 0.9 M photons every run, 10–30 s a run as before.
+* ``--zscores 25 --z-first 1`` and ``--z-first 26``, F at 12:30 (first crown): **z s.d.
+  0.822, max |z| 1.93, |z| > 3 in 0 % — met**; mean 1 408.6 lx (one stage 1 408.8), mean
+  relative s.e. 0.95 %, median 0.9 M photons (max 2.0 M).
+* ``--golden --scenarios A B C D E A-sky --hours 12:30 15:30`` (96 s): **12 of 12 within 2 %
+  or 3 combined s.e.**: A +0.20 / +0.44 %, B +0.82 / −0.57 %, C +5.16 % (+2.05 s.e.) /
+  −2.51 % (−1.20), D −0.12 / −2.30 % (−2.25), E −0.40 / −0.43 %, A-sky +1.03 % (+2.17) /
+  +1.35 % (+2.21).
+GOLDEN_F
+
 With the unscattered sky at the sensor points (radtree.engines.forward.skypoint,
 ``engine.forward_direct_sky``, default on: sky and ground glow through specular transmissions
 estimated at the points, 1 024 directions per sensor and round, sky photons tallied only once

@@ -121,6 +121,13 @@ within 5 % at 1.5 standard errors; with 16 it was 1.036 ± 0.017, not resolved a
 13:30 1.014 ± 0.004 — met, worst 2.5 %; slats scan k / orig k 1.001 ± 0.003 (8/8), 0.992 ±
 0.151 (3/8), map 1.005 ± 0.012 (7/8) — the same 8 realisations as above, so the same figures.
 
+Session 24 (2026-12-07 22:55–22:59 UTC, load 2.7–3.1, 260 s wall): the leaf areas printed
+are now those of the grids each scan scenario's crown is built from (``points_crown_grid``:
+along the file's scan-angle beams), no longer of vertical columns: inverted from the scans
+−2.0 %, the crown in the returns' hull −1.5 % (mean of 32; per realisation +5.1 … −6.5 %).
+The expectations are the same runs as above, to the digit (sensors 10:30 1.001 ± 0.002,
+13:30 1.025 ± 0.016, map 1.014 ± 0.004).
+
 ``tests/test_points_hull.py`` holds the direct-sun figures in CI (4 scans).
 
     python benchmarks/lidar_facade.py [--seeds 8] [--turbid-seeds 32] [--hours 10:30 13:30]
