@@ -61,7 +61,14 @@ per run of seeds:
   or 3 combined s.e.**: A +0.20 / +0.44 %, B +0.82 / −0.57 %, C +5.16 % (+2.05 s.e.) /
   −2.51 % (−1.20), D −0.12 / −2.30 % (−2.25), E −0.40 / −0.43 %, A-sky +1.03 % (+2.17) /
   +1.35 % (+2.21).
-GOLDEN_F
+* ``--golden --scenarios F`` (8 crowns each, three processes, 22:59–23:14 UTC, load 2.3–3.1,
+  149–230 s an hour): **6 of 7 within 2 % or 3 combined s.e.**: 10:30 +0.15 % (+0.16 s.e.),
+  11:30 −0.87 % (−1.24), **12:30 −2.33 % (−3.50): MISS** (one stage −1.98 %, −2.89), 13:30
+  −2.51 % (−2.88), 14:30 −0.88 % (−1.28), 15:30 −0.96 % (−1.26; one stage −2.79 %, −3.82:
+  the miss then), 16:30 −0.30 % (−0.59). Mean over the hours −1.10 % (one stage −1.47 %):
+  the forward quantity is the scattered light averaged over the 0.5 m patches, which reads
+  below the points behind the free crowns (*patch against point*, below: crown 1 at 12:30
+  −3.4 %); the stages do not touch it. 7.2 M photons an hour (0.9 M a crown).
 
 With the unscattered sky at the sensor points (radtree.engines.forward.skypoint,
 ``engine.forward_direct_sky``, default on: sky and ground glow through specular transmissions
