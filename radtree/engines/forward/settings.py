@@ -160,7 +160,9 @@ class ForwardSettings:
         if isinstance(k, bool) or not isinstance(k, int) or k < 1 \
                 or self.photons // k < self.batches:
             raise _bad("forward_stages", f"must be a whole number ≥ 1 that leaves each stage "
-                       f"at least {self.batches} photons of the round's {self.photons}, got {k!r}")
+                       f"at least {self.batches} photons (one a batch) of the round's "
+                       f"{self.photons}, got {k!r}: raise engine.photons or lower "
+                       f"engine.forward_stages")
         ww = self.window
         if isinstance(ww, bool) or not isinstance(ww, int | float) or not math.isfinite(ww) \
                 or ww < 0:
@@ -208,5 +210,7 @@ class ForwardSettings:
         count = (f"{self.photons} photons" if self.target_rel_se is None else
                  f"photons in rounds of {self.photons} to a {self.target_rel_se:.1%} standard "
                  f"error of each grid mean (cap {self.max_photons})")
+        if self.stages > 1:
+            count += f", each round in {self.stages} stages"
         return (f"{count}, {source}, {scatter}, threshold {self.threshold:g}, "
                 f"patches {self.patch_m:g} m, {self.batches} batches, seed {self.seed}")
