@@ -60,7 +60,9 @@ per run of seeds:
 * ``--golden --scenarios A B C D E A-sky --hours 12:30 15:30`` (96 s): **12 of 12 within 2 %
   or 3 combined s.e.**: A +0.20 / +0.44 %, B +0.82 / −0.57 %, C +5.16 % (+2.05 s.e.) /
   −2.51 % (−1.20), D −0.12 / −2.30 % (−2.25), E −0.40 / −0.43 %, A-sky +1.03 % (+2.17) /
-  +1.35 % (+2.21).
+  +1.35 % (+2.21); ``--hours 10:30 11:30 13:30 14:30 16:30`` (23:15–23:28 UTC): 30 of 30,
+  −3.27 % (C 11:30, −1.74 s.e.) … +2.44 % (D 10:30, +2.27; E 11:30, +1.81), largest |s.e.|
+  2.27: **A–E and A-sky 42 of 42**, as with one stage.
 * ``--golden --scenarios F`` (8 crowns each, three processes, 22:59–23:14 UTC, load 2.3–3.1,
   149–230 s an hour): **6 of 7 within 2 % or 3 combined s.e.**: 10:30 +0.15 % (+0.16 s.e.),
   11:30 −0.87 % (−1.24), **12:30 −2.33 % (−3.50): MISS** (one stage −1.98 %, −2.89), 13:30
