@@ -28,7 +28,8 @@ FLAT_KEYS = {
     "forward_direct_sun", "pmap_photons", "pmap_caustic_photons", "pmap_bandwidth", "dense_lw",
     "dense_rays", "mist_extinction", "mist_sun",   # + Radiance mist crowns (issue 43)
     "forward_window",   # + the forward weight window (issue 40)
-    "forward_direct_sky"}   # + the sky at the sensor points (issue 40)
+    "forward_direct_sky",   # + the sky at the sensor points (issue 40)
+    "forward_stages"}   # + the rounds' stages (issue 40)
 
 
 def test_the_file_keeps_its_flat_keys():

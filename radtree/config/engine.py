@@ -121,9 +121,10 @@ class ForwardParams(Checked):
     # estimated at the sensor points, sky photons tallied on the patches only once scattered:
     # radtree.engines.forward.skypoint
     forward_direct_sky: bool = True
-    # every round traced in this many stages, the focused launch's rings allotted again before
-    # each from all photons so far (1 = the round at once; default 4: the error's heavy tail
-    # of a round allotted from the pilot alone, benchmarks/forward.py): radtree.engines.forward.strata
+    # every round of the focused launch traced in this many stages, its rings allotted again
+    # before each from all photons so far (1 = the round at once; default 4: the error's heavy
+    # tail of a round allotted from the pilot alone, benchmarks/forward.py; a beam or a
+    # uniform launch traces its rounds at once): radtree.engines.forward.strata
     forward_stages: int = field(default=4, metadata=meta(1))
 
 

@@ -307,12 +307,14 @@ def _rounds(h: _Hour, tracer: ForwardTracer, strata: list[Stratum] | None
     at_points = _at_points(h)
     budget = Budget(s.photons, s.target_rel_se, s.max_photons)
     traced, sizing, rows, rounds = 0, 0, [], 0
+    # stages re-allot the focused launch's rings (a uniform launch has none: its round at once);
     # a stage's photons: the first round's as _focus allotted them (the pilot's taken off)
-    stage = s.photons // s.stages if strata is None else sum(st.photons for st in strata)
+    stages = 1 if strata is None else s.stages
+    stage = s.photons if strata is None else sum(st.photons for st in strata)
     leg = s.photons
     while leg > 0:
         for _ in range(max(1, leg // s.photons)):
-            for _ in range(s.stages):
+            for _ in range(stages):
                 if strata is not None and traced:   # later stages: allotted from all so far
                     reallocate(strata, stage, s.batches)
                 n, r = _round(h, tracer, strata, at_points, stage)
@@ -320,7 +322,7 @@ def _rounds(h: _Hour, tracer: ForwardTracer, strata: list[Stratum] | None
                 rows.append(r)
                 _open_window(h, tracer)
             rounds += 1
-            stage = s.photons // s.stages
+            stage = s.photons // stages
         per_batch = np.vstack(rows)
         grid_batches = {name: per_batch[:, h.det.slices[name]].mean(axis=1)
                         for name in h.names}

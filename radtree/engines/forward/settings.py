@@ -72,7 +72,8 @@ class ForwardSettings:
     ``sky_rays`` directions per sensor, batch and stage, sky photons tallied on the patches
     only once scattered (:mod:`.skypoint`; whole-scene sun and sky only). ``stages``: every
     round traced in that many equal stages, the focused launch's rings allotted again before
-    each from all photons so far (:mod:`.strata`, *Re-allocation*; 1: the round at once).
+    each from all photons so far (:mod:`.strata`, *Re-allocation*; 1: the round at once; a
+    uniform launch or a beam, without rings, traces its rounds at once).
     """
 
     photons: int = 1_000_000
@@ -210,7 +211,7 @@ class ForwardSettings:
         count = (f"{self.photons} photons" if self.target_rel_se is None else
                  f"photons in rounds of {self.photons} to a {self.target_rel_se:.1%} standard "
                  f"error of each grid mean (cap {self.max_photons})")
-        if self.stages > 1:
+        if self.stages > 1 and self.focus_m is not None and self.beam_diameter_m is None:
             count += f", each round in {self.stages} stages"
         return (f"{count}, {source}, {scatter}, threshold {self.threshold:g}, "
                 f"patches {self.patch_m:g} m, {self.batches} batches, seed {self.seed}")
