@@ -57,6 +57,10 @@ per run of seeds:
 * ``--zscores 25 --z-first 1`` and ``--z-first 26``, F at 12:30 (first crown): **z s.d.
   0.822, max |z| 1.93, |z| > 3 in 0 % — met**; mean 1 408.6 lx (one stage 1 408.8), mean
   relative s.e. 0.95 %, median 0.9 M photons (max 2.0 M).
+* ``--zscores 50 --hours 12:30 --scenarios A-sky`` and ``--hours 14:30 --scenarios B`` (two
+  processes, 23:36–23:48 UTC): A-sky 12:30 **z s.d. 1.058, max |z| 2.50, none beyond 3**
+  (relative s.e. 0.77 %, median 0.9 M photons, max 3.0 M); B 14:30 **0.969, max 2.54, none**
+  (0.85 %, 0.9 M every run) — met at both.
 * ``--golden --scenarios A B C D E A-sky --hours 12:30 15:30`` (96 s): **12 of 12 within 2 %
   or 3 combined s.e.**: A +0.20 / +0.44 %, B +0.82 / −0.57 %, C +5.16 % (+2.05 s.e.) /
   −2.51 % (−1.20), D −0.12 / −2.30 % (−2.25), E −0.40 / −0.43 %, A-sky +1.03 % (+2.17) /
