@@ -43,12 +43,71 @@ COMMANDS = {
     "lidar": "radtree.cli.lidar:lidar_command",
 }
 
+#: command name → the first sentence of its help: what `radtree --help` lists, without
+#: importing every command (tests/test_cli_help.py checks them against the commands)
+SUMMARIES = {
+    "new": ("Write FOLDER/radtree.toml — every field with its unit and default — and copy the "
+            "inputs into FOLDER/data/."),
+    "doctor": "Which engines are usable, with versions.",
+    "build": "Write the Radiance build folder of PROJECT.",
+    "simulate": "Trace every scenario × hour of PROJECT → PROJECT/results/illuminance.csv.",
+    "convergence": ("Trace the façade sensors of PROJECT over increasing -ab (1, 2, 3, 4, 6, 8 "
+                    "and the crown model's own) and print the façade mean and its change per "
+                    "step."),
+    "hemi": "Analyse a fisheye photo, or every JPEG/PNG/TIFF in a folder.",
+    "report": "Statistics, plots and an HTML report of PROJECT → PROJECT/report/index.html.",
+    "calibrate": ("Calibrate the crown of PROJECT (a folder with radtree.toml, or the file) to a"
+                  " target permeability by tracing straight rays from the façade sensors through"
+                  " the built crown."),
+    "sweep": "Run PROJECT once per combination of unknown parameters and rank their effect.",
+    "diagnose": ("Find where simulation and measurement disagree, name the missing effect, add "
+                 "it."),
+    "annual": ("Annual daylight (8760 h) with a deciduous tree: UDI, DA, sDA, ASE, monthly "
+               "means."),
+    "permeability": ("How a scenario's fit depends on the crown's global permeability (measured:"
+                     " 5–6 %)."),
+    "verify": ("Physics checks: uncollided transmission through random leaf layers against "
+               "exp(−G·LAI/cos θ) and under floating spheres against its numerical integral, "
+               "energy conservation, turbid, voxel and mist crowns, forward vs backward engines "
+               "on the reduced Mendoza louvers dome and a free volume crown; then every output "
+               "path beyond the engines: annual, Honeybee and EnergyPlus exports, glTF, the "
+               "photo round trip, the diagnose self-test."),
+    "bsdf": "Compute the BSDF of a scenario's crown layer, leaf-on and leaf-off.",
+    "method": ("What the study's numbers owe to its method: scenarios A–E traced as the project "
+               "sets them (the study's TracePro method in examples/mendoza-tracepro), with the "
+               "threshold, the beam and the crown form changed one at a time, and at every dome "
+               "radius of RADII."),
+    "export": "Write PROJECT's crowns or scene for other tools into DIR.",
+    "cache": "Show the build cache: crowns and their OBJ mesh text kept between builds.",
+    "lidar": "Trees from airborne laser scanning (ALS) tiles, one tree's points from a tile.",
+}
+
 
 class LazyGroup(RadtreeGroup):
-    """The main group with its commands imported on first use (:data:`COMMANDS`)."""
+    """The main group with its commands imported on first use (:data:`COMMANDS`); its
+    ``--help`` lists them from :data:`SUMMARIES`, importing none."""
 
     def list_commands(self, ctx: click.Context) -> list[str]:
         return sorted(set(self.commands) | set(COMMANDS))
+
+    def format_commands(self, ctx: click.Context, formatter: click.HelpFormatter) -> None:
+        """The "Commands" section, as click writes it (its short-help rule, the width)."""
+        from click.utils import make_default_short_help
+
+        names = self.list_commands(ctx)
+        if not names:
+            return
+        limit = formatter.width - 6 - max(len(n) for n in names)
+        rows = []
+        for name in names:
+            if name in SUMMARIES and name not in self.commands:
+                rows.append((name, make_default_short_help(SUMMARIES[name], limit)))
+            else:
+                cmd = self.get_command(ctx, name)
+                if cmd is not None and not cmd.hidden:
+                    rows.append((name, cmd.get_short_help_str(limit)))
+        with formatter.section("Commands"):
+            formatter.write_dl(rows)
 
     def get_command(self, ctx: click.Context, name: str) -> click.Command | None:
         if name not in self.commands and name in COMMANDS:
