@@ -100,12 +100,10 @@ class LazyGroup(RadtreeGroup):
         limit = formatter.width - 6 - max(len(n) for n in names)
         rows = []
         for name in names:
-            if name in SUMMARIES and name not in self.commands:
+            if name in SUMMARIES:
                 rows.append((name, make_default_short_help(SUMMARIES[name], limit)))
-            else:
-                cmd = self.get_command(ctx, name)
-                if cmd is not None and not cmd.hidden:
-                    rows.append((name, cmd.get_short_help_str(limit)))
+            elif (cmd := self.get_command(ctx, name)) is not None and not cmd.hidden:
+                rows.append((name, cmd.get_short_help_str(limit)))   # added outside COMMANDS
         with formatter.section("Commands"):
             formatter.write_dl(rows)
 

@@ -185,8 +185,8 @@ def is_stand_in(sc: Any) -> bool:
 
 
 def is_reference_study(project: Project) -> bool:
-    """The reference study's project (``examples/mendoza-*``): the sensor-dome crown form, or
-    measured daily means per sensor row. Only its report shows the study's sections."""
+    """A project run by the reference study's method: the sensor-dome crown form, or measured
+    daily means per sensor row. Only such a report shows the study's sections."""
     return (project.measured_rows is not None or project.tree.form == "dome"
             or any(s.form == "dome" for s in project.scenarios))
 
