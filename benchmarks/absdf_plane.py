@@ -36,7 +36,7 @@ from pathlib import Path
 import numpy as np
 
 from radtree.bsdf.klems import read_klems
-from radtree.engines.radiance.binaries import run
+from radtree.engines.radiance.binaries import monte_carlo_options, run
 
 
 def floats(text: str) -> list[float]:
@@ -56,8 +56,8 @@ def plane_ratio(xml: Path, work: Path, material: str, zenith_deg: float, ab: int
     run(["oconv", f"{material}.rad"], cwd=work, stdout_path=work / f"{material}.oct")
     grid = np.linspace(-3, 3, 5)
     pts = "".join(f"{x} {y} -1 0 0 1\n" for x in grid for y in grid)
-    out = run(["rtrace", "-h", "-I", "-u-", "-ab", str(ab), "-ad", "16384", "-aa", "0", "-lw",
-               "1e-6", f"{material}.oct"], cwd=work, stdin=pts.encode()).decode().split()
+    out = run(["rtrace", "-h", "-I", "-u-", *monte_carlo_options(ab, 16384, 1e-6),
+               f"{material}.oct"], cwd=work, stdin=pts.encode()).decode().split()
     e_sun = 1e6 * 2 * math.pi * (1 - math.cos(math.radians(0.533 / 2)))
     e = np.array(out, float).reshape(-1, 3)[:, 1] / (e_sun * math.cos(z))
     return float(e.mean()), float(e.std(ddof=1) / math.sqrt(len(e)))

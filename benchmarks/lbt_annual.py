@@ -224,22 +224,29 @@ def radtree_sky_part(project: Path, replicates: int, hours: np.ndarray) -> np.nd
 
 def exact_hour(build: Path, row: list[str], site: tuple[float, float, float], *,
                sun: bool, env: dict) -> float:
-    """Office 1's mean lux by ``rtrace -ab 4 -ad 8192 -lw 1e-5`` under ``gendaylit`` with the
-    EPW ``row``'s DNI/DHI at the hour's middle (``sun`` False: its sky alone, ``-s``)."""
+    """Office 1's mean lux by ``rtrace`` (:func:`~radtree.engines.radiance.binaries.
+    monte_carlo_options` ``-ab 4 -ad 8192 -lw 1e-5``: no super-sampling) under ``gendaylit``
+    with the EPW ``row``'s DNI/DHI at the hour's middle. ``sun`` False: the same sky with the
+    sun's source taken out, its ground glow still lit by the sun (ρ·E_global/π, what
+    ``gendaymtx -s`` carries in its ground patch); ``gendaylit -s`` would also darken the
+    ground glow (its perezlum ground term 1.8 instead of 18.0 at 30 Aug 11:30)."""
+    from radtree.engines.radiance.binaries import monte_carlo_options
     from radtree.engines.radiance.writer import rgb_to_lux
 
     lat, lon, tz = site
     geometry = sorted(str(p.relative_to(build)) for p in (build / "geometry").glob("*.rad"))
     sky = subprocess.run(["gendaylit", row[1], row[2], str(int(row[3]) - 0.5), "-a", str(lat),
                           "-o", str(-lon), "-m", str(-15 * tz), "-W", row[14], row[15], "-O",
-                          "0", "-g", "0.15", *([] if sun else ["-s"])],
+                          "0", "-g", "0.15"],
                          capture_output=True, text=True, env=env, check=True).stdout
+    if not sun:
+        sky = "void brightfunc skyfunc" + sky.split("void brightfunc skyfunc", 1)[1]
     (build / "ref.sky").write_text(sky + SKY_GLOWS)
     with (build / "ref.oct").open("wb") as fh:
         subprocess.run(["oconv", "ref.sky", "materials.rad", "skies/1330_ground.rad",
                         *geometry], cwd=build, stdout=fh, check=True, env=env)
-    out = subprocess.run(["rtrace", "-h", "-I", "-ab", "4", "-ad", "8192", "-lw", "1e-5",
-                          "-aa", "0", "ref.oct"], cwd=build,
+    out = subprocess.run(["rtrace", "-h", "-I", *monte_carlo_options(4, 8192, 1e-5), "ref.oct"],
+                         cwd=build,
                          input=(build / "grids" / "Office_1.pts").read_text(), text=True,
                          capture_output=True, check=True, env=env).stdout
     return float(rgb_to_lux(np.loadtxt(out.splitlines()).reshape(-1, 3)).mean())

@@ -16,7 +16,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from radtree.engines.radiance.binaries import run
+from radtree.engines.radiance.binaries import monte_carlo_options, run
 from radtree.engines.radiance.bsdf import wrap_flux
 from radtree.engines.radiance.materials import material_text
 from radtree.optics import KLEMS_FULL_RINGS, Bsdf
@@ -52,8 +52,8 @@ def sensor_lux(folder: Path, material: Bsdf, ab: int) -> np.ndarray:
     (folder / "s.rad").write_text(scene)
     run(["oconv", "s.rad"], cwd=folder, stdout_path=folder / "s.oct")
     pts = "".join(f"{x} {y} -1 0 0 1\n" for x in (-1, 0, 1) for y in (-1, 0, 1))
-    out = run(["rtrace", "-h", "-I", "-u-", "-ab", str(ab), "-ad", "4096", "-aa", "0", "-lw",
-               "1e-5", "s.oct"], cwd=folder, stdin=pts.encode()).decode().split()
+    out = run(["rtrace", "-h", "-I", "-u-", *monte_carlo_options(ab, 4096, 1e-5), "s.oct"],
+              cwd=folder, stdin=pts.encode()).decode().split()
     return np.array(out, float).reshape(-1, 3)[:, 1]
 
 

@@ -12,7 +12,7 @@ import pytest
 
 from radtree.bsdf.klems import read_klems
 from radtree.config import CrownBsdf, check_key, load_project
-from radtree.engines.radiance.binaries import run
+from radtree.engines.radiance.binaries import monte_carlo_options, run
 from radtree.engines.radiance.bsdf import FluxSettings, check_bsdf, klems_bsdf, write_system
 from radtree.engines.radiance.materials import material_text
 from radtree.errors import ConfigError, EngineError
@@ -50,7 +50,7 @@ def test_plates_read_back_exactly_and_orient_the_bsdf_material(tmp_path):
              "void glow skyglow\n0\n0\n4 1 1 1 0\nskyglow source sky\n0\n0\n4 0 0 1 360\n")
     (tmp_path / "t.rad").write_text(scene)
     run(["oconv", "t.rad"], cwd=tmp_path, stdout_path=tmp_path / "t.oct")
-    out = run(["rtrace", "-h", "-I", "-u-", "-ab", "1", "-ad", "256", "-lw", "1e-4", "t.oct"],
+    out = run(["rtrace", "-h", "-I", "-u-", *monte_carlo_options(1, 256, 1e-4), "t.oct"],
               cwd=tmp_path, stdin=b"0 0 1 0 0 -1\n0 0 -1 0 0 1\n").decode().split()
     normal_side, back_side = float(out[0]), float(out[3])
     assert back_side == pytest.approx(0.8 * math.pi, rel=0.02)

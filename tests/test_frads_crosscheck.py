@@ -14,12 +14,16 @@ the same irradiance:
 * frads' ``ThreePhaseMethod`` (its own rfluxmtx set-up: receivers, senders, up vectors,
   sky receiver) with the same XML.
 
-Mean over the sensors: all three within 3 %. Needs the ``crosscheck`` extra (frads).
+Mean over the sensors: the two chains within 3 % of each other (0.996). Against ``rtrace``
+without super-sampling (``-as 0``, :func:`radtree.engines.radiance.binaries.
+monte_carlo_options`) both read 0.966 / 0.970: the issue's 3 % is **not met** (strict xfail;
+the 0.9994 measured before compared with rtrace's default ``-as 512``, 3.4 % low here).
+Needs the ``crosscheck`` extra (frads).
 
 The same room with the window turned round (its material's normal to the sky: the light
 enters through the XML's back side, as it leaves a free crown's envelope from the inside):
 the chain with :func:`~radtree.engines.radiance.threephase.turned_xml` against rtrace, 3 %
-(the XML as it is reads 0.79: its back block differs from the front).
+(0.970 against ``-as 0``; the XML as it is reads 0.79: its back block differs from the front).
 """
 
 from __future__ import annotations
@@ -84,7 +88,7 @@ def crown_xml(tmp_path_factory) -> Path:
 def rtrace_reference(folder: Path, xml: Path, back: bool = False) -> np.ndarray:
     """Work-plane irradiance per unit sky radiance with the BSDF window; ``back``: the
     material's normal to the sky (the XML's back side outside)."""
-    from radtree.engines.radiance.binaries import FIXED_SEED, run
+    from radtree.engines.radiance.binaries import FIXED_SEED, monte_carlo_options, run
 
     tris = window_tris()[:, ::-1] if back else window_tris()
     win = (f"void BSDF crown_m\n6 0 {xml} 0 0 1 .\n0\n0\n"
@@ -94,8 +98,8 @@ def rtrace_reference(folder: Path, xml: Path, back: bool = False) -> np.ndarray:
     oct_ = folder / "ref.oct"
     run(["oconv", str(folder / "ref.rad")], stdout_path=oct_)
     pts = "".join(f"{x} {y} {z} 0 0 1\n" for x, y, z in SENSORS)
-    out = run(["rtrace", "-h", "-I", FIXED_SEED, "-ab", "6", "-ad", "4096", "-lw", "1e-4",
-               "-aa", "0", str(oct_)], stdin=pts.encode())
+    out = run(["rtrace", "-h", "-I", FIXED_SEED, *monte_carlo_options(6, 4096, 1e-4), str(oct_)],
+              stdin=pts.encode())
     rgb = np.array(out.decode().split(), float).reshape(-1, 3)
     return rgb.mean(axis=1)
 
@@ -149,6 +153,20 @@ def frads_chain(folder: Path, xml: Path) -> np.ndarray:
 
 
 @needs_radiance
+def test_three_phase_chain_agrees_with_frads(crown_xml, tmp_path):
+    """The two chains (radtree's, frads') on the same room and XML: within 3 %."""
+    pytest.importorskip("frads")
+    ours = radtree_chain(tmp_path, crown_xml)
+    theirs = frads_chain(tmp_path, crown_xml)
+    assert ours.mean() / theirs.mean() == pytest.approx(1.0, abs=CLAIM)
+
+
+@needs_radiance
+@pytest.mark.xfail(strict=True, reason=(
+    "issue 40 item 2, not met: against rtrace without ambient super-sampling (-as 0) both "
+    "chains read 0.966 / 0.970 of the direct trace (-ad 4096; -ad 16384 -u+: 0.965). The "
+    "0.9994 measured before was against rtrace's default -as 512, which read 3.4 % low "
+    "(radtree.engines.radiance.binaries.monte_carlo_options)"))
 def test_three_phase_chain_agrees_with_frads_and_rtrace(crown_xml, tmp_path):
     pytest.importorskip("frads")
     ref = rtrace_reference(tmp_path, crown_xml)

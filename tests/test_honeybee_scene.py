@@ -31,10 +31,10 @@ REPEATS = 8        # independent fixed-seed estimates per octree
 def rtrace(build: Path, octree: Path, pts: str) -> np.ndarray:
     """(REPEATS, sensors) lux at ``pts`` in ``octree``: the grid fed :data:`REPEATS` times to
     one fixed-seed ``rtrace -ab 2 -ad 1024`` (independent, reproducible estimates)."""
-    from radtree.engines.radiance.binaries import FIXED_SEED, require_radiance
+    from radtree.engines.radiance.binaries import FIXED_SEED, monte_carlo_options, require_radiance
     from radtree.engines.radiance.writer import rgb_to_lux
 
-    opts = ["-h", "-I", FIXED_SEED, "-ab", "2", "-ad", "1024", "-aa", "0", "-lw", "1e-4"]
+    opts = ["-h", "-I", FIXED_SEED, *monte_carlo_options(2, 1024, 1e-4)]
     out = subprocess.run(["rtrace", *opts, str(octree)], cwd=build,
                          input=(pts * REPEATS).encode(), capture_output=True, check=True,
                          env=require_radiance().env()).stdout

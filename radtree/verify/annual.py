@@ -152,7 +152,7 @@ def point_in_time(scene: Scene, scene_rad: Path, wea, i: int, folder: Path,
     order) under gendaylit's sky and sun for WEA row ``i`` (ground reflectance ``rho``): lux
     per sensor, and gendaylit's output."""
     from radtree.annual.coefficients import points_text
-    from radtree.engines.radiance.binaries import run
+    from radtree.engines.radiance.binaries import monte_carlo_options, run
     from radtree.engines.radiance.sky import perez_sky_suffix
 
     cmd = ["gendaylit", str(wea.month[i]), str(wea.day[i]), f"{wea.hour[i]:.3f}", "-a",
@@ -162,8 +162,8 @@ def point_in_time(scene: Scene, scene_rad: Path, wea, i: int, folder: Path,
     (folder / "hour.sky").write_text(text + perez_sky_suffix(True))
     octree = folder / "hour.oct"
     run(["oconv", str(scene_rad), str(folder / "hour.sky")], stdout_path=octree)
-    out = run(["rtrace", "-h", "-I", "-ab", str(ab), "-ad", str(ref_ad), "-aa", "0", "-lw",
-               "1e-5", str(octree)], stdin=points_text(scene, list(grids)).encode())
+    out = run(["rtrace", "-h", "-I", *monte_carlo_options(ab, ref_ad, 1e-5), str(octree)],
+              stdin=points_text(scene, list(grids)).encode())
     return np.loadtxt(out.decode().splitlines(), ndmin=2)[:, :3] @ LUX, text
 
 

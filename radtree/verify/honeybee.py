@@ -168,9 +168,9 @@ def _direct_rows(what: str, build: Path, ours: Path, hb: Path) -> list[Check]:
 def _total_row(what: str, build: Path, ours: Path, hb: Path, repeats: int) -> Check:
     """The work-plane mean at ``-ab 2 -ad 1024``, ``repeats`` independent estimates per
     octree: within :data:`TOTAL_CLAIM` or 3 combined standard errors."""
-    from radtree.engines.radiance.binaries import FIXED_SEED
+    from radtree.engines.radiance.binaries import FIXED_SEED, monte_carlo_options
 
-    opts = ["-h", "-I", FIXED_SEED, "-ab", "2", "-ad", "1024", "-aa", "0", "-lw", "1e-4"]
+    opts = ["-h", "-I", FIXED_SEED, *monte_carlo_options(2, 1024, 1e-4)]
     a = _rtrace(build, ours, opts, repeats).mean(axis=1)
     b = _rtrace(build, hb, opts, repeats).mean(axis=1)
     se = float(np.hypot(a.std(ddof=1), b.std(ddof=1)) / np.sqrt(repeats))
