@@ -21,7 +21,8 @@ the folder holds already are not repeated):
    crown all year in both (the recipe knows no seasons; radtree's seasonal sDA beside).
 5. An exact reference at ``--reference-hours`` diffuse-dominated hours (radtree 200–400 lx, no
    direct sun, office 1, no crown): ``gendaylit`` with the EPW's DNI/DHI at the hour's middle,
-   ``rtrace -ab 4 -ad 8192 -lw 1e-5``, with and without its sun (``-s``): sky and sun parts.
+   ``rtrace -ab 4 -ad 8192 -lw 1e-5 -as 0``, with and without the sun's source (the ground
+   glow still sun-lit, as in ``gendaymtx -s``): sky and sun parts.
 
 Measured 2026-12-07 11:44–12:45 UTC, load 11–28 (≈ 6 sessions on 2 cores); lbt-recipes 0.29.1,
 queenbee-local 1.0.3, honeybee-radiance 1.66.299, pyradiance 1.3.1 (Radiance 6.0a); enhanced
@@ -56,34 +57,39 @@ default, ``--work`` with the recipes' results: the same figures). lbt − radtre
   (office 2, crown; per sensor 0.90–1.05, both tools' noise); the recipe's sky matrix over
   radtree's on radtree's coefficients 1.005 (the recipe leaves ``gendaymtx -g`` at 0.2,
   radtree uses the project's 0.15). ASE equal to 0.0 pp: both trace each hour's sun exactly.
-* Where they differ — the reflected sun. At the 195 diffuse-dominated hours lbt reads a median
-  0.976 of radtree; split against the exact reference (4 hours, -ad 4096):
-  sky part radtree 1.055–1.070, lbt 1.068–1.083 of exact (both take gendaymtx's Perez patches;
-  ``--mf 4`` does not change it, 141.5 vs 138.6 lx at hour 632: it is the patch sky against
-  gendaylit's perezlum.cal near the horizon, not the patch size); sun part (half the light
-  in these hours: sun on the street and the opposite façade) radtree 0.96–1.00, lbt 0.875–0.935
-  at -ad 8192 and 0.91–0.96 at -ad 32768 (the recipe's total sky re-traced). Totals: radtree
-  1.013–1.029, lbt 0.968–1.004. The recipe carries the sun as sky patches — ``gendaymtx``
-  spreads each hour's sun over its 4 nearest Reinhart patches, weights 1/(1.002 − cos)
-  (Radiance ``src/gen/gendaymtx.c``, ``AddDirect``) — which rays reach only by ambient
-  sampling (a glow, not a light source), so the reflected sun comes in low and converges
-  slowly; radtree's unit suns are light sources tested from every ambient hit. Per sensor the
-  deep ones differ most (the recipe's sun part, its total sky at -ad 32768, 0.70–0.79 of
-  radtree's 6 passes for the lowest tenth of office 1's sensors), and DA300 is decided there:
-  7 % of sensor-hours are ≥ 300 lx in radtree (one pass) and < 300 in the recipe (median
-  0.71 of radtree), 1 % the other way. The direct-sky subtraction is not it: at the 16 of
-  the 195 hours where it subtracts nothing the recipe reads 0.948 of radtree. DA moves 69.0 → 69.3 with the recipe's total sky at
-  -ad 32768 instead of 8192: not the recipe's noise.
+* Where they differ — the reflected sun. **Re-measured 8 Dec 2026 (session 25)** against an
+  unbiased exact reference: ``rtrace`` without ambient super-sampling (``-as 0``,
+  :func:`radtree.engines.radiance.binaries.monte_carlo_options`; rtrace's default ``-as 512``
+  read these interiors low — behind the crown 4–6 % at ``-ad 4096``, 12 % at ``-ad 1024`` on a
+  uniform sky) and a sky part that keeps the sun-lit ground glow (``gendaylit -s`` also darkens
+  the ground, its perezlum ground term 1.8 instead of 18.0). The figures this docstring gave
+  before (sky part 1.055–1.083 of exact in both tools, radtree's sky term through the crown
+  17–18 % high, "the truth between the tools") came from those two reference errors.
+  At 4 of the 192 diffuse-dominated hours (office 1, no crown, seed 1; this run's radtree
+  hourly is one pass): lbt/radtree median 0.971; rtrace 245.9 / 266.9 / 318.4 / 358.9 lx
+  (14 Oct, 22 Oct, 17 Nov, 22 Dec, 8:30); **sky part radtree 1.001–1.017 of exact**; sun part
+  (light reflected from the sun-lit street and opposite building) radtree 1.375 / 1.220 /
+  1.008 / 1.033, totals radtree 1.139 / 1.091 / 1.007 / 1.018, lbt 1.121 / 1.086 / 0.966 /
+  0.952. radtree's unit sun at each hour's exact position (``-ab 4 -ad 1024``) reads the
+  reference's sun part to 0.3 % (83.2 / 103.4 / 180.3 / 194.3 lx against 83.4 / 103.3 / 179.7
+  / 194.2): what differs is the interpolation between sun patches, MF 1 (the default) 113.2 /
+  124.4 / 178.3 / 196.7, MF 2 89.4 / 102.6 / 180.9 / 195.0, MF 4 85.4 / 103.1 / 180.3 / 194.5
+  (the October morning suns near a façade's grazing angle). The recipe carries the sun as sky
+  patches — ``gendaymtx`` spreads each hour's sun over its 4 nearest Reinhart patches, weights
+  1/(1.002 − cos) (Radiance ``src/gen/gendaymtx.c``, ``AddDirect``) — which rays reach only by
+  ambient sampling (a glow, not a light source); it reads 0.95–0.97 of exact in Nov/Dec and,
+  smeared like radtree's MF 1, high on the October mornings. Per sensor the deep ones differ
+  most (the recipe's sun part, its total sky at -ad 32768, 0.70–0.79 of radtree's 6 passes for
+  the lowest tenth of office 1's sensors, session 20), and DA300 is decided there.
 * Office 2 with the crown, UDI < 100 +8.8 pp: 11 % of its sensor-hours read < 100 lx in lbt
-  and ≥ 100 in radtree (median 80 vs 127 lx), all day, all year; the sky parts agree there
-  (19.8 vs 20.9 lx), the sun part (scattered by the leaves) is 60 vs 107 lx; unchanged at
-  -ad 32768 (22.7 → 22.1 %). Exact hourly rtrace (``-ad 4096``, radtree's leafed scene) at the
-  two hours where most of its sensors flip (30 Aug and 4 May, 11:30; the sun in front, through
-  the crown): the truth lies between the tools. Grid mean radtree (6 passes) 1.090 / 1.062 of
-  exact (sky part 1.180 / 1.172, sun part 1.059 / 1.039), lbt 1.027 / 0.988 (-ad 32768);
-  sensors below 100 lx: exact 21 / 24, radtree 12 / 19, lbt 28 / 36. radtree's UDI < 100 is
-  low there and lbt's high; radtree's sky term through the crown reads 17–18 % above
-  gendaylit's sky (6–8 % without the crown) — the two Perez skies of Radiance, left as found.
+  and ≥ 100 in radtree (median 80 vs 127 lx), all day, all year; the sky parts agree there, the
+  sun part (scattered by the leaves) is 60 vs 107 lx; unchanged at -ad 32768 (22.7 → 22.1 %).
+  At the two hours where most of its sensors flip (30 Aug and 4 May, 11:30; the sun in front,
+  through the crown), against the unbiased reference (``-ab 4 -ad 4096 -as 0``, radtree's leafed
+  scene, 8 Dec 2026): rtrace 350.0 / 396.9 lx, **radtree 1.031 / 1.015** (one pass; sky part
+  1.036 / 1.031 — gendaymtx's patch sky against perezlum averaged over the same patches,
+  weighted by office 2's coefficients, 1.025 / 1.023, its horizon patches 1.11–1.13 — sun part
+  1.029 / 1.011), **lbt 0.974 / 0.946** (-ad 32768). radtree is the closer of the two.
 * No input of ``annual-daylight-enhanced`` changes the sun's treatment or the sky density (its
   inputs: model, wea, north, radiance-parameters, thresholds, schedule, grid filter, CPU and
   sensor counts); ``-ad`` is the only lever and moves its diffuse-hour median only 0.976 →
@@ -207,7 +213,8 @@ def radtree_sky_part(project: Path, replicates: int, hours: np.ndarray) -> np.nd
     """Office 1's mean lux of radtree's sky term alone (no sun) at ``hours``, from the annual
     run's cached sky coefficients (no tracing)."""
     from radtree.annual.coefficients import CoefficientRunner
-    from radtree.annual.run import LUX, AnnualOptions, plan_annual, plan_year, with_season
+    from radtree.annual.combine import LUX
+    from radtree.annual.run import AnnualOptions, plan_annual, plan_year, with_season
     from radtree.config import load_project
 
     proj = load_project(project)
