@@ -13,8 +13,10 @@ checkBSDF but not the genBSDF script:
   ``h=+kf``, ``behind.dat``);
 * front pass: ``face.dat`` → T_f, ``behind.dat`` → R_f; back pass: ``behind.dat`` → T_b,
   ``face.dat`` → R_b; each transposed to photopic Y with ``rmtxop -fa -t -c 0.2651 0.6701
-  0.0648`` and wrapped with ``wrapBSDF -a kf -c`` (``-c``: rfluxmtx gives flux factors,
-  wrapBSDF divides by the projected solid angle to get BSDF values).
+  0.0648``, made reciprocal patch by patch (:func:`reciprocal_patches`: rtrace reads the
+  opposite side's block of what rmtxop reads) and wrapped with ``wrapBSDF -a kf -c``
+  (``-c``: rfluxmtx gives flux factors, wrapBSDF divides by the projected solid angle to
+  get BSDF values).
 
 Unlike genBSDF the sample is one periodic cell tiled ``tiles`` × ``tiles`` times as Radiance
 ``instance``s of the cell octree; the senders cover the centre cell only, so light may move
@@ -43,6 +45,9 @@ from radtree.optics import KLEMS_FULL_RINGS, Material
 log = logging.getLogger(__name__)
 
 EPS = 1e-5
+#: the way a Klems XML is assembled from the rfluxmtx passes, part of every sample's cache
+#: key (2: made reciprocal patch by patch, :func:`reciprocal_patches`)
+XML_VERSION = 2
 #: photopic Y of Radiance RGB (the weights genBSDF passes to rmtxop -c)
 Y_WEIGHTS = ("0.2651", "0.6701", "0.0648")
 
@@ -191,11 +196,12 @@ def wrap_klems(folder: Path, name: str, thickness: float, width: float, height: 
 def klems_bsdf(folder: Path, settings: FluxSettings, name: str, thickness: float,
                width: float, height: float, comment: str = "") -> BsdfRun:
     """Run both rfluxmtx passes in ``folder`` (after :func:`write_system`) and wrap the four
-    Klems matrices into ``folder/<name>.xml`` (sample ``thickness``, ``width``, ``height``
-    in m); checkBSDF must accept it."""
+    Klems matrices, made reciprocal (:func:`wrap_flux`), into ``folder/<name>.xml`` (sample
+    ``thickness``, ``width``, ``height`` in m); checkBSDF must accept it."""
     t0 = time.perf_counter()
     flux_passes(folder, settings)
-    xml = wrap_klems(folder, name, thickness, width, height, comment)
+    flux = {key: np.loadtxt(folder / f"{key}.dat", ndmin=2) for key in KEYS}
+    xml = wrap_flux(folder, flux, name, thickness, width, height, comment)
     return BsdfRun(xml, check_bsdf(xml), time.perf_counter() - t0)
 
 
@@ -240,6 +246,55 @@ def reciprocal_rings(flux: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
     return out
 
 
+def opposite_patches() -> np.ndarray:
+    """For each Klems patch the patch of its ring whose azimuth is 180° away: the reciprocity
+    map of Radiance's Klems library (``src/util/cmbsdf.c``, ``recip_in_from_out`` /
+    ``recip_out_from_in`` over the incident/outgoing vectors of ``src/common/bsdf_m.c``)."""
+    out, first = [], 0
+    for _, _, _, n in KLEMS_FULL_RINGS:
+        out += [first + (j + n // 2) % n for j in range(n)]
+        first += n
+    return np.array(out)
+
+
+def reciprocal_patches(flux: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
+    """Flux matrices F[out, in] = f[out, in] Λ_out (``tf rf tb rb``) made reciprocal patch by
+    patch: f_tf[o, i] = f_tb[m(i), m(o)], f_rf[o, i] = f_rf[m(i), m(o)], the same for rb,
+    with m = :func:`opposite_patches` — each pair set to its mean, then a patch that would
+    send out more than it receives (T + R > 1) scaled down together with its partners.
+
+    Radiance reads one XML two ways: rmtxop/dctimestep take "Transmission Front" as it
+    stands (``cm_loadBTDF``), while rtrace's ``BSDF`` material traces from the viewer and
+    looks the pair up in the block of the opposite side ("Transmission Back" for a ray from
+    the back), assuming reciprocity (``src/rt/m_bsdf.c``, ``sample_sdf``). The two passes of
+    a sample are independent Monte Carlo estimates (and a chord envelope's columns come from
+    different rings' samples): left apart, the three-phase chain and a direct rtrace of the
+    same crown differ by their noise (3.4 % on the frads room of
+    ``tests/test_frads_crosscheck.py``; 0.5 % once reciprocal). The mean also halves the
+    variance."""
+    _, lam = klems_patch_rings()
+    m = opposite_patches()
+
+    def recip(f: np.ndarray) -> np.ndarray:
+        return f[np.ix_(m, m)].T
+
+    f = {k: flux[k] / lam[:, None] for k in KEYS}
+    tf = 0.5 * (f["tf"] + recip(f["tb"]))
+    rf = 0.5 * (f["rf"] + recip(f["rf"]))
+    rb = 0.5 * (f["rb"] + recip(f["rb"]))
+
+    def keep(t: np.ndarray, r: np.ndarray) -> np.ndarray:
+        total = lam @ t + lam @ r
+        return np.where(total > 1.0, 1.0 / np.where(total > 1.0, total, 1.0), 1.0)
+
+    cf, cb = keep(tf, rf), keep(recip(tf), rb)
+    tf = tf * np.minimum(cf[None, :], cb[m][:, None])
+    rf = rf * np.minimum(cf[None, :], cf[m][:, None])
+    rb = rb * np.minimum(cb[None, :], cb[m][:, None])
+    out = {"tf": tf, "rf": rf, "tb": recip(tf), "rb": rb}
+    return {k: out[k] * lam[:, None] for k in KEYS}
+
+
 def klems_bsdf_rings(folder: Path, *, ring_folders: list[Path], settings: FluxSettings,
                      name: str, thickness: float, width: float, height: float,
                      comment: str = "") -> BsdfRun:
@@ -268,9 +323,11 @@ def klems_bsdf_rings(folder: Path, *, ring_folders: list[Path], settings: FluxSe
 
 def wrap_flux(folder: Path, flux: dict[str, np.ndarray], name: str, thickness: float,
               width: float, height: float, comment: str = "") -> Path:
-    """The four flux matrices F[out, in] (``tf rf tb rb``) written to ``folder/*.dat`` and
-    wrapped (:func:`wrap_klems`) into ``folder/<name>.xml``."""
+    """The four flux matrices F[out, in] (``tf rf tb rb``) made reciprocal patch by patch
+    (:func:`reciprocal_patches`), written to ``folder/*.dat`` and wrapped
+    (:func:`wrap_klems`) into ``folder/<name>.xml``."""
     folder.mkdir(parents=True, exist_ok=True)
+    flux = reciprocal_patches(flux)
     for key in KEYS:
         np.savetxt(folder / f"{key}.dat", flux[key], fmt="%.7e", delimiter="\t")
     return wrap_klems(folder, name, thickness, width, height, comment)
