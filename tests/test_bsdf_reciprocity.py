@@ -15,6 +15,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from radtree.engines.radiance.binaries import run
 from radtree.engines.radiance.bsdf import (
     KEYS,
     klems_patch_rings,
@@ -23,7 +24,6 @@ from radtree.engines.radiance.bsdf import (
     wrap_flux,
     wrap_klems,
 )
-from radtree.engines.radiance.binaries import run
 from radtree.engines.radiance.threephase import read_matrix
 from tests.conftest import needs_radiance
 

@@ -22,8 +22,8 @@ from pathlib import Path
 from radtree.config import Project, Scenario
 from radtree.config.schema import Tree
 from radtree.engines.radiance.bsdf import (
-    BsdfRun,
     XML_VERSION,
+    BsdfRun,
     FluxSettings,
     check_bsdf,
     klems_bsdf,
