@@ -257,11 +257,32 @@ def opposite_patches() -> np.ndarray:
     return np.array(out)
 
 
+def _ratio(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    return np.divide(a, b, out=np.zeros_like(a), where=b > 0)
+
+
+def _scale_symmetric(b: np.ndarray, col: np.ndarray) -> np.ndarray:
+    """z_o b[o, i] z_i (b symmetric) whose column sums are ``col`` (symmetric Sinkhorn,
+    z ← √(z ⊙ col / b z))."""
+    z = np.where(col > 0, 1.0, 0.0)
+    for _ in range(1000):
+        z_new = np.sqrt(z * _ratio(col, b @ z))
+        if np.allclose(z_new, z, rtol=1e-12, atol=0.0):
+            break
+        z = z_new
+    return z_new[:, None] * b * z_new[None, :]
+
+
 def reciprocal_patches(flux: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
     """Flux matrices F[out, in] = f[out, in] Λ_out (``tf rf tb rb``) made reciprocal patch by
     patch: f_tf[o, i] = f_tb[m(i), m(o)], f_rf[o, i] = f_rf[m(i), m(o)], the same for rb,
-    with m = :func:`opposite_patches` — each pair set to its mean, then a patch that would
-    send out more than it receives (T + R > 1) scaled down together with its partners.
+    with m = :func:`opposite_patches`; each pair is set to its mean. Reflection is then
+    scaled, one factor per patch (symmetric Sinkhorn), so that every incident patch keeps the
+    reflectance its pass gave it (the column sums Σ_o F[o, i], exact for a deterministic
+    layer: each ray's energy is tallied in its column; the mean alone would mix in the noisy
+    row sums). Transmission keeps the mean (a per-patch scaling of both sides would bias the
+    undeviated peak low by the noise of the two estimates), scaled down only where T + R
+    would exceed 1, element (o, i) by the smaller factor of its two incident patches.
 
     Radiance reads one XML two ways: rmtxop/dctimestep take "Transmission Front" as it
     stands (``cm_loadBTDF``), while rtrace's ``BSDF`` material traces from the viewer and
@@ -270,28 +291,30 @@ def reciprocal_patches(flux: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
     a sample are independent Monte Carlo estimates (and a chord envelope's columns come from
     different rings' samples): left apart, the three-phase chain and a direct rtrace of the
     same crown differ by their noise (3.4 % on the frads room of
-    ``tests/test_frads_crosscheck.py``; 0.5 % once reciprocal). The mean also halves the
-    variance."""
+    ``tests/test_frads_crosscheck.py``, ≤ 1 % once reciprocal,
+    ``benchmarks/threephase_reciprocity.py``)."""
     _, lam = klems_patch_rings()
     m = opposite_patches()
+    both = np.outer(lam, lam)
 
     def recip(f: np.ndarray) -> np.ndarray:
         return f[np.ix_(m, m)].T
 
     f = {k: flux[k] / lam[:, None] for k in KEYS}
+    out = {}
+    for key in ("rf", "rb"):
+        # b[o, i] = Λ f[m(o), i] Λ is symmetric for a reciprocal f; its column sums are Λ R
+        b = (0.5 * (f[key] + recip(f[key])) * both)[m]
+        out[key] = _scale_symmetric(b, flux[key].sum(axis=0) * lam)[m] / both
     tf = 0.5 * (f["tf"] + recip(f["tb"]))
-    rf = 0.5 * (f["rf"] + recip(f["rf"]))
-    rb = 0.5 * (f["rb"] + recip(f["rb"]))
 
     def keep(t: np.ndarray, r: np.ndarray) -> np.ndarray:
         total = lam @ t + lam @ r
-        return np.where(total > 1.0, 1.0 / np.where(total > 1.0, total, 1.0), 1.0)
+        return np.where(total > 1.0, _ratio(1.0 - lam @ r, lam @ t), 1.0).clip(0.0, 1.0)
 
-    cf, cb = keep(tf, rf), keep(recip(tf), rb)
-    tf = tf * np.minimum(cf[None, :], cb[m][:, None])
-    rf = rf * np.minimum(cf[None, :], cf[m][:, None])
-    rb = rb * np.minimum(cb[None, :], cb[m][:, None])
-    out = {"tf": tf, "rf": rf, "tb": recip(tf), "rb": rb}
+    cf, cb = keep(tf, out["rf"]), keep(recip(tf), out["rb"])
+    out["tf"] = tf * np.minimum(cf[None, :], cb[m][:, None])
+    out["tb"] = recip(out["tf"])
     return {k: out[k] * lam[:, None] for k in KEYS}
 
 
