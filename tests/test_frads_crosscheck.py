@@ -15,8 +15,9 @@ the same irradiance:
   sky receiver) with the same XML.
 
 Mean over the sensors, against ``rtrace`` without super-sampling (``-as 0``,
-:func:`radtree.engines.radiance.binaries.monte_carlo_options`): radtree's chain 1.009, frads
-1.021, window turned round 0.991 (8 Dec 2026) — the issue's 3 % is met. Needs the
+:func:`radtree.engines.radiance.binaries.monte_carlo_options`): radtree's chain 0.9998, frads
+1.007, window turned round 0.992 (8 Dec 2026) — the issue's 3 % is met
+(``benchmarks/threephase_reciprocity.py``: ≤ 1.1 % at higher ``-ad``). Needs the
 ``crosscheck`` extra (frads).
 
 The chain reads the XML's "Transmission Front" (``rmtxop``, ``cm_loadBTDF``); rtrace traces
