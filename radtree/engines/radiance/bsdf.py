@@ -262,8 +262,9 @@ def _ratio(a: np.ndarray, b: np.ndarray) -> np.ndarray:
 
 
 def _scale_symmetric(b: np.ndarray, col: np.ndarray) -> np.ndarray:
-    """z_o b[o, i] z_i (b symmetric) whose column sums are ``col`` (symmetric Sinkhorn,
-    z ← √(z ⊙ col / b z))."""
+    """z_o b[o, i] z_i (b symmetric) whose column sums are ``col``: the symmetric form of the
+    Sinkhorn–Knopp iteration, z ← √(z ⊙ col / b z) (Sinkhorn & Knopp 1967; Knight, SIAM J.
+    Matrix Anal. Appl. 30, 2008 — both cited from memory)."""
     z = np.where(col > 0, 1.0, 0.0)
     for _ in range(1000):
         z_new = np.sqrt(z * _ratio(col, b @ z))
