@@ -305,10 +305,15 @@ def test_five_phase_sun(runs):
         b = np.concatenate([first.total[state][g] for g in first.total[state]]).sum()
         ratios[state] = a / b
     # measured (fixed seed, the shell as aBSDF: the sun through the peak a shadow ray, the
-    # same in runs (1) and (2)): 1.004 leaf-on, 0.995 leaf-off; with the plain BSDF 0.939
-    # and 1.123 (the sun through the Klems peak found by sampling in each run)
-    assert abs(ratios["leaf_on"] - 1.004) < 0.03, ratios
-    assert abs(ratios["leaf_off"] - 0.995) < 0.03, ratios
+    # same in runs (1) and (2)): 0.945 leaf-on, 0.985 leaf-off with the crown XML reciprocal
+    # patch by patch (radtree.engines.radiance.bsdf.reciprocal_patches; before: 1.004 and
+    # 0.995, rcontrib reading the XML's back block, the chain its front block). The crown's
+    # 10 rays a Klems patch make this ratio a matter of the XML's realisation: both blocks
+    # from the back pass 1.015 / 0.937, both from the front pass 0.913 / 0.962 (8 Dec 2026).
+    # With the plain BSDF (before) 0.939 and 1.123 (the sun through the Klems peak found by
+    # sampling in each run)
+    assert abs(ratios["leaf_on"] - 0.945) < 0.03, ratios
+    assert abs(ratios["leaf_off"] - 0.985) < 0.03, ratios
     folder = project.results_dir / "annual" / "threephase"
     for sub in ("sun_leaf_on", "sun_leaf_on_black", "sun_leaf_on_explicit_black"):
         assert list((folder / sub).glob("sun_direct_*.npy")), sub

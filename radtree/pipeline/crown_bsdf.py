@@ -22,6 +22,7 @@ from pathlib import Path
 from radtree.config import Project, Scenario
 from radtree.config.schema import Tree
 from radtree.engines.radiance.bsdf import (
+    XML_VERSION,
     BsdfRun,
     FluxSettings,
     check_bsdf,
@@ -162,7 +163,8 @@ def sample_key(sample: SlabSample | RingSamples | PatchDepthSample,
             h.update(material_text(slab.materials[name]).encode())
         h.update(json.dumps([slab.width, slab.height, slab.thickness]).encode())
     # rfluxmtx -n only splits the work: not part of the key
-    h.update(json.dumps([sample.thickness, repr(replace(settings, nproc=1))]).encode())
+    h.update(json.dumps([sample.thickness, repr(replace(settings, nproc=1)),
+                         XML_VERSION]).encode())
     return h.hexdigest()[:16]
 
 

@@ -13,8 +13,10 @@ checkBSDF but not the genBSDF script:
   ``h=+kf``, ``behind.dat``);
 * front pass: ``face.dat`` → T_f, ``behind.dat`` → R_f; back pass: ``behind.dat`` → T_b,
   ``face.dat`` → R_b; each transposed to photopic Y with ``rmtxop -fa -t -c 0.2651 0.6701
-  0.0648`` and wrapped with ``wrapBSDF -a kf -c`` (``-c``: rfluxmtx gives flux factors,
-  wrapBSDF divides by the projected solid angle to get BSDF values).
+  0.0648``, made reciprocal patch by patch (:func:`reciprocal_patches`: rtrace reads the
+  opposite side's block of what rmtxop reads) and wrapped with ``wrapBSDF -a kf -c``
+  (``-c``: rfluxmtx gives flux factors, wrapBSDF divides by the projected solid angle to
+  get BSDF values).
 
 Unlike genBSDF the sample is one periodic cell tiled ``tiles`` × ``tiles`` times as Radiance
 ``instance``s of the cell octree; the senders cover the centre cell only, so light may move
@@ -43,6 +45,9 @@ from radtree.optics import KLEMS_FULL_RINGS, Material
 log = logging.getLogger(__name__)
 
 EPS = 1e-5
+#: the way a Klems XML is assembled from the rfluxmtx passes, part of every sample's cache
+#: key (2: made reciprocal patch by patch, :func:`reciprocal_patches`)
+XML_VERSION = 2
 #: photopic Y of Radiance RGB (the weights genBSDF passes to rmtxop -c)
 Y_WEIGHTS = ("0.2651", "0.6701", "0.0648")
 
@@ -191,11 +196,12 @@ def wrap_klems(folder: Path, name: str, thickness: float, width: float, height: 
 def klems_bsdf(folder: Path, settings: FluxSettings, name: str, thickness: float,
                width: float, height: float, comment: str = "") -> BsdfRun:
     """Run both rfluxmtx passes in ``folder`` (after :func:`write_system`) and wrap the four
-    Klems matrices into ``folder/<name>.xml`` (sample ``thickness``, ``width``, ``height``
-    in m); checkBSDF must accept it."""
+    Klems matrices, made reciprocal (:func:`wrap_flux`), into ``folder/<name>.xml`` (sample
+    ``thickness``, ``width``, ``height`` in m); checkBSDF must accept it."""
     t0 = time.perf_counter()
     flux_passes(folder, settings)
-    xml = wrap_klems(folder, name, thickness, width, height, comment)
+    flux = {key: np.loadtxt(folder / f"{key}.dat", ndmin=2) for key in KEYS}
+    xml = wrap_flux(folder, flux, name, thickness, width, height, comment)
     return BsdfRun(xml, check_bsdf(xml), time.perf_counter() - t0)
 
 
@@ -240,6 +246,79 @@ def reciprocal_rings(flux: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
     return out
 
 
+def opposite_patches() -> np.ndarray:
+    """For each Klems patch the patch of its ring whose azimuth is 180° away: the reciprocity
+    map of Radiance's Klems library (``src/util/cmbsdf.c``, ``recip_in_from_out`` /
+    ``recip_out_from_in`` over the incident/outgoing vectors of ``src/common/bsdf_m.c``)."""
+    out, first = [], 0
+    for _, _, _, n in KLEMS_FULL_RINGS:
+        out += [first + (j + n // 2) % n for j in range(n)]
+        first += n
+    return np.array(out)
+
+
+def _ratio(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    return np.divide(a, b, out=np.zeros_like(a), where=b > 0)
+
+
+def _scale_symmetric(b: np.ndarray, col: np.ndarray) -> np.ndarray:
+    """z_o b[o, i] z_i (b symmetric) whose column sums are ``col``: the symmetric form of the
+    Sinkhorn–Knopp iteration, z ← √(z ⊙ col / b z) (Sinkhorn & Knopp 1967; Knight, SIAM J.
+    Matrix Anal. Appl. 30, 2008 — both cited from memory)."""
+    z = np.where(col > 0, 1.0, 0.0)
+    for _ in range(1000):
+        z_new = np.sqrt(z * _ratio(col, b @ z))
+        if np.allclose(z_new, z, rtol=1e-12, atol=0.0):
+            break
+        z = z_new
+    return z_new[:, None] * b * z_new[None, :]
+
+
+def reciprocal_patches(flux: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
+    """Flux matrices F[out, in] = f[out, in] Λ_out (``tf rf tb rb``) made reciprocal patch by
+    patch: f_tf[o, i] = f_tb[m(i), m(o)], f_rf[o, i] = f_rf[m(i), m(o)], the same for rb,
+    with m = :func:`opposite_patches`; each pair is set to its mean. Reflection is then
+    scaled, one factor per patch (symmetric Sinkhorn), so that every incident patch keeps the
+    reflectance its pass gave it (the column sums Σ_o F[o, i], exact for a deterministic
+    layer: each ray's energy is tallied in its column; the mean alone would mix in the noisy
+    row sums). Transmission keeps the mean (a per-patch scaling of both sides would bias the
+    undeviated peak low by the noise of the two estimates), scaled down only where T + R
+    would exceed 1, element (o, i) by the smaller factor of its two incident patches.
+
+    Radiance reads one XML two ways: rmtxop/dctimestep take "Transmission Front" as it
+    stands (``cm_loadBTDF``), while rtrace's ``BSDF`` material traces from the viewer and
+    looks the pair up in the block of the opposite side ("Transmission Back" for a ray from
+    the back), assuming reciprocity (``src/rt/m_bsdf.c``, ``sample_sdf``). The two passes of
+    a sample are independent Monte Carlo estimates (and a chord envelope's columns come from
+    different rings' samples): left apart, the three-phase chain and a direct rtrace of the
+    same crown differ by their noise (3.4 % on the frads room of
+    ``tests/test_frads_crosscheck.py``, ≤ 1 % once reciprocal,
+    ``benchmarks/threephase_reciprocity.py``)."""
+    _, lam = klems_patch_rings()
+    m = opposite_patches()
+    both = np.outer(lam, lam)
+
+    def recip(f: np.ndarray) -> np.ndarray:
+        return f[np.ix_(m, m)].T
+
+    f = {k: flux[k] / lam[:, None] for k in KEYS}
+    out = {}
+    for key in ("rf", "rb"):
+        # b[o, i] = Λ f[m(o), i] Λ is symmetric for a reciprocal f; its column sums are Λ R
+        b = (0.5 * (f[key] + recip(f[key])) * both)[m]
+        out[key] = _scale_symmetric(b, flux[key].sum(axis=0) * lam)[m] / both
+    tf = 0.5 * (f["tf"] + recip(f["tb"]))
+
+    def keep(t: np.ndarray, r: np.ndarray) -> np.ndarray:
+        total = lam @ t + lam @ r
+        return np.where(total > 1.0, _ratio(1.0 - lam @ r, lam @ t), 1.0).clip(0.0, 1.0)
+
+    cf, cb = keep(tf, out["rf"]), keep(recip(tf), out["rb"])
+    out["tf"] = tf * np.minimum(cf[None, :], cb[m][:, None])
+    out["tb"] = recip(out["tf"])
+    return {k: out[k] * lam[:, None] for k in KEYS}
+
+
 def klems_bsdf_rings(folder: Path, *, ring_folders: list[Path], settings: FluxSettings,
                      name: str, thickness: float, width: float, height: float,
                      comment: str = "") -> BsdfRun:
@@ -268,9 +347,11 @@ def klems_bsdf_rings(folder: Path, *, ring_folders: list[Path], settings: FluxSe
 
 def wrap_flux(folder: Path, flux: dict[str, np.ndarray], name: str, thickness: float,
               width: float, height: float, comment: str = "") -> Path:
-    """The four flux matrices F[out, in] (``tf rf tb rb``) written to ``folder/*.dat`` and
-    wrapped (:func:`wrap_klems`) into ``folder/<name>.xml``."""
+    """The four flux matrices F[out, in] (``tf rf tb rb``) made reciprocal patch by patch
+    (:func:`reciprocal_patches`), written to ``folder/*.dat`` and wrapped
+    (:func:`wrap_klems`) into ``folder/<name>.xml``."""
     folder.mkdir(parents=True, exist_ok=True)
+    flux = reciprocal_patches(flux)
     for key in KEYS:
         np.savetxt(folder / f"{key}.dat", flux[key], fmt="%.7e", delimiter="\t")
     return wrap_klems(folder, name, thickness, width, height, comment)
