@@ -53,6 +53,15 @@ the leaf-on sun runs 247 s): ``fivephase`` façade within 1.1 pp on every band (
 façade within 2.2 pp (>3000 +2.2), work plane UDI <100 +8.1, 100–300 −8.5, sDA −2.5;
 ``explicit`` within 0.5 pp as before.
 
+Measured again 2026-12-08 01:27 UTC with the crown XMLs reciprocal patch by patch
+(:func:`radtree.engines.radiance.bsdf.reciprocal_patches`; the same command and folder, so the
+dc runs were reused and the BSDFs regenerated; load 2–3.4; 3-phase 511 s wall, the BSDFs
+222 s): ``fivephase`` façade within 0.9 pp on every band (UDI <100 +0.9, 100–300 +0.7,
+300–3000 −0.9, >3000 −0.7), work plane UDI <100 **+4.7**, 100–300 **−5.4**, 300–3000 −0.1,
+>3000 +0.7, sDA **+5.0** (7.5 against 2.5 %: the grid's few sensors above the line) — still
+**not met on the work plane**; ``bsdf`` work plane UDI <100 +7.1, 100–300 −7.5, sDA −2.5;
+``explicit`` within 0.5 pp.
+
 Run: ``nice .venv/bin/python benchmarks/threephase.py [--work DIR] [--samples 200] [-j 2]``.
 """
 
