@@ -26,6 +26,24 @@ explicit cache) and traces scenario B's set-up:
 Prints per hour: explicit mean ± s.e.; the default run's ratio; each XML set's ratio; the mean
 and s.d. of the ratio over XML sets; the hours within 5 %.
 
+**With the crown XMLs reciprocal patch by patch** (:func:`radtree.engines.radiance.bsdf.
+reciprocal_patches`, the default since 8 Dec 2026): ``--xmls 4`` in a fresh folder with the
+explicit reference below reused, 8 Dec 2026 01:18–01:28 UTC, load 1.9–3.4 (each XML set
+155–189 s). BSDF / explicit:
+
+====================  =====  =====  =====  =====  =====  =====  =====  ==========
+aBSDF, one run        10:30  11:30  12:30  13:30  14:30  15:30  16:30  worst
+====================  =====  =====  =====  =====  =====  =====  =====  ==========
+set 0 (the default)   0.985  0.976  0.962  0.965  0.987  0.963  0.978  3.8 %
+set 1                 0.985  0.980  0.954  0.952  0.969  0.961  0.971  4.8 %
+set 2                 0.993  0.983  0.965  0.952  0.978  0.967  0.975  4.8 %
+set 3                 0.976  0.967  0.960  0.957  0.978  0.964  0.962  4.3 %
+s.d. over the sets    0.7 %  0.7 %  0.5 %  0.6 %  0.7 %  0.2 %  0.7 %
+====================  =====  =====  =====  =====  =====  =====  =====  ==========
+
+7 of 7 hours within 5 % for each set — met, with the same systematic −2 … −4 % and a thin
+margin (12:30 and 13:30: 0.952–0.965).
+
 **The default since issue 40's aBSDF change: ``tree.bsdf.material = "aBSDF"``.** Measured
 2026-12-07 16:56 UTC (``--xmls 3``, the same three XML sets as below, reused; load 4.1–4.9 on
 2 cores; a 7-hour trace 16–21 s at ``-ad 2048``, as the plain BSDF's). BSDF / explicit:
