@@ -447,7 +447,8 @@ def against_radiance(hours: list[str], scenarios: list[str]) -> None:
     print(f" within 2 % or 3 s.e.: {tally}", flush=True)
 
 
-def against_golden(hours: list[str], scenarios: list[str], realisations: int | None) -> None:
+def against_golden(hours: list[str], scenarios: list[str], realisations: int | None,
+                   converged: bool = False) -> None:
     """The forward engine at the project's defaults against the Radiance golden table
     (tests/golden/mendoza_radiance_full.csv: Radiance at the example's settings, rtrace's
     fixed seed, per-row s.e. from a clock-seeded rerun), façade mean per scenario-hour: the
@@ -455,7 +456,12 @@ def against_golden(hours: list[str], scenarios: list[str], realisations: int | N
     with crown realisations (F) traced as each of them (their own crowns and engine seeds) and
     averaged, as the golden's rows are (``realisations`` < all: only the first ones, stated).
     Combined s.e. = √(forward s.e.² + golden s.e.²), the golden's from its 8 rows (independent
-    sensor paths): √Σ lux_se² / 8."""
+    sensor paths): √Σ lux_se² / 8.
+
+    ``converged``: the reference is instead Radiance at converged settings, traced here —
+    :data:`CONVERGED` (``-ad 4096 -lw 1e-5``, the scenario's ``-ab``), clock seed ``-u+``,
+    :data:`CONVERGED_RUNS` runs of each crown, s.e. from their spread (the issue's "Radiance
+    at converged settings"; the golden is the example's settings and rtrace's fixed seed)."""
     import pandas as pd
 
     from radtree.config import effective_project
@@ -467,9 +473,13 @@ def against_golden(hours: list[str], scenarios: list[str], realisations: int | N
     gold = gold[gold["grid"] == "facade"]
     proj = load_project(MENDOZA, overrides={"site.hours": hours, "sensors.dense_grid": False,
                                             "sensors.dense_hours": hours[:1]})
+    what = (f"Radiance at -ad {CONVERGED[0]} -lw {CONVERGED[1]:g}, -u+, {CONVERGED_RUNS} runs a "
+            "crown" if converged else "the Radiance golden")
     print("forward (project defaults, weight window factor "
-          f"{proj.engine.forward.forward_window:g}) vs the Radiance golden, façade mean", flush=True)
+          f"{proj.engine.forward.forward_window:g}) vs {what}, façade mean", flush=True)
     tally = Tally()
+    ref: list[tuple[float, float, float, float]] = []
+    label = "radiance" if converged else "golden"
     for hour in hours:
         for name in scenarios:
             subs = realisations_of(proj, proj.scenario(name))[:realisations or None]
@@ -488,14 +498,44 @@ def against_golden(hours: list[str], scenarios: list[str], realisations: int | N
                 ms.append(m + extra)
                 ses.append(se)
                 photons += fw.photons
+                if converged:
+                    ref.append(converged_radiance(built, st, eff) + (extra, 0.0))
             m, se = float(np.mean(ms)), float(np.sqrt(np.sum(np.square(ses))) / len(ses))
-            g = gold[(gold["scenario"] == name) & (gold["time"] == hour)]
-            gm, gse = float(g["lux"].mean()), float(np.sqrt((g["lux_se"] ** 2).sum()) / len(g))
-            print(f"  {name:6s} {hour}: golden {gm:8.1f} ± {gse:5.1f}  forward {m:8.1f} ± {se:6.1f}"
+            if converged:
+                r = np.array([(a + b, s) for a, s, b, _ in ref])
+                gm, gse = float(r[:, 0].mean()), float(np.sqrt((r[:, 1] ** 2).sum()) / len(r))
+                ref.clear()
+            else:
+                g = gold[(gold["scenario"] == name) & (gold["time"] == hour)]
+                gm, gse = float(g["lux"].mean()), float(np.sqrt((g["lux_se"] ** 2).sum()) / len(g))
+            print(f"  {name:6s} {hour}: {label} {gm:8.1f} ± {gse:5.1f}  forward {m:8.1f} ± {se:6.1f}"
                   f" ({se / m:5.2%}, {photons / 1e6:5.1f} M photons, {len(subs)} crown(s))  "
                   f"{tally.verdict(m, gm, math.hypot(se, gse))}  "
                   f"({time.perf_counter() - t0:.0f} s)", flush=True)
     print(f" within 2 % or 3 combined s.e.: {tally}", flush=True)
+
+
+#: converged Radiance of ``--golden --converged``: (-ad, -lw); the scenario's own -ab
+CONVERGED = (4096, 1e-5)
+#: clock-seeded runs of each crown at :data:`CONVERGED`
+CONVERGED_RUNS = 2
+
+
+def converged_radiance(built, st, eff) -> tuple[float, float]:
+    """(façade mean, its s.e.) of :data:`CONVERGED_RUNS` clock-seeded (``-u+``) Radiance runs of
+    one built scene-hour at :data:`CONVERGED` (lux, the engine's traced mean, no ground terms)."""
+    from radtree.engines.radiance import writer
+    from radtree.engines.registry import get_engine
+
+    e = replace(eff, radiance=replace(eff.radiance, ad=CONVERGED[0], lw=CONVERGED[1]))
+    saved, writer.FIXED_SEED = writer.FIXED_SEED, "-u+"
+    try:
+        v = np.array([float(get_engine("radiance").trace_once(built.scene, st, e, built.ab,
+                                                               ["facade"])["facade"].lux.mean())
+                      for _ in range(CONVERGED_RUNS)])
+    finally:
+        writer.FIXED_SEED = saved
+    return float(v.mean()), float(v.std(ddof=1) / np.sqrt(len(v)))
 
 
 def radiance_repeats(hours: list[str], scenarios: list[str], repeats: int) -> None:
@@ -553,6 +593,9 @@ def main() -> None:
                     help="no tracing: z of the runs in these --z-out files")
     ap.add_argument("--radiance", action="store_true")
     ap.add_argument("--golden", action="store_true")
+    ap.add_argument("--converged", action="store_true",
+                    help="--golden: against Radiance at converged settings traced here "
+                         "(CONVERGED, clock seed) instead of the golden table")
     ap.add_argument("--radiance-repeats", type=int, default=0, metavar="N",
                     help="Radiance alone: N clock-seeded runs per scenario-hour")
     ap.add_argument("--realisations", type=int, default=None,
@@ -584,7 +627,7 @@ def main() -> None:
     elif a.radiance_repeats:
         radiance_repeats(a.hours, a.scenarios or every, a.radiance_repeats)
     elif a.golden:
-        against_golden(a.hours, a.scenarios or every, a.realisations)
+        against_golden(a.hours, a.scenarios or every, a.realisations, a.converged)
     elif a.radiance:
         against_radiance(a.hours, a.scenarios or every)
     elif a.patch_bias:
