@@ -181,6 +181,10 @@ def main() -> int:
     ap.add_argument("--crossings", type=float, default=STREET_LOUVERS.crossings)
     ap.add_argument("--sidelap", type=float, default=AlsScan.sidelap)
     ap.add_argument("--footprint-rays", type=int, default=1)
+    ap.add_argument("--max-returns", type=int, default=AlsScan.max_returns)
+    ap.add_argument("--range-resolution", type=float, default=AlsScan.range_resolution_m)
+    ap.add_argument("--echo-weight", default="equal", choices=("equal", "intensity"))
+    ap.add_argument("--dump", default=None, help="append per-tree rows (JSON lines) here")
     ap.add_argument("--seed", type=int, default=0, help="the scanner's seed")
     ap.add_argument("--seeds", default=None,
                     help="several scanner seeds (e.g. 0-5): a table per seed and a summary")
@@ -220,7 +224,8 @@ def run(args: argparse.Namespace, seed: int) -> list[str]:
     trees = synthetic_street()
     t0 = time.perf_counter()
     scan = AlsScan(pulse_density_m2=args.pulses, sidelap=args.sidelap,
-                   footprint_rays=args.footprint_rays, seed=seed)
+                   footprint_rays=args.footprint_rays, max_returns=args.max_returns,
+                   range_resolution_m=args.range_resolution, seed=seed)
     pts, areas, _ = scan_street(trees, scan, lv)
     beams = None if args.vertical else {
         "origins": lambda t: scan.origins(t.xyz, line=t.source_id),
@@ -236,7 +241,8 @@ def run(args: argparse.Namespace, seed: int) -> list[str]:
         for r, c, d in pairs:
             dt, tt = seg.trees[r], trees[c]
             clip = write_subset(tile_path, seg.tree_mask(dt.id), Path(tmp) / f"{dt.id}.laz")
-            grid = tree_voxels(clip, mean_cos(lv), **(beams or {}))
+            grid = tree_voxels(clip, mean_cos(lv), **(beams or {}),
+                               echo_weight=args.echo_weight)
             rows.append((tt, dt, d, grid.leaf_area_m2, areas[tt.id], grid.size_m))
     seconds = time.perf_counter() - t0
     print(f"synthetic street: {len(trees)} trees, crossings {lv.crossings:g}, slats "
@@ -254,6 +260,13 @@ def run(args: argparse.Namespace, seed: int) -> list[str]:
         print(f"{tt.id:5} {dt.id:5} {d:5.2f} {tt.height_m:7.2f} {dt.height_m:6.2f} "
               f"{dh[-1]:+6.2f} {2 * tt.crown_radius_m:7.2f} {dt.crown_diameter_m:6.2f} "
               f"{100 * dd[-1]:+6.1f} {la_true:8.1f} {la:7.1f} {100 * dla[-1]:+6.1f}")
+    if args.dump:
+        import json
+
+        with open(args.dump, "a") as fh:
+            for (tt, _, _, la, la_true, _), e in zip(rows, dla):
+                fh.write(json.dumps({"seed": seed, "tree": tt.id, "la": la,
+                                     "true": la_true, "err": e}) + "\n")
     dh_a, dd_a, dla_a = np.abs(dh), np.abs(dd), np.abs(dla)
     print(f"trees: true {len(trees)}, detected {len(seg.trees)}, matched {len(rows)} "
           f"(target: exact) — {'met' if len(seg.trees) == len(rows) == len(trees) else 'NOT met'}")

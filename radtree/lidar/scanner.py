@@ -98,6 +98,7 @@ class ScanPoints:
     line: np.ndarray = field(default_factory=lambda: np.zeros(0, np.int64))
     time: np.ndarray = field(default_factory=lambda: np.zeros(0))
     scan_angle_deg: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    intensity: np.ndarray = field(default_factory=lambda: np.zeros(0))
 
 
 def _pulses(lo: np.ndarray, hi: np.ndarray, scan: AlsScan, rng: np.random.Generator
@@ -152,25 +153,27 @@ def scan_als(vertices: np.ndarray, faces: np.ndarray, face_class: np.ndarray,
                + (r * np.sin(phi))[..., None] * e2[:, None, :]).reshape(-1, 3)
     dirs = np.repeat(d, m, axis=0)
     loc, ray, tri = mesh.ray.intersects_location(origins, dirs, multiple_hits=False)
-    xyz, cls, number, total, pulse_of = echoes(loc, pulse=ray // m, dist=np.einsum(
+    xyz, cls, number, total, pulse_of, share = echoes(loc, pulse=ray // m, dist=np.einsum(
         "ij,ij->i", loc - origins[ray], dirs[ray]), tri=tri, face_class=face_class,
-        pulses=k, resolution_m=scan.range_resolution_m)
+        pulses=k, resolution_m=scan.range_resolution_m, rays=m)
     keep = number <= scan.max_returns
     xyz, cls, number, pulse_of = xyz[keep], cls[keep], number[keep], pulse_of[keep]
     total = np.minimum(total[keep], scan.max_returns)
     _, across = scan._axes()
     angle = np.degrees(np.arctan2(d[:, :2] @ across, -d[:, 2]))   # + right of the line
     return ScanPoints(xyz, cls, number, total, lines[pulse_of], pulse_of / PULSE_RATE_HZ,
-                      angle[pulse_of])
+                      angle[pulse_of], share[keep])
 
 
 def echoes(loc: np.ndarray, *, pulse: np.ndarray, dist: np.ndarray, tri: np.ndarray,
-           face_class: np.ndarray, pulses: int, resolution_m: float
-           ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+           face_class: np.ndarray, pulses: int, resolution_m: float, rays: int = 1
+           ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """Sub-ray hits (``loc`` (h, 3), their pulse, range m, face) grouped into returns: sorted
     by range within a pulse, a new return where the range jumps by ≥ ``resolution_m``; each
     at the mean of its hits, with its first hit's class. (xyz, class, return number, number
-    of returns of the pulse, pulse) per return, in pulse order."""
+    of returns of the pulse, pulse, share) per return, in pulse order; share: the return's
+    sub-rays among the pulse's ``rays`` (the part of the footprint it intercepted, which
+    its intensity records)."""
     order = np.lexsort((dist, pulse))
     pulse, dist, loc, tri = pulse[order], dist[order], loc[order], tri[order]
     new = np.ones(len(pulse), bool)
@@ -179,14 +182,16 @@ def echoes(loc: np.ndarray, *, pulse: np.ndarray, dist: np.ndarray, tri: np.ndar
     n_ret = int(ret[-1] + 1) if len(ret) else 0
     xyz = np.zeros((n_ret, 3))
     np.add.at(xyz, ret, loc)
-    xyz /= np.maximum(np.bincount(ret, minlength=n_ret), 1)[:, None]
+    hits = np.bincount(ret, minlength=n_ret)
+    xyz /= np.maximum(hits, 1)[:, None]
     cls = np.asarray(face_class)[tri[new]].astype(np.uint8)
     pulse_of = pulse[new]
     first = np.ones(n_ret, bool)
     first[1:] = pulse_of[1:] != pulse_of[:-1]
     number = np.arange(n_ret) - np.maximum.accumulate(np.where(first, np.arange(n_ret), 0)) + 1
     total = np.bincount(pulse_of, minlength=pulses)[pulse_of]
-    return xyz, cls, number.astype(np.uint8), total.astype(np.uint8), pulse_of
+    return (xyz, cls, number.astype(np.uint8), total.astype(np.uint8), pulse_of,
+            hits / float(rays))
 
 
 def ground_plane(lo: tuple[float, float], hi: tuple[float, float], margin: float = 50.0

@@ -201,10 +201,29 @@ def _columns(xy: np.ndarray, heights: np.ndarray, *, size_m: float, g: float,
     return float(x0), float(y0), pad, below_top
 
 
+def echo_weights(tile: Tile, rule: str = "equal") -> np.ndarray:
+    """Each return's share of its pulse (module text): ``"equal"`` 1 / number of returns;
+    ``"intensity"`` its intensity over the summed intensity of its pulse's returns in the
+    tile (a pulse: one flight line or scan position and one GPS time), falling back to
+    1 / number of returns for a pulse whose returns carry no intensity."""
+    equal = 1.0 / np.maximum(tile.number_of_returns, 1).astype(float)
+    if rule == "equal" or tile.intensity is None or tile.gps_time is None:
+        return equal
+    if rule != "intensity":
+        raise ValueError(f"echo weight {rule!r}: 'equal' or 'intensity'")
+    sid = np.zeros(len(tile)) if tile.source_id is None else tile.source_id
+    _, pulse = np.unique(np.column_stack([sid, tile.gps_time]), axis=0, return_inverse=True)
+    pulse = pulse.ravel()
+    inten = np.asarray(tile.intensity, float)
+    total = np.bincount(pulse, weights=inten)[pulse]
+    with np.errstate(divide="ignore", invalid="ignore"):
+        return np.where(total > 0, inten / total, equal)
+
+
 def _beam_pad(tile: Tile, *, heights: np.ndarray, origin: np.ndarray, size: float,
               g_of_mu: Callable[[np.ndarray], np.ndarray], ground_m: float = 0.5,
               empty: tuple[np.ndarray, np.ndarray] | None = None,
-              envelope_m: float | None = None
+              envelope_m: float | None = None, echo_weight: str = "equal"
               ) -> tuple[float, float, np.ndarray, BeamCounts, np.ndarray | None]:
     """(x0, y0, pad, entering beams, envelope fractions) by following every point's beam
     (:mod:`radtree.lidar.beams`) on the grid over the points' extent, heights 0 … the highest
@@ -221,7 +240,7 @@ def _beam_pad(tile: Tile, *, heights: np.ndarray, origin: np.ndarray, size: floa
     end = np.column_stack([xy, heights])
     start = np.asarray(origin, float) - np.column_stack(
         [np.zeros((len(xy), 2)), tile.xyz[:, 2] - heights])   # terrain under the return
-    weight = 1.0 / np.maximum(tile.number_of_returns, 1).astype(float)
+    weight = echo_weights(tile, echo_weight)
     hit = heights >= ground_m
     if empty is not None and len(empty[0]):
         shift = np.array([0.0, 0.0, float(np.median(tile.xyz[:, 2] - heights))])
@@ -261,7 +280,8 @@ def tree_voxels(path: str | Path, g: float, size_m: float | None = None,
                 g_of_mu: Callable[[np.ndarray], np.ndarray] | None = None,
                 empty: Callable[[Tile], tuple[np.ndarray, np.ndarray]] | None = None,
                 fill: bool = True, envelope: bool = True,
-                pulse_min: float = PULSE_MIN, pool: bool = True) -> VoxelGrid:
+                pulse_min: float = PULSE_MIN, pool: bool = True,
+                echo_weight: str = "equal") -> VoxelGrid:
     """The plant area density grid of the one tree in ``path`` (module text); ConfigError
     naming the file and the fix for an empty or one-point tree, no ground, a voxel finer
     than the point spacing supports. With ``origins`` (where each point's beam was fired,
@@ -299,7 +319,7 @@ def tree_voxels(path: str | Path, g: float, size_m: float | None = None,
             tile, heights=heights, origin=origins(tile), size=size,
             g_of_mu=g_of_mu or (lambda mu: np.full(np.shape(mu), g)),
             empty=None if empty is None else empty(tile),
-            envelope_m=spacing if envelope else None)
+            envelope_m=spacing if envelope else None, echo_weight=echo_weight)
         entering = counts.entering
     lowest_k = int(np.floor(heights[veg].min() / size))
     if frac is not None:
