@@ -180,10 +180,12 @@ def main() -> int:
     ap.add_argument("--pulses", type=float, default=20.0, help="pulses per m²")
     ap.add_argument("--crossings", type=float, default=STREET_LOUVERS.crossings)
     ap.add_argument("--sidelap", type=float, default=AlsScan.sidelap)
-    ap.add_argument("--footprint-rays", type=int, default=1)
+    ap.add_argument("--footprint-rays", type=int, default=AlsScan.footprint_rays)
     ap.add_argument("--max-returns", type=int, default=AlsScan.max_returns)
     ap.add_argument("--range-resolution", type=float, default=AlsScan.range_resolution_m)
-    ap.add_argument("--echo-weight", default="equal", choices=("equal", "intensity"))
+    ap.add_argument("--echo-weight", default="intensity", choices=("equal", "intensity"))
+    ap.add_argument("--louvers-seed", type=int, default=STREET_LOUVERS.seed,
+                    help="the slats' realisation (seed of the first tree)")
     ap.add_argument("--dump", default=None, help="append per-tree rows (JSON lines) here")
     ap.add_argument("--seed", type=int, default=0, help="the scanner's seed")
     ap.add_argument("--seeds", default=None,
@@ -220,7 +222,7 @@ def run(args: argparse.Namespace, seed: int) -> list[str]:
     )
     from radtree.trees.volume import mean_cos
 
-    lv = replace(STREET_LOUVERS, crossings=args.crossings)
+    lv = replace(STREET_LOUVERS, crossings=args.crossings, seed=args.louvers_seed)
     trees = synthetic_street()
     t0 = time.perf_counter()
     scan = AlsScan(pulse_density_m2=args.pulses, sidelap=args.sidelap,
@@ -248,6 +250,7 @@ def run(args: argparse.Namespace, seed: int) -> list[str]:
     print(f"synthetic street: {len(trees)} trees, crossings {lv.crossings:g}, slats "
           f"{lv.slat_size_m:g} m at {lv.inclination_deg:g}°; scan {args.pulses:g} pulses/m², "
           f"sidelap {args.sidelap:g}, {args.footprint_rays} ray(s) a pulse, seed {seed}, "
+          f"returns weighted {args.echo_weight}, slat seed {lv.seed}, "
           f"{len(pts.xyz)} points, spacing {tile.spacing_m():.2f} m; inversion "
           f"{'vertical columns' if args.vertical else 'along the beams'}; {seconds:.1f} s")
     print(f"{'tree':5} {'det':5} {'dist':>5} {'h true':>7} {'h det':>6} {'dh':>6} "
@@ -264,9 +267,9 @@ def run(args: argparse.Namespace, seed: int) -> list[str]:
         import json
 
         with open(args.dump, "a") as fh:
-            for (tt, _, _, la, la_true, _), e in zip(rows, dla):
-                fh.write(json.dumps({"seed": seed, "tree": tt.id, "la": la,
-                                     "true": la_true, "err": e}) + "\n")
+            for (tt, _, _, la, la_true, size), e in zip(rows, dla):
+                fh.write(json.dumps({"seed": seed, "tree": tt.id, "la": la, "true": la_true,
+                                     "err": e, "voxel_m": size}) + "\n")
     dh_a, dd_a, dla_a = np.abs(dh), np.abs(dd), np.abs(dla)
     print(f"trees: true {len(trees)}, detected {len(seg.trees)}, matched {len(rows)} "
           f"(target: exact) — {'met' if len(seg.trees) == len(rows) == len(trees) else 'NOT met'}")

@@ -118,24 +118,38 @@ def beam_density(beams: Beams, *, lo: np.ndarray, size: float, shape: tuple[int,
     envelope's exit, :mod:`radtree.lidar.envelope`); unbounded when None."""
     c = beam_counts(beams, lo=lo, size=size, shape=shape, g_of_mu=g_of_mu,
                     beyond_max=beyond_max)
-    return density(c.entering, c.hits, c.optical), c.entering, c.hits
+    return density(c.entering, c.hits, c.optical, c.effective()), c.entering, c.hits
 
 
 @dataclass(frozen=True)
 class BeamCounts:
     """Per voxel (arrays of the grid's shape): the beams entering N and intercepted I
-    (weighted) and their summed optical path per unit density Σ w·G(μ)·l (m)."""
+    (weighted), their summed optical path per unit density Σ w·G(μ)·l (m) and the sum of the
+    entering beams' squared weights Σ w² (None: every weight 1)."""
 
     entering: np.ndarray
     hits: np.ndarray
     optical: np.ndarray
+    entering_sq: np.ndarray | None = None
+
+    def effective(self) -> np.ndarray:
+        """The effective number of entering beams n = (Σ w)² / Σ w² (Kish 1965, *Survey
+        Sampling*, cited from memory): N itself when every weight is 1."""
+        if self.entering_sq is None:
+            return self.entering
+        with np.errstate(divide="ignore", invalid="ignore"):
+            return np.where(self.entering_sq > 0, self.entering**2 / self.entering_sq, 0.0)
 
 
-def density(entering: np.ndarray, hits: np.ndarray, optical: np.ndarray) -> np.ndarray:
-    """PAD (m²/m³) = −ln((N − I + ½)/(N + ½)) / l̄_G with l̄_G = optical / N (module
+def density(entering: np.ndarray, hits: np.ndarray, optical: np.ndarray,
+            effective: np.ndarray | None = None) -> np.ndarray:
+    """PAD (m²/m³) = −ln((n·(1 − I/N) + ½)/(n + ½)) / l̄_G with l̄_G = optical / N and n the
+    effective number of beams (``effective``; N when None: −ln((N − I + ½)/(N + ½)), module
     text); 0 where no beam entered."""
+    n = entering if effective is None else effective
     with np.errstate(divide="ignore", invalid="ignore"):
-        gap = (np.maximum(entering - hits, 0.0) + 0.5) / (entering + 0.5)   # module text
+        gap_w = np.maximum(entering - hits, 0.0) / entering
+        gap = (n * gap_w + 0.5) / (n + 0.5)   # module text
         path = optical / entering
         return np.where((entering > 0) & (path > 0), -np.log(np.minimum(gap, 1.0)) / path,
                         0.0)
@@ -166,4 +180,6 @@ def beam_counts(beams: Beams, *, lo: np.ndarray, size: float, shape: tuple[int, 
     pair = seg * n + cell
     first[1:] = pair[1:] != pair[:-1]
     entering = np.bincount(cell[first], weights=w[seg[first]], minlength=n)
-    return BeamCounts(entering.reshape(shape), hits.reshape(shape), optical.reshape(shape))
+    entering_sq = np.bincount(cell[first], weights=w[seg[first]] ** 2, minlength=n)
+    return BeamCounts(entering.reshape(shape), hits.reshape(shape), optical.reshape(shape),
+                      entering_sq.reshape(shape))

@@ -50,7 +50,7 @@ class AlsScan(Checked):
     line_spacing_m: float = field(default=150.0, metadata=meta(1.0, 10000.0))
     heading_deg: float = field(default=0.0, metadata=meta(0.0, 360.0))
     beam_divergence_mrad: float = field(default=0.5, metadata=meta(0.0, 10.0))
-    footprint_rays: int = field(default=1, metadata=meta(1, 64))
+    footprint_rays: int = field(default=16, metadata=meta(1, 64))
     range_resolution_m: float = field(default=1.5, metadata=meta(0.0, 100.0))
     max_returns: int = field(default=4, metadata=meta(1, 15))
     sidelap: float = field(default=0.3, metadata=meta(0.0, 0.9))

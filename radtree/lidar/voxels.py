@@ -256,7 +256,7 @@ def _beam_pad(tile: Tile, *, heights: np.ndarray, origin: np.ndarray, size: floa
         start, end, hit, weight, beyond_max = _clip_beams(env, start, end, hit, weight)
     counts = beam_counts(Beams(start, end, hit, weight), lo=lo, size=size, shape=shape,
                          g_of_mu=g_of_mu, beyond_max=beyond_max)
-    pad = density(counts.entering, counts.hits, counts.optical)
+    pad = density(counts.entering, counts.hits, counts.optical, counts.effective())
     frac = None if env is None else env.fractions(lo, size, shape)
     return float(x0), float(y0), pad, counts, frac
 
@@ -281,7 +281,7 @@ def tree_voxels(path: str | Path, g: float, size_m: float | None = None,
                 empty: Callable[[Tile], tuple[np.ndarray, np.ndarray]] | None = None,
                 fill: bool = True, envelope: bool = True,
                 pulse_min: float = PULSE_MIN, pool: bool = True,
-                echo_weight: str = "equal") -> VoxelGrid:
+                echo_weight: str = "intensity") -> VoxelGrid:
     """The plant area density grid of the one tree in ``path`` (module text); ConfigError
     naming the file and the fix for an empty or one-point tree, no ground, a voxel finer
     than the point spacing supports. With ``origins`` (where each point's beam was fired,
@@ -320,7 +320,7 @@ def tree_voxels(path: str | Path, g: float, size_m: float | None = None,
             g_of_mu=g_of_mu or (lambda mu: np.full(np.shape(mu), g)),
             empty=None if empty is None else empty(tile),
             envelope_m=spacing if envelope else None, echo_weight=echo_weight)
-        entering = counts.entering
+        entering = counts.effective()
     lowest_k = int(np.floor(heights[veg].min() / size))
     if frac is not None:
         if fill:
