@@ -274,3 +274,22 @@ def test_dense_crown_base_pooled(tmp_path: Path) -> None:
     assert out[1, True][0] == pytest.approx(-0.037, abs=0.02)
     assert out[1, True][1] == pytest.approx(51.1, rel=0.10)
     assert out[1, False][0] > 0.08 and out[1, False][1] > 1.4 * 51.1
+
+
+def test_echo_weights_intensity_share() -> None:
+    """Returns weighted by their intensity's share of the pulse (a pulse: line and GPS
+    time), 1/number of returns where intensity is missing or pulses cannot be told apart."""
+    from radtree.lidar.tile import Tile
+    from radtree.lidar.voxels import echo_weights
+
+    n = np.array([2, 2, 1, 3, 3, 3], np.uint8)
+    tile = Tile(Path("x.laz"), np.zeros((6, 3)), np.full(6, 5, np.uint8),
+                np.array([1, 2, 1, 1, 2, 3], np.uint8), n, {}, None,
+                np.array([1, 1, 1, 2, 2, 2]), np.array([0.0, 0.0, 1.0, 0.0, 0.0, 0.0]),
+                None, np.array([3.0, 1.0, 7.0, 0.0, 0.0, 0.0]))
+    w = echo_weights(tile, "intensity")
+    assert w == pytest.approx([0.75, 0.25, 1.0, 1 / 3, 1 / 3, 1 / 3])
+    assert echo_weights(tile, "equal") == pytest.approx(1.0 / n)
+    no_time = Tile(tile.path, tile.xyz, tile.classification, tile.return_number, n, {}, None,
+                   np.ones(6, np.int64), np.zeros(6), None, np.arange(1.0, 7.0))
+    assert echo_weights(no_time, "intensity") == pytest.approx(1.0 / n)

@@ -20,13 +20,23 @@ follows (:mod:`radtree.lidar.beams`); without it, the scan angle and flight line
 (:mod:`radtree.lidar.scan_angle`).
 
 Footprint: a pulse is ``footprint_rays`` parallel sub-rays spread uniformly over a disc of
-diameter ``altitude · beam_divergence_mrad / 1000`` (m) across the beam. Each sub-ray stops at
-the first surface it meets (trimesh, Embree when installed); the sub-rays' hits are sorted by
-range and grouped into returns separated by at least ``range_resolution_m``; a pulse records up
-to ``max_returns`` returns (first … last), each at the mean position of its sub-rays' hits
-and with the class of its first hit's face. With one sub-ray (the default) every pulse has
-exactly one return: the first surface along a thin beam. Leaf transmittance does not pass
-laser light on (a return is recorded, the sub-ray ends there). Units: metres, z up.
+diameter ``altitude · beam_divergence_mrad / 1000`` (m) across the beam (default 16 sub-rays
+over 0.15 m). Each sub-ray stops at the first surface it meets (trimesh, Embree when
+installed); the sub-rays' hits are sorted by range and grouped into returns separated by at
+least ``range_resolution_m`` (1.5 m: a stated value, not a particular sensor's); a pulse
+records up to ``max_returns`` returns (first … last, 4 by default), each at the mean position
+of its sub-rays' hits, with the class of its first hit's face and as intensity the share of
+the pulse's sub-rays it stopped (:attr:`ScanPoints.intensity`, 0–1; LAS ``intensity`` × 65535:
+every surface equally reflective). Leaf transmittance does not pass laser light on (a
+sub-ray ends at its hit). Discrete-return airborne scanners record several returns a pulse:
+the USGS 3DEP Lidar Base Specification (v2.1, "Collection requirements", usgs.gov) requires
+multiple discrete returns, at least three a pulse, with an intensity for each (normalised
+linearly to 16 bits), and LAS point records carry each return's "return number" within its
+pulse and the pulse's "number of returns" (e.g. ArcGIS Pro's ``LasPoint.NumberOfReturns``:
+"the total number of returns for a given pulse"). With 16 sub-rays a pulse grazing a 0.3 m
+slat goes on to the leaves and ground below it, as a real footprint does; with one
+(``footprint_rays = 1``, the default until 2026-12-08) every pulse has exactly one return,
+the first surface along a thin beam. Units: metres, z up.
 """
 
 from __future__ import annotations

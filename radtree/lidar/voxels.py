@@ -70,7 +70,19 @@ façade crown of ``benchmarks/lidar_facade.py``: radius 5 m, vertical semi-axis 
 undersampled and their few sampled voxels are rim voxels reached from the side, so the layer
 took the mean of 1–3 of them, or 0 when none (scans 1–4 at 20 pulses/m²: leaf area +11.4,
 +5.3, −5.3, −2.4 %; the crown's lowest 2.4 m 82.7, 65.1, 40.4, 53.9 m² for 51.1). Pooled:
-−3.7, −5.8, −5.0, −3.4 %; 50.2, 41.8, 47.9, 53.9 m² (``tests/test_lidar_beams.py``).
+−3.7, −5.8, −5.0, −3.4 %; 50.2, 41.8, 47.9, 53.9 m² (``tests/test_lidar_beams.py``; one thin
+ray a pulse).
+
+Several returns a pulse (``echo_weight``, :func:`echo_weights`): each return is a sub-beam
+from the pulse's origin to it, weighted by its intensity's share of the pulse's returns
+(``"intensity"``, the default: the part of the footprint it intercepted, when every surface
+reflects alike) or by 1/(number of returns) (``"equal"``); :mod:`radtree.lidar.beams`. A
+file of single returns gives every beam weight 1 either way. Real intensities also carry
+each surface's reflectance (leaves against asphalt or soil), which the shares then mix in;
+not corrected here. "Beams" in the 5-beam minimum are effective beams, (Σ w)² / Σ w²
+(:meth:`radtree.lidar.beams.BeamCounts.effective`). On the synthetic street's default scan
+(16 sub-rays a pulse over the 0.15 m footprint, up to 4 returns) the crown base is entered by
+many partial pulses and seldom undersampled.
 """
 
 from __future__ import annotations
@@ -204,8 +216,10 @@ def _columns(xy: np.ndarray, heights: np.ndarray, *, size_m: float, g: float,
 def echo_weights(tile: Tile, rule: str = "equal") -> np.ndarray:
     """Each return's share of its pulse (module text): ``"equal"`` 1 / number of returns;
     ``"intensity"`` its intensity over the summed intensity of its pulse's returns in the
-    tile (a pulse: one flight line or scan position and one GPS time), falling back to
-    1 / number of returns for a pulse whose returns carry no intensity."""
+    tile (a pulse: one flight line or scan position and one GPS time; a return of the pulse
+    clipped out of the file is not counted), falling back to 1 / number of returns for a
+    pulse whose returns carry no intensity (all 0) or that cannot be told apart (more points
+    share its line and time than its number of returns: a file without GPS times)."""
     equal = 1.0 / np.maximum(tile.number_of_returns, 1).astype(float)
     if rule == "equal" or tile.intensity is None or tile.gps_time is None:
         return equal
@@ -216,8 +230,10 @@ def echo_weights(tile: Tile, rule: str = "equal") -> np.ndarray:
     pulse = pulse.ravel()
     inten = np.asarray(tile.intensity, float)
     total = np.bincount(pulse, weights=inten)[pulse]
+    # a "pulse" holding more returns than its number of returns is no pulse (no GPS times)
+    one_pulse = np.bincount(pulse)[pulse] <= np.maximum(tile.number_of_returns, 1)
     with np.errstate(divide="ignore", invalid="ignore"):
-        return np.where(total > 0, inten / total, equal)
+        return np.where((total > 0) & one_pulse, inten / total, equal)
 
 
 def _beam_pad(tile: Tile, *, heights: np.ndarray, origin: np.ndarray, size: float,
