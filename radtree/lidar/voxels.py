@@ -194,8 +194,11 @@ def fill_occluded(pad: np.ndarray, entering: np.ndarray, *, lowest_k: int
 
 
 def _columns(xy: np.ndarray, heights: np.ndarray, *, size_m: float, g: float,
-             ground_m: float) -> tuple[float, float, np.ndarray, np.ndarray]:
-    """(x0, y0, pad, beams reaching each voxel N(z_top)) of the column inversion."""
+             ground_m: float, weight: np.ndarray | None = None
+             ) -> tuple[float, float, np.ndarray, np.ndarray]:
+    """(x0, y0, pad, beams reaching each voxel N(z_top)) of the column inversion; each return
+    counted with its ``weight`` (:func:`echo_weights`; 1 when None), the ½ added in effective
+    beams (Σ w)² / Σ w² (:meth:`radtree.lidar.beams.BeamCounts.effective`)."""
     x0, y0 = (np.floor(xy.min(axis=0) / size_m) * size_m).tolist()
     ij = np.floor((xy - [x0, y0]) / size_m).astype(np.int64)
     nx, ny = (ij.max(axis=0) + 1).tolist()
@@ -203,12 +206,17 @@ def _columns(xy: np.ndarray, heights: np.ndarray, *, size_m: float, g: float,
     nz = max(1, int(math.ceil(heights[veg].max() / size_m))) if veg.any() else 1
     k = np.where(veg, np.floor(heights / size_m).astype(np.int64), -1)
     k = np.clip(k, -1, nz - 1)
+    w = np.ones(len(heights)) if weight is None else np.asarray(weight, float)
     counts = np.zeros((nx, ny, nz + 1))   # [..., 0] = ground, [..., k + 1] = layer k
-    np.add.at(counts, (ij[:, 0], ij[:, 1], k + 1), 1.0)
+    np.add.at(counts, (ij[:, 0], ij[:, 1], k + 1), w)
+    squares = np.zeros((nx, ny, nz + 1))
+    np.add.at(squares, (ij[:, 0], ij[:, 1], k + 1), w * w)
     below_top = np.cumsum(counts, axis=2)[..., 1:]        # N(z_top of layer k)
     below_bottom = below_top - counts[..., 1:]            # N(z_bottom of layer k)
+    n_eff = BeamCounts(below_top, below_top - below_bottom, below_top,
+                       np.cumsum(squares, axis=2)[..., 1:]).effective()
     with np.errstate(divide="ignore", invalid="ignore"):
-        gap = (below_bottom + 0.5) / (below_top + 0.5)       # ½ added to both counts
+        gap = (n_eff * below_bottom / below_top + 0.5) / (n_eff + 0.5)   # ½ added
         pad = np.where(below_top > 0, -np.log(np.minimum(gap, 1.0)) / (g * size_m), 0.0)
     return float(x0), float(y0), pad, below_top
 
@@ -329,7 +337,7 @@ def tree_voxels(path: str | Path, g: float, size_m: float | None = None,
     frac = None
     if origins is None:
         x0, y0, pad, entering = _columns(tile.xyz[:, :2], heights, size_m=size, g=g,
-                                         ground_m=0.5)
+                                         ground_m=0.5, weight=echo_weights(tile, echo_weight))
     else:
         x0, y0, pad, counts, frac = _beam_pad(
             tile, heights=heights, origin=origins(tile), size=size,
