@@ -43,6 +43,7 @@ Count, heights and diameters are met at every seed at both settings. Noise and b
     16 sub-rays, ½ added to N        −0.2 %     2.4 %          3.3 %   (120/120; not taken)
     8 sub-rays, ½ added to N         −0.3 %     2.6 %          3.3 %   (119/120)
     8 sub-rays, equal 1/n, ½ to N    −4.4 %     2.3 %          3.3 %   (114/120)
+    16 sub-rays, equal 1/n           −5.7 %     2.4 %          3.4 %   (104/120)
 
 The scan noise scales as the sampling: ×0.59 for 4× the pulses (1/√4 = 0.5), ×0.58 for the
 returns behind the first (≈ 1.14 returns a pulse on a dense crown, but each partial pulse
