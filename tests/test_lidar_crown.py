@@ -67,14 +67,16 @@ def test_voxel_errors_name_file_and_fix(tmp_path: Path) -> None:
 
 def test_scanner_against_geometry() -> None:
     """An opaque 4 m × 4 m square 5 m up over a 10 m × 10 m scan: 16 % of the pulses return
-    from it (jittered grid), classes from the faces; five sub-rays a pulse over a 1.5 m
-    footprint give two returns (roof then ground) on the square's rim only."""
+    from it (jittered grid), classes from the faces (one thin ray a pulse); five sub-rays a
+    pulse over a 1.5 m footprint give two returns (roof then ground) on the square's rim
+    only, each with the share of the sub-rays it stopped as its intensity (a pulse's sum 1)."""
     v = np.array([[3, 3, 5], [7, 3, 5], [7, 7, 5], [3, 7, 5],
                   [-50, -50, 0], [60, -50, 0], [60, 60, 0], [-50, 60, 0]], float)
     f = np.array([[0, 1, 2], [0, 2, 3], [4, 5, 6], [4, 6, 7]])
     cls = np.array([6, 6, 2, 2])
-    pts = scan_als(v, f, cls, (0, 0), (10, 10), AlsScan(pulse_density_m2=400, seed=2))
-    assert len(pts.xyz) == 40_000
+    pts = scan_als(v, f, cls, (0, 0), (10, 10), AlsScan(pulse_density_m2=400, footprint_rays=1,
+                                                              seed=2))
+    assert len(pts.xyz) == 40_000 and np.all(pts.intensity == 1.0)
     roof = pts.classification == 6
     assert roof.mean() == pytest.approx(0.16, abs=0.004)
     assert np.allclose(pts.xyz[roof, 2], 5.0) and np.allclose(pts.xyz[~roof, 2], 0.0)
@@ -89,6 +91,11 @@ def test_scanner_against_geometry() -> None:
     assert np.allclose(first[:, 2], 5.0) and np.allclose(last[:, 2], 0.0)
     rim = np.minimum(np.abs(first[:, :2] - 3), np.abs(first[:, :2] - 7)).min(axis=1)
     assert rim.max() < 0.75 + 0.05   # the footprint radius (300 m × 5 mrad / 2) from the rim
+    fifths = wide.intensity * 5
+    assert np.allclose(fifths, np.round(fifths)) and np.all(wide.intensity > 0)
+    assert np.allclose(np.bincount(np.round(wide.time * 1e5).astype(int),
+                                   weights=wide.intensity)[np.unique(
+                                       np.round(wide.time * 1e5).astype(int))], 1.0)
 
 
 @pytest.fixture(scope="module")

@@ -39,11 +39,12 @@ def write_points(out: str | Path, xyz: np.ndarray, classification: np.ndarray,
                  number_of_returns: np.ndarray | None = None, crs: str | None = None,
                  scale_m: float = 0.001, *, source_id: np.ndarray | None = None,
                  gps_time: np.ndarray | None = None,
-                 scan_angle_deg: np.ndarray | None = None) -> Path:
+                 scan_angle_deg: np.ndarray | None = None,
+                 intensity: np.ndarray | None = None) -> Path:
     """Write points (m) as LAS 1.4 point format 6 (LAZ when ``out`` ends in ``.laz``), with a
     CRS (anything pyproj reads) when given; coordinates to ``scale_m``; the point source id
-    (flight line, scan position), GPS time (s) and scan angle (degrees; LAS 1.4 stores it
-    in steps of 0.006°) when given."""
+    (flight line, scan position), GPS time (s), scan angle (degrees; LAS 1.4 stores it
+    in steps of 0.006°) and intensity (0–1, stored linearly on 16 bits: × 65535) when given."""
     import laspy
 
     out = Path(out)
@@ -69,6 +70,9 @@ def write_points(out: str | Path, xyz: np.ndarray, classification: np.ndarray,
     if scan_angle_deg is not None and len(scan_angle_deg):
         las.scan_angle = np.clip(np.round(np.asarray(scan_angle_deg, float) / SCAN_ANGLE_STEP),
                                  -30000, 30000).astype(np.int16)
+    if intensity is not None and len(intensity):
+        las.intensity = np.round(np.clip(np.asarray(intensity, float), 0.0, 1.0)
+                                 * 65535).astype(np.uint16)
     return _write(las, out)
 
 

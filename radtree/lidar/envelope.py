@@ -127,9 +127,13 @@ def fill_undersampled(pad: np.ndarray, entering: np.ndarray, *, inside: np.ndarr
                          / np.maximum(n_sampled, 1), np.nan)
     if counts is not None:
         n_u = np.sum(counts.entering * under, axis=(0, 1))
-        pooled = density(n_u, np.sum(counts.hits * under, axis=(0, 1)),
-                         np.sum(counts.optical * under, axis=(0, 1)))
-        layer = np.where(n_u >= pulse_min, pooled, layer)
+        sq = None if counts.entering_sq is None else np.sum(counts.entering_sq * under, (0, 1))
+        pooled_counts = BeamCounts(n_u, np.sum(counts.hits * under, axis=(0, 1)),
+                                   np.sum(counts.optical * under, axis=(0, 1)), sq)
+        n_eff = pooled_counts.effective()
+        pooled = density(pooled_counts.entering, pooled_counts.hits, pooled_counts.optical,
+                         n_eff)
+        layer = np.where(n_eff >= pulse_min, pooled, layer)
     for i in range(len(layer) - 2, -1, -1):          # nothing in a layer: the one above
         if np.isnan(layer[i]):
             layer[i] = layer[i + 1]

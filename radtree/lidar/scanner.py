@@ -20,13 +20,23 @@ follows (:mod:`radtree.lidar.beams`); without it, the scan angle and flight line
 (:mod:`radtree.lidar.scan_angle`).
 
 Footprint: a pulse is ``footprint_rays`` parallel sub-rays spread uniformly over a disc of
-diameter ``altitude · beam_divergence_mrad / 1000`` (m) across the beam. Each sub-ray stops at
-the first surface it meets (trimesh, Embree when installed); the sub-rays' hits are sorted by
-range and grouped into returns separated by at least ``range_resolution_m``; a pulse records up
-to ``max_returns`` returns (first … last), each at the mean position of its sub-rays' hits
-and with the class of its first hit's face. With one sub-ray (the default) every pulse has
-exactly one return: the first surface along a thin beam. Leaf transmittance does not pass
-laser light on (a return is recorded, the sub-ray ends there). Units: metres, z up.
+diameter ``altitude · beam_divergence_mrad / 1000`` (m) across the beam (default 16 sub-rays
+over 0.15 m). Each sub-ray stops at the first surface it meets (trimesh, Embree when
+installed); the sub-rays' hits are sorted by range and grouped into returns separated by at
+least ``range_resolution_m`` (1.5 m: a stated value, not a particular sensor's); a pulse
+records up to ``max_returns`` returns (first … last, 4 by default), each at the mean position
+of its sub-rays' hits, with the class of its first hit's face and as intensity the share of
+the pulse's sub-rays it stopped (:attr:`ScanPoints.intensity`, 0–1; LAS ``intensity`` × 65535:
+every surface equally reflective). Leaf transmittance does not pass laser light on (a
+sub-ray ends at its hit). Discrete-return airborne scanners record several returns a pulse:
+the USGS 3DEP Lidar Base Specification (v2.1, "Collection requirements", usgs.gov) requires
+multiple discrete returns, at least three a pulse, with an intensity for each (normalised
+linearly to 16 bits), and LAS point records carry each return's "return number" within its
+pulse and the pulse's "number of returns" (e.g. ArcGIS Pro's ``LasPoint.NumberOfReturns``:
+"the total number of returns for a given pulse"). With 16 sub-rays a pulse grazing a 0.3 m
+slat goes on to the leaves and ground below it, as a real footprint does; with one
+(``footprint_rays = 1``, the default until 2026-12-08) every pulse has exactly one return,
+the first surface along a thin beam. Units: metres, z up.
 """
 
 from __future__ import annotations
@@ -50,7 +60,7 @@ class AlsScan(Checked):
     line_spacing_m: float = field(default=150.0, metadata=meta(1.0, 10000.0))
     heading_deg: float = field(default=0.0, metadata=meta(0.0, 360.0))
     beam_divergence_mrad: float = field(default=0.5, metadata=meta(0.0, 10.0))
-    footprint_rays: int = field(default=1, metadata=meta(1, 64))
+    footprint_rays: int = field(default=16, metadata=meta(1, 64))
     range_resolution_m: float = field(default=1.5, metadata=meta(0.0, 100.0))
     max_returns: int = field(default=4, metadata=meta(1, 15))
     sidelap: float = field(default=0.3, metadata=meta(0.0, 0.9))
@@ -98,6 +108,7 @@ class ScanPoints:
     line: np.ndarray = field(default_factory=lambda: np.zeros(0, np.int64))
     time: np.ndarray = field(default_factory=lambda: np.zeros(0))
     scan_angle_deg: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    intensity: np.ndarray = field(default_factory=lambda: np.zeros(0))
 
 
 def _pulses(lo: np.ndarray, hi: np.ndarray, scan: AlsScan, rng: np.random.Generator
@@ -152,25 +163,27 @@ def scan_als(vertices: np.ndarray, faces: np.ndarray, face_class: np.ndarray,
                + (r * np.sin(phi))[..., None] * e2[:, None, :]).reshape(-1, 3)
     dirs = np.repeat(d, m, axis=0)
     loc, ray, tri = mesh.ray.intersects_location(origins, dirs, multiple_hits=False)
-    xyz, cls, number, total, pulse_of = echoes(loc, pulse=ray // m, dist=np.einsum(
+    xyz, cls, number, total, pulse_of, share = echoes(loc, pulse=ray // m, dist=np.einsum(
         "ij,ij->i", loc - origins[ray], dirs[ray]), tri=tri, face_class=face_class,
-        pulses=k, resolution_m=scan.range_resolution_m)
+        pulses=k, resolution_m=scan.range_resolution_m, rays=m)
     keep = number <= scan.max_returns
     xyz, cls, number, pulse_of = xyz[keep], cls[keep], number[keep], pulse_of[keep]
     total = np.minimum(total[keep], scan.max_returns)
     _, across = scan._axes()
     angle = np.degrees(np.arctan2(d[:, :2] @ across, -d[:, 2]))   # + right of the line
     return ScanPoints(xyz, cls, number, total, lines[pulse_of], pulse_of / PULSE_RATE_HZ,
-                      angle[pulse_of])
+                      angle[pulse_of], share[keep])
 
 
 def echoes(loc: np.ndarray, *, pulse: np.ndarray, dist: np.ndarray, tri: np.ndarray,
-           face_class: np.ndarray, pulses: int, resolution_m: float
-           ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+           face_class: np.ndarray, pulses: int, resolution_m: float, rays: int = 1
+           ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """Sub-ray hits (``loc`` (h, 3), their pulse, range m, face) grouped into returns: sorted
     by range within a pulse, a new return where the range jumps by ≥ ``resolution_m``; each
     at the mean of its hits, with its first hit's class. (xyz, class, return number, number
-    of returns of the pulse, pulse) per return, in pulse order."""
+    of returns of the pulse, pulse, share) per return, in pulse order; share: the return's
+    sub-rays among the pulse's ``rays`` (the part of the footprint it intercepted, which
+    its intensity records)."""
     order = np.lexsort((dist, pulse))
     pulse, dist, loc, tri = pulse[order], dist[order], loc[order], tri[order]
     new = np.ones(len(pulse), bool)
@@ -179,14 +192,16 @@ def echoes(loc: np.ndarray, *, pulse: np.ndarray, dist: np.ndarray, tri: np.ndar
     n_ret = int(ret[-1] + 1) if len(ret) else 0
     xyz = np.zeros((n_ret, 3))
     np.add.at(xyz, ret, loc)
-    xyz /= np.maximum(np.bincount(ret, minlength=n_ret), 1)[:, None]
+    hits = np.bincount(ret, minlength=n_ret)
+    xyz /= np.maximum(hits, 1)[:, None]
     cls = np.asarray(face_class)[tri[new]].astype(np.uint8)
     pulse_of = pulse[new]
     first = np.ones(n_ret, bool)
     first[1:] = pulse_of[1:] != pulse_of[:-1]
     number = np.arange(n_ret) - np.maximum.accumulate(np.where(first, np.arange(n_ret), 0)) + 1
     total = np.bincount(pulse_of, minlength=pulses)[pulse_of]
-    return xyz, cls, number.astype(np.uint8), total.astype(np.uint8), pulse_of
+    return (xyz, cls, number.astype(np.uint8), total.astype(np.uint8), pulse_of,
+            hits / float(rays))
 
 
 def ground_plane(lo: tuple[float, float], hi: tuple[float, float], margin: float = 50.0

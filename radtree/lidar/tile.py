@@ -34,7 +34,7 @@ class Tile:
     ``number_of_returns``, ``extra`` dimensions by name, ``crs`` (WKT text or None), the
     LAS ``point_source_id`` (flight line or scan position), ``gps_time`` (s) and scan angle
     (degrees from nadir, + right of the flight direction) of every point (zeros when the file
-    has none)."""
+    has none) and its LAS ``intensity`` (as stored, None when not read)."""
 
     path: Path
     xyz: np.ndarray
@@ -46,6 +46,7 @@ class Tile:
     source_id: np.ndarray | None = None
     gps_time: np.ndarray | None = None
     scan_angle_deg: np.ndarray | None = None
+    intensity: np.ndarray | None = None
 
     def __len__(self) -> int:
         return len(self.xyz)
@@ -71,7 +72,8 @@ class Tile:
                     {k: v[mask] for k, v in self.extra.items()}, self.crs,
                     None if self.source_id is None else self.source_id[mask],
                     None if self.gps_time is None else self.gps_time[mask],
-                    None if self.scan_angle_deg is None else self.scan_angle_deg[mask])
+                    None if self.scan_angle_deg is None else self.scan_angle_deg[mask],
+                    None if self.intensity is None else self.intensity[mask])
 
 
 def _las(path: Path) -> Any:
@@ -135,7 +137,7 @@ def read_tile(path: str | Path) -> Tile:
                 np.asarray(las.number_of_returns, np.uint8), extra, crs_wkt(las),
                 np.asarray(las.point_source_id, np.int64),
                 np.asarray(las.gps_time, float) if "gps_time" in las.point_format.dimension_names
-                else np.zeros(n), scan_angle(las))
+                else np.zeros(n), scan_angle(las), np.asarray(las.intensity, float))
     check_metric(tile)
     return tile
 

@@ -119,9 +119,9 @@ def scan_tls(vertices: np.ndarray, *, faces: np.ndarray, face_class: np.ndarray,
     dist = np.einsum("ij,ij->i", loc - scan.position, dirs[ray])
     near = dist <= scan.max_range_m
     loc, ray, tri, dist = loc[near], ray[near], tri[near], dist[near]
-    xyz, cls, number, total, shot = echoes(loc, pulse=ray // m, dist=dist, tri=tri,
-                                           face_class=face_class, pulses=len(d),
-                                           resolution_m=scan.range_resolution_m)
+    xyz, cls, number, total, shot, _ = echoes(loc, pulse=ray // m, dist=dist, tri=tri,
+                                              face_class=face_class, pulses=len(d),
+                                              resolution_m=scan.range_resolution_m, rays=m)
     last = number == total
     keep = {"first": number == 1, "last": last, "first_last": (number == 1) | last,
             "all": np.ones(len(number), bool)}[scan.returns]

@@ -70,7 +70,19 @@ façade crown of ``benchmarks/lidar_facade.py``: radius 5 m, vertical semi-axis 
 undersampled and their few sampled voxels are rim voxels reached from the side, so the layer
 took the mean of 1–3 of them, or 0 when none (scans 1–4 at 20 pulses/m²: leaf area +11.4,
 +5.3, −5.3, −2.4 %; the crown's lowest 2.4 m 82.7, 65.1, 40.4, 53.9 m² for 51.1). Pooled:
-−3.7, −5.8, −5.0, −3.4 %; 50.2, 41.8, 47.9, 53.9 m² (``tests/test_lidar_beams.py``).
+−3.7, −5.8, −5.0, −3.4 %; 50.2, 41.8, 47.9, 53.9 m² (``tests/test_lidar_beams.py``; one thin
+ray a pulse).
+
+Several returns a pulse (``echo_weight``, :func:`echo_weights`): each return is a sub-beam
+from the pulse's origin to it, weighted by its intensity's share of the pulse's returns
+(``"intensity"``, the default: the part of the footprint it intercepted, when every surface
+reflects alike) or by 1/(number of returns) (``"equal"``); :mod:`radtree.lidar.beams`. A
+file of single returns gives every beam weight 1 either way. Real intensities also carry
+each surface's reflectance (leaves against asphalt or soil), which the shares then mix in;
+not corrected here. "Beams" in the 5-beam minimum are effective beams, (Σ w)² / Σ w²
+(:meth:`radtree.lidar.beams.BeamCounts.effective`). On the synthetic street's default scan
+(16 sub-rays a pulse over the 0.15 m footprint, up to 4 returns) the crown base is entered by
+many partial pulses and seldom undersampled.
 """
 
 from __future__ import annotations
@@ -182,8 +194,11 @@ def fill_occluded(pad: np.ndarray, entering: np.ndarray, *, lowest_k: int
 
 
 def _columns(xy: np.ndarray, heights: np.ndarray, *, size_m: float, g: float,
-             ground_m: float) -> tuple[float, float, np.ndarray, np.ndarray]:
-    """(x0, y0, pad, beams reaching each voxel N(z_top)) of the column inversion."""
+             ground_m: float, weight: np.ndarray | None = None
+             ) -> tuple[float, float, np.ndarray, np.ndarray]:
+    """(x0, y0, pad, beams reaching each voxel N(z_top)) of the column inversion; each return
+    counted with its ``weight`` (:func:`echo_weights`; 1 when None), the ½ added in effective
+    beams (Σ w)² / Σ w² (:meth:`radtree.lidar.beams.BeamCounts.effective`)."""
     x0, y0 = (np.floor(xy.min(axis=0) / size_m) * size_m).tolist()
     ij = np.floor((xy - [x0, y0]) / size_m).astype(np.int64)
     nx, ny = (ij.max(axis=0) + 1).tolist()
@@ -191,20 +206,48 @@ def _columns(xy: np.ndarray, heights: np.ndarray, *, size_m: float, g: float,
     nz = max(1, int(math.ceil(heights[veg].max() / size_m))) if veg.any() else 1
     k = np.where(veg, np.floor(heights / size_m).astype(np.int64), -1)
     k = np.clip(k, -1, nz - 1)
+    w = np.ones(len(heights)) if weight is None else np.asarray(weight, float)
     counts = np.zeros((nx, ny, nz + 1))   # [..., 0] = ground, [..., k + 1] = layer k
-    np.add.at(counts, (ij[:, 0], ij[:, 1], k + 1), 1.0)
+    np.add.at(counts, (ij[:, 0], ij[:, 1], k + 1), w)
+    squares = np.zeros((nx, ny, nz + 1))
+    np.add.at(squares, (ij[:, 0], ij[:, 1], k + 1), w * w)
     below_top = np.cumsum(counts, axis=2)[..., 1:]        # N(z_top of layer k)
     below_bottom = below_top - counts[..., 1:]            # N(z_bottom of layer k)
+    n_eff = BeamCounts(below_top, below_top - below_bottom, below_top,
+                       np.cumsum(squares, axis=2)[..., 1:]).effective()
     with np.errstate(divide="ignore", invalid="ignore"):
-        gap = (below_bottom + 0.5) / (below_top + 0.5)       # ½ added to both counts
+        gap = (n_eff * below_bottom / below_top + 0.5) / (n_eff + 0.5)   # ½ added
         pad = np.where(below_top > 0, -np.log(np.minimum(gap, 1.0)) / (g * size_m), 0.0)
     return float(x0), float(y0), pad, below_top
+
+
+def echo_weights(tile: Tile, rule: str = "equal") -> np.ndarray:
+    """Each return's share of its pulse (module text): ``"equal"`` 1 / number of returns;
+    ``"intensity"`` its intensity over the summed intensity of its pulse's returns in the
+    tile (a pulse: one flight line or scan position and one GPS time; a return of the pulse
+    clipped out of the file is not counted), falling back to 1 / number of returns for a
+    pulse whose returns carry no intensity (all 0) or that cannot be told apart (more points
+    share its line and time than its number of returns: a file without GPS times)."""
+    equal = 1.0 / np.maximum(tile.number_of_returns, 1).astype(float)
+    if rule == "equal" or tile.intensity is None or tile.gps_time is None:
+        return equal
+    if rule != "intensity":
+        raise ValueError(f"echo weight {rule!r}: 'equal' or 'intensity'")
+    sid = np.zeros(len(tile)) if tile.source_id is None else tile.source_id
+    _, pulse = np.unique(np.column_stack([sid, tile.gps_time]), axis=0, return_inverse=True)
+    pulse = pulse.ravel()
+    inten = np.asarray(tile.intensity, float)
+    total = np.bincount(pulse, weights=inten)[pulse]
+    # a "pulse" holding more returns than its number of returns is no pulse (no GPS times)
+    one_pulse = np.bincount(pulse)[pulse] <= np.maximum(tile.number_of_returns, 1)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        return np.where((total > 0) & one_pulse, inten / total, equal)
 
 
 def _beam_pad(tile: Tile, *, heights: np.ndarray, origin: np.ndarray, size: float,
               g_of_mu: Callable[[np.ndarray], np.ndarray], ground_m: float = 0.5,
               empty: tuple[np.ndarray, np.ndarray] | None = None,
-              envelope_m: float | None = None
+              envelope_m: float | None = None, echo_weight: str = "equal"
               ) -> tuple[float, float, np.ndarray, BeamCounts, np.ndarray | None]:
     """(x0, y0, pad, entering beams, envelope fractions) by following every point's beam
     (:mod:`radtree.lidar.beams`) on the grid over the points' extent, heights 0 … the highest
@@ -221,7 +264,7 @@ def _beam_pad(tile: Tile, *, heights: np.ndarray, origin: np.ndarray, size: floa
     end = np.column_stack([xy, heights])
     start = np.asarray(origin, float) - np.column_stack(
         [np.zeros((len(xy), 2)), tile.xyz[:, 2] - heights])   # terrain under the return
-    weight = 1.0 / np.maximum(tile.number_of_returns, 1).astype(float)
+    weight = echo_weights(tile, echo_weight)
     hit = heights >= ground_m
     if empty is not None and len(empty[0]):
         shift = np.array([0.0, 0.0, float(np.median(tile.xyz[:, 2] - heights))])
@@ -237,7 +280,7 @@ def _beam_pad(tile: Tile, *, heights: np.ndarray, origin: np.ndarray, size: floa
         start, end, hit, weight, beyond_max = _clip_beams(env, start, end, hit, weight)
     counts = beam_counts(Beams(start, end, hit, weight), lo=lo, size=size, shape=shape,
                          g_of_mu=g_of_mu, beyond_max=beyond_max)
-    pad = density(counts.entering, counts.hits, counts.optical)
+    pad = density(counts.entering, counts.hits, counts.optical, counts.effective())
     frac = None if env is None else env.fractions(lo, size, shape)
     return float(x0), float(y0), pad, counts, frac
 
@@ -261,7 +304,8 @@ def tree_voxels(path: str | Path, g: float, size_m: float | None = None,
                 g_of_mu: Callable[[np.ndarray], np.ndarray] | None = None,
                 empty: Callable[[Tile], tuple[np.ndarray, np.ndarray]] | None = None,
                 fill: bool = True, envelope: bool = True,
-                pulse_min: float = PULSE_MIN, pool: bool = True) -> VoxelGrid:
+                pulse_min: float = PULSE_MIN, pool: bool = True,
+                echo_weight: str = "intensity") -> VoxelGrid:
     """The plant area density grid of the one tree in ``path`` (module text); ConfigError
     naming the file and the fix for an empty or one-point tree, no ground, a voxel finer
     than the point spacing supports. With ``origins`` (where each point's beam was fired,
@@ -293,14 +337,14 @@ def tree_voxels(path: str | Path, g: float, size_m: float | None = None,
     frac = None
     if origins is None:
         x0, y0, pad, entering = _columns(tile.xyz[:, :2], heights, size_m=size, g=g,
-                                         ground_m=0.5)
+                                         ground_m=0.5, weight=echo_weights(tile, echo_weight))
     else:
         x0, y0, pad, counts, frac = _beam_pad(
             tile, heights=heights, origin=origins(tile), size=size,
             g_of_mu=g_of_mu or (lambda mu: np.full(np.shape(mu), g)),
             empty=None if empty is None else empty(tile),
-            envelope_m=spacing if envelope else None)
-        entering = counts.entering
+            envelope_m=spacing if envelope else None, echo_weight=echo_weight)
+        entering = counts.effective()
     lowest_k = int(np.floor(heights[veg].min() / size))
     if frac is not None:
         if fill:

@@ -56,16 +56,18 @@ from radtree.lidar.voxels import VoxelGrid
 SUB = 4
 
 
-def vertical_beams(path: str | Path) -> tuple[np.ndarray, np.ndarray]:
-    """(x, y (n, 2) m, heights above ground (n,) m) of every return of the tree in ``path``
-    but buildings and noise — as :func:`radtree.lidar.voxels.tree_voxels` reads them."""
+def vertical_beams(path: str | Path) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(x, y (n, 2) m, heights above ground (n,) m, weights (n,)) of every return of the tree
+    in ``path`` but buildings and noise — as :func:`radtree.lidar.voxels.tree_voxels` reads
+    them (weights: :func:`radtree.lidar.voxels.echo_weights`, by intensity share)."""
     from radtree.lidar.ground import NOT_TREES, heights_above_ground
     from radtree.lidar.tile import read_tile
+    from radtree.lidar.voxels import echo_weights
 
     tile = read_tile(path)
     heights, _ = heights_above_ground(tile, "class")
     keep = ~np.isin(tile.classification, NOT_TREES)
-    return tile.xyz[keep, :2], heights[keep]
+    return tile.xyz[keep, :2], heights[keep], echo_weights(tile, "intensity")[keep]
 
 
 def crown_centre(grid: VoxelGrid) -> np.ndarray:
@@ -154,12 +156,13 @@ def solve_mean_gap(mean_gap: Callable[[np.ndarray], np.ndarray], gap: np.ndarray
 
 
 def footprint_density(grid: VoxelGrid, inside: np.ndarray, *, xy: np.ndarray,
-                      heights: np.ndarray, ground_m: float = 0.5
-                      ) -> tuple[np.ndarray, np.ndarray]:
+                      heights: np.ndarray, ground_m: float = 0.5,
+                      weights: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
     """(u m²/m³, counted) per voxel: the column inversion of :mod:`radtree.lidar.voxels` on
     the beams through the hull's part of each voxel only (module text). ``xy`` (n, 2) m and
     ``heights`` (n,) m above ground of every return of the tree, ground returns included (one
-    vertical beam each); ``counted``: voxels some beam reached."""
+    vertical beam each, of weight ``weights``: 1 when None; the ½ added in effective beams,
+    (Σ w)² / Σ w²); ``counted``: voxels some beam reached."""
     nx, ny, nz = grid.pad.shape
     sub = inside.shape[0] // nx
     w, g = grid.size_m / sub, grid.g
@@ -168,10 +171,14 @@ def footprint_density(grid: VoxelGrid, inside: np.ndarray, *, xy: np.ndarray,
     ok = (fi >= 0) & (fi < nx * sub) & (fj >= 0) & (fj < ny * sub)
     k = np.where(heights >= ground_m, np.floor(heights / grid.size_m), -1).astype(np.int64)
     k = np.clip(k, -1, nz - 1)
+    wt = np.ones(len(heights)) if weights is None else np.asarray(weights, float)
     counts = np.zeros((nx * sub, ny * sub, nz + 1))      # [..., 0] ground, [..., k + 1] layer k
-    np.add.at(counts, (fi[ok], fj[ok], k[ok] + 1), 1.0)
+    np.add.at(counts, (fi[ok], fj[ok], k[ok] + 1), wt[ok])
+    squares = np.zeros((nx * sub, ny * sub, nz + 1))
+    np.add.at(squares, (fi[ok], fj[ok], k[ok] + 1), wt[ok] ** 2)
     below = np.cumsum(counts, axis=2)
     top, bottom = below[..., 1:], below[..., :-1]        # N(z_top), N(z_bottom) per cell column
+    top_sq = np.cumsum(squares, axis=2)[..., 1:]
 
     def per_voxel(a: np.ndarray) -> np.ndarray:           # (nx, ny, nz, sub²)
         return a.reshape(nx, sub, ny, sub, nz).transpose(0, 2, 4, 1, 3).reshape(
@@ -183,7 +190,9 @@ def footprint_density(grid: VoxelGrid, inside: np.ndarray, *, xy: np.ndarray,
     n_top_sum = n_top.sum(axis=-1)
     n_bottom = (per_voxel(bottom) * lit).sum(axis=-1)
     counted = n_top_sum > 0
-    gap = (n_bottom[counted] + 0.5) / (n_top_sum[counted] + 0.5)
+    sq = (per_voxel(top_sq) * lit).sum(axis=-1)[counted]
+    n_eff = n_top_sum[counted] ** 2 / np.maximum(sq, 1e-300)     # effective beams
+    gap = (n_eff * n_bottom[counted] / n_top_sum[counted] + 0.5) / (n_eff + 0.5)
     u = np.zeros((nx, ny, nz))
     us, _ = _solve_u(paths[counted], weights=n_top[counted], gap=np.minimum(gap, 1.0), g=g)
     u[counted] = np.where(gap < 1.0, us, 0.0)
@@ -191,13 +200,13 @@ def footprint_density(grid: VoxelGrid, inside: np.ndarray, *, xy: np.ndarray,
 
 
 def sharpen(grid: VoxelGrid, *, sub: int = SUB,
-            beams: tuple[np.ndarray, np.ndarray] | None = None, margin_m: float = 0.0,
+            beams: tuple[np.ndarray, ...] | None = None, margin_m: float = 0.0,
             density: Callable[[VoxelGrid, np.ndarray], tuple[np.ndarray, np.ndarray]]
             | None = None) -> tuple[VoxelGrid, int]:
     """(the grid on cells of side size_m/``sub`` with its plant area inside the returns' hull
     (widened by ``margin_m``), voxels with plant area that no beam through their hull part
     reached — their leaf area kept, spread over their inside cells) (module text). ``beams``:
-    (x, y, heights) of :func:`vertical_beams` for the vertical-beam inversion; None spreads
+    (x, y, heights[, weights]) of :func:`vertical_beams` for the vertical-beam inversion; None spreads
     every voxel's leaf area over its inside cells. ``density``: (grid, inside) → (u, counted)
     instead, e.g. the re-inversion along tilted beams
     (:func:`radtree.trees.points_rim.beam_footprint_density`)."""
@@ -213,7 +222,8 @@ def sharpen(grid: VoxelGrid, *, sub: int = SUB,
     unreached = 0
     if beams is not None and density is None:
         def density(gr: VoxelGrid, ins: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-            return footprint_density(gr, ins, xy=beams[0], heights=beams[1])
+            return footprint_density(gr, ins, xy=beams[0], heights=beams[1],
+                                     weights=beams[2] if len(beams) > 2 else None)
     if density is not None and dense.any():
         uf, counted = density(grid, inside)
         u = np.where(dense & counted, uf, u)

@@ -16,18 +16,20 @@ Here the re-inversion along the tilted beams: every beam b (origin → return; a
 beam on to the exit of its return's voxel, the chord it was exposed to, as
 :mod:`radtree.lidar.beams` counts it) is walked on the hull's cells (side w = v / sub,
 Amanatides & Woo 1987 via :func:`radtree.lidar.beams.traverse`); ℓ_b is its length in the
-voxel's inside cells. Of the beams with ℓ_b > 0 (weight w_b = 1/number of returns), N enter
-and I are intercepted in the voxel; the density u of the inside cells is
+voxel's inside cells. Of the beams with ℓ_b > 0 (weight w_b: the return's share of its pulse,
+:func:`radtree.lidar.voxels.echo_weights`), N enter and I are intercepted in the voxel (weighted;
+n = N²/Σ w_b² the effective number of beams, :mod:`radtree.lidar.beams`); the density u of the
+inside cells is
 
-    u = −ln( (N − I + ½) / (N + ½) ) / l̄_G,   l̄_G = Σ_b w_b·G(μ_b)·ℓ_b / N
+    u = −ln( (n·(1 − I/N) + ½) / (n + ½) ) / l̄_G,   l̄_G = Σ_b w_b·G(μ_b)·ℓ_b / N
 
 (the voxel inversion's own estimator, :mod:`radtree.lidar.beams`, on the beams through the
 hull part only, ``estimator = "mean_path"``, the default), or u solving
-Σ_b w_b exp(−u·G(μ_b)·ℓ_b) / Σ_b w_b = (N − I + ½) / (N + ½) (``"sum_exp"``, the vertical
+Σ_b w_b exp(−u·G(μ_b)·ℓ_b) / Σ_b w_b = (n·(1 − I/N) + ½) / (n + ½) (``"sum_exp"``, the vertical
 columns' rule of :mod:`radtree.trees.points_hull`, which takes each beam's own path in the
 hull part into account). Only rim voxels (the hull crosses them) are re-inverted: a voxel
 wholly inside the hull keeps the inversion's estimate. A voxel that fewer than ``pulse_min``
-beams entered through its hull part keeps the inversion's leaf area spread over its inside
+(effective) beams entered through its hull part keeps the inversion's leaf area spread over its inside
 cells (the undersampled voxels' rule of :mod:`radtree.lidar.voxels`).
 
 Measured (2026-12-07, ``benchmarks/lidar_facade.py --seeds 8 --turbid-seeds 16``, turbid
@@ -46,8 +48,8 @@ from pathlib import Path
 
 import numpy as np
 
-from radtree.lidar.beams import Beams, chord_beyond, traverse
-from radtree.lidar.voxels import PULSE_MIN, VoxelGrid
+from radtree.lidar.beams import BeamCounts, Beams, chord_beyond, traverse
+from radtree.lidar.voxels import PULSE_MIN, VoxelGrid, echo_weights
 from radtree.trees.points_hull import solve_mean_gap
 
 
@@ -59,7 +61,6 @@ def tilted_beams(path: str | Path, origins: np.ndarray | None = None) -> Beams:
     from radtree.lidar.ground import NOT_TREES, heights_above_ground
     from radtree.lidar.scan_angle import HEIGHT_RANGE_M, scan_angle_origins
     from radtree.lidar.tile import read_tile
-
     tile = read_tile(path)
     if origins is None:
         o = scan_angle_origins(tile)
@@ -70,8 +71,7 @@ def tilted_beams(path: str | Path, origins: np.ndarray | None = None) -> Beams:
     end = np.column_stack([xyz[:, :2], h])
     start = np.asarray(origins, float)[keep] - np.column_stack(
         [np.zeros((len(h), 2)), xyz[:, 2] - h])
-    weight = 1.0 / np.maximum(tile.number_of_returns[keep], 1).astype(float)
-    return Beams(start, end, h >= 0.5, weight)
+    return Beams(start, end, h >= 0.5, echo_weights(tile, "intensity")[keep])
 
 
 def beam_footprint_density(grid: VoxelGrid, inside: np.ndarray, *, beams: Beams,
@@ -108,12 +108,14 @@ def beam_footprint_density(grid: VoxelGrid, inside: np.ndarray, *, beams: Beams,
     hit = beams.hit[b] & (end_vox == pv)
     gb = np.asarray(g_of_mu(np.abs(d[b, 2])), float)
     n = nx * ny * nz
-    entering = np.bincount(pv, weights=wb, minlength=n)
-    hits = np.bincount(pv, weights=wb * hit, minlength=n)
+    counts = BeamCounts(np.bincount(pv, weights=wb, minlength=n),
+                        np.bincount(pv, weights=wb * hit, minlength=n),
+                        np.zeros(n), np.bincount(pv, weights=wb**2, minlength=n))
+    entering, hits, n_eff = counts.entering, counts.hits, counts.effective()
     rim = (inside.reshape(nx, sub, ny, sub, nz, sub).sum(axis=(1, 3, 5)) < sub**3).ravel()
-    counted = (entering >= pulse_min) & rim
-    with np.errstate(divide="ignore", invalid="ignore"):
-        gap = (np.maximum(entering - hits, 0.0) + 0.5) / (entering + 0.5)
+    counted = (n_eff >= pulse_min) & rim
+    with np.errstate(divide="ignore", invalid="ignore"):   # the voxels' gap (beams.density)
+        gap = (n_eff * np.maximum(entering - hits, 0.0) / entering + 0.5) / (n_eff + 0.5)
     if estimator == "mean_path":
         optical = np.bincount(pv, weights=wb * gb * ell, minlength=n)
         with np.errstate(divide="ignore", invalid="ignore"):

@@ -134,4 +134,5 @@ def write_scan(points: ScanPoints, out: str | Path, offset: tuple[float, float] 
     xyz = points.xyz + [offset[0], offset[1], 0.0]
     return write_points(out, xyz, points.classification, points.return_number,
                         points.number_of_returns, crs=crs, source_id=points.line,
-                        gps_time=points.time, scan_angle_deg=points.scan_angle_deg)
+                        gps_time=points.time, scan_angle_deg=points.scan_angle_deg,
+                        intensity=points.intensity)
