@@ -358,11 +358,11 @@ class ThreePhase:
         total = sums.sum(axis=0) + v_sky.sum(axis=(1, 2))
         share = sums / np.where(total > 0, total, 1.0)
         groups = [g for k, g in enumerate(self.groups) if share[k].max() >= TILE_SHARE]
-        rest: dict[tuple[str, int], list[int]] = {}
+        rest: dict[tuple[str, int, int], list[int]] = {}
         for k, g in enumerate(self.groups):
             if share[k].max() < TILE_SHARE:
-                rest.setdefault((g.material, g.coarse), []).append(k)
-        for (material, coarse), ks in sorted(rest.items()):
+                rest.setdefault((g.material, g.coarse, g.part), []).append(k)
+        for (material, coarse, _), ks in sorted(rest.items()):
             if share[ks].sum(axis=0).max() < VISIBLE_SHARE:
                 continue
             mean = np.sum([self.groups[k].normal * self.groups[k].area for k in ks], axis=0)
@@ -370,7 +370,8 @@ class ThreePhase:
             groups.append(FacetGroup(material, np.concatenate([self.groups[k].triangles
                                                                for k in ks]),
                                      mean / np.linalg.norm(mean), self.groups[ks[0]].direction,
-                                     self.groups[ks[0]].up, coarse, weight))
+                                     self.groups[ks[0]].up, coarse, weight,
+                                     self.groups[ks[0]].part))
         return groups
 
     def daylight(self, state: str, groups: list[FacetGroup], room_side: bool = False
