@@ -50,7 +50,9 @@ crown XMLs of ``--samples 500``; façade / work plane):
   in front of the cap, facing the glazing, 0.0072–0.0093 (4–5 ×). The chain then reflected
   the crown's own light back at the sensors (R·D' was 6.7 % of the façade's light). Wound
   away from the room: **façade 0.991, work plane 0.950** (``-c 100``; ``-c 400``: 0.994 /
-  0.956). Per façade row 0.96, 1.02, 1.01, 1.01, 0.97.
+  0.956). Per façade row 0.96, 1.02, 1.01, 1.01, 0.97. At the old reference settings
+  (``--ad 1024 --lw 1e-3``, 04:02 UTC) the same chain read 0.953 / 1.043: the reference's
+  error there (façade 0.0462, work plane 0.0036) is larger than the claim.
 * Not resolved: the work plane's −5 %. With the office XMLs' reflection zeroed (and the
   per-crown grouping) the chain read 0.989 / 0.987, so it sits in the crown's reflection or
   the light it scatters toward the window, not in the sampling of D (``-c`` × 4 moved it by
