@@ -63,6 +63,13 @@ dc runs were reused and the BSDFs regenerated; load 2–3.4; 3-phase 511 s wall,
 ``explicit`` within 0.5 pp.
 
 Run: ``nice .venv/bin/python benchmarks/threephase.py [--work DIR] [--samples 200] [-j 2]``.
+
+Measured again 2026-12-08 03:53–03:59 UTC after the three-phase closure fixes (one facet
+group per crown; the room-side daylight matrices traced into the room; the 01:27 folder
+copied, load 2–3.4; the benchmark 370 s wall): ``fivephase`` façade UDI <100 +1.1, 100–300
++1.2, 300–3000 −1.5, >3000 −0.9, work plane sDA +2.5, UDI <100 +4.9, 100–300 −5.5,
+300–3000 −0.1, >3000 +0.7 — the work plane's miss is unchanged; ``explicit``, whose sky
+is the same chain, within 0.5 pp: the miss is in the five-phase sun.
 """
 
 from __future__ import annotations

@@ -325,3 +325,87 @@ def test_five_phase_sun(runs):
             assert isinstance(m, Plastic) and m.reflectance == 0.0
         else:
             assert m == plan.scenes["leaf_on"].materials[name]
+
+
+def test_facet_groups_one_crown_each():
+    """Two crowns of a row in one mesh (their own vertices, as the BSDF shell builds them):
+    facets of one plane orientation in both crowns are two groups, never one (issue 40: a
+    group's daylight matrix is the mean over its facets, and the office's sensors see only
+    the central crown: with one group across the row the façade read 1.131 × the direct
+    trace, per crown 1.034)."""
+    import trimesh
+
+    from radtree.annual.facets import FACETS, shell_parts
+    from radtree.annual.threephase import facet_groups
+    from radtree.optics import Bsdf
+    from radtree.scene import Mesh
+    from radtree.trees.bsdf_shell import BSDF_SHELL, inward
+    from radtree.trees.model import TreeModel
+
+    sphere = trimesh.creation.icosphere(subdivisions=1, radius=2.0)
+    verts, faces = [], []
+    for k, x in enumerate((-3.0, 3.0)):
+        c = np.array([x, 5.0, 6.0])
+        v = np.asarray(sphere.vertices) + c
+        verts.append(v)
+        faces.append(inward(v, np.asarray(sphere.faces), c) + k * len(v))
+    v, f = np.concatenate(verts), np.concatenate(faces)
+    np.testing.assert_array_equal(np.unique(shell_parts(f)), [0, 1])
+    model = TreeModel(meshes=[Mesh("s", BSDF_SHELL, v, f)],
+                      materials={BSDF_SHELL: Bsdf(BSDF_SHELL, "crown.xml")}, notes=[],
+                      recommended_ab=2, info={}, form="free", model="louvers")
+    planes = facet_groups(model, sensors_inside=False, level=FACETS)
+    assert len(planes) == len(f)                # 2 × 80 facets, 80 orientations
+    for g in planes:
+        assert len(np.unique(np.sign(g.triangles[:, :, 0].mean(axis=1)))) == 1
+    assert sorted({g.part for g in planes}) == [0, 1]
+    share: dict[tuple[int, int], float] = {}
+    for g in planes:
+        share[(g.coarse, g.part)] = share.get((g.coarse, g.part), 0.0) + g.weight
+    np.testing.assert_allclose(list(share.values()), 1.0)   # per crown's level-0 group
+    coarse = facet_groups(model, sensors_inside=False)      # level 0: 14 per crown
+    assert len(coarse) == 28
+
+
+def test_room_side_sender_is_wound_away_from_the_room():
+    """rfluxmtx sends a sender's rays away from its polygons' normal whatever ``h=±kf``
+    (:func:`test_room_side_sender_sends_into_the_room`): the transmitted light's sender sits
+    behind the facets (away from the room), wound to the room; the room side's in front of
+    them, wound away from it."""
+    from radtree.engines.radiance import threephase as rad3
+
+    tris = np.array([[[0, 0, 1], [1, 0, 1], [1, 1, 1]], [[0, 0, 1], [1, 1, 1], [0, 1, 1]]],
+                    float)
+    for room_side, dz in ((True, 1.0), (False, -1.0)):     # the room above the square
+        text = rad3.sender_text(tris, np.array([0.0, 0.0, 1.0]), room_side=room_side)
+        assert text.startswith("#@rfluxmtx h=-kf")
+        t = np.array(text.split("\n9 ")[1].split("\n")[0].split(), float).reshape(3, 3)
+        assert np.sign(np.cross(t[1] - t[0], t[2] - t[0])[2]) == -dz
+        np.testing.assert_allclose(t[:, 2], 1.0 + dz * rad3.SENDER_OFFSET_M)
+
+
+@needs_radiance
+def test_room_side_sender_sends_into_the_room(tmp_path):
+    """A unit square at z = 1 whose room is above it, a uniform sky (radiance 1 above the
+    horizon) and nothing else: the room-side daylight matrix sees the whole sky
+    (Σ_j Λ_j Σ_sky D_j = π) and the transmitted light's sees none of it."""
+    from radtree.engines.radiance import threephase as rad3
+
+    tris = np.array([[[0, 0, 1], [1, 0, 1], [1, 1, 1]], [[0, 0, 1], [1, 1, 1], [0, 1, 1]]],
+                    float)
+    octree = rad3.octree(tmp_path, "far", "void plastic p\n0\n0\n5 .5 .5 .5 0 0\n\n"
+                         "p polygon far\n0\n0\n12 100 100 -50 101 100 -50 101 101 -50 "
+                         "100 101 -50\n")
+    bounds = np.radians([0, 5, 15, 25, 35, 45, 55, 65, 75, 90])
+    n_phi = [1, 8, 16, 20, 24, 24, 24, 16, 12]
+    lam = np.concatenate([[np.pi * (np.sin(b) ** 2 - np.sin(a) ** 2) / n] * n
+                          for a, b, n in zip(bounds[:-1], bounds[1:], n_phi)])
+    seen = {}
+    for room_side in (True, False):
+        text = rad3.sender_text(tris, np.array([0.0, 0.0, 1.0]), room_side=room_side)
+        path = rad3.daylight_matrix(tmp_path, octree, f"s{int(room_side)}", text, 1, 20,
+                                    ["-ab", "1", "-ad", "2", "-aa", "0"], 1)
+        d = rad3.read_matrix(path.read_bytes(), "D").mean(axis=2)
+        seen[room_side] = float(lam @ d[:, 1:].sum(axis=1))
+    assert seen[True] == pytest.approx(np.pi, rel=1e-3)
+    assert seen[False] == 0.0

@@ -60,6 +60,7 @@ class FacetGroup:
     up: tuple[float, float, float] | None = None
     coarse: int = -1
     weight: float = 1.0
+    part: int = -1
 
     @property
     def area(self) -> float:
@@ -70,6 +71,25 @@ class FacetGroup:
     @property
     def key(self) -> str:
         return f"{self.material}_{len(self.triangles)}"
+
+
+def shell_parts(faces: np.ndarray) -> np.ndarray:
+    """(k,) label of the connected piece of a mesh each of its ``faces`` (k, 3) vertex indices
+    belongs to (faces sharing a vertex index are connected). A free crown row's envelopes
+    are glued where neighbours meet but keep their own vertices
+    (:func:`radtree.trees.bsdf_shell.build_bsdf_crown`), so each crown's part of a band is
+    its own piece."""
+    from scipy.sparse import coo_matrix
+    from scipy.sparse.csgraph import connected_components
+
+    k = len(faces)
+    if k == 0:
+        return np.zeros(0, np.int64)
+    _, vid = np.unique(np.asarray(faces, np.int64).ravel(), return_inverse=True)
+    n_v = int(vid.max()) + 1
+    graph = coo_matrix((np.ones(3 * k), (np.repeat(np.arange(k), 3), k + vid.ravel())),
+                       shape=(k + n_v, k + n_v))
+    return connected_components(graph, directed=False)[1][:k].astype(np.int64)
 
 
 def facet_groups(model: TreeModel, sensors_inside: bool, tile_m: float = 0.0,
@@ -93,6 +113,7 @@ def facet_groups(model: TreeModel, sensors_inside: bool, tile_m: float = 0.0,
         area = np.linalg.norm(n, axis=1)
         keep = area > 1e-12
         tri, n, area = tri[keep], n[keep] / area[keep][:, None], 0.5 * area[keep]
+        faces = mesh.faces[keep]
         coarse = np.argmax(n @ _DIRS.T, axis=1)
         if level == FACETS:
             _, direction = np.unique(np.round(n / PLANE_TOLERANCE).astype(np.int64), axis=0,
@@ -101,10 +122,15 @@ def facet_groups(model: TreeModel, sensors_inside: bool, tile_m: float = 0.0,
         else:
             direction = np.argmax(n @ group_directions(level).T, axis=1)
         cell = np.zeros((len(tri), 3), np.int64)
+        part = np.zeros(len(tri), np.int64)
         if tile_m > 0 and (tiled is None or mesh.material in tiled):
             cell = np.floor(tri.mean(axis=1) / tile_m).astype(np.int64)
-        _, which = np.unique(np.column_stack([direction, cell]), axis=0, return_inverse=True)
-        _, parent = np.unique(np.column_stack([coarse, cell]), axis=0, return_inverse=True)
+        else:     # untiled: never one group across the crowns of a row (CROWN_PARTS)
+            part = shell_parts(faces)
+        _, which = np.unique(np.column_stack([direction, cell, part]), axis=0,
+                             return_inverse=True)
+        _, parent = np.unique(np.column_stack([coarse, cell, part]), axis=0,
+                              return_inverse=True)
         which, parent = which.ravel(), parent.ravel()
         parent_area = np.bincount(parent, weights=area)
         for d in np.unique(which):
@@ -113,5 +139,5 @@ def facet_groups(model: TreeModel, sensors_inside: bool, tile_m: float = 0.0,
             weight = float(area[pick].sum() / parent_area[parent[pick][0]])
             groups.append(FacetGroup(mesh.material, tri[pick], mean / np.linalg.norm(mean),
                                      int(direction[pick][0]), up, int(coarse[pick][0]),
-                                     min(1.0, weight)))
+                                     min(1.0, weight), int(part[pick][0])))
     return groups

@@ -126,6 +126,20 @@ resolution on the crown XML's straight-through part, not its sampling — a fine
 that part (a tensor tree, or the sun-like treatment of the five-phase method) is the next
 step.
 
+**One group per crown; the room side turned round (issue 40, the office's row of three
+crowns, 8 December 2026).** The office's closure read façade 1.135, work plane 1.025 with a
+converged reference (``benchmarks/threephase_closure.py``, whose docstring holds the
+measurements). Two causes: (1) a row's envelopes are glued into one shell, and grouping by
+plane orientation put the facets of one orientation of all three crowns into one group, whose
+daylight matrix is their mean while the sensors see the central crown — groups are now also
+split by connected piece (:func:`~radtree.annual.facets.shell_parts`: each crown keeps its own
+vertices), and the merged groups of :meth:`ThreePhase.d_groups` too (1.034 / 1.006); (2)
+rfluxmtx sends a sender's rays away from its normal whatever ``h=±kf``, so the room-side
+daylight matrices (sender wound to the room, ``h=+kf``) looked back into the crown and read
+4–5 × the light arriving from the room's side; the sender is now wound away from the room
+(:func:`~radtree.engines.radiance.threephase.sender_text`): façade 0.991, work plane 0.950.
+The work plane's −5 % is not resolved (with the XMLs' reflection zeroed 0.987).
+
 A second weather file reruns ``gendaymtx`` and the products only (the sun coefficients
 are reused when the sun positions are the same, i.e. the same site); a second leaf state
 reuses ``V`` (and the dome's ``D``). Not ray traced: light crossing the shell is turned
@@ -358,11 +372,11 @@ class ThreePhase:
         total = sums.sum(axis=0) + v_sky.sum(axis=(1, 2))
         share = sums / np.where(total > 0, total, 1.0)
         groups = [g for k, g in enumerate(self.groups) if share[k].max() >= TILE_SHARE]
-        rest: dict[tuple[str, int], list[int]] = {}
+        rest: dict[tuple[str, int, int], list[int]] = {}
         for k, g in enumerate(self.groups):
             if share[k].max() < TILE_SHARE:
-                rest.setdefault((g.material, g.coarse), []).append(k)
-        for (material, coarse), ks in sorted(rest.items()):
+                rest.setdefault((g.material, g.coarse, g.part), []).append(k)
+        for (material, coarse, _), ks in sorted(rest.items()):
             if share[ks].sum(axis=0).max() < VISIBLE_SHARE:
                 continue
             mean = np.sum([self.groups[k].normal * self.groups[k].area for k in ks], axis=0)
@@ -370,7 +384,8 @@ class ThreePhase:
             groups.append(FacetGroup(material, np.concatenate([self.groups[k].triangles
                                                                for k in ks]),
                                      mean / np.linalg.norm(mean), self.groups[ks[0]].direction,
-                                     self.groups[ks[0]].up, coarse, weight))
+                                     self.groups[ks[0]].up, coarse, weight,
+                                     self.groups[ks[0]].part))
         return groups
 
     def daylight(self, state: str, groups: list[FacetGroup], room_side: bool = False

@@ -102,14 +102,26 @@ def blocker_text(triangles: list[np.ndarray]) -> str:
 
 def sender_text(triangles: np.ndarray, normal: np.ndarray, room_side: bool = False,
                 up: tuple[float, float, float] | None = None) -> str:
-    """The daylight-matrix sender of one group: its facets moved :data:`SENDER_OFFSET_M`
-    away from the room, ``h=-kf`` (rays leave away from the room: the light the group
-    transmits); ``room_side``: moved towards the room, ``h=+kf`` (rays leave into the room:
-    the light the group reflects back into it)."""
+    """The daylight-matrix sender of one group (``triangles`` wound to the room, ``normal``
+    towards it): its facets moved :data:`SENDER_OFFSET_M` away from the room (rays leave
+    away from the room: the light the group transmits); ``room_side``: moved towards the
+    room and wound the other way (rays leave into the room: the light the group reflects
+    back into it).
+
+    rfluxmtx sends a sender's rays to the side its polygons' normal points *away* from,
+    whatever the sign of ``h=±kf`` (measured: a polygon under a uniform sky, normal down,
+    ``h=+kf`` and ``h=-kf`` both see the sky, normal up neither; the Radiance tutorials'
+    window sender, normal into the room, ``h=-kf``, sends its rays out), so the room side is
+    the winding turned round, not ``h=+kf`` (issue 40: with ``h=+kf`` and the room's winding
+    the "room-side" rays went back into the crown and read the light the crown sends into
+    the room, ≈ 5 × the light arriving at the office's wall cap from the room's side)."""
     n = np.asarray(normal, float)
-    sign, hemi = (1.0, "+kf") if room_side else (-1.0, "-kf")
-    moved = np.asarray(triangles, float) + sign * SENDER_OFFSET_M * n
-    return f"#@rfluxmtx h={hemi} u={up_text(n, up)}\n\n" + _polygons("void", "tp_sender", moved)
+    tri = np.asarray(triangles, float)
+    if room_side:     # towards the room, its normal away from it
+        moved, n = tri[:, ::-1] + SENDER_OFFSET_M * n, -n
+    else:
+        moved = tri - SENDER_OFFSET_M * n
+    return f"#@rfluxmtx h=-kf u={up_text(n, up)}\n\n" + _polygons("void", "tp_sender", moved)
 
 
 def read_matrix(data: bytes, what: str) -> np.ndarray:
