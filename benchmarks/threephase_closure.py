@@ -60,6 +60,31 @@ crown XMLs of ``--samples 500``; façade / work plane):
   a Lambertian wall cap's transmission 3.5 % low 5 mm in front of it (0.289 × the light 2 mm
   behind it, ``-u+`` 0.300, T = 0.3); on the office XMLs ``-u+`` moved the reference by
   0.6 %.
+* **The reflection term's frame and block (helper ``shells2``, 8 December 2026 04:10–04:30
+  UTC, load 2.4–4.3; same settings, ``--xml`` controlled XMLs in a copy of the 500-sample
+  folder).** T = 0.3 δ/Λ with R = 0.3 sent into one half of the outgoing hemisphere (Klems
+  patch-centre azimuth 0–180°, the material's +y = up, or 180–360°, down), against δ × 0.3
+  with R = 0 (reference 0.0999 / 0.0122, chain 0.0974 / 0.0121): reflection up, reference
+  0.1450 / 0.0174, chain 0.1423 / 0.0168 (0.981 / 0.965); down, reference 0.1518 / 0.0174,
+  chain 0.1540 / 0.0181 (1.015 / 1.043). The chain's gain from reflection is the reference's
+  within −10 … +15 % in both directions and its rows follow the reference's (up: 0.036 …
+  0.048 against 0.039 … 0.049 per façade row), so the up/down axis is not mirrored and the
+  block is the right one (the shell's normals point into the crown, so light from the room's
+  side meets the XML's "Reflection Front", which ``turned_xml`` + ``room_reflection_xml``
+  hand to rmtxop). A left/right mirror cannot move a total on this scene (symmetric about the
+  central crown's vertical plane, uniform sky). Lambertian XMLs: T 0.3, R 0.1 → 0.998 /
+  1.088; T 0.3, R 0 → 1.008 / 1.108: reflection adds 0.0013 to the work-plane reference and
+  0.0012 to the chain (façade 0.0121 and 0.0112). **So the reflection term is applied in the
+  right frame and block; the work plane's error follows how diffuse T is** (δ × 0.3: 0.991,
+  Lambertian 1.108, the office XMLs 0.987 with R zeroed); its cause is not found.
+* Also seen: an XML whose reflection block on the room's side is all zero ("Reflection
+  Front" 0, "Reflection Back" up) still gets a reflected term (façade 0.0109 of 0.1413;
+  without it the chain would read 1.008 / 1.006): rmtxop's ``cm_loadBTDF`` falls back to the
+  other transmission block by reciprocity when the one it reads is absent (Radiance
+  ``src/common/cmbsdf.c``; that an all-zero block counts as absent is inferred from this
+  run), and ``room_reflection_xml`` puts the other reflection block there. Crown XMLs have both blocks, so the office is not affected. The chain reads façade
+  rows 5.0, 5.5 and 6.0 m alike (0.0957, 0.0957, 0.0955 for δ × 0.3; the reference 0.0951 …
+  0.1026): one wall-cap tile fills those sensors' view.
 """
 
 from __future__ import annotations
