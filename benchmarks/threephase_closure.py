@@ -60,31 +60,51 @@ crown XMLs of ``--samples 500``; façade / work plane):
   a Lambertian wall cap's transmission 3.5 % low 5 mm in front of it (0.289 × the light 2 mm
   behind it, ``-u+`` 0.300, T = 0.3); on the office XMLs ``-u+`` moved the reference by
   0.6 %.
-* **The reflection term's frame and block (helper ``shells2``, 8 December 2026 04:10–04:30
-  UTC, load 2.4–4.3; same settings, ``--xml`` controlled XMLs in a copy of the 500-sample
-  folder).** T = 0.3 δ/Λ with R = 0.3 sent into one half of the outgoing hemisphere (Klems
-  patch-centre azimuth 0–180°, the material's +y = up, or 180–360°, down), against δ × 0.3
-  with R = 0 (reference 0.0999 / 0.0122, chain 0.0974 / 0.0121): reflection up, reference
-  0.1450 / 0.0174, chain 0.1423 / 0.0168 (0.981 / 0.965); down, reference 0.1518 / 0.0174,
-  chain 0.1540 / 0.0181 (1.015 / 1.043). The chain's gain from reflection is the reference's
-  within −10 … +15 % in both directions and its rows follow the reference's (up: 0.036 …
-  0.048 against 0.039 … 0.049 per façade row), so the up/down axis is not mirrored and the
-  block is the right one (the shell's normals point into the crown, so light from the room's
-  side meets the XML's "Reflection Front", which ``turned_xml`` + ``room_reflection_xml``
-  hand to rmtxop). A left/right mirror cannot move a total on this scene (symmetric about the
-  central crown's vertical plane, uniform sky). Lambertian XMLs: T 0.3, R 0.1 → 0.998 /
-  1.088; T 0.3, R 0 → 1.008 / 1.108: reflection adds 0.0013 to the work-plane reference and
-  0.0012 to the chain (façade 0.0121 and 0.0112). **So the reflection term is applied in the
-  right frame and block; the work plane's error follows how diffuse T is** (δ × 0.3: 0.991,
-  Lambertian 1.108, the office XMLs 0.987 with R zeroed); its cause is not found.
-* Also seen: an XML whose reflection block on the room's side is all zero ("Reflection
-  Front" 0, "Reflection Back" up) still gets a reflected term (façade 0.0109 of 0.1413;
-  without it the chain would read 1.008 / 1.006): rmtxop's ``cm_loadBTDF`` falls back to the
-  other transmission block by reciprocity when the one it reads is absent (Radiance
-  ``src/common/cmbsdf.c``; that an all-zero block counts as absent is inferred from this
-  run), and ``room_reflection_xml`` puts the other reflection block there. Crown XMLs have both blocks, so the office is not affected. The chain reads façade
-  rows 5.0, 5.5 and 6.0 m alike (0.0957, 0.0957, 0.0955 for δ × 0.3; the reference 0.0951 …
-  0.1026): one wall-cap tile fills those sensors' view.
+* **The reflection term's frame and block (helper ``shells2``, 8 December 2026 04:10–04:30 UTC,
+  load 2.4–4.3; same settings, ``--xml`` controlled XMLs in a copy of the 500-sample folder).**
+  T = 0.3 δ/Λ with R = 0.3 sent into one half of the outgoing hemisphere (Klems patch-centre
+  azimuth 0–180°, the material's +y = up, or 180–360°, down), against δ × 0.3 with R = 0
+  (reference 0.0999 / 0.0122, chain 0.0974 / 0.0121): reflection up, reference 0.1450 / 0.0174,
+  chain 0.1423 / 0.0168 (0.981 / 0.965); down, reference 0.1518 / 0.0174, chain 0.1540 / 0.0181
+  (1.015 / 1.043); the reference's work plane does not tell up from down, the chain's does.
+  **These XMLs are not reciprocal, and rtrace does not apply them as rmtxop does** (below), so
+  they test little. Lambertian XMLs (reciprocal): T 0.3, R 0.1 → 0.998 / 1.088; T 0.3, R 0 →
+  1.008 / 1.108: reflection adds 0.0013 to the work-plane reference and 0.0012 to the chain
+  (façade 0.0121 and 0.0112) — the reflection term's total is right; the work plane's error
+  follows how diffuse T is (δ × 0.3: 0.991, Lambertian 1.108, the office XMLs with R zeroed
+  0.987). Its cause is not found. The block is the right one: the shell's normals point into
+  the crown, so light from the room's side meets the XML's "Reflection Front" (Radiance
+  ``bsdf_m.c`` swaps WINDOW's front and back), which ``turned_xml`` + ``room_reflection_xml``
+  hand to rmtxop.
+* **A left/right mirror in T (found, not fixed).** One 1 × 1 m window (normal down, into the
+  room, BSDF ``u=+Y``) in a black ceiling, a glow patch 45° up to one side, two sensors 1 m
+  below and 1 m to either side (``benchmarks/klems_handedness.py``): an XML that passes light only when both the incident and the
+  outgoing Klems patch have local x > 0 (azimuth within ±80°; unchanged by reciprocity) lights
+  the sensor on the far side of the window from the glow in rtrace (0.0161), the sensor on the
+  glow's side in the chain (``rmtxop V T D``, sender ``h=-kf``, receiver ``h=kf``, both
+  ``u=+Y``: 0.0171, the other 0; with the receiver ``h=-kf`` too, 0 / 0.0171). Radiance indexes a Klems matrix's incident and outgoing
+  patches in one frame (``bsdf_m.c``: fi/bi/fo/bo_getndx all take the propagation direction's
+  x, y), while rfluxmtx's ``h=-kf`` sender takes x = −(up × normal) and the ``h=kf`` receiver x
+  = +(up × normal) (``rfluxmtx.c`` ``prepare_sampler``, ``klems_full.cal`` ``kbin``). So
+  ``V·T·D`` reflects the transmitted light left/right about the up vector. From the frames
+  (rtrace's x = normal × up, as measured; derived, not measured on a crown): on the D side for
+  free crowns (normals into the crown), on the V side for the dome; the room-side ``V·R·D'``
+  (sender wound away from the room, x = up × n on both sides) is in rtrace's frame. A fix (not made,
+  derived): the dome's receivers ``h=-kf``; free crowns' outward D sender ``h=kf``. On this
+  scene (symmetric about the central crown's vertical plane, a uniform sky, crown XMLs without
+  a left/right bias) it cannot move a grid mean; it would under a low sun to one side or a
+  left/right-biased XML. An XML that is not reciprocal (light passed only from incident patches
+  with x > 0, every outgoing patch alike) is applied transposed by rtrace (only the far sensor
+  lit, 0.0079 / 0) and as written by rmtxop (0.0085 / 0.0085).
+* Also seen: an XML whose reflection block on the room's side is all zero ("Reflection Front"
+  0, "Reflection Back" up) still gets a reflected term (façade 0.0109 of 0.1413; without it the
+  chain would read 1.008 / 1.006): rmtxop's ``cm_loadBTDF`` falls back to the other
+  transmission block by reciprocity when the one it reads is absent (Radiance
+  ``src/common/cmbsdf.c``; that an all-zero block counts as absent is inferred from this run),
+  and ``room_reflection_xml`` puts the other reflection block there. Crown XMLs have both
+  blocks, so the office is not affected. The chain reads façade rows 5.0, 5.5 and 6.0 m alike
+  (0.0957, 0.0957, 0.0955 for δ × 0.3; the reference 0.0951 … 0.1026): one wall-cap tile fills
+  those sensors' view.
 """
 
 from __future__ import annotations
