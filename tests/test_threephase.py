@@ -384,6 +384,35 @@ def test_room_side_sender_is_wound_away_from_the_room():
         np.testing.assert_allclose(t[:, 2], 1.0 + dz * rad3.SENDER_OFFSET_M)
 
 
+def _sender_x_axis(text: str, up: np.ndarray) -> np.ndarray:
+    """The Klems x axis rfluxmtx gives a sender (``rfluxmtx.c`` ``prepare_sampler``):
+    up × polygon normal, turned round for ``h=-kf``."""
+    t = np.array(text.split("\n9 ")[1].split("\n")[0].split(), float).reshape(3, 3)
+    nrm = np.cross(t[1] - t[0], t[2] - t[0])
+    x = np.cross(up, nrm / np.linalg.norm(nrm))
+    return -x if "h=-kf" in text.split("\n")[0] else x
+
+
+def test_free_crown_sender_in_the_material_frame():
+    """A free crown's shell normals point into the crown (away from the room, ``n``); rtrace
+    applies the XML with x = material normal × up for incident and outgoing patches alike
+    (``benchmarks/klems_handedness.py``), the view matrix's ``h=kf`` receiver has x = up × n.
+    The outward daylight matrix's sender (T's incident patches) and the room side's (R's)
+    must take the same x, or V·T·D mirrors T left/right (the office closure: 0.991 / 0.950
+    with the mirror, 1.009 / 1.014 without)."""
+    from radtree.engines.radiance import threephase as rad3
+
+    tris = np.array([[[0, 0, 0], [1, 0, 0], [1, 0, 1]], [[0, 0, 0], [1, 0, 1], [0, 0, 1]]],
+                    float)
+    n = np.array([0.0, -1.0, 0.0])          # wound to the room (−y); the crown at +y
+    up = np.array([0.0, 0.0, 1.0])
+    rtrace_x = np.cross(-n, up)             # the material's normal −n
+    for room_side in (False, True):
+        text = rad3.sender_text(tris, n, room_side, (0.0, 0.0, 1.0), material_faces_room=False)
+        np.testing.assert_allclose(_sender_x_axis(text, up), rtrace_x, atol=1e-12)
+    np.testing.assert_allclose(np.cross(up, n), rtrace_x)      # the receiver's x
+
+
 @needs_radiance
 def test_room_side_sender_sends_into_the_room(tmp_path):
     """A unit square at z = 1 whose room is above it, a uniform sky (radiance 1 above the

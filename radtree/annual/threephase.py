@@ -410,7 +410,8 @@ class ThreePhase:
         tag = "r" if room_side else "g"
         out: list[Path] = []
         for k, g in enumerate(groups):
-            sender = rad3.sender_text(g.triangles, g.normal, room_side, g.up)
+            sender = rad3.sender_text(g.triangles, g.normal, room_side, g.up,
+                                      material_faces_room=self.inside)
             c = daylight_samples(self.samples, g)
             key = "|".join([sender, text, " ".join(ambient), str(c), str(self.mf)])
 
