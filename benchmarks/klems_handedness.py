@@ -18,7 +18,9 @@ sensor on the far side (light keeps its horizontal direction: Radiance indexes i
 outgoing patches in one frame, ``bsdf_m.c``), the chain the near one: ``h=-kf`` and ``h=kf``
 take opposite x axes (``rfluxmtx.c`` ``prepare_sampler``, ``klems_full.cal`` ``kbin``), so
 V·T·D mirrors the transmitted light left/right about the up vector (see
-``benchmarks/threephase_closure.py``'s docstring). Not fixed in radtree.
+``benchmarks/threephase_closure.py``'s docstring). Fixed for free crowns (their outward
+sender ``h=+kf``, :func:`radtree.engines.radiance.threephase.sender_text`); the dome keeps the
+tutorial convention.
 """
 
 from __future__ import annotations

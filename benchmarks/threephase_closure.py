@@ -70,34 +70,33 @@ crown XMLs of ``--samples 500``; façade / work plane):
   **These XMLs are not reciprocal, and rtrace does not apply them as rmtxop does** (below), so
   they test little. Lambertian XMLs (reciprocal): T 0.3, R 0.1 → 0.998 / 1.088; T 0.3, R 0 →
   1.008 / 1.108: reflection adds 0.0013 to the work-plane reference and 0.0012 to the chain
-  (façade 0.0121 and 0.0112) — the reflection term's total is right; the work plane's error
-  follows how diffuse T is (δ × 0.3: 0.991, Lambertian 1.108, the office XMLs with R zeroed
-  0.987). Its cause is not found. The block is the right one: the shell's normals point into
-  the crown, so light from the room's side meets the XML's "Reflection Front" (Radiance
-  ``bsdf_m.c`` swaps WINDOW's front and back), which ``turned_xml`` + ``room_reflection_xml``
-  hand to rmtxop.
-* **A left/right mirror in T (found, not fixed).** One 1 × 1 m window (normal down, into the
-  room, BSDF ``u=+Y``) in a black ceiling, a glow patch 45° up to one side, two sensors 1 m
-  below and 1 m to either side (``benchmarks/klems_handedness.py``): an XML that passes light
-  only when both the incident and the outgoing Klems patch have local x > 0 (azimuth within
-  ±80°; unchanged by reciprocity) lights the sensor on the far side of the window from the glow
-  in rtrace (0.0161), the sensor on the glow's side in the chain (``rmtxop V T D``, sender
-  ``h=-kf``, receiver ``h=kf``, both ``u=+Y``: 0.0171, the other 0; with the receiver ``h=-kf``
-  too, 0 / 0.0171). Radiance indexes a Klems matrix's incident and outgoing patches in one
-  frame (``bsdf_m.c``: fi/bi/fo/bo_getndx all take the propagation direction's x, y), while
-  rfluxmtx's ``h=-kf`` sender takes x = −(up × normal) and the ``h=kf`` receiver x = +(up ×
-  normal) (``rfluxmtx.c`` ``prepare_sampler``, ``klems_full.cal`` ``kbin``). So ``V·T·D``
-  reflects the transmitted light left/right about the up vector. From the frames (rtrace's x =
-  normal × up, as measured; derived, not measured on a crown): on the D side for free crowns
-  (normals into the crown), on the V side for the dome; the room-side ``V·R·D'`` (sender wound
-  away from the room, x = up × n on both sides) is in rtrace's frame. A fix (not made,
-  derived): the dome's receivers ``h=-kf`` (and its room-side D' sender ``h=kf``); free crowns'
-  outward D sender ``h=kf``. On this scene (symmetric about the central crown's vertical plane,
-  a uniform sky, crown XMLs without a left/right bias) it cannot move a grid mean; it would
-  under a low sun to one side or a left/right-biased XML. An XML that is not reciprocal (light
-  passed only from incident patches with x > 0, every outgoing patch alike) is applied
-  transposed by rtrace (only the far sensor lit, 0.0079 / 0) and as written by rmtxop (0.0085 /
-  0.0085).
+  (façade 0.0121 and 0.0112) — the reflection term's total is right. The office XMLs' −5 % was
+  the mirror of T below; the Lambertian XML's work plane (1.108 with R 0; δ × 0.3: 0.991) is
+  not explained by it (a uniform T has no left/right) and stays open. The block is the right
+  one: the shell's normals point into the crown, so light from the room's side meets the XML's
+  "Reflection Front" (Radiance ``bsdf_m.c`` swaps WINDOW's front and back), which
+  ``turned_xml`` + ``room_reflection_xml`` hand to rmtxop.
+* **A left/right mirror in T (found; fixed for free crowns).** One 1 × 1 m window (normal down,
+  into the room, BSDF ``u=+Y``) in a black ceiling, a glow patch 45° up to one side, two
+  sensors 1 m below and 1 m to either side (``benchmarks/klems_handedness.py``): an XML that
+  passes light only when both the incident and the outgoing Klems patch have local x > 0
+  (azimuth within ±80°; unchanged by reciprocity) lights the sensor on the far side of the
+  window from the glow in rtrace (0.0161), the sensor on the glow's side in the chain (``rmtxop
+  V T D``, sender ``h=-kf``, receiver ``h=kf``, both ``u=+Y``: 0.0171, the other 0; with the
+  receiver ``h=-kf`` too, 0 / 0.0171). Radiance indexes a Klems matrix's incident and outgoing
+  patches in one frame (``bsdf_m.c``: fi/bi/fo/bo_getndx all take the propagation direction's
+  x, y), while rfluxmtx's ``h=-kf`` sender takes x = −(up × normal) and the ``h=kf`` receiver x
+  = +(up × normal) (``rfluxmtx.c`` ``prepare_sampler``, ``klems_full.cal`` ``kbin``). So
+  ``V·T·D`` reflects the transmitted light left/right about the up vector. From the frames
+  (rtrace's x = normal × up, as measured; derived, not measured on a crown): on the D side for
+  free crowns (normals into the crown), on the V side for the dome; the room-side ``V·R·D'``
+  (sender wound away from the room, x = up × n on both sides) is in rtrace's frame. The fix for
+  free crowns: their outward D sender ``h=+kf`` (``sender_text(material_faces_room=False)``);
+  the dome keeps the tutorial convention (its V side stays mirrored, open). **The office
+  closure with it (04:32 UTC, load 1.1–2.1, same settings): façade 1.009, work plane 1.014**
+  (ground 0.929 / 0.884, 0.0026 / 0.0002 of light); per façade row 0.994, 1.036, 1.018, 1.018,
+  0.986 — so the scene or the crown XMLs are not left/right symmetric after all, and the mirror
+  was the work plane's −5 %.
 * Also seen: an XML whose reflection block on the room's side is all zero ("Reflection Front"
   0, "Reflection Back" up) still gets a reflected term (façade 0.0109 of 0.1413; without it the
   chain would read 1.008 / 1.006): rmtxop's ``cm_loadBTDF`` falls back to the other
