@@ -117,7 +117,7 @@ def sender_text(triangles: np.ndarray, normal: np.ndarray, room_side: bool = Fal
     the "room-side" rays went back into the crown and read the light the crown sends into
     the room, ≈ 5 × the light arriving at the office's wall cap from the room's side).
 
-    The sign of ``h=±kf`` sets the Klems x axis: ±(up × polygon normal) for ``h=∓kf``
+    The sign of ``h=±kf`` sets the Klems x axis: ±(up × polygon normal) for ``h=±kf``
     (``rfluxmtx.c`` ``prepare_sampler``), while rtrace applies the XML in one frame for
     incident and outgoing patches with x = material normal × up (``bsdf_m.c``; measured by
     ``benchmarks/klems_handedness.py``) and the view matrix's ``h=kf`` receiver has
