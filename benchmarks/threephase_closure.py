@@ -60,6 +60,52 @@ crown XMLs of ``--samples 500``; façade / work plane):
   a Lambertian wall cap's transmission 3.5 % low 5 mm in front of it (0.289 × the light 2 mm
   behind it, ``-u+`` 0.300, T = 0.3); on the office XMLs ``-u+`` moved the reference by
   0.6 %.
+* **The reflection term's frame and block (helper ``shells2``, 8 December 2026 04:10–04:30 UTC,
+  load 2.4–4.3; same settings, ``--xml`` controlled XMLs in a copy of the 500-sample folder).**
+  T = 0.3 δ/Λ with R = 0.3 sent into one half of the outgoing hemisphere (Klems patch-centre
+  azimuth 0–180°, the material's +y = up, or 180–360°, down), against δ × 0.3 with R = 0
+  (reference 0.0999 / 0.0122, chain 0.0974 / 0.0121): reflection up, reference 0.1450 / 0.0174,
+  chain 0.1423 / 0.0168 (0.981 / 0.965); down, reference 0.1518 / 0.0174, chain 0.1540 / 0.0181
+  (1.015 / 1.043); the reference's work plane does not tell up from down, the chain's does.
+  **These XMLs are not reciprocal, and rtrace does not apply them as rmtxop does** (below), so
+  they test little. Lambertian XMLs (reciprocal): T 0.3, R 0.1 → 0.998 / 1.088; T 0.3, R 0 →
+  1.008 / 1.108: reflection adds 0.0013 to the work-plane reference and 0.0012 to the chain
+  (façade 0.0121 and 0.0112) — the reflection term's total is right. The office XMLs' −5 % was
+  the mirror of T below; the Lambertian XML's work plane (1.108 with R 0; δ × 0.3: 0.991) is
+  not explained by it (a uniform T has no left/right) and stays open. The block is the right
+  one: the shell's normals point into the crown, so light from the room's side meets the XML's
+  "Reflection Front" (Radiance ``bsdf_m.c`` swaps WINDOW's front and back), which
+  ``turned_xml`` + ``room_reflection_xml`` hand to rmtxop.
+* **A left/right mirror in T (found; fixed for free crowns).** One 1 × 1 m window (normal down,
+  into the room, BSDF ``u=+Y``) in a black ceiling, a glow patch 45° up to one side, two
+  sensors 1 m below and 1 m to either side (``benchmarks/klems_handedness.py``): an XML that
+  passes light only when both the incident and the outgoing Klems patch have local x > 0
+  (azimuth within ±80°; unchanged by reciprocity) lights the sensor on the far side of the
+  window from the glow in rtrace (0.0161), the sensor on the glow's side in the chain (``rmtxop
+  V T D``, sender ``h=-kf``, receiver ``h=kf``, both ``u=+Y``: 0.0171, the other 0; with the
+  receiver ``h=-kf`` too, 0 / 0.0171). Radiance indexes a Klems matrix's incident and outgoing
+  patches in one frame (``bsdf_m.c``: fi/bi/fo/bo_getndx all take the propagation direction's
+  x, y), while rfluxmtx's ``h=-kf`` sender takes x = −(up × normal) and the ``h=kf`` receiver x
+  = +(up × normal) (``rfluxmtx.c`` ``prepare_sampler``, ``klems_full.cal`` ``kbin``). So
+  ``V·T·D`` reflects the transmitted light left/right about the up vector. From the frames
+  (rtrace's x = normal × up, as measured; derived, not measured on a crown): on the D side for
+  free crowns (normals into the crown), on the V side for the dome; the room-side ``V·R·D'``
+  (sender wound away from the room, x = up × n on both sides) is in rtrace's frame. The fix for
+  free crowns: their outward D sender ``h=+kf`` (``sender_text(material_faces_room=False)``);
+  the dome keeps the tutorial convention (its V side stays mirrored, open). **The office
+  closure with it (04:32 UTC, load 1.1–2.1, same settings): façade 1.009, work plane 1.014**
+  (ground 0.929 / 0.884, 0.0026 / 0.0002 of light); per façade row 0.994, 1.036, 1.018, 1.018,
+  0.986 — so the scene or the crown XMLs are not left/right symmetric after all, and the mirror
+  was the work plane's −5 %.
+* Also seen: an XML whose reflection block on the room's side is all zero ("Reflection Front"
+  0, "Reflection Back" up) still gets a reflected term (façade 0.0109 of 0.1413; without it the
+  chain would read 1.008 / 1.006): rmtxop's ``cm_loadBTDF`` falls back to the other
+  transmission block by reciprocity when the one it reads is absent (Radiance
+  ``src/common/cmbsdf.c``; that an all-zero block counts as absent is inferred from this run),
+  and ``room_reflection_xml`` puts the other reflection block there. Crown XMLs have both
+  blocks, so the office is not affected. The chain reads façade rows 5.0, 5.5 and 6.0 m alike
+  (0.0957, 0.0957, 0.0955 for δ × 0.3; the reference 0.0951 … 0.1026): one wall-cap tile fills
+  those sensors' view.
 """
 
 from __future__ import annotations

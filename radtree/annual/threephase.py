@@ -138,7 +138,10 @@ rfluxmtx sends a sender's rays away from its normal whatever ``h=±kf``, so the 
 daylight matrices (sender wound to the room, ``h=+kf``) looked back into the crown and read
 4–5 × the light arriving from the room's side; the sender is now wound away from the room
 (:func:`~radtree.engines.radiance.threephase.sender_text`): façade 0.991, work plane 0.950.
-The work plane's −5 % is not resolved (with the XMLs' reflection zeroed 0.987).
+(3) V·T·D mirrored T left/right about the up vector (rfluxmtx's ``h=-kf`` sender and
+``h=kf`` receiver take opposite Klems x axes, ``benchmarks/klems_handedness.py``): free
+crowns' outward sender is now ``h=+kf``: façade 1.009, work plane 1.014 (the dome keeps the
+tutorial convention, its V side mirrored, open).
 
 A second weather file reruns ``gendaymtx`` and the products only (the sun coefficients
 are reused when the sun positions are the same, i.e. the same site); a second leaf state
@@ -407,7 +410,8 @@ class ThreePhase:
         tag = "r" if room_side else "g"
         out: list[Path] = []
         for k, g in enumerate(groups):
-            sender = rad3.sender_text(g.triangles, g.normal, room_side, g.up)
+            sender = rad3.sender_text(g.triangles, g.normal, room_side, g.up,
+                                      material_faces_room=self.inside)
             c = daylight_samples(self.samples, g)
             key = "|".join([sender, text, " ".join(ambient), str(c), str(self.mf)])
 

@@ -101,7 +101,8 @@ def blocker_text(triangles: list[np.ndarray]) -> str:
 
 
 def sender_text(triangles: np.ndarray, normal: np.ndarray, room_side: bool = False,
-                up: tuple[float, float, float] | None = None) -> str:
+                up: tuple[float, float, float] | None = None, *,
+                material_faces_room: bool = True) -> str:
     """The daylight-matrix sender of one group (``triangles`` wound to the room, ``normal``
     towards it): its facets moved :data:`SENDER_OFFSET_M` away from the room (rays leave
     away from the room: the light the group transmits); ``room_side``: moved towards the
@@ -114,14 +115,26 @@ def sender_text(triangles: np.ndarray, normal: np.ndarray, room_side: bool = Fal
     window sender, normal into the room, ``h=-kf``, sends its rays out), so the room side is
     the winding turned round, not ``h=+kf`` (issue 40: with ``h=+kf`` and the room's winding
     the "room-side" rays went back into the crown and read the light the crown sends into
-    the room, ≈ 5 × the light arriving at the office's wall cap from the room's side)."""
+    the room, ≈ 5 × the light arriving at the office's wall cap from the room's side).
+
+    The sign of ``h=±kf`` sets the Klems x axis: ±(up × polygon normal) for ``h=±kf``
+    (``rfluxmtx.c`` ``prepare_sampler``), while rtrace applies the XML in one frame for
+    incident and outgoing patches with x = material normal × up (``bsdf_m.c``; measured by
+    ``benchmarks/klems_handedness.py``) and the view matrix's ``h=kf`` receiver has
+    x = up × n. ``material_faces_room`` False (free crowns: the shell's normals point into
+    the crown): the outward sender is ``h=+kf`` so that T's incident patches are in the
+    frame of the receiver and of rtrace (with ``h=-kf`` the chain mirrored T left/right:
+    the office closure read 0.991 / 0.950, now 1.009 / 1.014). True (the dome, a window
+    whose material normal faces the room): the tutorial's ``h=-kf``, unchanged (there the
+    receiver's x is the mirrored one; not fixed)."""
     n = np.asarray(normal, float)
     tri = np.asarray(triangles, float)
     if room_side:     # towards the room, its normal away from it
         moved, n = tri[:, ::-1] + SENDER_OFFSET_M * n, -n
     else:
         moved = tri - SENDER_OFFSET_M * n
-    return f"#@rfluxmtx h=-kf u={up_text(n, up)}\n\n" + _polygons("void", "tp_sender", moved)
+    sign = "-" if room_side or material_faces_room else "+"
+    return f"#@rfluxmtx h={sign}kf u={up_text(n, up)}\n\n" + _polygons("void", "tp_sender", moved)
 
 
 def read_matrix(data: bytes, what: str) -> np.ndarray:
