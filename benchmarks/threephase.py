@@ -70,6 +70,14 @@ copied, load 2–3.4; the benchmark 370 s wall): ``fivephase`` façade UDI <100 
 +1.2, 300–3000 −1.5, >3000 −0.9, work plane sDA +2.5, UDI <100 +4.9, 100–300 −5.5,
 300–3000 −0.1, >3000 +0.7 — the work plane's miss is unchanged; ``explicit``, whose sky
 is the same chain, within 0.5 pp: the miss is in the five-phase sun.
+
+Measured again 2026-12-08 04:52–05:00 UTC after the third fix (free crowns' T no longer
+mirrored left/right, ``sender_text(material_faces_room=False)``; the 01:27 folder copied
+afresh to /tmp/fp_s26, load 1.6–2.7, 262 s wall): ``fivephase`` façade UDI <100 +1.1,
+100–300 +1.2, 300–3000 −1.5, >3000 −0.8 (sDA 0.0); work plane sDA +5.0, UDI <100 **+4.9**,
+100–300 **−5.5**, 300–3000 −0.0, >3000 +0.7 — **not met on the work plane**, unchanged by the
+chain fixes; ``bsdf`` work plane UDI <100 +7.2, 100–300 −7.5, sDA −2.5; ``explicit``
+within 0.5 pp on both grids (its sky is the fixed chain).
 """
 
 from __future__ import annotations
