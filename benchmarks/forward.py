@@ -64,8 +64,15 @@ example's settings with ``-u+`` read 1 442.7 ± 4.1 (4 runs), ``-lw 1e-4`` 1 459
 at 12:30 with ``-u+``, 2 runs each: the example's settings 1 242.9 ± 7.7, ``-ad 4096 -lw
 1e-5`` 1 249.9 ± 1.7 (× 1.006). So the fixed seed reads these façades ≈ 1 % high (as it does
 in a room lit through a 1 m window, tests/test_reference_rtrace.py), and F's 12:30 "miss"
-against the golden below was that offset plus the patch offset. A–E and A-sky were not
-re-measured against converged Radiance (their 42 of 42 below are against the golden).
+against the golden below was that offset plus the patch offset.
+
+A–E and A-sky against the same converged reference, ``--golden --converged --scenarios A B C
+D E A-sky`` (forward at its defaults re-run in the same process; 2026-12-08 04:47–05:10 UTC,
+12:30 then the other six hours, 180 s and 1 715 s wall, load 0.5–2.7): **42 of 42 within 2 %
+or 3 combined s.e.**; 37 within 2 %; the largest C 10:30 −3.28 % (−2.03 s.e.), C 15:30
+−2.78 % (−1.92), C 12:30 +2.91 % (+1.78), E 11:30 +2.28 % (+1.70); the largest |s.e.| A-sky
+12:30 +2.81 and 15:30 +2.69 (+1.23 %, +1.51 %). Radiance's s.e. is from its 2 runs per case.
+With F above, **49 of 49 scenario-hours** within 2 % or 3 combined s.e. of converged Radiance.
 
 With every round in stages (``engine.forward_stages`` = 4, the default since session 24: the
 rings re-allotted before each stage from all photons so far, radtree.engines.forward.strata,
