@@ -515,7 +515,7 @@ def against_golden(hours: list[str], scenarios: list[str], realisations: int | N
     print("forward (project defaults, weight window factor "
           f"{proj.engine.forward.forward_window:g}) vs {what}, façade mean", flush=True)
     tally = Tally()
-    ref: list[tuple[float, float, float, float]] = []
+    ref: list[tuple[float, float]] = []   # --converged: (mean + ground terms, s.e.) a crown
     label = "radiance" if converged else "golden"
     for hour in hours:
         for name in scenarios:
@@ -536,10 +536,11 @@ def against_golden(hours: list[str], scenarios: list[str], realisations: int | N
                 ses.append(se)
                 photons += fw.photons
                 if converged:
-                    ref.append(converged_radiance(built, st, eff) + (extra, 0.0))
+                    c_mean, c_se = converged_radiance(built, st, eff)
+                    ref.append((c_mean + extra, c_se))
             m, se = float(np.mean(ms)), float(np.sqrt(np.sum(np.square(ses))) / len(ses))
             if converged:
-                r = np.array([(a + b, s) for a, s, b, _ in ref])
+                r = np.array(ref)
                 gm, gse = float(r[:, 0].mean()), float(np.sqrt((r[:, 1] ** 2).sum()) / len(r))
                 ref.clear()
             else:
@@ -558,21 +559,26 @@ CONVERGED = (4096, 1e-5)
 CONVERGED_RUNS = 2
 
 
-def converged_radiance(built, st, eff) -> tuple[float, float]:
-    """(façade mean, its s.e.) of :data:`CONVERGED_RUNS` clock-seeded (``-u+``) Radiance runs of
-    one built scene-hour at :data:`CONVERGED` (lux, the engine's traced mean, no ground terms)."""
+def clock_seeded_runs(built, st, eff, runs: int) -> tuple[float, float]:
+    """(façade mean, its s.e.) of ``runs`` clock-seeded (rtrace ``-u+``) Radiance runs of one
+    built scene-hour at the engine settings ``eff`` (lux, the traced mean, no ground terms)."""
     from radtree.engines.radiance import writer
     from radtree.engines.registry import get_engine
 
-    e = replace(eff, radiance=replace(eff.radiance, ad=CONVERGED[0], lw=CONVERGED[1]))
+    rad = get_engine("radiance")
     saved, writer.FIXED_SEED = writer.FIXED_SEED, "-u+"
     try:
-        v = np.array([float(get_engine("radiance").trace_once(built.scene, st, e, built.ab,
-                                                               ["facade"])["facade"].lux.mean())
-                      for _ in range(CONVERGED_RUNS)])
+        v = np.array([float(rad.trace_once(built.scene, st, eff, built.ab, ["facade"])
+                            ["facade"].lux.mean()) for _ in range(runs)])
     finally:
         writer.FIXED_SEED = saved
     return float(v.mean()), float(v.std(ddof=1) / np.sqrt(len(v)))
+
+
+def converged_radiance(built, st, eff) -> tuple[float, float]:
+    """:func:`clock_seeded_runs` (:data:`CONVERGED_RUNS` of them) at :data:`CONVERGED`."""
+    e = replace(eff, radiance=replace(eff.radiance, ad=CONVERGED[0], lw=CONVERGED[1]))
+    return clock_seeded_runs(built, st, e, CONVERGED_RUNS)
 
 
 def radiance_repeats(hours: list[str], scenarios: list[str], repeats: int) -> None:
@@ -580,23 +586,13 @@ def radiance_repeats(hours: list[str], scenarios: list[str], repeats: int) -> No
     of ``repeats`` clock-seeded runs (rtrace ``-u+``) on the build the forward z-scores trace
     (a scenario with crown realisations: its first crown): mean ± s.e. over the runs."""
     from radtree.config import effective_project
-    from radtree.engines.radiance import writer
-    from radtree.engines.registry import get_engine
 
-    rad = get_engine("radiance")
-    saved = writer.FIXED_SEED
-    writer.FIXED_SEED = "-u+"
-    try:
-        for proj, name, hour, built, st in _cases(hours, scenarios):
-            eff = effective_project(proj, proj.scenario(name)).engine
-            t0 = time.perf_counter()
-            v = np.array([float(rad.trace_once(built.scene, st, eff, built.ab, ["facade"])
-                                ["facade"].lux.mean()) for _ in range(repeats)])
-            print(f"  {name:6s} {hour}: radiance {v.mean():8.1f} ± {v.std(ddof=1) / np.sqrt(len(v)):5.1f}"
-                  f" lx over {len(v)} clock-seeded runs ({time.perf_counter() - t0:.0f} s)",
-                  flush=True)
-    finally:
-        writer.FIXED_SEED = saved
+    for proj, name, hour, built, st in _cases(hours, scenarios):
+        eff = effective_project(proj, proj.scenario(name)).engine
+        t0 = time.perf_counter()
+        m, se = clock_seeded_runs(built, st, eff, repeats)
+        print(f"  {name:6s} {hour}: radiance {m:8.1f} ± {se:5.1f} lx over {repeats} "
+              f"clock-seeded runs ({time.perf_counter() - t0:.0f} s)", flush=True)
 
 
 def patch_bias(hours: list[str], scenarios: list[str], side: float) -> None:

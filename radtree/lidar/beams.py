@@ -147,12 +147,18 @@ class BeamCounts:
     entering_sq: np.ndarray | None = None
 
     def effective(self) -> np.ndarray:
-        """The effective number of entering beams n = (Σ w)² / Σ w² (Kish 1965, *Survey
-        Sampling*, cited from memory): N itself when every weight is 1."""
-        if self.entering_sq is None:
-            return self.entering
-        with np.errstate(divide="ignore", invalid="ignore"):
-            return np.where(self.entering_sq > 0, self.entering**2 / self.entering_sq, 0.0)
+        """:func:`effective_beams` of the entering beams."""
+        return effective_beams(self.entering, self.entering_sq)
+
+
+def effective_beams(weights: np.ndarray, squares: np.ndarray | None) -> np.ndarray:
+    """The effective number of beams n = (Σ w)² / Σ w² from their summed ``weights`` and
+    summed squared weights (Kish 1965, *Survey Sampling*, cited from memory): Σ w itself
+    when ``squares`` is None (every weight 1); 0 where no beam."""
+    if squares is None:
+        return weights
+    with np.errstate(divide="ignore", invalid="ignore"):
+        return np.where(squares > 0, weights**2 / squares, 0.0)
 
 
 def density(entering: np.ndarray, hits: np.ndarray, optical: np.ndarray,

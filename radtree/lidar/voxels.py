@@ -95,7 +95,7 @@ from pathlib import Path
 import numpy as np
 
 from radtree.errors import ConfigError
-from radtree.lidar.beams import BeamCounts
+from radtree.lidar.beams import BeamCounts, effective_beams
 from radtree.lidar.envelope import Envelope, fill_undersampled
 from radtree.lidar.ground import NOT_TREES, heights_above_ground
 from radtree.lidar.tile import Tile, read_tile
@@ -198,7 +198,7 @@ def _columns(xy: np.ndarray, heights: np.ndarray, *, size_m: float, g: float,
              ) -> tuple[float, float, np.ndarray, np.ndarray]:
     """(x0, y0, pad, beams reaching each voxel N(z_top)) of the column inversion; each return
     counted with its ``weight`` (:func:`echo_weights`; 1 when None), the ½ added in effective
-    beams (Σ w)² / Σ w² (:meth:`radtree.lidar.beams.BeamCounts.effective`)."""
+    beams (Σ w)² / Σ w² (:func:`radtree.lidar.beams.effective_beams`)."""
     x0, y0 = (np.floor(xy.min(axis=0) / size_m) * size_m).tolist()
     ij = np.floor((xy - [x0, y0]) / size_m).astype(np.int64)
     nx, ny = (ij.max(axis=0) + 1).tolist()
@@ -213,8 +213,7 @@ def _columns(xy: np.ndarray, heights: np.ndarray, *, size_m: float, g: float,
     np.add.at(squares, (ij[:, 0], ij[:, 1], k + 1), w * w)
     below_top = np.cumsum(counts, axis=2)[..., 1:]        # N(z_top of layer k)
     below_bottom = below_top - counts[..., 1:]            # N(z_bottom of layer k)
-    n_eff = BeamCounts(below_top, below_top - below_bottom, below_top,
-                       np.cumsum(squares, axis=2)[..., 1:]).effective()
+    n_eff = effective_beams(below_top, np.cumsum(squares, axis=2)[..., 1:])
     with np.errstate(divide="ignore", invalid="ignore"):
         gap = (n_eff * below_bottom / below_top + 0.5) / (n_eff + 0.5)   # ½ added
         pad = np.where(below_top > 0, -np.log(np.minimum(gap, 1.0)) / (g * size_m), 0.0)
